@@ -1,0 +1,1 @@
+"""MuJoCo playback, consistency checks and offscreen rendering of ZRP manipulators."""
