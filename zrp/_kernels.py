@@ -16,7 +16,7 @@ from numba import njit
 
 
 @njit(cache=True, fastmath=False)
-def fk_pose_one(q, axes, bodies, prism, out):  # noqa: ANN001
+def fk_pose_one(q, axes, bodies, prism, out):
     """Eqs (1)-(6) for one joint vector: writes p and E_{n+1} into out[0:7]."""
     n = axes.shape[0]
     e0 = 1.0
@@ -77,14 +77,14 @@ def fk_pose_one(q, axes, bodies, prism, out):  # noqa: ANN001
 
 
 @njit(cache=True)
-def fk_pose_batch(q, axes, bodies, prism, out):  # noqa: ANN001
+def fk_pose_batch(q, axes, bodies, prism, out):
     """Batched :func:`fk_pose_one`: q (N, n) -> out (N, 7)."""
     for i in range(q.shape[0]):
         fk_pose_one(q[i], axes, bodies, prism, out[i])
 
 
 @njit(cache=True)
-def fk_jac_one(q, axes, bodies, prism, pose, jac):  # noqa: ANN001
+def fk_jac_one(q, axes, bodies, prism, pose, jac):
     """Pose (7,) and the eq (7) Jacobian [omega_h; V_p] (6, n) of one joint vector."""
     n = axes.shape[0]
     e0 = 1.0
@@ -170,7 +170,7 @@ def fk_jac_one(q, axes, bodies, prism, pose, jac):  # noqa: ANN001
 
 
 @njit(cache=True)
-def jac_batch(q, axes, bodies, prism, pose, jac):  # noqa: ANN001
+def jac_batch(q, axes, bodies, prism, pose, jac):
     """Batched :func:`fk_jac_one`: q (N, n) -> pose (N, 7), jac (N, 6, n)."""
     for i in range(q.shape[0]):
         fk_jac_one(q[i], axes, bodies, prism, pose[i], jac[i])
