@@ -10,6 +10,13 @@ direct kinematics of the same joint values (the controller does not know the err
   2 sqrt(2) sin(theta_eps / 2), about sqrt(2) theta_eps. Both are reported: ``delta_r`` as the
   paper defines it (dimensionless) and ``angle_rad`` = theta_eps.
 
+**Rounding.** Written literally, eq (15) subtracts e0^2 ~ 1 from 1, so it cannot resolve
+deviations below ~sqrt(4 * 2^-52) ~ 3e-8: an exact-zero error rotation composed in double
+precision comes out as 0, 3e-8, 6e-8, 7e-8... The paper's 0 % row of Table 3, 5.96E-8, is
+2^-24 exactly, i.e. this rounding floor. Here delta_R is evaluated in the algebraically
+identical form sqrt(8 e.e) = 2 sqrt(2) ||e|| (using e0^2 + e.e = 1), which has no floor;
+:func:`delta_r_literal` keeps the literal formula for the comparison.
+
 With a zero perturbation both are exactly zero; the paper's 0 % rows (1.07E-8 mm, 5.96E-8)
 are instead the error of its inverse kinematics against the commanded circle, which
 :mod:`zrp.paper` reports from the IK result.
@@ -26,9 +33,16 @@ from .errors import InputError
 from .kinematics import check_q, end_effector_pose
 from .model import Manipulator
 from .perturb import Perturbation
-from .rodrigues import er_angle, er_conjugate, er_delta_r, er_multiply, er_to_rotvec
+from .rodrigues import er_angle, er_conjugate, er_multiply, er_to_rotvec
 
-__all__ = ["Deviation", "check_times", "pose_deviation", "trajectory_deviation"]
+__all__ = [
+    "Deviation",
+    "check_times",
+    "delta_r_eq15",
+    "delta_r_literal",
+    "pose_deviation",
+    "trajectory_deviation",
+]
 
 F64 = NDArray[np.float64]
 
@@ -49,6 +63,29 @@ def check_times(t: ArrayLike | None, n_points: int, name: str = "t") -> F64:
     if np.any(np.diff(arr) < 0):
         raise InputError(f"{name}: expected non-decreasing times")
     return arr
+
+
+def delta_r_eq15(e_err: ArrayLike) -> F64:
+    """Eqs (15)-(16) in rounding-free form: sqrt(8 e.e) = 2 sqrt(2) |sin(theta/2)|.
+
+    Args:
+        e_err: unit Euler-Rodrigues parameters of the error rotation, shape (..., 4).
+
+    Returns:
+        delta_R, shape (...), dimensionless (about sqrt(2) theta for small theta in rad).
+    """
+    e = np.asarray(e_err, dtype=float)
+    return np.sqrt(8.0) * np.linalg.norm(e[..., 1:], axis=-1)
+
+
+def delta_r_literal(e_err: ArrayLike) -> F64:
+    """Eq (15) exactly as printed, sqrt(4 (1 - e0^2 + e.e)), shape (..., 4) -> (...).
+
+    Has a rounding floor of ~3e-8 (see the module docstring); prefer :func:`delta_r_eq15`.
+    """
+    e = np.asarray(e_err, dtype=float)
+    ee = np.sum(e[..., 1:] ** 2, axis=-1)
+    return np.sqrt(np.maximum(4.0 * (1.0 - e[..., 0] ** 2 + ee), 0.0))
 
 
 @dataclass(frozen=True, eq=False)
@@ -134,7 +171,7 @@ def pose_deviation(nominal: Manipulator, actual: Manipulator, q: ArrayLike,
         dp=dp,
         rotvec=er_to_rotvec(e_err),
         delta_p=np.linalg.norm(dp, axis=-1),  # eq (17)
-        delta_r=er_delta_r(e_err),  # eqs (15)-(16)
+        delta_r=delta_r_eq15(e_err),  # eqs (15)-(16)
         angle_rad=er_angle(e_err),
         unit=nominal.length_unit,
         convention=convention,
