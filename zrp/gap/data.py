@@ -1,0 +1,438 @@
+"""Measurement data of the sim-to-real gap diagnosis: strict CSV loading and validation.
+
+One row per measured point, rows in measurement order. Columns (header names, any order):
+
+* ``pose`` (required): an id; all rows of a pose share the same joint values.
+* ``point`` (optional): which target on the tool (e.g. one of several reflectors); default "p".
+* ``q1`` .. ``qn`` (required): joint values, rad (deg with ``deg=True``) for revolute joints,
+  the model's length unit for prismatic ones.
+* ``x``, ``y``, ``z`` (required): measured position in the model's length unit, in the
+  instrument's frame (or the robot's base frame with ``frame="base"``).
+* ``qw``, ``qx``, ``qy``, ``qz`` (optional, all four): measured orientation (loaded and checked;
+  the diagnosis uses positions only and says so with a warning).
+* ``t`` (s), ``temp`` (deg C), ``load`` (kg) (optional).
+* ``dir1`` .. ``dirn`` (optional, all n): the direction from which each joint approached the
+  pose (-1, 0 or +1); when absent it is taken from the measurement order (see
+  :meth:`Measurements.approach_direction`).
+
+Nothing is dropped silently: an unknown column, a missing value, a non-number or a NaN is an
+error naming the file, line and column.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import warnings
+from dataclasses import dataclass
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError, ZRPWarning
+from ..model import Manipulator
+
+__all__ = [
+    "FRAMES",
+    "DataWarning",
+    "Measurements",
+    "load_measurements",
+]
+
+F64 = NDArray[np.float64]
+FRAMES = ("instrument", "base")
+OPTIONAL_SCALARS = ("t", "temp", "load")
+QUAT_COLUMNS = ("qw", "qx", "qy", "qz")
+
+
+class DataWarning(ZRPWarning):
+    """Measurement data are usable but suspicious (repeats, unused columns, few poses)."""
+
+
+def _freeze(a: NDArray) -> NDArray:
+    a = np.array(a)
+    a.setflags(write=False)
+    return a
+
+
+def _opt(a: ArrayLike | None, shape: tuple[int, ...], name: str) -> F64 | None:
+    if a is None:
+        return None
+    arr = np.array(a, dtype=float)
+    if arr.shape != shape:
+        raise InputError(f"{name}: expected shape {shape}, got {arr.shape}")
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        r = int(np.argwhere(bad)[0][0])
+        raise InputError(f"{name}: row {r} is not a finite number ({arr.reshape(len(arr), -1)[r]})")
+    return _freeze(arr)
+
+
+@dataclass(frozen=True, eq=False)
+class Measurements:
+    """Validated measurements, one row per measured point (R rows, n joints).
+
+    Attributes:
+        pose: pose ids, shape (R,) (strings).
+        point: point labels, shape (R,) (strings).
+        q: joint values, rad (revolute) or length unit (prismatic), shape (R, n).
+        xyz: measured positions, length unit of the model, shape (R, 3).
+        frame: "instrument" (an unknown rigid transform from the base, estimated) or "base".
+        t: time, s, shape (R,), or None.
+        temp: temperature, deg C, shape (R,), or None.
+        load: payload, kg, shape (R,), or None.
+        quat: measured orientation (qw, qx, qy, qz), shape (R, 4), or None (not used).
+        direction: approach direction per joint (-1, 0, +1), shape (R, n), or None.
+        lines: source line number of each row (for messages), shape (R,).
+        source: file name or a description, for messages.
+    """
+
+    pose: NDArray
+    point: NDArray
+    q: F64
+    xyz: F64
+    frame: str = "instrument"
+    t: F64 | None = None
+    temp: F64 | None = None
+    load: F64 | None = None
+    quat: F64 | None = None
+    direction: F64 | None = None
+    lines: NDArray[np.int64] | None = None
+    source: str = "measurements"
+
+    def __post_init__(self) -> None:
+        q = np.array(self.q, dtype=float)
+        if q.ndim != 2 or q.shape[0] == 0:
+            raise InputError(f"{self.source}: q: expected shape (R, n) with R >= 1 rows, got "
+                             f"{q.shape}")
+        r, n = q.shape
+        pose = np.array([str(p) for p in np.asarray(self.pose).ravel()], dtype=object)
+        point = (np.array(["p"] * r, dtype=object) if self.point is None else
+                 np.array([str(p) for p in np.asarray(self.point).ravel()], dtype=object))
+        if pose.shape != (r,) or point.shape != (r,):
+            raise InputError(f"{self.source}: pose and point: expected {r} entries each, got "
+                             f"{pose.shape[0]} and {point.shape[0]}")
+        lines = (np.arange(r, dtype=np.int64) + 2 if self.lines is None
+                 else np.asarray(self.lines, dtype=np.int64))
+        if lines.shape != (r,):
+            raise InputError(f"{self.source}: lines: expected shape ({r},), got {lines.shape}")
+        object.__setattr__(self, "lines", _freeze(lines))
+        object.__setattr__(self, "pose", _freeze(pose))
+        object.__setattr__(self, "point", _freeze(point))
+        if self.frame not in FRAMES:
+            raise InputError(f"frame: {self.frame!r} is not a frame; expected one of {FRAMES}")
+        for name, arr, shape in (("q", q, (r, n)), ("xyz", self.xyz, (r, 3))):
+            a = np.array(arr, dtype=float)
+            if a.shape != shape:
+                raise InputError(f"{self.source}: {name}: expected shape {shape}, got {a.shape}")
+            bad = ~np.isfinite(a)
+            if bad.any():
+                i, c = (int(v) for v in np.argwhere(bad)[0])
+                col = f"q{c + 1}" if name == "q" else "xyz"[c]
+                raise InputError(f"{self.source} line {lines[i]}: column {col} is {a[i, c]}; "
+                                 "expected a finite number")
+            object.__setattr__(self, name, _freeze(a))
+        for name in OPTIONAL_SCALARS:
+            object.__setattr__(self, name, _opt(getattr(self, name), (r,), name))
+        object.__setattr__(self, "quat", _opt(self.quat, (r, 4), "quat"))
+        object.__setattr__(self, "direction", _opt(self.direction, (r, n), "direction"))
+        if self.direction is not None and not np.all(np.isin(self.direction, (-1.0, 0.0, 1.0))):
+            i = int(np.argwhere(~np.isin(self.direction, (-1.0, 0.0, 1.0)))[0][0])
+            raise InputError(f"{self.source} line {lines[i]}: dir columns must be -1, 0 or +1")
+        self._check_structure()
+
+    # ---- structure ----------------------------------------------------------------------
+    def _check_structure(self) -> None:
+        seen: dict[tuple[str, str], int] = {}
+        first_row: dict[str, int] = {}
+        for i, (p, m) in enumerate(zip(self.pose, self.point)):
+            key = (p, m)
+            if key in seen:
+                raise InputError(
+                    f"{self.source} line {self.lines[i]}: pose {p!r} point {m!r} was already "
+                    f"measured on line {self.lines[seen[key]]}; each (pose, point) must appear "
+                    "once (give repeated measurements their own pose id)")
+            seen[key] = i
+            if p in first_row:
+                j = first_row[p]
+                if not np.array_equal(self.q[i], self.q[j]):
+                    c = int(np.argmax(self.q[i] != self.q[j]))
+                    raise InputError(
+                        f"{self.source} line {self.lines[i]}: pose {p!r} has q{c + 1} = "
+                        f"{self.q[i, c]!r} but {self.q[j, c]!r} on line {self.lines[j]}; all "
+                        "rows of a pose must share the same joint values")
+                for name in ("temp", "load"):
+                    arr = getattr(self, name)
+                    if arr is not None and arr[i] != arr[j]:
+                        raise InputError(
+                            f"{self.source} line {self.lines[i]}: pose {p!r} has {name} "
+                            f"{arr[i]} but {arr[j]} on line {self.lines[j]}; all rows of a pose "
+                            f"must share {name}")
+            else:
+                first_row[p] = i
+
+    @property
+    def n_rows(self) -> int:
+        """R, the number of measured points."""
+        return int(self.q.shape[0])
+
+    @property
+    def n_joints(self) -> int:
+        return int(self.q.shape[1])
+
+    @cached_property
+    def pose_ids(self) -> tuple[str, ...]:
+        """Pose ids in order of first appearance (measurement order), length P."""
+        return tuple(dict.fromkeys(self.pose.tolist()))
+
+    @cached_property
+    def point_labels(self) -> tuple[str, ...]:
+        """Point labels in order of first appearance, length M."""
+        return tuple(dict.fromkeys(self.point.tolist()))
+
+    @cached_property
+    def pose_index(self) -> NDArray[np.int64]:
+        """Row -> index into :attr:`pose_ids`, shape (R,)."""
+        lut = {p: i for i, p in enumerate(self.pose_ids)}
+        return _freeze(np.array([lut[p] for p in self.pose], dtype=np.int64))
+
+    @cached_property
+    def point_index(self) -> NDArray[np.int64]:
+        """Row -> index into :attr:`point_labels`, shape (R,)."""
+        lut = {p: i for i, p in enumerate(self.point_labels)}
+        return _freeze(np.array([lut[p] for p in self.point], dtype=np.int64))
+
+    @cached_property
+    def first_row(self) -> NDArray[np.int64]:
+        """Index of the first row of each pose, shape (P,)."""
+        _, idx = np.unique(self.pose_index, return_index=True)
+        return _freeze(idx)
+
+    @cached_property
+    def q_pose(self) -> F64:
+        """Joint values per pose, shape (P, n)."""
+        return _freeze(self.q[self.first_row])
+
+    def per_pose(self, name: str) -> F64 | None:
+        """A per-row column (``t``, ``temp``, ``load``) reduced to one value per pose, shape (P,)
+        (the pose's first row; ``t`` may differ between a pose's rows)."""
+        arr = getattr(self, name)
+        return None if arr is None else _freeze(arr[self.first_row])
+
+    def approach_direction(self) -> F64:
+        """Direction from which each joint approached each pose, shape (P, n), values -1/0/+1.
+
+        From the ``dir`` columns when given; otherwise from the measurement order: the sign of
+        q(pose) - q(previous pose); when a joint did not move the previous direction is kept;
+        the first pose (and a joint that has not moved yet) gets 0 (unknown).
+        """
+        if self.direction is not None:
+            return _freeze(self.direction[self.first_row])
+        q = self.q_pose
+        d = np.zeros_like(q)
+        for i in range(1, q.shape[0]):
+            step = np.sign(q[i] - q[i - 1])
+            d[i] = np.where(step != 0.0, step, d[i - 1])
+        return _freeze(d)
+
+    def repeat_groups(self) -> NDArray[np.int64]:
+        """Group index per pose, shape (P,): poses with identical joint values (repeats) share
+        a group. Used to keep repeats on the same side of the split and for the noise floor."""
+        _, inv = np.unique(self.q_pose, axis=0, return_inverse=True)
+        return _freeze(np.asarray(inv, dtype=np.int64).ravel())
+
+    def subset(self, pose_mask: ArrayLike) -> Measurements:
+        """The rows of the poses selected by ``pose_mask`` (shape (P,) bool)."""
+        pm = np.asarray(pose_mask, dtype=bool)
+        rows = pm[self.pose_index]
+        pick = (lambda a: None if a is None else a[rows])  # noqa: E731
+        return Measurements(self.pose[rows], self.point[rows], self.q[rows], self.xyz[rows],
+                            self.frame, pick(self.t), pick(self.temp), pick(self.load),
+                            pick(self.quat), pick(self.direction), self.lines[rows],
+                            self.source)
+
+    @classmethod
+    def from_arrays(cls, pose: ArrayLike, q: ArrayLike, xyz: ArrayLike, *,
+                    point: ArrayLike | None = None, frame: str = "instrument",
+                    t: ArrayLike | None = None, temp: ArrayLike | None = None,
+                    load: ArrayLike | None = None, direction: ArrayLike | None = None,
+                    source: str = "measurements") -> Measurements:
+        """Build from arrays (q in rad, xyz in the model's length unit); see the class doc."""
+        return cls(np.asarray(pose), None if point is None else np.asarray(point),
+                   np.asarray(q, dtype=float), np.asarray(xyz, dtype=float), frame,
+                   None if t is None else np.asarray(t, dtype=float),
+                   None if temp is None else np.asarray(temp, dtype=float),
+                   None if load is None else np.asarray(load, dtype=float), None,
+                   None if direction is None else np.asarray(direction, dtype=float),
+                   None, source)
+
+    def to_csv(self, path: str | Path, *, deg: bool = False, overwrite: bool = False) -> None:
+        """Write in the CSV format :func:`load_measurements` reads (q in deg with ``deg``)."""
+        from ..errors import OutputExistsError
+
+        path = Path(path)
+        if path.exists() and not overwrite:
+            raise OutputExistsError(f"{path}: exists; pass overwrite=True (--force) to replace it")
+        n = self.n_joints
+        q = np.degrees(self.q) if deg else self.q
+        cols = ["pose", "point", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z"]
+        extra = [c for c in OPTIONAL_SCALARS if getattr(self, c) is not None]
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(cols + extra)
+            for i in range(self.n_rows):
+                w.writerow([self.pose[i], self.point[i], *(repr(float(v)) for v in q[i]),
+                            *(repr(float(v)) for v in self.xyz[i]),
+                            *(repr(float(getattr(self, c)[i])) for c in extra)])
+
+
+def _number(text: str, src: str, line: int, col: str) -> float:
+    s = text.strip()
+    if s == "":
+        raise InputError(f"{src} line {line}: column {col} is empty; expected a number")
+    try:
+        v = float(s)
+    except ValueError:
+        raise InputError(f"{src} line {line}: column {col} is {s!r}; expected a number") from None
+    if not math.isfinite(v):
+        raise InputError(f"{src} line {line}: column {col} is {s!r}; expected a finite number")
+    return v
+
+
+def load_measurements(path: str | Path, model: Manipulator, *, deg: bool = False,
+                      frame: str = "instrument") -> Measurements:
+    """Read a measurement CSV (format in the module docstring) strictly.
+
+    Args:
+        path: the CSV file.
+        model: the robot model (gives n, the joint types and the length unit).
+        deg: revolute joint values (and nothing else) are in degrees.
+        frame: "instrument" (positions in an unknown instrument frame) or "base".
+
+    Raises:
+        InputError: naming the file, line and column of the first problem.
+    """
+    path = Path(path)
+    src = str(path)
+    if frame not in FRAMES:
+        raise InputError(f"frame: {frame!r} is not a frame; expected one of {FRAMES}")
+    if not path.is_file():
+        raise InputError(f"{src}: no such file")
+    n = model.n
+    qcols = [f"q{k}" for k in range(1, n + 1)]
+    dcols = [f"dir{k}" for k in range(1, n + 1)]
+    required = ["pose", *qcols, "x", "y", "z"]
+    allowed = [*required, "point", *QUAT_COLUMNS, *OPTIONAL_SCALARS, *dcols]
+    with open(path, newline="", encoding="utf-8-sig") as fh:
+        text = fh.read()
+    if not text.strip():
+        raise InputError(f"{src}: the file is empty; expected a header line with the columns "
+                         f"{', '.join(required)} (optional: point, t, temp, load, qw..qz, dir1..)")
+    reader = csv.reader(text.splitlines())
+    header: list[str] | None = None
+    rows: list[tuple[int, list[str]]] = []
+    for lineno, rec in enumerate(reader, start=1):
+        if not rec or all(not c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
+            continue
+        if header is None:
+            header = [c.strip() for c in rec]
+            continue
+        rows.append((lineno, rec))
+    assert header is not None
+    dup = sorted({c for c in header if header.count(c) > 1})
+    if dup:
+        raise InputError(f"{src} line 1: column(s) {', '.join(dup)} appear more than once")
+    unknown = [c for c in header if c not in allowed]
+    if unknown:
+        extra_q = [c for c in unknown if c.startswith("q") and c[1:].isdigit()]
+        hint = (f" (the model {model.name!r} has {n} joints: q1..q{n})" if extra_q else "")
+        raise InputError(f"{src} line 1: unknown column(s) {', '.join(unknown)}{hint}; valid "
+                         f"columns are {', '.join(allowed)}")
+    missing = [c for c in required if c not in header]
+    if missing:
+        raise InputError(f"{src} line 1: missing column(s) {', '.join(missing)}; required: "
+                         f"{', '.join(required)} (q in rad, or deg with --deg; x, y, z in "
+                         f"{model.length_unit})")
+    quat_given = [c for c in QUAT_COLUMNS if c in header]
+    if quat_given and len(quat_given) != 4:
+        raise InputError(f"{src} line 1: orientation needs all of qw, qx, qy, qz; got only "
+                         f"{', '.join(quat_given)}")
+    dir_given = [c for c in dcols if c in header]
+    if dir_given and len(dir_given) != n:
+        raise InputError(f"{src} line 1: approach directions need all of {', '.join(dcols)}; "
+                         f"got only {', '.join(dir_given)}")
+    if not rows:
+        raise InputError(f"{src}: no data rows after the header; expected one row per "
+                         "measured point")
+    col = {c: i for i, c in enumerate(header)}
+    r = len(rows)
+    pose = np.empty(r, dtype=object)
+    point = np.array(["p"] * r, dtype=object)
+    q = np.empty((r, n))
+    xyz = np.empty((r, 3))
+    opt = {c: np.empty(r) for c in OPTIONAL_SCALARS if c in col}
+    quat = np.empty((r, 4)) if quat_given else None
+    dirs = np.empty((r, n)) if dir_given else None
+    lines = np.empty(r, dtype=np.int64)
+    for i, (lineno, rec) in enumerate(rows):
+        if len(rec) != len(header):
+            raise InputError(f"{src} line {lineno}: {len(rec)} fields, but the header has "
+                             f"{len(header)} ({', '.join(header)})")
+        lines[i] = lineno
+        pid = rec[col["pose"]].strip()
+        if not pid:
+            raise InputError(f"{src} line {lineno}: column pose is empty; expected an id")
+        pose[i] = pid
+        if "point" in col:
+            lab = rec[col["point"]].strip()
+            if not lab:
+                raise InputError(f"{src} line {lineno}: column point is empty; expected a label")
+            point[i] = lab
+        for k, c in enumerate(qcols):
+            q[i, k] = _number(rec[col[c]], src, lineno, c)
+        for k, c in enumerate("xyz"):
+            xyz[i, k] = _number(rec[col[c]], src, lineno, c)
+        for c, arr in opt.items():
+            arr[i] = _number(rec[col[c]], src, lineno, c)
+        if quat is not None:
+            for k, c in enumerate(QUAT_COLUMNS):
+                quat[i, k] = _number(rec[col[c]], src, lineno, c)
+            nq = float(np.linalg.norm(quat[i]))
+            if abs(nq - 1.0) > 1e-3:
+                raise InputError(f"{src} line {lineno}: orientation (qw, qx, qy, qz) has norm "
+                                 f"{nq:.6g}; expected a unit quaternion")
+        if dirs is not None:
+            for k, c in enumerate(dcols):
+                v = _number(rec[col[c]], src, lineno, c)
+                if v not in (-1.0, 0.0, 1.0):
+                    raise InputError(f"{src} line {lineno}: column {c} is {v:g}; expected -1, 0 "
+                                     "or +1")
+                dirs[i, k] = v
+    rev = ~np.asarray(model.prismatic)
+    if deg:
+        q[:, rev] = np.radians(q[:, rev])
+    else:
+        big = np.abs(q[:, rev]) > 2.0 * math.pi + 1e-6
+        if big.any():
+            i, k = (int(v) for v in np.argwhere(big)[0])
+            kk = int(np.flatnonzero(rev)[k])
+            raise InputError(
+                f"{src} line {lines[i]}: column q{kk + 1} is {q[i, kk]:g}, more than 2 pi rad: "
+                "the joint values look like degrees; pass --deg (deg=True)")
+    if "temp" in opt:
+        tv = opt["temp"]
+        if np.any((tv < -60.0) | (tv > 150.0)):
+            i = int(np.argmax((tv < -60.0) | (tv > 150.0)))
+            raise InputError(f"{src} line {lines[i]}: column temp is {tv[i]:g}; expected a "
+                             "temperature in deg C (-60 to 150)")
+    if "load" in opt and np.any(opt["load"] < 0.0):
+        i = int(np.argmax(opt["load"] < 0.0))
+        raise InputError(f"{src} line {lines[i]}: column load is {opt['load'][i]:g}; expected "
+                         "a payload mass in kg >= 0")
+    if quat is not None:
+        warnings.warn(f"{src}: measured orientations (qw..qz) are loaded but the diagnosis uses "
+                      "positions only", DataWarning, stacklevel=2)
+    return Measurements(pose, point, q, xyz, frame, opt.get("t"), opt.get("temp"),
+                        opt.get("load"), quat, dirs, lines, src)

@@ -1,0 +1,315 @@
+"""The effect library: each effect is a parametrised correction of the model.
+
+Every parameter is a :class:`ParamSpec` of one *kind*, and the kind fixes how it enters the
+corrected model (see :mod:`zrp.gap.problem`, which also gives the analytic Jacobian):
+
+* ``rot`` / ``trans``: the instrument-to-base registration (``base_frame``): a small rotation
+  (rad, left-multiplied on the initial estimate) and the translation (length unit).
+* ``tool``: one component of a tool point's offset t (length unit, zero-reference base frame;
+  the point is p + R_n t).
+* ``dq``: a joint correction q_actual = q + sum_i theta_i B_i(pose), with a fixed basis B of
+  shape (P, n) per parameter. ``joint_offset`` (B = 1), ``encoder_scale`` (B = q),
+  ``joint_compliance`` (B = gravity torque or a lumped-mass moment arm), ``backlash``
+  (B = -approach direction), ``cyclic_error`` (B = sin(h q), cos(h q)) are all of this kind.
+* ``link``: one component of a body-vector correction db_{k,0} (length unit).
+* ``tilt``: a tilt of a joint axis towards one of its tangents t1, t2 (rad), exact:
+  u' = (u + a t1 + b t2) / |u + a t1 + b t2| (tangents from :func:`zrp.sensitivity.axis_tangents`).
+* ``thermal``: all body vectors scale by (1 + kappa (temp - T_ref)), kappa in 1/deg C.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError
+from ..kinematics import forward_kinematics
+from ..model import Manipulator
+from ..sensitivity import axis_tangents
+from .data import Measurements
+
+__all__ = [
+    "EFFECTS",
+    "KINDS",
+    "REGISTRATION",
+    "Context",
+    "ParamSpec",
+    "effect_parameters",
+    "gravity_torques_mjcf",
+    "registration_parameters",
+]
+
+F64 = NDArray[np.float64]
+
+#: Candidate effects, in the order they are tried (ties are broken by this order).
+EFFECTS = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment",
+           "joint_compliance", "backlash", "thermal_expansion", "cyclic_error")
+REGISTRATION = ("base_frame", "tool_offset")
+KINDS = ("rot", "trans", "tool", "dq", "link", "tilt", "thermal")
+G_STANDARD = 9.80665  # m/s^2
+LENGTH_TO_M = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254}
+
+
+@dataclass(frozen=True, eq=False)
+class ParamSpec:
+    """One parameter of the corrected model.
+
+    Attributes:
+        name: e.g. "q2.offset", "b3.x", "u4.t1", "base.rz", "tool[smr1].x".
+        unit: e.g. "rad", "mm", "1", "1/degC", "rad/mm".
+        effect: one of :data:`EFFECTS` or :data:`REGISTRATION`.
+        kind: one of :data:`KINDS` (how it enters the model).
+        joint: 1-based joint (or body-vector index for ``link``); 0 when not joint-specific.
+        comp: component/index within the kind (xyz component, tangent 0/1, tool point index).
+        basis: for ``dq`` only, the joint correction per unit parameter, shape (P, n).
+        group: parameters tested together for significance (e.g. all of one joint).
+    """
+
+    name: str
+    unit: str
+    effect: str
+    kind: str
+    joint: int = 0
+    comp: int = 0
+    basis: F64 | None = None
+    group: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in KINDS:
+            raise InputError(f"ParamSpec {self.name}: kind {self.kind!r} not in {KINDS}")
+        if self.effect not in EFFECTS + REGISTRATION:
+            raise InputError(f"ParamSpec {self.name}: effect {self.effect!r} not in "
+                             f"{EFFECTS + REGISTRATION}")
+        if (self.kind == "dq") != (self.basis is not None):
+            raise InputError(f"ParamSpec {self.name}: a basis is required for kind 'dq' only")
+        if not self.group:
+            object.__setattr__(self, "group", self.name)
+
+
+def gravity_torques_mjcf(path: str, q_pose: F64, load_kg: F64 | None = None,
+                         tool_arm: F64 | None = None) -> F64:
+    """Gravity torque on each joint from an MJCF model's inertias, shape (P, n).
+
+    The MJCF must have exactly n hinge/slide joints in the model's order with the same zero
+    (as the project's MJCF export writes them). Returns ``qfrc_bias`` at zero velocity (the
+    generalised gravity force, N m for hinges, in the MJCF's units).
+
+    Args:
+        q_pose: joint values, rad, shape (P, n).
+    """
+    import mujoco
+
+    try:
+        m = mujoco.MjModel.from_xml_path(str(path))
+    except Exception as exc:  # mujoco raises ValueError with its own message
+        raise InputError(f"--mjcf {path}: cannot load: {exc}") from exc
+    n = q_pose.shape[1]
+    if m.nq != n or m.nv != n:
+        raise InputError(f"--mjcf {path}: has {m.nq} position coordinates, but the model has {n} "
+                         "joints; the MJCF must have one hinge/slide joint per model joint")
+    d = mujoco.MjData(m)
+    out = np.empty(q_pose.shape)
+    for i, q in enumerate(q_pose):
+        d.qpos[:] = q
+        d.qvel[:] = 0.0
+        mujoco.mj_forward(m, d)
+        out[i] = d.qfrc_bias
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class Context:
+    """Everything the effects need about the data, per pose (P poses, n joints).
+
+    Attributes:
+        model: the nominal model.
+        meas: the measurements.
+        gravity_torque: gravity torque per joint from MJCF inertias, shape (P, n), or None
+            (then the lumped-mass model is used).
+        gravity_dir: unit direction of gravity in the base frame, shape (3,).
+        harmonics: harmonics of ``cyclic_error`` (periods 2 pi / h in the joint angle).
+        t_ref_degC: reference temperature of ``thermal_expansion`` (default: mean of the data).
+    """
+
+    model: Manipulator
+    meas: Measurements
+    gravity_torque: F64 | None = None
+    gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    harmonics: tuple[int, ...] = (1, 2)
+    t_ref_degC: float | None = None
+
+    def __post_init__(self) -> None:
+        if self.meas.n_joints != self.model.n:
+            raise InputError(f"measurements have {self.meas.n_joints} joint columns but the model "
+                             f"{self.model.name!r} has {self.model.n} joints")
+        g = np.asarray(self.gravity_dir, dtype=float)
+        if g.shape != (3,) or not np.isclose(np.linalg.norm(g), 1.0):
+            raise InputError(f"gravity_dir: expected a unit 3-vector, got {self.gravity_dir}")
+        if self.gravity_torque is not None and np.shape(self.gravity_torque) != (
+                len(self.meas.pose_ids), self.model.n):
+            raise InputError(f"gravity_torque: expected shape ({len(self.meas.pose_ids)}, "
+                             f"{self.model.n}), got {np.shape(self.gravity_torque)}")
+        if not self.harmonics or any(int(h) < 1 for h in self.harmonics):
+            raise InputError(f"harmonics: expected positive integers, got {self.harmonics}")
+
+    @property
+    def n(self) -> int:
+        return self.model.n
+
+    @cached_property
+    def q(self) -> F64:
+        """Joint values per pose, shape (P, n)."""
+        return self.meas.q_pose
+
+    @cached_property
+    def tangents(self) -> F64:
+        """Axis tangents t1, t2 of each nominal axis, shape (n, 2, 3)."""
+        return axis_tangents(self.model.axes)
+
+    @cached_property
+    def t_ref(self) -> float | None:
+        temp = self.meas.per_pose("temp")
+        if temp is None:
+            return None
+        return float(np.mean(temp)) if self.t_ref_degC is None else float(self.t_ref_degC)
+
+    @cached_property
+    def dtemp(self) -> F64 | None:
+        """temp - T_ref per pose, deg C, shape (P,), or None."""
+        temp = self.meas.per_pose("temp")
+        return None if temp is None else temp - float(self.t_ref)  # type: ignore[arg-type]
+
+    @cached_property
+    def nominal_fk(self):  # noqa: ANN201
+        return forward_kinematics(self.model, self.q)
+
+    def moment_arms(self) -> tuple[list[str], F64]:
+        """Lumped-mass moment arms h[p, k, j] = u_k . ((P_j - p_k) x g_dir) (length unit).
+
+        Mass points P_j: the points on joints 2..n and the end effector (points that coincide
+        at q = 0 are merged). Returns the point labels (J,) and h, shape (P, n, J); entries of
+        points not beyond joint k are 0.
+        """
+        fk = self.nominal_fk
+        n = self.n
+        g = np.asarray(self.gravity_dir, dtype=float)
+        zero = forward_kinematics(self.model, np.zeros(n))
+        labels: list[str] = []
+        cols: list[F64] = []
+        owners: list[int] = []
+        seen: list[F64] = []
+        for j in range(1, n + 1):  # 0-based joint j -> point on joint j+1; j == n: the ee
+            pz = zero.position if j == n else zero.points[j]
+            if any(np.linalg.norm(pz - s) < 1e-9 for s in seen):
+                continue
+            seen.append(pz)
+            labels.append("ee" if j == n else f"p{j + 1}")
+            cols.append(fk.position if j == n else fk.points[:, j])
+            owners.append(j)
+        h = np.zeros((self.q.shape[0], n, len(cols)))
+        for jj, (pt, owner) in enumerate(zip(cols, owners)):
+            for k in range(n):
+                if k >= owner or self.model.prismatic[k]:
+                    continue
+                arm = np.cross(pt - fk.points[:, k], g)
+                h[:, k, jj] = np.einsum("pi,pi->p", fk.axes[:, k], arm)
+        return labels, h
+
+
+def registration_parameters(ctx: Context) -> list[ParamSpec]:
+    """``base_frame`` (unless the data are in the base frame) and ``tool_offset`` specs."""
+    unit = ctx.model.length_unit
+    specs: list[ParamSpec] = []
+    if ctx.meas.frame == "instrument":
+        specs += [ParamSpec(f"base.r{c}", "rad", "base_frame", "rot", 0, i, group="base")
+                  for i, c in enumerate("xyz")]
+        specs += [ParamSpec(f"base.t{c}", unit, "base_frame", "trans", 0, i, group="base")
+                  for i, c in enumerate("xyz")]
+    for m, lab in enumerate(ctx.meas.point_labels):
+        specs += [ParamSpec(f"tool[{lab}].{c}", unit, "tool_offset", "tool", 0, 3 * m + i,
+                            group=f"tool[{lab}]") for i, c in enumerate("xyz")]
+    return specs
+
+
+def _dq(ctx: Context, name: str, unit: str, effect: str, k: int, col: F64,
+        group: str | None = None) -> ParamSpec:
+    basis = np.zeros(ctx.q.shape)
+    basis[:, k] = col
+    basis.setflags(write=False)
+    return ParamSpec(name, unit, effect, "dq", k + 1, 0, basis, group or f"q{k + 1}")
+
+
+def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str | None]:
+    """The full (possibly redundant) parameter set of one effect.
+
+    Returns:
+        the specs, and None, or an empty list and the reason the effect cannot be tried
+        (e.g. ``thermal_expansion`` without a ``temp`` column).
+    """
+    if effect not in EFFECTS:
+        raise InputError(f"effect: {effect!r} is not an effect; valid: {', '.join(EFFECTS)}")
+    model, n, q = ctx.model, ctx.n, ctx.q
+    unit = model.length_unit
+    junit = [unit if p else "rad" for p in model.prismatic]
+    if effect == "joint_offset":
+        return [_dq(ctx, f"q{k + 1}.offset", junit[k], effect, k, np.ones(len(q)))
+                for k in range(n)], None
+    if effect == "encoder_scale":
+        return [_dq(ctx, f"q{k + 1}.scale", "1", effect, k, q[:, k]) for k in range(n)], None
+    if effect == "cyclic_error":
+        rev = [k for k in range(n) if not model.prismatic[k]]
+        if not rev:
+            return [], "no revolute joint"
+        return [_dq(ctx, f"q{k + 1}.{fn}{h}", "rad", effect, k,
+                    np.sin(h * q[:, k]) if fn == "sin" else np.cos(h * q[:, k]))
+                for k in rev for h in ctx.harmonics for fn in ("sin", "cos")], None
+    if effect == "backlash":
+        d = ctx.meas.approach_direction()
+        ks = [k for k in range(n) if np.any(d[:, k] > 0) and np.any(d[:, k] < 0)]
+        if not ks:
+            return [], "no joint approaches its poses from both directions"
+        return [_dq(ctx, f"q{k + 1}.backlash", junit[k], effect, k, -d[:, k])
+                for k in ks], None
+    if effect == "joint_compliance":
+        specs: list[ParamSpec] = []
+        load = ctx.meas.per_pose("load")
+        if ctx.gravity_torque is not None:
+            tau = np.array(ctx.gravity_torque, dtype=float)
+            if load is not None:
+                _, h = ctx.moment_arms()
+                to_m = LENGTH_TO_M.get(unit)
+                if to_m is None:
+                    raise InputError(f"length_unit {unit!r}: cannot convert to m for the load "
+                                     f"torque; known: {', '.join(LENGTH_TO_M)}")
+                tau = tau + G_STANDARD * load[:, None] * h[:, :, -1] * to_m
+            for k in range(n):
+                if np.ptp(tau[:, k]) > 0 or np.any(tau[:, k] != 0):
+                    specs.append(_dq(ctx, f"q{k + 1}.compliance", f"{junit[k]}/(N m)", effect,
+                                     k, tau[:, k]))
+            return specs, None
+        labels, h = ctx.moment_arms()
+        h = np.where(np.abs(h) > 1e-9 * model.characteristic_length, h, 0.0)
+        for k in range(n):
+            for jj, lab in enumerate(labels):
+                if np.any(h[:, k, jj] != 0.0):
+                    specs.append(_dq(ctx, f"q{k + 1}.w_{lab}", f"rad/{unit}", effect, k,
+                                     h[:, k, jj]))
+            if load is not None and np.ptp(load) > 0 and np.any(h[:, k, -1] != 0.0):
+                specs.append(_dq(ctx, f"q{k + 1}.w_load", f"rad/({unit} kg)", effect, k,
+                                 load * h[:, k, -1]))
+        return specs, (None if specs else "no joint carries a gravity torque")
+    if effect == "link_length":
+        return [ParamSpec(f"b{k + 1}.{c}", unit, effect, "link", k + 1, i, group=f"b{k + 1}")
+                for k in range(n + 1) for i, c in enumerate("xyz")], None
+    if effect == "axis_misalignment":
+        return [ParamSpec(f"u{k + 1}.t{t + 1}", "rad", effect, "tilt", k + 1, t,
+                          group=f"q{k + 1}") for k in range(n) for t in range(2)], None
+    # thermal_expansion
+    if ctx.dtemp is None:
+        return [], "no temp column"
+    if np.ptp(ctx.dtemp) < 0.1:
+        return [], f"temp varies by only {np.ptp(ctx.dtemp):.3g} deg C"
+    return [ParamSpec("kappa", "1/degC", effect, "thermal", 0, 0, group="kappa")], None

@@ -1,0 +1,249 @@
+"""The corrected model of a set of parameters, its residuals and its analytic Jacobian.
+
+For pose i (joint values q_i, rad) and tool point j, the corrected model predicts
+
+    m_ij = R_b (p(q'_i) + R_n(q'_i) t_j) + t_b,    q'_i = q_i + sum_s theta_s B_s[i]
+
+where p and R_n come from the zero-reference-position forward kinematics of the corrected
+geometry (body vectors b_{k,0} + db_k, scaled by 1 + kappa dT_i; axes tilted), R_b =
+exp([phi]) R_b0 and t_b the registration. The Jacobian columns (derivations in
+docs/diagnosis.md) are exact at any theta and are checked against finite differences in the
+tests:
+
+* rot: -[R_b x]_x J_l(phi) (J_l: left Jacobian of SO(3));  trans: I;  tool t_j: R_b R_n;
+* dq (joint k): R_b (u_k x (x - p_k)) B[i, k] (revolute), R_b u_k B[i, k] (prismatic);
+* link db_k: R_b s_i R_{k-1};  thermal: R_b dT_i sum_k R_{k-1} b_{k,0};
+* tilt of axis k along dv: omega = R_{k-1}(sin q_k du + (1 - cos q_k) u x du) with
+  du = (I - u u^T) dv / |v|; column R_b (omega x (x - p_k)) (revolute) or R_b q_k R_{k-1} du.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError
+from .effects import Context, ParamSpec
+
+__all__ = ["Problem", "left_jacobian", "rotation_matrix", "skew"]
+
+F64 = NDArray[np.float64]
+
+
+def skew(v: ArrayLike) -> F64:
+    """Cross-product matrices, shape (..., 3) -> (..., 3, 3)."""
+    v = np.asarray(v, dtype=float)
+    z = np.zeros(v.shape[:-1])
+    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
+                     np.stack([v[..., 2], z, -v[..., 0]], -1),
+                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
+
+
+def rotation_matrix(rotvec: ArrayLike) -> F64:
+    """exp([phi]_x) for a rotation vector phi (rad), shape (3,) -> (3, 3)."""
+    phi = np.asarray(rotvec, dtype=float)
+    th = float(np.linalg.norm(phi))
+    k = skew(phi)
+    if th < 1e-8:
+        return np.eye(3) + k + 0.5 * k @ k
+    return np.eye(3) + np.sin(th) / th * k + (1.0 - np.cos(th)) / th**2 * k @ k
+
+
+def left_jacobian(rotvec: ArrayLike) -> F64:
+    """Left Jacobian of SO(3): d exp(phi) = [J_l(phi) dphi]_x exp(phi), shape (3, 3)."""
+    phi = np.asarray(rotvec, dtype=float)
+    th = float(np.linalg.norm(phi))
+    k = skew(phi)
+    if th < 1e-6:
+        return np.eye(3) + 0.5 * k + k @ k / 6.0
+    return (np.eye(3) + (1.0 - np.cos(th)) / th**2 * k + (th - np.sin(th)) / th**3 * k @ k)
+
+
+def _axis_rotations(u: F64, q: F64) -> F64:
+    """Rotations about the unit axis u (3,) by angles q (S,): shape (S, 3, 3)."""
+    k = skew(u)
+    s = np.sin(q)[:, None, None]
+    c = np.cos(q)[:, None, None]
+    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+
+
+class Problem:
+    """Residuals and Jacobian of the corrected model on a subset of poses.
+
+    Args:
+        ctx: the data context.
+        specs: the parameters (p of them), in column order.
+        poses: indices of the poses used (into ``ctx.meas.pose_ids``), shape (S,).
+        base_rotation: R_b0, the initial instrument-from-base rotation, shape (3, 3).
+    """
+
+    def __init__(self, ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike,
+                 base_rotation: ArrayLike | None = None) -> None:
+        self.ctx = ctx
+        self.specs = tuple(specs)
+        self.poses = np.asarray(poses, dtype=np.int64)
+        if self.poses.ndim != 1 or self.poses.size == 0:
+            raise InputError("poses: expected a non-empty 1-D array of pose indices")
+        meas = ctx.meas
+        P = len(meas.pose_ids)
+        local = np.full(P, -1, dtype=np.int64)
+        local[self.poses] = np.arange(self.poses.size)
+        rows = np.flatnonzero(local[meas.pose_index] >= 0)
+        self.rows = rows
+        self.row_pose = local[meas.pose_index[rows]]
+        self.row_point = meas.point_index[rows]
+        self.measured = meas.xyz[rows]
+        self.base_rotation = np.eye(3) if base_rotation is None else np.asarray(
+            base_rotation, dtype=float)
+        self.instrument = meas.frame == "instrument"
+        kinds = np.array([s.kind for s in self.specs])
+        self.idx = {k: np.flatnonzero(kinds == k) for k in
+                    ("rot", "trans", "tool", "dq", "link", "tilt", "thermal")}
+        if self.instrument and (self.idx["rot"].size != 3 or self.idx["trans"].size != 3):
+            raise InputError("instrument-frame data need the 6 base_frame parameters")
+        self.B = (np.stack([self.specs[i].basis[self.poses] for i in self.idx["dq"]], -1)
+                  if self.idx["dq"].size else np.zeros((self.poses.size, ctx.n, 0)))
+        self.dT = (None if ctx.dtemp is None else ctx.dtemp[self.poses])
+        if self.idx["thermal"].size and self.dT is None:
+            raise InputError("thermal_expansion needs a temp column")
+        self.q = ctx.q[self.poses]
+
+    @property
+    def size(self) -> int:
+        """p, the number of parameters."""
+        return len(self.specs)
+
+    @property
+    def n_residuals(self) -> int:
+        return 3 * self.rows.size
+
+    # ---- geometry of the corrected model -----------------------------------------------
+    def geometry(self, theta: F64) -> tuple[F64, F64, F64]:
+        """Corrected axes (n, 3) (unit), un-normalised axes v (n, 3), bodies (n + 1, 3)."""
+        model = self.ctx.model
+        bodies = np.array(model.bodies, dtype=float)
+        for i in self.idx["link"]:
+            s = self.specs[i]
+            bodies[s.joint - 1, s.comp] += theta[i]
+        v = np.array(model.axes, dtype=float)
+        tang = self.ctx.tangents
+        for i in self.idx["tilt"]:
+            s = self.specs[i]
+            v[s.joint - 1] += theta[i] * tang[s.joint - 1, s.comp]
+        u = v / np.linalg.norm(v, axis=1, keepdims=True)
+        return u, v, bodies
+
+    def tool_offsets(self, theta: F64) -> F64:
+        """Tool offsets t_j, shape (M, 3)."""
+        t = np.zeros((len(self.ctx.meas.point_labels), 3))
+        for i in self.idx["tool"]:
+            c = self.specs[i].comp
+            t[c // 3, c % 3] = theta[i]
+        return t
+
+    def base(self, theta: F64) -> tuple[F64, F64]:
+        """R_b (3, 3) and t_b (3,)."""
+        if not self.instrument:
+            return np.eye(3), np.zeros(3)
+        return (rotation_matrix(theta[self.idx["rot"]]) @ self.base_rotation,
+                np.asarray(theta[self.idx["trans"]], dtype=float))
+
+    def joint_values(self, theta: F64) -> F64:
+        """Corrected joint values q' per pose, shape (S, n)."""
+        return self.q + self.B @ theta[self.idx["dq"]]
+
+    # ---- evaluation -----------------------------------------------------------------------
+    def evaluate(self, theta: ArrayLike, jac: bool = True) -> tuple[F64, F64 | None]:
+        """Predicted positions (R, 3) and, with ``jac``, the Jacobian (R, 3, p)."""
+        theta = np.asarray(theta, dtype=float)
+        if theta.shape != (self.size,):
+            raise InputError(f"theta: expected shape ({self.size},), got {theta.shape}")
+        model = self.ctx.model
+        n = model.n
+        S = self.poses.size
+        q = self.joint_values(theta)
+        u, v, bodies = self.geometry(theta)
+        scale = np.ones(S)
+        if self.idx["thermal"].size:
+            scale = 1.0 + theta[self.idx["thermal"][0]] * self.dT
+        rprev = np.empty((S, n + 1, 3, 3))
+        pts = np.empty((S, n, 3))
+        ucur = np.empty((S, n, 3))
+        bsum = np.zeros((S, 3))
+        pos = np.zeros((S, 3))
+        r = np.broadcast_to(np.eye(3), (S, 3, 3))
+        for k in range(n + 1):
+            rprev[:, k] = r
+            bk = r @ bodies[k]
+            bsum += bk
+            pos = pos + scale[:, None] * bk
+            if k == n:
+                break
+            pts[:, k] = pos
+            uc = r @ u[k]
+            ucur[:, k] = uc
+            if model.prismatic[k]:
+                pos = pos + q[:, k, None] * uc
+            else:
+                r = r @ _axis_rotations(u[k], q[:, k])
+        rn = rprev[:, n]
+        t = self.tool_offsets(theta)
+        rp, rpt = self.row_pose, self.row_point
+        x = pos[rp] + np.einsum("rij,rj->ri", rn[rp], t[rpt])
+        rb, tb = self.base(theta)
+        pred = x @ rb.T + tb
+        if not jac:
+            return pred, None
+        R = rp.size
+        J = np.zeros((R, 3, self.size))
+        # columns in the base frame first, rotated by R_b below
+        if self.idx["tool"].size:
+            for i in self.idx["tool"]:
+                c = self.specs[i].comp
+                m, cc = divmod(c, 3)
+                sel = rpt == m
+                J[sel, :, i] = rn[rp[sel], :, cc]
+        if self.idx["dq"].size:
+            rel = x[:, None, :] - pts[rp]  # (R, n, 3)
+            dxdq = np.where(model.prismatic[None, :, None], ucur[rp],
+                            np.cross(ucur[rp], rel))
+            J[:, :, self.idx["dq"]] = np.einsum("rkc,rkp->rcp", dxdq, self.B[rp])
+        for i in self.idx["link"]:
+            s = self.specs[i]
+            J[:, :, i] = scale[rp, None] * rprev[rp, s.joint - 1, :, s.comp]
+        if self.idx["tilt"].size:
+            tang = self.ctx.tangents
+            for i in self.idx["tilt"]:
+                s = self.specs[i]
+                k = s.joint - 1
+                uk = u[k]
+                du = (tang[k, s.comp] - uk * (uk @ tang[k, s.comp])) / np.linalg.norm(v[k])
+                if model.prismatic[k]:
+                    J[:, :, i] = (q[:, k, None] * (rprev[:, k] @ du))[rp]
+                else:
+                    loc = (np.sin(q[:, k])[:, None] * du
+                           + (1.0 - np.cos(q[:, k]))[:, None] * np.cross(uk, du))
+                    om = np.einsum("sij,sj->si", rprev[:, k], loc)
+                    J[:, :, i] = np.cross(om[rp], x - pts[rp, k])
+        if self.idx["thermal"].size:
+            J[:, :, self.idx["thermal"][0]] = self.dT[rp, None] * bsum[rp]
+        J = np.einsum("ij,rjp->rip", rb, J)
+        if self.instrument:
+            y = x @ rb.T
+            jl = left_jacobian(theta[self.idx["rot"]])
+            J[:, :, self.idx["rot"]] = -skew(y) @ jl
+            J[:, :, self.idx["trans"]] = np.eye(3)
+        return pred, J
+
+    def residual(self, theta: ArrayLike) -> F64:
+        """Predicted minus measured, shape (3R,) (x, y, z per row)."""
+        pred, _ = self.evaluate(theta, jac=False)
+        return (pred - self.measured).ravel()
+
+    def residual_and_jacobian(self, theta: ArrayLike) -> tuple[F64, F64]:
+        """Residual (3R,) and Jacobian (3R, p)."""
+        pred, J = self.evaluate(theta, jac=True)
+        assert J is not None
+        return (pred - self.measured).ravel(), J.reshape(-1, self.size)
