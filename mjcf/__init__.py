@@ -1,1 +1,33 @@
-"""MJCF models of ZRP manipulators (built with mujoco.MjSpec) and import from MJCF/URDF."""
+"""MJCF models of ZRP manipulators (built with mujoco.MjSpec) and import from MJCF/URDF.
+
+* :func:`build` compiles a :class:`zrp.Manipulator` (nominal or perturbed) into a MuJoCo model
+  whose qpos = 0 is the zero reference position; :func:`save_mjcf` writes it as XML.
+* :func:`manipulator_from_mujoco` / :func:`from_mjcf` read a serial arm from MJCF or URDF.
+"""
+
+from .build import BuiltArm, MJCFOptions, build, build_spec, mjcf_xml, save_mjcf
+from .errors import MJCFCompileError, MJCFImportError, MJCFOutputError
+from .importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
+from .inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
+from .units import LENGTH_UNITS, metres_per_unit
+
+__all__ = [
+    "INERTIA_MODELS",
+    "LENGTH_UNITS",
+    "BodyInertia",
+    "BuiltArm",
+    "MJCFCompileError",
+    "MJCFImportError",
+    "MJCFOptions",
+    "MJCFOutputError",
+    "build",
+    "build_spec",
+    "from_mjcf",
+    "load_mujoco_model",
+    "manipulator_from_mujoco",
+    "metres_per_unit",
+    "mjcf_xml",
+    "puma560_inertias",
+    "rod_inertias",
+    "save_mjcf",
+]

@@ -1,0 +1,159 @@
+"""Read a serial arm from an MJCF file (or a URDF, which MuJoCo loads) into a ZRP model.
+
+The zero reference position is MuJoCo's qpos = 0 (not the model's ``qpos0``/``ref``): at
+qpos = 0 MuJoCo's kinematics gives, for each hinge/slide joint on the chain from the world to
+the end body, its world axis (u_{k,0}) and anchor (the point on joint k); the body vectors are
+the differences of consecutive anchors, b_{1,0} being the first anchor (from the world origin)
+and b_{n+1,0} the vector from the last anchor to the end-effector point. The end effector is a
+site (or a body frame): its position is p and its frame's z and y columns give u_{a,0} and
+u_{t,0} (the ``zrp.hand_frame`` convention). Everything is expressed in the world frame.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from zrp.errors import InputError
+from zrp.model import Manipulator
+
+from .errors import MJCFImportError
+from .units import metres_per_unit
+
+__all__ = ["from_mjcf", "load_mujoco_model", "manipulator_from_mujoco"]
+
+_HINGE = int(mujoco.mjtJoint.mjJNT_HINGE)
+_SLIDE = int(mujoco.mjtJoint.mjJNT_SLIDE)
+_CHAIN_JOINTS = (_HINGE, _SLIDE)
+
+
+def load_mujoco_model(source: str | os.PathLike[str] | mujoco.MjModel) -> mujoco.MjModel:
+    """Compile an MJCF/URDF file path, an MJCF string or pass through an :class:`MjModel`."""
+    if isinstance(source, mujoco.MjModel):
+        return source
+    if isinstance(source, str) and source.lstrip().startswith("<"):
+        try:
+            return mujoco.MjModel.from_xml_string(source)
+        except ValueError as exc:
+            raise MJCFImportError(f"source: MuJoCo could not load the XML text: {exc}") from exc
+    if not isinstance(source, (str, os.PathLike)):
+        raise InputError(f"source: expected a file path, an XML string or a mujoco.MjModel, got "
+                         f"{type(source).__name__}")
+    path = Path(source)
+    if not path.is_file():
+        raise MJCFImportError(f"source: no such file {str(path)!r} (expected an MJCF .xml or a "
+                              f".urdf file)")
+    try:
+        return mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as exc:
+        raise MJCFImportError(f"source {str(path)!r}: MuJoCo could not load it: {exc}") from exc
+
+
+def _name(m: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:
+    return mujoco.mj_id2name(m, obj, i) or f"#{i}"
+
+
+def _end_body(m: mujoco.MjModel, site: str | None, body: str | None) -> tuple[int, int]:
+    """(body id, site id or -1) of the end effector."""
+    if site is not None and body is not None:
+        raise InputError("site, body: give at most one of them (the end-effector frame)")
+    if site is not None:
+        sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, site)
+        if sid < 0:
+            names = [_name(m, mujoco.mjtObj.mjOBJ_SITE, i) for i in range(m.nsite)]
+            raise MJCFImportError(f"site: no site named {site!r}; the model has {names}")
+        return int(m.site_bodyid[sid]), int(sid)
+    if body is not None:
+        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
+        if bid < 0:
+            names = [_name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, m.nbody)]
+            raise MJCFImportError(f"body: no body named {body!r}; the model has {names}")
+        return int(bid), -1
+    # Default: the deepest body carrying joints; it must be unique (a single chain).
+    njoint_path = np.zeros(m.nbody, dtype=int)
+    for b in range(1, m.nbody):
+        njoint_path[b] = njoint_path[m.body_parentid[b]] + int(m.body_jntnum[b])
+    deepest = int(njoint_path.max())
+    if deepest == 0:
+        raise MJCFImportError("the model has no hinge or slide joint: nothing to import")
+    tips = [b for b in range(1, m.nbody) if njoint_path[b] == deepest
+            and not any(m.body_parentid[c] == b and njoint_path[c] == deepest
+                        for c in range(1, m.nbody))]
+    if len(tips) > 1:
+        names = [_name(m, mujoco.mjtObj.mjOBJ_BODY, b) for b in tips]
+        raise MJCFImportError(f"the kinematic tree branches (end bodies {names}); name the end "
+                              f"effector with site= or body=")
+    bid = tips[0]
+    sites = [s for s in range(m.nsite) if m.site_bodyid[s] == bid]
+    return bid, (sites[0] if len(sites) == 1 else -1)
+
+
+def manipulator_from_mujoco(
+    source: str | os.PathLike[str] | mujoco.MjModel,
+    *,
+    site: str | None = None,
+    body: str | None = None,
+    length_unit: str = "mm",
+    name: str | None = None,
+) -> Manipulator:
+    """Import the serial chain from the world to the end effector as a :class:`zrp.Manipulator`.
+
+    Args:
+        source: MJCF/URDF path, MJCF text, or a compiled :class:`mujoco.MjModel`.
+        site: name of the end-effector site (its frame gives u_a = z, u_t = y).
+        body: or the name of the end body (its frame is used); default: the unique deepest body
+            with joints, and its site if it has exactly one.
+        length_unit: unit of the returned model ("mm", "m", ...); MuJoCo works in metres.
+        name: model name; default the MJCF model name.
+
+    Raises:
+        MJCFImportError: ball/free joints on the chain, a branching tree without site/body, an
+            unknown site/body name, or a file MuJoCo cannot load.
+    """
+    m = load_mujoco_model(source)
+    scale = metres_per_unit(length_unit)
+    bid, sid = _end_body(m, site, body)
+    chain = []
+    b = bid
+    while b > 0:
+        chain.append(b)
+        b = int(m.body_parentid[b])
+    chain.reverse()
+    joints: list[int] = []
+    for b in chain:
+        for j in range(m.body_jntadr[b], m.body_jntadr[b] + m.body_jntnum[b]):
+            if int(m.jnt_type[j]) not in _CHAIN_JOINTS:
+                kind = mujoco.mjtJoint(m.jnt_type[j]).name
+                raise MJCFImportError(
+                    f"joint {_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)!r} in body "
+                    f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, b)!r} is {kind}; only hinge and "
+                    f"slide joints form a ZRP serial arm")
+            joints.append(j)
+    if not joints:
+        raise MJCFImportError(f"no hinge or slide joint between the world and body "
+                              f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, bid)!r}")
+    d = mujoco.MjData(m)
+    d.qpos[:] = 0.0
+    mujoco.mj_kinematics(m, d)
+    axes = np.array([d.xaxis[j] for j in joints])
+    anchors = np.array([d.xanchor[j] for j in joints])
+    if sid >= 0:
+        p, frame = d.site_xpos[sid].copy(), d.site_xmat[sid].reshape(3, 3).copy()
+    else:
+        p, frame = d.xpos[bid].copy(), d.xmat[bid].reshape(3, 3).copy()
+    bodies = np.vstack([anchors[:1], np.diff(anchors, axis=0), (p - anchors[-1])[None]]) / scale
+    types = ["prismatic" if int(m.jnt_type[j]) == _SLIDE else "revolute"
+             for j in joints]
+    names = [_name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in joints]
+    model_name = name or bytes(m.names).split(b"\0", 1)[0].decode() or "imported arm"
+    return Manipulator.from_arrays(axes, bodies, axial=frame[:, 2], transverse=frame[:, 1],
+                                   types=types, name=model_name, length_unit=length_unit,
+                                   joint_names=[n if not n.startswith("#") else "" for n in names])
+
+
+def from_mjcf(path: str | os.PathLike[str], **kwargs: object) -> Manipulator:
+    """Alias of :func:`manipulator_from_mujoco` for a file (MJCF or URDF)."""
+    return manipulator_from_mujoco(path, **kwargs)  # type: ignore[arg-type]
