@@ -168,7 +168,9 @@ def _newton(q, pd, erd, axes, bodies, prism, m, inv_l, w0, lam_max, tol_p, tol_o
         else:
             for i in range(3):
                 rhs[i] = err[3 + i] * inv_l
-        _dls_solve(jac, rhs, m, inv_l, w0, lam_max, dq, info)
+        # Newton steps are small: damp only very close to the singularity (w < w0 / 100),
+        # so that the projection still converges quadratically where the rates were damped.
+        _dls_solve(jac, rhs, m, inv_l, 0.01 * w0, lam_max, dq, info)
         s = 0.0
         for j in range(n):
             q[j] += dq[j]

@@ -155,7 +155,7 @@ def track_trajectory(
     gain: float | None = None,
     position_tol: float | None = None,
     orientation_tol_rad: float = 1e-13,
-    max_iter: int = 10,
+    max_iter: int = 20,
     manipulability_threshold: float = 1e-3,
     max_damping: float = 0.05,
     warn: bool = True,
@@ -205,6 +205,10 @@ def track_trajectory(
         gain = 50.0 if correction == "feedback" else 0.0
     if not np.isfinite(gain) or gain < 0:
         raise InputError(f"gain: expected a finite number >= 0 (1/s), got {gain!r}")
+    if correction == "feedback" and gain * trajectory.duration / steps > 0.3:
+        warnings.warn(f"gain * h = {gain * trajectory.duration / steps:.3g} exceeds 0.3: the "
+                      f"feedback is outside the predictor-corrector's stability region; use "
+                      f"more steps or a smaller gain", TrackingWarning, stacklevel=2)
     if task == "pose" and model.n < 6:
         warnings.warn(f"task='pose' with {model.n} joints: the orientation cannot be tracked "
                       "independently; damped least squares will share the error",

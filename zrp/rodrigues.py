@@ -196,14 +196,16 @@ def er_delta_r(e_err: ArrayLike) -> F64:
     theta). Reported as the paper defines it; see :func:`er_angle` for the plain angle theta.
 
     Args:
-        e_err: parameters of the error rotation, shape (..., 4).
+        e_err: unit parameters of the error rotation, shape (..., 4).
 
     Returns:
         shape (...), dimensionless (numerically close to sqrt(2) times theta in rad).
     """
     e = np.asarray(e_err, dtype=float)
     ee = np.sum(e[..., 1:] ** 2, axis=-1)
-    return np.sqrt(np.maximum(4.0 * (1.0 - e[..., 0] ** 2 + ee), 0.0))
+    # For unit parameters 1 - e0^2 equals e.e exactly; using e.e avoids the cancellation of
+    # 1 - e0^2 near e0 = 1, which would lose all digits for theta below about 1e-8 rad.
+    return np.sqrt(8.0 * ee)
 
 
 def er_to_scipy_quat(e: ArrayLike) -> F64:

@@ -1,0 +1,174 @@
+"""Forward kinematics and the Jacobian against independent references."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.spatial.transform import Rotation
+
+import zrp
+from zrp.rodrigues import er_to_matrix
+from zrp.testing import random_arm
+
+
+def scipy_fk(model, q):
+    """Independent composition with scipy's Rotation (product of exponentials at q = 0)."""
+    r = Rotation.identity()
+    p = np.zeros(3)
+    bodies, axes = np.array(model.bodies), np.array(model.axes)  # writable copies for scipy
+    for k in range(model.n):
+        p = p + r.apply(bodies[k])
+        u = axes[k]
+        if model.prismatic[k]:
+            p = p + q[k] * r.apply(u)
+        else:
+            r = r * Rotation.from_rotvec(u * q[k])
+    p = p + r.apply(bodies[-1])
+    return p, r.as_matrix()
+
+
+@pytest.mark.parametrize("n", [3, 4, 6, 7, 8])
+def test_fk_matches_scipy_composition(rng, n):
+    for _trial in range(5):
+        model = random_arm(rng, n, p_prismatic=0.3)
+        q = rng.uniform(-np.pi, np.pi, n)
+        fk = zrp.forward_kinematics(model, q)
+        p_ref, r_ref = scipy_fk(model, q)
+        np.testing.assert_allclose(fk.position, p_ref, atol=1e-10)
+        np.testing.assert_allclose(fk.rotation, r_ref, atol=1e-13)
+        np.testing.assert_allclose(fk.axial, r_ref @ model.end_effector.axial, atol=1e-13)
+        np.testing.assert_allclose(fk.transverse, r_ref @ model.end_effector.transverse,
+                                   atol=1e-13)
+        # fast compiled path agrees with the vectorised NumPy path
+        p, e = zrp.end_effector_pose(model, q)
+        np.testing.assert_allclose(p, fk.position, atol=1e-10)
+        np.testing.assert_allclose(e, fk.er, atol=1e-14)
+
+
+def test_zero_configuration_gives_sums_of_body_vectors_exactly(rng):
+    for model in (zrp.load_model("puma"), random_arm(rng, 7, 0.3), zrp.load_model("stanford")):
+        q = np.zeros(model.n)
+        expected = np.zeros(3)
+        for b in model.bodies:
+            expected = expected + b
+        fk = zrp.forward_kinematics(model, q)
+        np.testing.assert_array_equal(fk.position, expected)
+        np.testing.assert_array_equal(zrp.end_effector_pose(model, q)[0], expected)
+        np.testing.assert_array_equal(fk.axes, model.axes)
+        np.testing.assert_array_equal(fk.axial, model.end_effector.axial)
+
+
+def test_puma_zero_is_wrist_singular(puma):
+    fk = zrp.forward_kinematics(puma, np.zeros(6))
+    np.testing.assert_allclose(fk.axes[3], -fk.axes[5])
+    assert np.linalg.matrix_rank(zrp.jacobian(puma, np.zeros(6)), tol=1e-9) == 5
+    assert np.linalg.matrix_rank(zrp.jacobian(puma, np.radians([0, 0, 0, 0, 90, 0])),
+                                 tol=1e-9) == 6
+
+
+def test_current_vectors_follow_eqs_1_and_2(rng):
+    model = random_arm(rng, 6)
+    q = rng.uniform(-3, 3, 6)
+    fk = zrp.forward_kinematics(model, q)
+    # body vectors keep their length and the points are their partial sums
+    np.testing.assert_allclose(np.linalg.norm(fk.bodies, axis=1),
+                               np.linalg.norm(model.bodies, axis=1), rtol=1e-13)
+    np.testing.assert_allclose(fk.points, np.cumsum(fk.bodies[:-1], axis=0), atol=1e-10)
+    # eq (1)/(13) remark: rotating u_{k,0} by joints 1..k or 1..k-1 gives the same u_k
+    for k in range(6):
+        r_k = np.eye(3)
+        for j in range(k + 1):
+            r_k = r_k @ Rotation.from_rotvec(np.array(model.axes[j]) * q[j]).as_matrix()
+        np.testing.assert_allclose(r_k @ model.axes[k], fk.axes[k], atol=1e-13)
+
+
+def _orientation_fd(model, q, k, h):
+    qp, qm = q.copy(), q.copy()
+    qp[k] += h
+    qm[k] -= h
+    rp = er_to_matrix(zrp.end_effector_pose(model, qp)[1])
+    rm = er_to_matrix(zrp.end_effector_pose(model, qm)[1])
+    return Rotation.from_matrix(rp @ rm.T).as_rotvec() / (2 * h)
+
+
+@pytest.mark.parametrize("n", [3, 5, 6, 7, 8])
+def test_jacobian_matches_finite_differences(rng, n):
+    for _trial in range(4):
+        model = random_arm(rng, n, p_prismatic=0.35)
+        q = rng.uniform(-np.pi, np.pi, n)
+        jac = zrp.jacobian(model, q)
+        h = 1e-6
+        for k in range(n):
+            qp, qm = q.copy(), q.copy()
+            qp[k] += h
+            qm[k] -= h
+            dp = (zrp.end_effector_pose(model, qp)[0] - zrp.end_effector_pose(model, qm)[0])
+            np.testing.assert_allclose(jac[3:, k], dp / (2 * h), atol=2e-6 * model.reach)
+            np.testing.assert_allclose(jac[:3, k], _orientation_fd(model, q, k, h), atol=1e-8)
+        if model.prismatic.any():
+            np.testing.assert_array_equal(jac[:3, model.prismatic], 0.0)
+
+
+def test_batched_shapes_and_consistency(rng, puma):
+    q = rng.uniform(-3, 3, (4, 5, 6))
+    fk = zrp.forward_kinematics(puma, q)
+    assert fk.position.shape == (4, 5, 3)
+    assert fk.axes.shape == (4, 5, 6, 3)
+    assert fk.bodies.shape == (4, 5, 7, 3)
+    assert fk.hand_frame.shape == (4, 5, 3, 3)
+    p, e = zrp.end_effector_pose(puma, q)
+    assert p.shape == (4, 5, 3) and e.shape == (4, 5, 4)
+    jac = zrp.jacobian(puma, q)
+    assert jac.shape == (4, 5, 6, 6)
+    np.testing.assert_allclose(jac[2, 3], zrp.jacobian(puma, q[2, 3]), atol=0)
+    np.testing.assert_allclose(p, fk.position, atol=1e-10)
+
+
+def test_hand_frame_is_right_handed_rotation(rng, puma):
+    fk = zrp.forward_kinematics(puma, rng.uniform(-3, 3, (20, 6)))
+    h = fk.hand_frame
+    np.testing.assert_allclose(np.einsum("nij,nik->njk", h, h), np.broadcast_to(np.eye(3), h.shape),
+                               atol=1e-14)
+    np.testing.assert_allclose(np.linalg.det(h), 1.0, atol=1e-14)
+    np.testing.assert_allclose(h[:, :, 2], fk.axial)
+    # the hand frame turns with R_n
+    np.testing.assert_allclose(h, fk.rotation @ puma.end_effector.frame, atol=1e-14)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.lists(st.floats(-20, 20, allow_nan=False), min_size=6, max_size=6),
+       st.floats(-3, 3, allow_nan=False))
+def test_property_joint1_rotates_whole_arm(q, delta):
+    """Turning joint 1 by delta rotates p about joint 1's axis (through b_{1,0}) by delta."""
+    model = zrp.load_model("puma")
+    q = np.array(q)
+    q2 = q.copy()
+    q2[0] += delta
+    p1 = zrp.forward_kinematics(model, q).position
+    p2 = zrp.forward_kinematics(model, q2).position
+    r = Rotation.from_rotvec(np.array(model.axes[0]) * delta)
+    np.testing.assert_allclose(p2, model.bodies[0] + r.apply(p1 - model.bodies[0]), atol=1e-9)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(3, 8), st.integers(0, 2**32 - 1))
+def test_property_first_order_step(n, seed):
+    """FK(q + dq) - FK(q) = J dq + O(|dq|^2) on random arms."""
+    rng = np.random.default_rng(seed)
+    model = random_arm(rng, n, 0.3)
+    q = rng.uniform(-3, 3, n)
+    dq = rng.normal(size=n) * 1e-6
+    dp = zrp.end_effector_pose(model, q + dq)[0] - zrp.end_effector_pose(model, q)[0]
+    lin = zrp.jacobian(model, q)[3:] @ dq
+    assert np.linalg.norm(dp - lin) <= 1e-9 * model.reach + 1e-6 * np.linalg.norm(lin)
+
+
+def test_bad_joint_values_are_named(puma):
+    with pytest.raises(zrp.InputError, match=r"shape \(\.\.\., 6\)"):
+        zrp.forward_kinematics(puma, np.zeros(5))
+    with pytest.raises(zrp.InputError, match=r"joint 3 \(q3\) is nan"):
+        zrp.end_effector_pose(puma, [0, 0, np.nan, 0, 0, 0])
+    with pytest.raises(zrp.InputError, match="joint 2"):
+        zrp.jacobian(puma, [[0, 0, 0, 0, 0, 0], [0, np.inf, 0, 0, 0, 0]])
+    with pytest.raises(zrp.InputError, match="expected numbers"):
+        zrp.forward_kinematics(puma, "abc")
