@@ -1,0 +1,813 @@
+"""The sim-to-real gap diagnosis: where the gap lies, which effect causes it, how far it shrinks.
+
+Entry point: :func:`diagnose` (in-process; the ``zrp diagnose`` command and the blind benchmark
+call it). The method and the JSON schema are documented in docs/diagnosis.md.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from ..errors import InputError, ZRPWarning
+from ..model import Manipulator
+from .data import DataWarning, Measurements
+from .effects import (
+    EFFECTS,
+    Context,
+    ParamSpec,
+    effect_parameters,
+    gravity_torques_mjcf,
+    registration_parameters,
+)
+from .fit import (
+    Aliased,
+    FitResult,
+    check_identifiable,
+    cv_rms,
+    f_test,
+    fit,
+    initial_registration,
+    point_errors,
+    wald_groups,
+)
+from .problem import Problem
+
+__all__ = [
+    "Candidate",
+    "Diagnosis",
+    "GapWarning",
+    "Metrics",
+    "NoiseFloor",
+    "ParameterEstimate",
+    "Step",
+    "diagnose",
+    "noise_floor",
+    "split_poses",
+]
+
+F64 = NDArray[np.float64]
+SCHEMA_VERSION = 1
+MIN_POSES = 8
+#: final withheld RMS above this multiple of the noise-floor RMS counts as unexplained.
+UNEXPLAINED_RATIO = 1.5
+#: 95th percentile of |r| for isotropic Gaussian noise, in units of sigma (chi, 3 dof).
+CHI3_P95 = 2.7954834829151074
+
+
+class GapWarning(ZRPWarning):
+    """The diagnosis ran but something limits what it can say (aliasing, poor data...)."""
+
+
+@dataclass(frozen=True)
+class Metrics:
+    """3-D position errors |r| of a set of measured points (length unit).
+
+    Attributes:
+        rms: sqrt(mean |r|^2).
+        p95: 95th percentile of |r|.
+        max: largest |r|.
+        n_points: number of measured points.
+    """
+
+    rms: float
+    p95: float
+    max: float
+    n_points: int
+
+    @classmethod
+    def of(cls, residual: F64) -> Metrics:
+        e = point_errors(residual)
+        return cls(float(np.sqrt(np.mean(e**2))), float(np.percentile(e, 95)), float(e.max()),
+                   int(e.size))
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"rms": self.rms, "p95": self.p95, "max": self.max, "n_points": self.n_points}
+
+
+@dataclass(frozen=True)
+class NoiseFloor:
+    """Measurement-noise estimate.
+
+    Attributes:
+        sigma: per-coordinate standard deviation (length unit), or None when the data allow no
+            estimate.
+        method: "rigid_links" (mutual distances of points measured in the same pose),
+            "repeats" (poses measured more than once), "given" or "none".
+        n_samples: number of distances or repeated coordinates it rests on.
+        detail: per-pair or per-method numbers for the report.
+    """
+
+    sigma: float | None
+    method: str
+    n_samples: int = 0
+    detail: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def rms(self) -> float | None:
+        """Expected 3-D RMS of pure noise, sqrt(3) sigma."""
+        return None if self.sigma is None else math.sqrt(3.0) * self.sigma
+
+    @property
+    def p95(self) -> float | None:
+        return None if self.sigma is None else CHI3_P95 * self.sigma
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"sigma": self.sigma, "rms": self.rms, "p95": self.p95, "method": self.method,
+                "n_samples": self.n_samples, "detail": self.detail}
+
+
+@dataclass(frozen=True)
+class ParameterEstimate:
+    """An identified parameter with its 95 % confidence interval (normal approximation)."""
+
+    name: str
+    effect: str
+    joint: int
+    unit: str
+    value: float
+    stderr: float
+    ci95: tuple[float, float]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "effect": self.effect, "joint": self.joint,
+                "unit": self.unit, "value": self.value, "stderr": self.stderr,
+                "ci95": list(self.ci95)}
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One effect tried at one step of the greedy search.
+
+    Attributes:
+        effect: the effect.
+        joints: joints (or body vectors for ``link_length``) whose parameters were significant.
+        n_params: parameters kept after the significance pruning.
+        cv_rms: cross-validated 3-D RMS on the fitting set (length unit); NaN if not fitted.
+        bic_delta: BIC change against the current model (negative is better).
+        p_value: F test of the improvement against the current model.
+        significant: it passed all the tests for being added.
+        note: why it was not tried or not significant.
+    """
+
+    effect: str
+    joints: tuple[int, ...]
+    n_params: int
+    cv_rms: float
+    bic_delta: float
+    p_value: float
+    significant: bool
+    note: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"effect": self.effect, "joints": list(self.joints), "n_params": self.n_params,
+                "cv_rms": None if math.isnan(self.cv_rms) else self.cv_rms,
+                "bic_delta": None if math.isnan(self.bic_delta) else self.bic_delta,
+                "p_value": self.p_value, "significant": self.significant, "note": self.note}
+
+
+@dataclass(frozen=True)
+class Step:
+    """One effect added to the model, with what it achieved on the withheld poses."""
+
+    effect: str
+    joints: tuple[int, ...]
+    parameters: tuple[ParameterEstimate, ...]
+    withheld: Metrics
+    fitting: Metrics
+    cv_rms: float
+    p_value: float
+    bic_delta: float
+    candidates: tuple[Candidate, ...]
+    aliased: tuple[Aliased, ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"effect": self.effect, "joints": list(self.joints),
+                "parameters": [p.to_dict() for p in self.parameters],
+                "rms": self.withheld.rms, "p95": self.withheld.p95, "max": self.withheld.max,
+                "withheld": self.withheld.to_dict(), "fitting": self.fitting.to_dict(),
+                "cv_rms": self.cv_rms, "p_value": self.p_value, "bic_delta": self.bic_delta,
+                "candidates": [c.to_dict() for c in self.candidates],
+                "aliased": [_alias_dict(a) for a in self.aliased]}
+
+
+def _alias_dict(a: Aliased) -> dict[str, Any]:
+    return {"name": a.name, "effect": a.effect, "partners": list(a.partners),
+            "fraction": a.fraction, "dropped": a.dropped}
+
+
+@dataclass(frozen=True, eq=False)
+class Diagnosis:
+    """The result of :func:`diagnose` (see docs/diagnosis.md for the JSON form).
+
+    Attributes:
+        model_name, length_unit: of the nominal model.
+        nominal: withheld errors after registration only.
+        nominal_fitting: fitting-set errors after registration only.
+        registration: the registration parameters (base frame, tool offsets).
+        steps: effects added, in order.
+        final: withheld errors of the final model.
+        noise_floor: the noise estimate.
+        unexplained: True when the final withheld RMS exceeds UNEXPLAINED_RATIO x the noise
+            floor RMS; None when there is no noise estimate.
+        verdict: one paragraph in plain words.
+        split: pose ids of the fitting and withheld sets and the CV folds.
+        where: the "where" analysis (see :func:`where_analysis`).
+        aliased: parameters that the data cannot tell apart (reported, never absorbed).
+        warnings: messages of the warnings raised during the run.
+        nominal_fit, final_fit: the fits (for plots and in-process use).
+        withheld_residual_before, withheld_residual_after: shape (3 Rw,).
+        context: the data context.
+        withheld_poses, fitting_poses: pose indices, shapes (Pw,), (Pf,).
+    """
+
+    model_name: str
+    length_unit: str
+    nominal: Metrics
+    nominal_fitting: Metrics
+    registration: tuple[ParameterEstimate, ...]
+    steps: tuple[Step, ...]
+    final: Metrics
+    noise_floor: NoiseFloor
+    unexplained: bool | None
+    verdict: str
+    split: dict[str, Any]
+    where: dict[str, Any]
+    aliased: tuple[Aliased, ...]
+    warnings: tuple[str, ...]
+    nominal_fit: FitResult
+    final_fit: FitResult
+    withheld_residual_before: F64
+    withheld_residual_after: F64
+    context: Context
+    fitting_poses: NDArray[np.int64]
+    withheld_poses: NDArray[np.int64]
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def effects(self) -> tuple[str, ...]:
+        """Effects found, in order ("none" alone when nothing helped)."""
+        return tuple(s.effect for s in self.steps) or ("none",)
+
+    @property
+    def top_effect(self) -> str:
+        """The first effect found, or "none"."""
+        return self.effects[0]
+
+    @property
+    def shrink(self) -> float:
+        """Final over nominal withheld RMS (1: no improvement)."""
+        return self.final.rms / self.nominal.rms if self.nominal.rms > 0 else 1.0
+
+    def parameter(self, name: str) -> ParameterEstimate:
+        """The final estimate of one parameter (from the last step that carries it)."""
+        for st in reversed(self.steps):
+            for p in st.parameters:
+                if p.name == name:
+                    return p
+        for p in self.registration:
+            if p.name == name:
+                return p
+        raise InputError(f"no identified parameter {name!r}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON document (schema in docs/diagnosis.md)."""
+        nf = self.noise_floor
+        return {
+            "schema_version": SCHEMA_VERSION,
+            "model": self.model_name,
+            "length_unit": self.length_unit,
+            "settings": self.settings,
+            "nominal": {"rms": self.nominal.rms, "p95": self.nominal.p95,
+                        "max": self.nominal.max, "n_points": self.nominal.n_points,
+                        "fitting": self.nominal_fitting.to_dict()},
+            "registration": [p.to_dict() for p in self.registration],
+            "steps": [s.to_dict() for s in self.steps],
+            "effects": list(self.effects),
+            "final": {**self.final.to_dict(), "shrink": self.shrink,
+                      "ratio_to_noise_floor": (None if nf.rms is None or nf.rms == 0
+                                               else self.final.rms / nf.rms)},
+            "noise_floor": nf.to_dict(),
+            "unexplained": self.unexplained,
+            "verdict": self.verdict,
+            "split": self.split,
+            "where": self.where,
+            "aliased": [_alias_dict(a) for a in self.aliased],
+            "warnings": list(self.warnings),
+        }
+
+
+# ---- split and noise floor ---------------------------------------------------------------
+
+def split_poses(meas: Measurements, rng: np.random.Generator, withheld_fraction: float = 0.25,
+                folds: int = 5) -> tuple[NDArray[np.int64], NDArray[np.int64],
+                                         list[NDArray[np.int64]]]:
+    """Seeded split by pose (repeats of a pose stay together).
+
+    Returns:
+        fitting pose indices, withheld pose indices, and the CV folds (a partition of the
+        fitting poses).
+    """
+    if not 0.0 < withheld_fraction < 1.0:
+        raise InputError(f"withheld_fraction: expected a value in (0, 1), got {withheld_fraction}")
+    if folds < 2:
+        raise InputError(f"folds: expected at least 2 cross-validation folds, got {folds}")
+    groups = meas.repeat_groups()
+    ng = int(groups.max()) + 1
+    order = rng.permutation(ng)
+    n_with = max(1, int(round(withheld_fraction * ng)))
+    if ng - n_with < 2:
+        raise InputError(f"only {ng} distinct poses: too few to withhold any; measure at least "
+                         f"{MIN_POSES} distinct poses")
+    withheld_groups = set(order[:n_with].tolist())
+    is_with = np.array([g in withheld_groups for g in groups])
+    fitting = np.flatnonzero(~is_with)
+    withheld = np.flatnonzero(is_with)
+    fit_groups = order[n_with:]
+    fold_of_group = {int(g): i % folds for i, g in enumerate(fit_groups)}
+    fold_id = np.array([fold_of_group[int(groups[p])] for p in fitting])
+    fold_list = [fitting[fold_id == f] for f in range(folds) if np.any(fold_id == f)]
+    return fitting, withheld, fold_list
+
+
+def noise_floor(meas: Measurements, poses: NDArray[np.int64] | None = None,
+                sigma: float | None = None) -> NoiseFloor:
+    """Estimate the per-coordinate noise sigma (length unit) without any robot model.
+
+    * Rigidly linked points: the distance between two points measured in the same pose is
+      the same in every pose; its spread is sqrt(2) sigma for isotropic noise.
+    * Repeats: poses with identical joint values; the spread of each point's coordinates.
+    Uses the rigid links when there are several points per pose, else repeats; ``sigma``
+    overrides both (method "given").
+    """
+    if sigma is not None:
+        if not (sigma > 0 and math.isfinite(sigma)):
+            raise InputError(f"noise sigma: expected a positive number, got {sigma}")
+        return NoiseFloor(float(sigma), "given", 0)
+    P = len(meas.pose_ids)
+    poses = np.arange(P) if poses is None else np.asarray(poses)
+    M = len(meas.point_labels)
+    pos = np.full((P, M, 3), np.nan)
+    pos[meas.pose_index, meas.point_index] = meas.xyz
+    pos = pos[poses]
+    detail: dict[str, Any] = {}
+    if M >= 2:
+        ss = 0.0
+        dof = 0
+        for a in range(M):
+            for b in range(a + 1, M):
+                d = np.linalg.norm(pos[:, a] - pos[:, b], axis=1)
+                d = d[np.isfinite(d)]
+                if d.size < 3:
+                    continue
+                ss += float(np.sum((d - d.mean()) ** 2))
+                dof += d.size - 1
+                mad = float(np.median(np.abs(d - np.median(d))))
+                detail[f"{meas.point_labels[a]}-{meas.point_labels[b]}"] = {
+                    "mean_distance": float(d.mean()), "std": float(d.std(ddof=1)),
+                    "robust_std": 1.4826 * mad, "n": int(d.size)}
+        if dof > 0:
+            return NoiseFloor(math.sqrt(ss / dof / 2.0), "rigid_links", dof, detail)
+    groups = meas.repeat_groups()[poses]
+    ss = 0.0
+    dof = 0
+    for g in np.unique(groups):
+        members = np.flatnonzero(groups == g)
+        if members.size < 2:
+            continue
+        x = pos[members]
+        for m in range(M):
+            xm = x[:, m][np.all(np.isfinite(x[:, m]), axis=1)]
+            if xm.shape[0] >= 2:
+                ss += float(np.sum((xm - xm.mean(0)) ** 2))
+                dof += 3 * (xm.shape[0] - 1)
+    if dof > 0:
+        return NoiseFloor(math.sqrt(ss / dof), "repeats", dof, detail)
+    return NoiseFloor(None, "none", 0, detail)
+
+
+# ---- where ---------------------------------------------------------------------------------
+
+def _r2(features: F64, y: F64) -> float:
+    """Share of the variance of y (N, 3) explained by a linear model in features (N, f)."""
+    X = np.column_stack([np.ones(len(y)), features])
+    yc = y - y.mean(0)
+    tss = float(np.sum(yc**2))
+    if tss <= 0 or len(y) <= X.shape[1] + 1:
+        return 0.0
+    coef = np.linalg.lstsq(X, y, rcond=None)[0]
+    rss = float(np.sum((y - X @ coef) ** 2))
+    return max(0.0, 1.0 - rss / tss)
+
+
+def where_analysis(ctx: Context, result: FitResult, max_components: int = 5) -> dict[str, Any]:
+    """Where the residual of ``result`` lies (evaluated on its own, the fitting, poses).
+
+    Returns a dict with ``per_point`` (RMS per point label), ``worst_poses``, ``joints``
+    (per joint: R^2 of the residual explained by a smooth function of the joint angle, and
+    binned RMS), ``order``/``time``/``temperature`` (R^2 against measurement order, t and temp),
+    ``regions`` (RMS per workspace region), ``projection`` (share of the residual each joint's
+    geometric parameters explain, after the registration) and ``components`` (the singular
+    vectors of the identification Jacobian that carry most of the residual).
+    """
+    meas = ctx.meas
+    rows = np.flatnonzero(np.isin(meas.pose_index, result.poses))
+    r = result.residual.reshape(-1, 3)
+    e = np.linalg.norm(r, axis=1)
+    pose_of_row = meas.pose_index[rows]
+    out: dict[str, Any] = {"evaluated_on": "fitting", "n_points": int(e.size)}
+    out["per_point"] = {lab: float(np.sqrt(np.mean(e[meas.point_index[rows] == m] ** 2)))
+                        for m, lab in enumerate(meas.point_labels)
+                        if np.any(meas.point_index[rows] == m)}
+    per_pose = {}
+    for p in np.unique(pose_of_row):
+        per_pose[meas.pose_ids[p]] = float(np.sqrt(np.mean(e[pose_of_row == p] ** 2)))
+    worst = sorted(per_pose.items(), key=lambda kv: -kv[1])[:5]
+    out["worst_poses"] = [{"pose": k, "rms": v} for k, v in worst]
+    q = ctx.q[pose_of_row]
+    joints = []
+    for k in range(ctx.n):
+        qk = q[:, k]
+        feats = (np.column_stack([qk, qk**2]) if ctx.model.prismatic[k] else
+                 np.column_stack([np.sin(qk), np.cos(qk), np.sin(2 * qk), np.cos(2 * qk)]))
+        edges = np.quantile(qk, np.linspace(0, 1, 7))
+        idx = np.clip(np.searchsorted(edges, qk, side="right") - 1, 0, 5)
+        bins = [{"lo": float(edges[b]), "hi": float(edges[b + 1]),
+                 "rms": float(np.sqrt(np.mean(e[idx == b] ** 2))) if np.any(idx == b) else None}
+                for b in range(6)]
+        joints.append({"joint": k + 1, "r2": _r2(feats, r) if np.ptp(qk) > 0 else 0.0,
+                       "range": [float(qk.min()), float(qk.max())], "bins": bins})
+    out["joints"] = joints
+    order = np.arange(e.size, dtype=float)
+    order = (order - order.mean()) / max(order.std(), 1.0)
+    out["order"] = {"r2": _r2(np.column_stack([order, order**2, order**3]), r)}
+    for name, key in (("t", "time"), ("temp", "temperature")):
+        arr = getattr(meas, name)
+        if arr is not None and np.ptp(arr[rows]) > 0:
+            z = arr[rows]
+            z = (z - z.mean()) / z.std()
+            out[key] = {"r2": _r2(np.column_stack([z, z**2]), r)}
+    fk = ctx.nominal_fk
+    pe = fk.position[pose_of_row]
+    rad = np.linalg.norm(pe[:, :2], axis=1)
+    redges = np.quantile(rad, [0, 1 / 3, 2 / 3, 1])
+    zmid = float(np.median(pe[:, 2]))
+    regions = []
+    for a in range(3):
+        for up in (False, True):
+            sel = ((rad >= redges[a]) & (rad <= redges[a + 1])
+                   & ((pe[:, 2] > zmid) if up else (pe[:, 2] <= zmid)))
+            if sel.any():
+                regions.append({"radius": [float(redges[a]), float(redges[a + 1])],
+                                "height": "upper" if up else "lower",
+                                "rms": float(np.sqrt(np.mean(e[sel] ** 2))),
+                                "n_points": int(sel.sum())})
+    out["regions"] = regions
+    out.update(_projection(ctx, result, max_components))
+    return out
+
+
+def _projection(ctx: Context, result: FitResult, max_components: int) -> dict[str, Any]:
+    geo: list[ParamSpec] = []
+    for eff in ("joint_offset", "link_length", "axis_misalignment"):
+        geo += effect_parameters(ctx, eff)[0]
+    keep, _ = check_identifiable(ctx, result, geo)
+    prob = Problem(ctx, list(result.specs) + keep, result.poses, result.base_rotation)
+    theta = np.concatenate([result.theta, np.zeros(len(keep))])
+    r, J = prob.residual_and_jacobian(theta)
+    nb = len(result.specs)
+    Qr, _ = np.linalg.qr(J[:, :nb])
+    G = J[:, nb:] - Qr @ (Qr.T @ J[:, nb:])
+    gn = np.linalg.norm(G, axis=0)
+    G = G / np.where(gn > 0, gn, 1.0)
+    rp = r - Qr @ (Qr.T @ r)
+    rr = float(rp @ rp)
+    proj: list[dict[str, Any]] = []
+    for k in range(1, ctx.n + 2):
+        cols = [i for i, s in enumerate(keep) if s.joint == k]
+        if not cols:
+            continue
+        Qk, _ = np.linalg.qr(G[:, cols])
+        share = float(np.sum((Qk.T @ rp) ** 2) / rr) if rr > 0 else 0.0
+        proj.append({"joint": k, "share": share,
+                     "parameters": [keep[i].name for i in cols]})
+    comps = []
+    if G.shape[1]:
+        U, sv, Vt = np.linalg.svd(G, full_matrices=False)
+        c = U.T @ rp
+        order = np.argsort(-(c**2))[:max_components]
+        for i in order:
+            load = Vt[i]
+            top = np.argsort(-np.abs(load))[:3]
+            comps.append({"share": float(c[i] ** 2 / rr) if rr > 0 else 0.0,
+                          "singular_value": float(sv[i]),
+                          "parameters": [{"name": keep[t].name, "loading": float(load[t])}
+                                         for t in top]})
+    total = float(np.sum((U.T @ rp) ** 2) / rr) if G.shape[1] and rr > 0 else 0.0
+    return {"projection": proj, "components": comps, "geometric_share": total}
+
+
+# ---- the diagnosis -------------------------------------------------------------------------
+
+def _estimates(result: FitResult, first: int, last: int | None = None) -> tuple[
+        ParameterEstimate, ...]:
+    se = result.stderr
+    out = []
+    for i in range(first, len(result.specs) if last is None else last):
+        s = result.specs[i]
+        v = float(result.theta[i])
+        h = 1.959963984540054 * float(se[i])
+        out.append(ParameterEstimate(s.name, s.effect, s.joint, s.unit, v, float(se[i]),
+                                     (v - h, v + h)))
+    return tuple(out)
+
+
+def _withheld(ctx: Context, result: FitResult, poses: NDArray[np.int64]) -> F64:
+    return Problem(ctx, result.specs, poses, result.base_rotation).residual(result.theta)
+
+
+def _fmt(x: float | None, unit: str) -> str:
+    return "n/a" if x is None else f"{x:.4g} {unit}"
+
+
+def diagnose(model: Manipulator, measurements: Measurements, *,
+             mjcf: str | None = None,
+             gravity_torque: F64 | None = None,
+             effects: Sequence[str] = EFFECTS,
+             rng: np.random.Generator | None = None,
+             seed: int = 0,
+             withheld_fraction: float = 0.25,
+             folds: int = 5,
+             alpha: float = 1e-3,
+             min_gain: float = 0.01,
+             max_steps: int = 4,
+             noise_sigma: float | None = None,
+             harmonics: tuple[int, ...] = (1, 2),
+             gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0),
+             progress: bool = False) -> Diagnosis:
+    """Diagnose the gap between ``model`` and ``measurements``.
+
+    Args:
+        model: the nominal robot model ("the sim").
+        measurements: measured tool points (see :func:`zrp.gap.load_measurements`).
+        mjcf: an MJCF file with the robot's inertias (gravity torques for
+            ``joint_compliance``); without it a lumped-mass model is identified.
+        gravity_torque: gravity torque per pose and joint, shape (P, n), instead of ``mjcf``.
+        effects: candidate effects (subset of :data:`zrp.gap.EFFECTS`).
+        rng: random generator for the split (default ``np.random.default_rng(seed)``).
+        withheld_fraction: share of the (distinct) poses withheld from fitting and selection.
+        folds: cross-validation folds within the fitting poses (used for ranking).
+        alpha: significance level of the F test that admits an effect; joint groups are kept
+            when their Wald p-value is below alpha / (number of groups).
+        min_gain: an effect must lower the cross-validated RMS by at least this fraction.
+        max_steps: most effects added.
+        noise_sigma: known per-coordinate instrument noise (length unit), overriding the
+            estimate from the data.
+        harmonics: harmonics of ``cyclic_error``.
+        gravity_dir: gravity direction in the base frame (lumped-mass compliance model).
+        progress: show a tqdm progress bar.
+
+    Returns:
+        the :class:`Diagnosis`.
+
+    Raises:
+        InputError: too few poses, units that do not fit the model, unidentifiable
+            registration, unknown effect names.
+    """
+    from tqdm.auto import tqdm
+
+    bad = [e for e in effects if e not in EFFECTS]
+    if bad:
+        raise InputError(f"effects: unknown {', '.join(bad)}; valid: {', '.join(EFFECTS)}")
+    if measurements.n_joints != model.n:
+        raise InputError(f"{measurements.source}: {measurements.n_joints} joint columns, but "
+                         f"the model {model.name!r} has {model.n} joints")
+    rng = np.random.default_rng(seed) if rng is None else rng
+    caught: list[str] = []
+    with warnings.catch_warnings(record=True) as wlist:
+        warnings.simplefilter("always")
+        result = _diagnose(model, measurements, mjcf, gravity_torque, tuple(effects), rng,
+                           withheld_fraction, folds, alpha, min_gain, max_steps, noise_sigma,
+                           harmonics, gravity_dir, progress, tqdm)
+    for w in wlist:
+        caught.append(str(w.message))
+        warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    object.__setattr__(result, "warnings", tuple(dict.fromkeys(caught)))
+    return result
+
+
+def _check_units(ctx: Context, poses: NDArray[np.int64]) -> None:
+    meas = ctx.meas
+    rows = np.isin(meas.pose_index, poses)
+    m = meas.xyz[rows]
+    p = ctx.nominal_fk.position[meas.pose_index[rows]]
+    sm = float(np.sqrt(np.mean(np.sum((m - m.mean(0)) ** 2, axis=1))))
+    sp = float(np.sqrt(np.mean(np.sum((p - p.mean(0)) ** 2, axis=1))))
+    unit = ctx.model.length_unit
+    if sp <= 1e-9 * ctx.model.characteristic_length:
+        raise InputError(f"{meas.source}: the end effector hardly moves between the poses "
+                         f"(spread {sp:.3g} {unit}); the data cannot be registered (are the "
+                         "joint values in degrees? then pass --deg)")
+    ratio = sm / sp
+    if not 1 / 3 < ratio < 3:
+        raise InputError(
+            f"{meas.source}: units do not fit: the measured points spread {sm:.4g} around "
+            f"their centre but the model's end effector spreads {sp:.4g} {unit} over the same "
+            f"poses (ratio {ratio:.3g}); x, y, z must be in {unit}, and q in rad (or deg with "
+            "--deg)")
+
+
+def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
+              gravity_torque: F64 | None, effects: tuple[str, ...], rng: np.random.Generator,
+              withheld_fraction: float, n_folds: int, alpha: float, min_gain: float,
+              max_steps: int, noise_sigma: float | None, harmonics: tuple[int, ...],
+              gravity_dir: tuple[float, float, float], progress: bool,
+              tqdm: Any) -> Diagnosis:  # noqa: ANN401
+    P = len(meas.pose_ids)
+    n_distinct = int(meas.repeat_groups().max()) + 1
+    if P < MIN_POSES or n_distinct < MIN_POSES:
+        raise InputError(f"{meas.source}: {P} pose(s), {n_distinct} distinct; the diagnosis "
+                         f"needs at least {MIN_POSES} distinct poses (a few hundred for a "
+                         "reliable answer)")
+    if n_distinct < P:
+        warnings.warn(f"{meas.source}: {P - n_distinct} pose(s) repeat the joint values of an "
+                      "earlier pose; repeats are kept together in the split and used for the "
+                      "noise floor", DataWarning, stacklevel=3)
+    if n_distinct < 50:
+        warnings.warn(f"{meas.source}: only {n_distinct} distinct poses; effects with many "
+                      "parameters will be hard to identify", DataWarning, stacklevel=3)
+    if mjcf is not None and gravity_torque is None:
+        gravity_torque = gravity_torques_mjcf(mjcf, meas.q_pose)
+    ctx = Context(model, meas, gravity_torque, gravity_dir, tuple(harmonics))
+    fitting, withheld, folds = split_poses(meas, rng, withheld_fraction, n_folds)
+    missing = [lab for m, lab in enumerate(meas.point_labels)
+               if not np.any(meas.point_index[np.isin(meas.pose_index, fitting)] == m)]
+    if missing:
+        raise InputError(f"{meas.source}: point(s) {', '.join(missing)} appear only in withheld "
+                         "poses; every point must be measured in several poses")
+    _check_units(ctx, fitting)
+    unit = model.length_unit
+
+    # registration
+    reg_specs = registration_parameters(ctx)
+    theta0, rb0 = initial_registration(ctx, reg_specs, fitting)
+    reg = fit(ctx, reg_specs, fitting, theta0, rb0)
+    if not np.all(np.isfinite(reg.stderr)):
+        bad = [s.name for s, v in zip(reg.specs, reg.stderr) if not np.isfinite(v)]
+        raise InputError(f"{meas.source}: the registration is not identifiable from these poses "
+                         f"({', '.join(bad)} undetermined); the joints must move enough to "
+                         "rotate the tool in several directions")
+    nominal_fit_metrics = Metrics.of(reg.residual)
+    if nominal_fit_metrics.rms > 0.1 * model.characteristic_length:
+        raise InputError(
+            f"{meas.source}: after registration the model still misses the measurements by "
+            f"{nominal_fit_metrics.rms:.4g} {unit} RMS ({100 * nominal_fit_metrics.rms / model.reach:.1f}"
+            " % of the reach): the model, the joint order/signs or the units (--deg) do not "
+            "match the data")
+    if nominal_fit_metrics.rms > 0.02 * model.characteristic_length:
+        warnings.warn(f"after registration the gap is {nominal_fit_metrics.rms:.4g} {unit} RMS, "
+                      "more than 2 % of the reach: check the model, joint signs and units",
+                      GapWarning, stacklevel=3)
+    before = _withheld(ctx, reg, withheld)
+    nominal = Metrics.of(before)
+    floor = noise_floor(meas, fitting, noise_sigma)
+    where = where_analysis(ctx, reg)
+
+    # greedy search
+    cache: dict[str, tuple[list[ParamSpec], str | None]] = {
+        e: effect_parameters(ctx, e) for e in effects}
+    current = reg
+    current_cv = cv_rms(ctx, reg, folds)
+    steps: list[Step] = []
+    all_aliased: list[Aliased] = []
+    used: set[str] = set()
+    bar = tqdm(total=max_steps * len(effects), desc="diagnose", disable=not progress,
+               leave=False)
+    for _ in range(max_steps):
+        cands: list[tuple[Candidate, FitResult | None, list[Aliased]]] = []
+        for eff in effects:
+            bar.update(1)
+            if eff in used:
+                continue
+            specs, why = cache[eff]
+            if not specs:
+                cands.append((Candidate(eff, (), 0, math.nan, math.nan, 1.0, False,
+                                        f"not tried: {why}"), None, []))
+                continue
+            keep, aliased = check_identifiable(ctx, current, specs)
+            if not keep:
+                cands.append((Candidate(eff, (), 0, math.nan, math.nan, 1.0, False,
+                                        "no parameter identifiable on top of the current "
+                                        "model"), None, aliased))
+                continue
+            nb = len(current.specs)
+            f1 = fit(ctx, list(current.specs) + keep, fitting,
+                     np.concatenate([current.theta, np.zeros(len(keep))]), rb0)
+            pv = wald_groups(f1, nb)
+            thr = alpha / max(len(pv), 1)
+            sig = {g for g, p in pv.items() if p < thr}
+            kept = [s for s in keep if s.group in sig]
+            if not kept:
+                cands.append((Candidate(eff, (), 0, cv_rms(ctx, f1, folds),
+                                        f1.bic - current.bic, f_test(current, f1), False,
+                                        "no joint significant"), None, aliased))
+                continue
+            if len(kept) < len(keep):
+                idx = [nb + i for i, s in enumerate(keep) if s.group in sig]
+                f1 = fit(ctx, list(current.specs) + kept, fitting,
+                         np.concatenate([f1.theta[:nb], f1.theta[idx]]), rb0)
+            cv = cv_rms(ctx, f1, folds)
+            pval = f_test(current, f1)
+            dbic = f1.bic - current.bic
+            joints = tuple(sorted({s.joint for s in kept if s.joint > 0}))
+            ok = pval < alpha and dbic < 0 and cv < current_cv * (1.0 - min_gain)
+            note = "" if ok else ("F test not significant" if pval >= alpha else
+                                  "BIC does not improve" if dbic >= 0 else
+                                  f"cross-validated RMS improves by less than {min_gain:.0%}")
+            cands.append((Candidate(eff, joints, len(kept), cv, dbic, pval, ok, note), f1,
+                          aliased))
+        ranked = sorted(cands, key=lambda c: (not c[0].significant,
+                                              math.inf if math.isnan(c[0].cv_rms)
+                                              else c[0].cv_rms))
+        best = ranked[0] if ranked else None
+        if best is None or not best[0].significant or best[1] is None:
+            if ranked:
+                steps_cands = tuple(c[0] for c in ranked)
+                where.setdefault("last_candidates", [c.to_dict() for c in steps_cands])
+            break
+        cand, f_new, aliased = best
+        assert f_new is not None
+        used.add(cand.effect)
+        nb = len(current.specs)
+        after = _withheld(ctx, f_new, withheld)
+        weak_or_dropped = tuple(a for a in aliased)
+        all_aliased += [a for a in aliased if a.name in {s.name for s in cache[cand.effect][0]}]
+        steps.append(Step(cand.effect, cand.joints, _estimates(f_new, nb), Metrics.of(after),
+                          Metrics.of(f_new.residual), cand.cv_rms, cand.p_value, cand.bic_delta,
+                          tuple(c[0] for c in ranked), weak_or_dropped))
+        current, current_cv = f_new, cand.cv_rms
+    bar.close()
+    after = _withheld(ctx, current, withheld)
+    final = Metrics.of(after)
+
+    # aliasing of the effects found (reported) and of joint 1 / last joint vs registration
+    for a in all_aliased:
+        if a.dropped:
+            warnings.warn(f"{a.name} ({a.effect}) cannot be told apart from "
+                          f"{', '.join(a.partners) or 'the registration'} with these data; it "
+                          "was not estimated separately", GapWarning, stacklevel=3)
+    unexplained: bool | None
+    if floor.rms is None:
+        unexplained = None
+    else:
+        unexplained = bool(final.rms > UNEXPLAINED_RATIO * floor.rms)
+    verdict = _verdict(steps, nominal, final, floor, unexplained, unit)
+    pid = meas.pose_ids
+    split = {"seed_note": "split drawn from the rng passed to diagnose()",
+             "withheld_fraction": withheld_fraction,
+             "fitting": [pid[i] for i in fitting], "withheld": [pid[i] for i in withheld],
+             "folds": [[pid[i] for i in f] for f in folds]}
+    settings = {"effects": list(effects), "alpha": alpha, "min_gain": min_gain,
+                "max_steps": max_steps, "folds": n_folds, "harmonics": list(harmonics),
+                "gravity_dir": list(gravity_dir), "frame": meas.frame,
+                "compliance_model": "mjcf" if gravity_torque is not None else "lumped_masses",
+                "thermal_t_ref_degC": ctx.t_ref, "n_poses": P,
+                "n_points": meas.n_rows, "point_labels": list(meas.point_labels)}
+    return Diagnosis(model.name, unit, nominal, nominal_fit_metrics,
+                     _estimates(reg, 0), tuple(steps), final, floor, unexplained, verdict,
+                     split, where, tuple(all_aliased), (), reg, current, before, after, ctx,
+                     fitting, withheld, settings)
+
+
+def _verdict(steps: list[Step], nominal: Metrics, final: Metrics, floor: NoiseFloor,
+             unexplained: bool | None, unit: str) -> str:
+    parts = []
+    if steps:
+        names = ", ".join(f"{s.effect} (joints {', '.join(map(str, s.joints)) or '-'})"
+                          for s in steps)
+        parts.append(f"Effects found, in order: {names}.")
+    else:
+        parts.append("No effect in the library improves the model significantly (none).")
+    parts.append(f"Withheld RMS {nominal.rms:.4g} {unit} after registration, "
+                 f"{final.rms:.4g} {unit} after correction "
+                 f"({100 * (1 - final.rms / nominal.rms) if nominal.rms > 0 else 0:.0f} % "
+                 "smaller).")
+    if floor.rms is None:
+        parts.append("The data allow no noise-floor estimate (one point per pose and no "
+                     "repeats), so whether a gap remains cannot be judged.")
+    else:
+        ratio = final.rms / floor.rms if floor.rms > 0 else math.inf
+        parts.append(f"Noise floor {_fmt(floor.rms, unit)} RMS ({floor.method}); the final "
+                     f"error is {ratio:.2g}x the floor.")
+        if unexplained:
+            parts.append(f"A gap of {final.rms:.4g} {unit} RMS remains that no effect in the "
+                         "library explains.")
+        else:
+            parts.append("What remains is at the noise floor.")
+    return " ".join(parts)

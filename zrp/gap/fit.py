@@ -1,0 +1,342 @@
+"""Registration, nonlinear least squares with the analytic Jacobians, identifiability and
+statistics (covariance, Wald and F tests, information criteria, linearised cross-validation).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import stats
+from scipy.optimize import least_squares
+
+from ..errors import InputError, ZRPWarning
+from .effects import Context, ParamSpec
+from .problem import Problem
+
+__all__ = [
+    "Aliased",
+    "FitResult",
+    "FitWarning",
+    "check_identifiable",
+    "cv_rms",
+    "f_test",
+    "fit",
+    "initial_registration",
+    "point_errors",
+    "wald_groups",
+]
+
+F64 = NDArray[np.float64]
+
+#: A parameter whose Jacobian column keeps less than this fraction of its norm after
+#: projection on the other columns cannot be told apart from them (structural aliasing).
+ALIAS_TOL = 1e-6
+#: Below this fraction it is identifiable only weakly (reported, kept).
+WEAK_TOL = 1e-2
+
+
+class FitWarning(ZRPWarning):
+    """A fit is poorly conditioned, did not converge, or the data hide some parameter."""
+
+
+@dataclass(frozen=True, eq=False)
+class FitResult:
+    """A least-squares fit of the corrected model on a set of poses.
+
+    Attributes:
+        specs: the parameters (p).
+        theta: values, shape (p,), in the units of the specs.
+        cov: covariance, shape (p, p) (from sigma^2 (J^T J)^-1 at the solution).
+        residual: predicted minus measured, shape (3R,).
+        jac: Jacobian at the solution, shape (3R, p).
+        base_rotation: R_b0 used by the problem, shape (3, 3).
+        poses: pose indices fitted, shape (S,).
+        converged: the solver reported success.
+    """
+
+    specs: tuple[ParamSpec, ...]
+    theta: F64
+    cov: F64
+    residual: F64
+    jac: F64
+    base_rotation: F64
+    poses: NDArray[np.int64]
+    converged: bool
+
+    def __post_init__(self) -> None:
+        p = len(self.specs)
+        if self.theta.shape != (p,) or self.cov.shape != (p, p):
+            raise InputError(f"FitResult: theta/cov shapes {self.theta.shape}/{self.cov.shape} "
+                             f"do not match {p} parameters")
+
+    @property
+    def rss(self) -> float:
+        """Residual sum of squares, length unit^2."""
+        return float(self.residual @ self.residual)
+
+    @property
+    def n_res(self) -> int:
+        return int(self.residual.size)
+
+    @property
+    def dof(self) -> int:
+        return max(self.n_res - len(self.specs), 1)
+
+    @property
+    def sigma(self) -> float:
+        """Residual standard deviation per coordinate, length unit."""
+        return float(np.sqrt(self.rss / self.dof))
+
+    @property
+    def stderr(self) -> F64:
+        """Standard errors, shape (p,)."""
+        return np.sqrt(np.clip(np.diag(self.cov), 0.0, None))
+
+    @property
+    def bic(self) -> float:
+        """Bayesian information criterion (Gaussian errors, unknown variance)."""
+        return float(self.n_res * np.log(self.rss / self.n_res) + len(self.specs)
+                     * np.log(self.n_res))
+
+    def value(self, name: str) -> float:
+        """The value of the parameter called ``name``."""
+        for s, v in zip(self.specs, self.theta):
+            if s.name == name:
+                return float(v)
+        raise InputError(f"no parameter {name!r}; fitted: {', '.join(s.name for s in self.specs)}")
+
+
+def point_errors(residual: F64) -> F64:
+    """3-D error per measured point |r|, shape (R,), from a residual of shape (3R,)."""
+    return np.linalg.norm(np.asarray(residual).reshape(-1, 3), axis=1)
+
+
+def _kabsch(a: F64, b: F64) -> tuple[F64, F64]:
+    """R, t minimising |R a + t - b| (a, b shape (N, 3))."""
+    ca, cb = a.mean(0), b.mean(0)
+    h = (a - ca).T @ (b - cb)
+    u, _, vt = np.linalg.svd(h)
+    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    return r, cb - r @ ca
+
+
+def initial_registration(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike,
+                         iterations: int = 60) -> tuple[F64, F64]:
+    """Starting values for the registration parameters (other parameters 0) and R_b0.
+
+    Alternates a Kabsch fit of the base frame with a linear solve of the tool offsets (the
+    nominal model is used for p and R_n).
+
+    Returns:
+        theta0 shape (p,), R_b0 shape (3, 3).
+    """
+    poses = np.asarray(poses, dtype=np.int64)
+    prob = Problem(ctx, specs, poses)
+    fk = ctx.nominal_fk
+    p = fk.position[poses][prob.row_pose]
+    rn = fk.rotation[poses][prob.row_pose]
+    m = prob.measured
+    M = len(ctx.meas.point_labels)
+    t = np.zeros((M, 3))
+    rb, tb = np.eye(3), np.zeros(3)
+    for _ in range(iterations if prob.instrument else 1):
+        x = p + np.einsum("rij,rj->ri", rn, t[prob.row_point])
+        if prob.instrument:
+            rb, tb = _kabsch(x, m)
+        local = (m - tb) @ rb  # = R_b^T (m - t_b)
+        for j in range(M):
+            sel = prob.row_point == j
+            t[j] = np.linalg.lstsq(rn[sel].reshape(-1, 3), (local[sel] - p[sel]).ravel(),
+                                   rcond=None)[0]
+    theta = np.zeros(len(specs))
+    for i, s in enumerate(specs):
+        if s.kind == "trans":
+            theta[i] = tb[s.comp]
+        elif s.kind == "tool":
+            theta[i] = t[s.comp // 3, s.comp % 3]
+    return theta, rb
+
+
+def _covariance(jac: F64, residual: F64) -> F64:
+    p = jac.shape[1]
+    dof = max(jac.shape[0] - p, 1)
+    s2 = float(residual @ residual) / dof
+    d = np.linalg.norm(jac, axis=0)
+    d = np.where(d > 0, d, 1.0)
+    _, sv, vt = np.linalg.svd(jac / d, full_matrices=False)
+    with np.errstate(divide="ignore"):
+        inv = np.where(sv > sv[0] * 1e-12, 1.0 / sv**2, np.inf)
+    cov = (vt.T * inv) @ vt
+    cov = np.where(np.isfinite(cov), cov, np.inf)
+    return s2 * cov / np.outer(d, d)
+
+
+def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: ArrayLike,
+        base_rotation: ArrayLike, *, max_nfev: int = 100) -> FitResult:
+    """Least squares (scipy ``least_squares``, Levenberg-Marquardt) with the analytic
+    Jacobian of :class:`~zrp.gap.problem.Problem`.
+
+    Args:
+        specs: parameters (p).
+        poses: pose indices, shape (S,).
+        theta0: starting values, shape (p,).
+        base_rotation: R_b0, shape (3, 3).
+    """
+    prob = Problem(ctx, specs, poses, base_rotation)
+    theta0 = np.asarray(theta0, dtype=float)
+    if prob.n_residuals <= prob.size:
+        raise InputError(f"{prob.n_residuals // 3} measured points give {prob.n_residuals} "
+                         f"coordinates, not enough for {prob.size} parameters; measure more "
+                         "poses")
+    cache: dict[bytes, tuple[F64, F64]] = {}
+
+    def both(th: F64) -> tuple[F64, F64]:
+        key = th.tobytes()
+        if key not in cache:
+            cache.clear()
+            cache[key] = prob.residual_and_jacobian(th)
+        return cache[key]
+
+    res = least_squares(lambda th: both(th)[0], theta0, jac=lambda th: both(th)[1],
+                        method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12,
+                        max_nfev=max_nfev)
+    r, J = prob.residual_and_jacobian(res.x)
+    ok = bool(res.status > 0)
+    if not ok:
+        warnings.warn(f"least squares did not converge ({res.message}) with "
+                      f"{len(specs)} parameters", FitWarning, stacklevel=2)
+    return FitResult(tuple(specs), res.x, _covariance(J, r), r, J, np.asarray(base_rotation),
+                     np.asarray(poses, dtype=np.int64), ok)
+
+
+@dataclass(frozen=True)
+class Aliased:
+    """A parameter that the data cannot tell apart from others.
+
+    Attributes:
+        name: the parameter.
+        effect: its effect.
+        partners: the parameters it trades against (largest share first).
+        fraction: share of its Jacobian column outside the span of the others (0: identical).
+        dropped: True when it was left out of the fit (structural), False when only weak.
+    """
+
+    name: str
+    effect: str
+    partners: tuple[str, ...]
+    fraction: float
+    dropped: bool
+
+
+def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[ParamSpec],
+                       poses: ArrayLike | None = None) -> tuple[list[ParamSpec], list[Aliased]]:
+    """Which candidate parameters the data can identify on top of ``base``.
+
+    The Jacobian of base + candidates is evaluated at the base solution; each candidate column
+    (normalised) is projected on the span of the base columns and of the candidates accepted
+    before it. A column that keeps less than ``ALIAS_TOL`` of its norm is dropped and reported
+    with the parameters it is aliased with; one that keeps less than ``WEAK_TOL`` is kept and
+    reported as weakly identifiable.
+
+    Returns:
+        the identifiable candidates, and the aliasing report.
+    """
+    poses = base.poses if poses is None else np.asarray(poses, dtype=np.int64)
+    specs = list(base.specs) + list(candidates)
+    prob = Problem(ctx, specs, poses, base.base_rotation)
+    theta = np.concatenate([base.theta, np.zeros(len(candidates))])
+    _, J = prob.residual_and_jacobian(theta)
+    norms = np.linalg.norm(J, axis=0)
+    nb = len(base.specs)
+    A = J[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
+    Q, _ = np.linalg.qr(A)
+    names = [s.name for s in specs]
+    accepted_cols = list(range(nb))
+    keep: list[ParamSpec] = []
+    report: list[Aliased] = []
+    for i, spec in enumerate(candidates):
+        col = J[:, nb + i]
+        nrm = norms[nb + i]
+        if nrm <= 1e-12 * max(norms.max(), 1.0):
+            report.append(Aliased(spec.name, spec.effect, (), 0.0, True))
+            continue
+        c = col / nrm
+        rr = c - Q @ (Q.T @ c)
+        rr = rr - Q @ (Q.T @ rr)
+        frac = float(np.linalg.norm(rr))
+        if frac < WEAK_TOL:
+            Acc = J[:, accepted_cols] / np.where(norms[accepted_cols] > 0, norms[accepted_cols],
+                                                 1.0)
+            coef = np.linalg.lstsq(Acc, c, rcond=None)[0]
+            order = np.argsort(-np.abs(coef))
+            partners = tuple(names[accepted_cols[o]] for o in order[:3]
+                             if abs(coef[o]) >= 0.2 * np.abs(coef).max())
+            report.append(Aliased(spec.name, spec.effect, partners, frac, frac < ALIAS_TOL))
+            if frac < ALIAS_TOL:
+                continue
+        keep.append(spec)
+        accepted_cols.append(nb + i)
+        Q = np.column_stack([Q, rr / frac])
+    return keep, report
+
+
+def wald_groups(result: FitResult, first: int) -> dict[str, float]:
+    """p-value of the Wald test (all parameters of a group zero) per group, for the parameters
+    from index ``first`` on."""
+    groups: dict[str, list[int]] = {}
+    for i in range(first, len(result.specs)):
+        groups.setdefault(result.specs[i].group, []).append(i)
+    out: dict[str, float] = {}
+    for g, idx in groups.items():
+        th = result.theta[idx]
+        C = result.cov[np.ix_(idx, idx)]
+        if not np.all(np.isfinite(C)):
+            out[g] = 1.0
+            continue
+        try:
+            chi2 = float(th @ np.linalg.solve(C, th))
+        except np.linalg.LinAlgError:
+            out[g] = 1.0
+            continue
+        out[g] = float(stats.chi2.sf(chi2, len(idx)))
+    return out
+
+
+def f_test(small: FitResult, big: FitResult) -> float:
+    """p-value of the F test that the extra parameters of ``big`` do not help."""
+    dp = len(big.specs) - len(small.specs)
+    if dp <= 0 or big.rss <= 0:
+        return 1.0
+    f = ((small.rss - big.rss) / dp) / (big.rss / big.dof)
+    return float(stats.f.sf(f, dp, big.dof)) if f > 0 else 1.0
+
+
+def cv_rms(ctx: Context, result: FitResult, folds: Sequence[NDArray[np.int64]]) -> float:
+    """Cross-validated 3-D RMS error (length unit) over the folds of the fitted poses.
+
+    For each fold, the parameters are refitted without it by one Gauss-Newton step from the
+    full solution (exact for parameters that enter linearly, second-order accurate for the
+    registration), and the error is evaluated on the fold. The folds' squared errors are pooled.
+    """
+    rows = np.flatnonzero(np.isin(ctx.meas.pose_index, result.poses))  # Problem's row order
+    prob_rows_pose = ctx.meas.pose_index[rows]
+    r = result.residual.reshape(-1, 3)
+    J = result.jac.reshape(r.shape[0], 3, -1)
+    sq = 0.0
+    cnt = 0
+    for f in folds:
+        held = np.isin(prob_rows_pose, f)
+        if not held.any():
+            continue
+        tr = ~held
+        Jt = J[tr].reshape(-1, J.shape[2])
+        d = np.linalg.lstsq(Jt, -r[tr].ravel(), rcond=None)[0]
+        rh = r[held] + np.einsum("rcp,p->rc", J[held], d)
+        sq += float(np.sum(rh**2))
+        cnt += int(held.sum())
+    return float(np.sqrt(sq / max(cnt, 1)))

@@ -1,0 +1,162 @@
+"""Synthetic measurements with known injected effects (for tests, examples and benchmarks).
+
+The injection goes through the toolkit's forward kinematics (:func:`zrp.forward_kinematics` of
+a perturbed :class:`~zrp.Manipulator` at perturbed joint values), not through the diagnosis's
+own corrected-model code, so that recovering the injection checks more than self-consistency.
+The physically simulated counterpart (MuJoCo) is the blind benchmark's job.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from ..errors import InputError
+from ..kinematics import forward_kinematics
+from ..model import Manipulator
+from ..sensitivity import axis_tangents, tilt_axes
+from .data import Measurements
+from .problem import rotation_matrix
+
+__all__ = ["Injection", "random_poses", "synthesize"]
+
+F64 = NDArray[np.float64]
+
+
+@dataclass(frozen=True)
+class Injection:
+    """Effects to inject, keyed by 1-based joint (or body vector for ``link``).
+
+    Attributes:
+        joint_offset: rad (length unit for prismatic joints) per joint.
+        encoder_scale: dimensionless scale error per joint (q_actual = q (1 + s)).
+        backlash: rad per joint; the joint lags against its direction of approach.
+        cyclic_error: per joint, (harmonic h, sin amplitude rad, cos amplitude rad).
+        compliance: rad per (N m) per joint; deflection = c tau with tau the gravity torque of
+            the point masses ``masses``.
+        masses: kg at mass points: "p{k}" (point on joint k) or "ee".
+        link: body-vector corrections (length unit), shape (3,) per body index 1..n+1.
+        tilt: axis tilts (rad) towards the tangents t1, t2 (zrp.sensitivity.axis_tangents).
+        thermal: kappa, 1/deg C (bodies scale by 1 + kappa (temp - t_ref)).
+        t_ref: reference temperature, deg C.
+    """
+
+    joint_offset: Mapping[int, float] = field(default_factory=dict)
+    encoder_scale: Mapping[int, float] = field(default_factory=dict)
+    backlash: Mapping[int, float] = field(default_factory=dict)
+    cyclic_error: Mapping[int, tuple[int, float, float]] = field(default_factory=dict)
+    compliance: Mapping[int, float] = field(default_factory=dict)
+    masses: Mapping[str, float] = field(default_factory=lambda: {"p3": 8.0, "p5": 4.0,
+                                                                 "ee": 3.0})
+    link: Mapping[int, tuple[float, float, float]] = field(default_factory=dict)
+    tilt: Mapping[int, tuple[float, float]] = field(default_factory=dict)
+    thermal: float = 0.0
+    t_ref: float = 20.0
+
+
+def random_poses(model: Manipulator, count: int, rng: np.random.Generator,
+                 limits_rad: ArrayLike | None = None) -> F64:
+    """Uniform random joint values within ``limits_rad`` (shape (n, 2); default +-2.5 rad),
+    shape (count, n)."""
+    lim = (np.tile([-2.5, 2.5], (model.n, 1)) if limits_rad is None
+           else np.asarray(limits_rad, dtype=float))
+    if lim.shape != (model.n, 2):
+        raise InputError(f"limits_rad: expected shape ({model.n}, 2), got {lim.shape}")
+    return rng.uniform(lim[:, 0], lim[:, 1], (count, model.n))
+
+
+def _gravity_torque(model: Manipulator, q: F64, masses: Mapping[str, float],
+                    g_dir: F64) -> F64:
+    """tau[p, k] = sum_j m_j 9.80665 u_k . ((P_j - p_k) x g_dir) * 1e-3 (N m for mm)."""
+    fk = forward_kinematics(model, q)
+    tau = np.zeros(q.shape)
+    for lab, m in masses.items():
+        if lab == "ee":
+            pt, owner = fk.position, model.n
+        else:
+            j = int(lab[1:]) - 1
+            pt, owner = fk.points[:, j], j
+        for k in range(model.n):
+            if k < owner and not model.prismatic[k]:
+                arm = np.cross(pt - fk.points[:, k], g_dir)
+                tau[:, k] += m * 9.80665 * 1e-3 * np.einsum("pi,pi->p", fk.axes[:, k], arm)
+    return tau
+
+
+def synthesize(model: Manipulator, q: ArrayLike, injection: Injection, *,
+               rng: np.random.Generator, noise_sigma: float = 0.02,
+               tool_offsets: ArrayLike = ((50.0, 0.0, 30.0), (-40.0, 60.0, 30.0),
+                                          (0.0, -70.0, 40.0)),
+               base_rotvec: ArrayLike = (0.02, -0.01, 0.8),
+               base_translation: ArrayLike = (1500.0, -300.0, 200.0),
+               frame: str = "instrument", temp: ArrayLike | None = None) -> Measurements:
+    """Measurements of the "real" robot = ``model`` with ``injection`` applied.
+
+    Args:
+        q: commanded joint values in measurement order, rad, shape (P, n).
+        injection: the effects.
+        rng: noise (and nothing else) is drawn from it.
+        noise_sigma: isotropic Gaussian noise per coordinate, length unit.
+        tool_offsets: t_j per tool point, zero-reference base frame, shape (M, 3).
+        base_rotvec, base_translation: instrument-from-base transform (ignored for "base").
+        temp: temperature per pose, deg C, shape (P,) (required for ``thermal``).
+
+    Returns:
+        Measurements with M rows per pose (points "s1".."sM").
+    """
+    q = np.array(q, dtype=float)
+    P, n = q.shape
+    if n != model.n:
+        raise InputError(f"q: expected {model.n} columns, got {n}")
+    inj = injection
+    qa = q.copy()
+    for k, v in inj.joint_offset.items():
+        qa[:, k - 1] += v
+    for k, v in inj.encoder_scale.items():
+        qa[:, k - 1] += v * q[:, k - 1]
+    if inj.backlash:
+        d = np.zeros_like(q)
+        for i in range(1, P):
+            s = np.sign(q[i] - q[i - 1])
+            d[i] = np.where(s != 0, s, d[i - 1])
+        for k, v in inj.backlash.items():
+            qa[:, k - 1] -= v * d[:, k - 1]
+    for k, (h, a, b) in inj.cyclic_error.items():
+        qa[:, k - 1] += a * np.sin(h * q[:, k - 1]) + b * np.cos(h * q[:, k - 1])
+    if inj.compliance:
+        tau = _gravity_torque(model, q, inj.masses, np.array([0.0, 0.0, -1.0]))
+        for k, c in inj.compliance.items():
+            qa[:, k - 1] += c * tau[:, k - 1]
+    bodies = np.array(model.bodies, dtype=float)
+    for k, db in inj.link.items():
+        bodies[k - 1] += np.asarray(db, dtype=float)
+    tilts = np.zeros((n, 2))
+    for k, tv in inj.tilt.items():
+        tilts[k - 1] = tv
+    axes = tilt_axes(model.axes, axis_tangents(model.axes), tilts)
+    t = np.asarray(tool_offsets, dtype=float)
+    if inj.thermal:
+        if temp is None:
+            raise InputError("thermal injection needs temp (deg C per pose)")
+    temp_arr = None if temp is None else np.asarray(temp, dtype=float)
+    pts = np.empty((P, t.shape[0], 3))
+    if inj.thermal and temp_arr is not None:
+        for i in range(P):
+            s = 1.0 + inj.thermal * (temp_arr[i] - inj.t_ref)
+            fk = forward_kinematics(model.with_arrays(axes=axes, bodies=bodies * s), qa[i])
+            pts[i] = fk.position + t @ fk.rotation.T
+    else:
+        fk = forward_kinematics(model.with_arrays(axes=axes, bodies=bodies), qa)
+        pts = fk.position[:, None, :] + np.einsum("pij,mj->pmi", fk.rotation, t)
+    if frame == "instrument":
+        rb = rotation_matrix(base_rotvec)
+        pts = pts @ rb.T + np.asarray(base_translation, dtype=float)
+    pts = pts + rng.normal(scale=noise_sigma, size=pts.shape)
+    M = t.shape[0]
+    return Measurements.from_arrays(
+        np.repeat(np.arange(P), M), np.repeat(q, M, axis=0), pts.reshape(-1, 3),
+        point=np.tile([f"s{j + 1}" for j in range(M)], P), frame=frame,
+        temp=None if temp_arr is None else np.repeat(temp_arr, M))
