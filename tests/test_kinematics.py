@@ -172,3 +172,33 @@ def test_bad_joint_values_are_named(puma):
         zrp.jacobian(puma, [[0, 0, 0, 0, 0, 0], [0, np.inf, 0, 0, 0, 0]])
     with pytest.raises(zrp.InputError, match="expected numbers"):
         zrp.forward_kinematics(puma, "abc")
+
+
+def test_vectorised_sincos_matches_libm():
+    from zrp import _kernels as K
+
+    x = np.concatenate([np.linspace(-100, 100, 200_001), [0.0, -0.0, 1e-300, np.pi / 4,
+                                                          np.pi / 2, np.pi, -np.pi, 1e5]])
+    s, c = np.empty_like(x), np.empty_like(x)
+    K.sincos_batch(x, s, c)
+    np.testing.assert_allclose(s, np.sin(x), rtol=0, atol=2.3e-16)
+    np.testing.assert_allclose(c, np.cos(x), rtol=0, atol=2.3e-16)
+
+
+def test_blocked_batch_kernels_match_single_pose_kernels(rng):
+    from zrp import _kernels as K
+
+    model = random_arm(rng, 7, 0.3)
+    q = rng.uniform(-4, 4, (1000, 7))  # spans several blocks
+    arrays = K.kernel_arrays(model.axes, model.bodies, model.prismatic)
+    out = np.empty((1000, 7))
+    pose = np.empty((1000, 7))
+    jac = np.empty((1000, 6, 7))
+    K.fk_pose_batch(q, *arrays, out)
+    K.jac_batch(q, *arrays, pose, jac)
+    one, j1 = np.empty(7), np.empty((6, 7))
+    for i in (0, 255, 256, 999):
+        K.fk_jac_one(q[i], *arrays, one, j1)
+        np.testing.assert_allclose(out[i], one, atol=1e-12)
+        np.testing.assert_allclose(pose[i], one, atol=1e-12)
+        np.testing.assert_allclose(jac[i], j1, atol=1e-12)

@@ -41,6 +41,8 @@ def check_q(model: Manipulator, q: ArrayLike, name: str = "q") -> F64:
             f"{name}: expected shape (..., {model.n}) for the {model.n} joints of "
             f"{model.name!r}, got shape {arr.shape}"
         )
+    if arr.dtype == np.float64 and arr.flags.c_contiguous and K.all_finite(arr):
+        return arr
     bad = ~np.isfinite(arr)
     if bad.any():
         idx = np.argwhere(bad)[0]
@@ -145,7 +147,6 @@ def jacobian(model: Manipulator, q: ArrayLike) -> F64:
     rad per joint unit, rows 3-5 in length unit per joint unit.
     """
     qf, batch = _flat(model, q)
-    pose = np.empty((qf.shape[0], 7))
     jac = np.empty((qf.shape[0], 6, model.n))
-    K.jac_batch(qf, *_karrays(model), pose, jac)
+    K.jac_batch(qf, *_karrays(model), np.empty((0, 7)), jac)
     return jac.reshape(*batch, 6, model.n)
