@@ -236,6 +236,8 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
     spec.visual.global_.offwidth = options.offscreen_size[0]
     spec.visual.global_.offheight = options.offscreen_size[1]
     spec.visual.quality.shadowsize = 2048
+    spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
+    spec.visual.headlight.diffuse = [0.55, 0.55, 0.55]
     spec.stat.extent = 1.2 * reach_m
     spec.stat.center = [0.0, 0.0, 0.0]
 

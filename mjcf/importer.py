@@ -126,10 +126,10 @@ def manipulator_from_mujoco(
     for b in chain:
         for j in range(m.body_jntadr[b], m.body_jntadr[b] + m.body_jntnum[b]):
             if int(m.jnt_type[j]) not in _CHAIN_JOINTS:
-                kind = mujoco.mjtJoint(m.jnt_type[j]).name
+                kind = mujoco.mjtJoint(m.jnt_type[j]).name.removeprefix("mjJNT_").lower()
                 raise MJCFImportError(
                     f"joint {_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)!r} in body "
-                    f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, b)!r} is {kind}; only hinge and "
+                    f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, b)!r} is a {kind} joint; only hinge and "
                     f"slide joints form a ZRP serial arm")
             joints.append(j)
     if not joints:

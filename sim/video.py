@@ -143,6 +143,7 @@ class VideoResult:
                 f"deviations drawn x{self.magnify:g}"]
         for lab, dp, dr, th in zip(self.labels, self.max_delta_p, self.max_delta_r,
                                    self.max_theta, strict=False):
+            lab = lab.replace("\n", "; ")
             rows.append(f"  {lab}: max delta_p {dp:.4g} {self.length_unit}, max delta_R (eq 15) "
                         f"{dr:.4g}, max theta {th:.4g} rad")
         return "\n".join(rows)
@@ -260,7 +261,7 @@ def _camera(r: OffscreenRenderer, segs: Sequence[_Segment], opts: VideoOptions) 
     bodies = np.asarray(seg.nominal.manipulator.bodies) * seg.nominal.scale
     reach = max(float(np.sum(np.linalg.norm(bodies, axis=1))), 0.2)
     centre = 0.5 * path_c
-    r.look_at(centre, 2.1 * reach, opts.azimuth, opts.elevation)
+    r.look_at(centre, 1.7 * reach, opts.azimuth, opts.elevation)
 
 
 def _draw_segment(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: VideoOptions,
