@@ -34,6 +34,7 @@ from .fit import (
     f_test,
     fit,
     initial_registration,
+    orthonormal_basis,
     point_errors,
     wald_groups,
 )
@@ -482,7 +483,8 @@ def _projection(ctx: Context, result: FitResult, max_components: int) -> dict[st
     theta = np.concatenate([result.theta, np.zeros(len(keep))])
     r, J = prob.residual_and_jacobian(theta)
     nb = len(result.specs)
-    Qr, _ = np.linalg.qr(J[:, :nb])
+    jn = np.linalg.norm(J[:, :nb], axis=0)
+    Qr = orthonormal_basis(J[:, :nb] / np.where(jn > 0, jn, 1.0))
     G = J[:, nb:] - Qr @ (Qr.T @ J[:, nb:])
     gn = np.linalg.norm(G, axis=0)
     G = G / np.where(gn > 0, gn, 1.0)
@@ -493,23 +495,26 @@ def _projection(ctx: Context, result: FitResult, max_components: int) -> dict[st
         cols = [i for i, s in enumerate(keep) if s.joint == k]
         if not cols:
             continue
-        Qk, _ = np.linalg.qr(G[:, cols])
+        Qk = orthonormal_basis(G[:, cols])
         share = float(np.sum((Qk.T @ rp) ** 2) / rr) if rr > 0 else 0.0
         proj.append({"joint": k, "share": share,
                      "parameters": [keep[i].name for i in cols]})
     comps = []
-    if G.shape[1]:
-        U, sv, Vt = np.linalg.svd(G, full_matrices=False)
-        c = U.T @ rp
+    total = 0.0
+    if G.shape[1] and rr > 0:
+        w, V = np.linalg.eigh(G.T @ G)
+        keep_sv = w > w.max() * 1e-12
+        w, V = w[keep_sv], V[:, keep_sv]
+        sv = np.sqrt(w)
+        c = (V.T @ (G.T @ rp)) / sv  # U^T r with U = G V / s
+        total = float(np.sum(c**2) / rr)
         order = np.argsort(-(c**2))[:max_components]
         for i in order:
-            load = Vt[i]
+            load = V[:, i]
             top = np.argsort(-np.abs(load))[:3]
-            comps.append({"share": float(c[i] ** 2 / rr) if rr > 0 else 0.0,
-                          "singular_value": float(sv[i]),
+            comps.append({"share": float(c[i] ** 2 / rr), "singular_value": float(sv[i]),
                           "parameters": [{"name": keep[t].name, "loading": float(load[t])}
                                          for t in top]})
-    total = float(np.sum((U.T @ rp) ** 2) / rr) if G.shape[1] and rr > 0 else 0.0
     return {"projection": proj, "components": comps, "geometric_share": total}
 
 

@@ -26,6 +26,7 @@ __all__ = [
     "f_test",
     "fit",
     "initial_registration",
+    "orthonormal_basis",
     "point_errors",
     "wald_groups",
 ]
@@ -162,17 +163,37 @@ def initial_registration(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayL
     return theta, rb
 
 
+def orthonormal_basis(a: F64, rtol: float = 1e-10) -> F64:
+    """An orthonormal basis of the column span of a (m, k) -> (m, r), via the Gram matrix
+    (much faster than a QR for tall matrices; columns should be normalised)."""
+    if a.shape[1] == 0:
+        return np.zeros((a.shape[0], 0))
+    w, v = np.linalg.eigh(a.T @ a)
+    keep = w > max(w.max(), 1e-300) * rtol
+    q = (a @ v[:, keep]) / np.sqrt(w[keep])
+    # one re-orthogonalisation pass for accuracy
+    w2, v2 = np.linalg.eigh(q.T @ q)
+    return (q @ v2) / np.sqrt(w2)
+
+
 def _covariance(jac: F64, residual: F64) -> F64:
+    """sigma^2 (J^T J)^-1 with column scaling; inf where J^T J is singular."""
     p = jac.shape[1]
     dof = max(jac.shape[0] - p, 1)
     s2 = float(residual @ residual) / dof
     d = np.linalg.norm(jac, axis=0)
     d = np.where(d > 0, d, 1.0)
-    _, sv, vt = np.linalg.svd(jac / d, full_matrices=False)
+    js = jac / d
+    w, v = np.linalg.eigh(js.T @ js)
     with np.errstate(divide="ignore"):
-        inv = np.where(sv > sv[0] * 1e-12, 1.0 / sv**2, np.inf)
-    cov = (vt.T * inv) @ vt
-    cov = np.where(np.isfinite(cov), cov, np.inf)
+        inv = np.where(w > max(w.max(), 1e-300) * 1e-12, 1.0 / w, np.inf)
+    cov = (v * np.where(np.isfinite(inv), inv, 0.0)) @ v.T
+    if not np.all(np.isfinite(inv)):
+        # parameters touching the null space get an infinite variance
+        null = v[:, ~np.isfinite(inv)]
+        touched = np.abs(null).max(axis=1) > 1e-6
+        cov[touched, :] = np.inf
+        cov[:, touched] = np.inf
     return s2 * cov / np.outer(d, d)
 
 
@@ -254,7 +275,7 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
     norms = np.linalg.norm(J, axis=0)
     nb = len(base.specs)
     A = J[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
-    Q, _ = np.linalg.qr(A)
+    Q = orthonormal_basis(A)
     names = [s.name for s in specs]
     accepted_cols = list(range(nb))
     keep: list[ParamSpec] = []
@@ -270,12 +291,12 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
         rr = rr - Q @ (Q.T @ rr)
         frac = float(np.linalg.norm(rr))
         if frac < WEAK_TOL:
-            Acc = J[:, accepted_cols] / np.where(norms[accepted_cols] > 0, norms[accepted_cols],
-                                                 1.0)
-            coef = np.linalg.lstsq(Acc, c, rcond=None)[0]
-            order = np.argsort(-np.abs(coef))
+            acc = J[:, accepted_cols] / np.where(norms[accepted_cols] > 0,
+                                                 norms[accepted_cols], 1.0)
+            corr = np.abs(acc.T @ c)  # cosines between normalised columns
+            order = np.argsort(-corr)
             partners = tuple(names[accepted_cols[o]] for o in order[:3]
-                             if abs(coef[o]) >= 0.2 * np.abs(coef).max())
+                             if corr[o] >= 0.5 * corr.max())
             report.append(Aliased(spec.name, spec.effect, partners, frac, frac < ALIAS_TOL))
             if frac < ALIAS_TOL:
                 continue
@@ -327,16 +348,25 @@ def cv_rms(ctx: Context, result: FitResult, folds: Sequence[NDArray[np.int64]]) 
     prob_rows_pose = ctx.meas.pose_index[rows]
     r = result.residual.reshape(-1, 3)
     J = result.jac.reshape(r.shape[0], 3, -1)
+    d = np.linalg.norm(result.jac, axis=0)
+    d = np.where(d > 0, d, 1.0)
+    Js = J / d
+    A = np.einsum("rcp,rcq->pq", Js, Js)
+    b = np.einsum("rcp,rc->p", Js, r)
     sq = 0.0
     cnt = 0
     for f in folds:
         held = np.isin(prob_rows_pose, f)
         if not held.any():
             continue
-        tr = ~held
-        Jt = J[tr].reshape(-1, J.shape[2])
-        d = np.linalg.lstsq(Jt, -r[tr].ravel(), rcond=None)[0]
-        rh = r[held] + np.einsum("rcp,p->rc", J[held], d)
+        Jh = Js[held]
+        Ah = A - np.einsum("rcp,rcq->pq", Jh, Jh)
+        bh = b - np.einsum("rcp,rc->p", Jh, r[held])
+        try:
+            step = -np.linalg.solve(Ah, bh)
+        except np.linalg.LinAlgError:
+            step = -np.linalg.lstsq(Ah, bh, rcond=None)[0]
+        rh = r[held] + np.einsum("rcp,p->rc", Jh, step)
         sq += float(np.sum(rh**2))
         cnt += int(held.sum())
     return float(np.sqrt(sq / max(cnt, 1)))
