@@ -79,7 +79,9 @@ class MJCFOptions:
     Attributes:
         inertia: "none" (1 g placeholder bodies: kinematics only), "rods" (uniform rods and
             motor masses, any arm) or "puma560" (literature values, 6R PUMA-type arms only).
-        actuators: add one position actuator per joint (``kp``, ``kv``).
+        actuators: add a PD servo per joint: a position actuator ``servo{k}`` (gain ``kp``) and,
+            if ``kv > 0``, a velocity actuator ``servo{k}_rate`` (gain ``kv``). ctrl holds the
+            n position set points, then the n rate set points (0 = plain damping).
         kp: position gain, N m/rad (N/m for prismatic joints).
         kv: velocity gain, N m s/rad (N s/m).
         gravity_compensation: compensate gravity on every body (MuJoCo ``gravcomp``).
@@ -261,6 +263,7 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
                      name=f"{pre}base", group=1)
 
     inertias = _inertias(model, options, scale)
+    joint_names: list[str] = []
     parent = world
     link_rgba = _with_alpha(options.link_rgba, alpha)
     for k in range(model.n):
@@ -290,11 +293,22 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
                 _visual_geom(body, mujoco.mjtGeom.mjGEOM_CYLINDER,
                              _with_alpha(REVOLUTE_RGBA, alpha), size=[1.35 * radius, 0],
                              fromto=[*(-h * u), *(h * u)], name=f"{pre}u{k + 1}")
-        if options.actuators:
-            act = spec.add_actuator(name=f"{pre}servo{k + 1}", target=joint.name,
-                                    trntype=mujoco.mjtTrn.mjTRN_JOINT)
-            act.set_to_position(kp=options.kp, kv=options.kv)
+        joint_names.append(joint.name)
         parent = body
+
+    if options.actuators:
+        # PD servo per joint as two actuators: position (kp), then rate (kv) set points, so
+        # ctrl = [n positions, n rates]. With rate set points 0 this is MuJoCo's position
+        # actuator with damping kv; feeding the reference rates removes the kv * qdot lag.
+        for k, jname in enumerate(joint_names):
+            act = spec.add_actuator(name=f"{pre}servo{k + 1}", target=jname,
+                                    trntype=mujoco.mjtTrn.mjTRN_JOINT)
+            act.set_to_position(kp=options.kp, kv=0.0)
+        if options.kv > 0:
+            for k, jname in enumerate(joint_names):
+                vel = spec.add_actuator(name=f"{pre}servo{k + 1}_rate", target=jname,
+                                        trntype=mujoco.mjtTrn.mjTRN_JOINT)
+                vel.set_to_velocity(kv=options.kv)
 
     tip = bodies_m[model.n]
     if options.visuals and np.linalg.norm(tip) > 1e-9:

@@ -49,6 +49,7 @@ class DynamicPlayback:
         orientation_error: angle between the two hand frames, rad, shape (N,).
         length_unit: the model's length unit.
         options: the MJCF options used (gains, inertias, gravity).
+        velocity_feedforward: whether the reference joint rates were fed to the servos.
     """
 
     t: F64
@@ -60,6 +61,7 @@ class DynamicPlayback:
     orientation_error: F64
     length_unit: str
     options: MJCFOptions
+    velocity_feedforward: bool = True
 
     @property
     def max_tracking_error(self) -> float:
@@ -73,7 +75,8 @@ class DynamicPlayback:
     def summary(self) -> str:
         o = self.options
         return (f"dynamic playback ({o.inertia} inertias, kp={o.kp:g}, kv={o.kv:g}, gravity "
-                f"{'compensated' if o.gravity_compensation else 'on'}): end-effector tracking "
+                f"{'compensated' if o.gravity_compensation else 'on'}, rate feedforward "
+                f"{'on' if self.velocity_feedforward else 'off'}): end-effector tracking "
                 f"error max {self.max_tracking_error:.4g} {self.length_unit}, rms "
                 f"{self.rms_tracking_error:.4g} {self.length_unit}, orientation max "
                 f"{np.max(self.orientation_error):.3g} rad")
@@ -86,6 +89,7 @@ def dynamic_playback(
     *,
     options: MJCFOptions | None = None,
     settle_s: float = 1.0,
+    velocity_feedforward: bool = True,
     progress: bool = False,
 ) -> DynamicPlayback:
     """Simulate position servos tracking ``q(t)`` under gravity.
@@ -97,6 +101,8 @@ def dynamic_playback(
         options: MJCF build options (must have ``actuators=True``); default
             :func:`default_dynamic_options`.
         settle_s: time the servos hold q[0] before t[0] (so the start is at rest), s.
+        velocity_feedforward: feed the reference joint rates (finite differences of ``q``) to
+            the rate servos; False = plain position servo with damping kv.
         progress: show a tqdm bar.
     """
     q = check_q(model, q)
@@ -117,10 +123,12 @@ def dynamic_playback(
     d = mujoco.MjData(m)
     qpos_cmd = arm.qpos(q)
     d.qpos[arm.qpos_adr] = qpos_cmd[0]
-    act_of_joint = np.arange(model.n)  # actuators are created in joint order
+    n = model.n
+    has_rate = m.nu == 2 * n  # actuators: n position servos, then n rate servos (mjcf.build)
+    qdot_cmd = np.gradient(qpos_cmd, t, axis=0) if velocity_feedforward else np.zeros_like(q)
     dt = m.opt.timestep
+    d.ctrl[:n] = qpos_cmd[0]
     for _ in range(round(settle_s / dt)):
-        d.ctrl[act_of_joint] = qpos_cmd[0]
         mujoco.mj_step(m, d)
     q_act = np.empty_like(q)
     pos = np.empty((len(t), 3))
@@ -138,7 +146,9 @@ def dynamic_playback(
     for i in range(1, len(t)):
         while sim_t < t[i] - 1e-12:
             s = min(max((sim_t + dt - t[i - 1]) / (t[i] - t[i - 1]), 0.0), 1.0)
-            d.ctrl[act_of_joint] = (1 - s) * qpos_cmd[i - 1] + s * qpos_cmd[i]
+            d.ctrl[:n] = (1 - s) * qpos_cmd[i - 1] + s * qpos_cmd[i]
+            if has_rate:
+                d.ctrl[n:] = (1 - s) * qdot_cmd[i - 1] + s * qdot_cmd[i]
             mujoco.mj_step(m, d)
             sim_t += dt
         record(i)
@@ -147,4 +157,5 @@ def dynamic_playback(
     fk = forward_kinematics(model, q)
     err = np.linalg.norm(pos - fk.position, axis=-1)
     rot = rotation_angle(frame, fk.hand_frame)
-    return DynamicPlayback(t, q, q_act, fk.position, pos, err, rot, model.length_unit, options)
+    return DynamicPlayback(t, q, q_act, fk.position, pos, err, rot, model.length_unit, options,
+                           velocity_feedforward)

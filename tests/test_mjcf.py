@@ -78,9 +78,12 @@ def test_puma560_inertias_and_actuators():
     arm = mjcf.build(model, mjcf.MJCFOptions(inertia="puma560", actuators=True, kp=900, kv=30))
     m = arm.model
     np.testing.assert_allclose(m.body_mass[arm.body_ids[1:]], [17.4, 4.8, 0.82, 0.34, 0.09])
-    assert m.nu == 6
-    np.testing.assert_allclose(m.actuator_gainprm[:, 0], 900)
-    np.testing.assert_allclose(m.actuator_biasprm[:, 1:3], [[-900, -30]] * 6)
+    assert m.nu == 12  # 6 position servos, then 6 rate servos
+    np.testing.assert_allclose(m.actuator_gainprm[:6, 0], 900)
+    np.testing.assert_allclose(m.actuator_biasprm[:6, 1:3], [[-900, 0]] * 6)
+    np.testing.assert_allclose(m.actuator_gainprm[6:, 0], 30)
+    np.testing.assert_allclose(m.actuator_biasprm[6:, 1:3], [[0, -30]] * 6)
+    np.testing.assert_array_equal(m.actuator_trnid[:, 0], np.r_[np.arange(6), np.arange(6)])
     # upper-arm centre of mass: 68 mm out from the shoulder along b3 (Armstrong et al. 1986)
     np.testing.assert_allclose(m.body_ipos[arm.body_ids[1]], [0.068, -0.0265, -0.006],
                                atol=1e-12)
