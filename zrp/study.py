@@ -182,11 +182,14 @@ def fit_linearity(xi: ArrayLike, y: ArrayLike) -> Linearity:
     """Fit y = slope |xi| + intercept (and per sign); xi in percent, shape (m,)."""
     xi = np.asarray(xi, dtype=float)
     y = np.asarray(y, dtype=float)
+    if xi.shape != y.shape or np.unique(np.abs(xi)).size < 2:
+        raise InputError(f"xi, y: expected equal shapes and at least two distinct |xi| levels, "
+                         f"got xi {xi.tolist()}")
     slope, icpt, r2 = _fit(np.abs(xi), y)
     pos = xi >= 0
     neg = xi <= 0
-    sp = _fit(np.abs(xi[pos]), y[pos])[0] if pos.sum() >= 2 else float("nan")
-    sn = _fit(np.abs(xi[neg]), y[neg])[0] if neg.sum() >= 2 else float("nan")
+    sp = _fit(np.abs(xi[pos]), y[pos])[0] if np.unique(xi[pos]).size >= 2 else float("nan")
+    sn = _fit(np.abs(xi[neg]), y[neg])[0] if np.unique(xi[neg]).size >= 2 else float("nan")
     return Linearity(slope, icpt, r2, sp, sn)
 
 
@@ -255,11 +258,14 @@ class StudyResult:
                              f"({', '.join(self.parameters)})") from exc
 
     def linearity(self, quantity: str = "delta_p") -> dict[str, Linearity]:
-        """Per parameter, the fit of max_t ``quantity`` against |xi|."""
+        """Per parameter, the fit of max_t ``quantity`` against |xi| (empty when the study has
+        fewer than two distinct |xi| levels)."""
         data = {"delta_p": self.max_delta_p, "delta_r": self.max_delta_r,
                 "angle_rad": self.max_angle_rad}
         if quantity not in data:
             raise InputError(f"quantity: expected one of {sorted(data)}, got {quantity!r}")
+        if np.unique(np.abs(self.xi_percent)).size < 2:
+            return {}
         return {p: fit_linearity(self.xi_percent, data[quantity][i])
                 for i, p in enumerate(self.parameters)}
 
