@@ -2,61 +2,44 @@
 
 * :func:`kinematic_playback` / :func:`consistency_check`: MuJoCo site poses along a joint
   trajectory, and their agreement with :func:`zrp.forward_kinematics`.
-* :func:`dynamic_playback`: position servos tracking the trajectory under gravity.
+* :func:`dynamic_playback`: PD servos tracking the trajectory under gravity.
 * :class:`OffscreenRenderer`: EGL/OSMesa rendering with overlays, released deterministically.
 * :func:`render_comparison_video`, :func:`render_paper_video`, :func:`render_teaching_sweep`.
+
+Names are loaded lazily, so ``import sim`` does not import ``mujoco``: call
+:func:`configure_backend` first when ``mujoco.Renderer`` should use the chosen backend too
+(MuJoCo fixes its GL backend when it is first imported).
 """
 
-from .dynamics import DynamicPlayback, default_dynamic_options, dynamic_playback
-from .gl import (
-    BACKENDS,
-    GLBackendError,
-    GLUnavailableError,
-    available_backend,
-    probe_backend,
-    resolve_backend,
-)
-from .playback import (
-    ConsistencyReport,
-    SitePoses,
-    consistency_check,
-    kinematic_playback,
-    rotation_angle,
-)
-from .render import OffscreenRenderer
-from .video import (
-    PAPER_LEVELS,
-    VideoOptions,
-    VideoResult,
-    VideoWriteError,
-    nice_factor,
-    render_comparison_video,
-    render_paper_video,
-    render_teaching_sweep,
-)
+from __future__ import annotations
 
-__all__ = [
-    "BACKENDS",
-    "PAPER_LEVELS",
-    "ConsistencyReport",
-    "DynamicPlayback",
-    "GLBackendError",
-    "GLUnavailableError",
-    "OffscreenRenderer",
-    "SitePoses",
-    "VideoOptions",
-    "VideoResult",
-    "VideoWriteError",
-    "available_backend",
-    "consistency_check",
-    "default_dynamic_options",
-    "dynamic_playback",
-    "kinematic_playback",
-    "nice_factor",
-    "probe_backend",
-    "render_comparison_video",
-    "render_paper_video",
-    "render_teaching_sweep",
-    "resolve_backend",
-    "rotation_angle",
-]
+import importlib
+from typing import Any
+
+_EXPORTS = {
+    "dynamics": ("DynamicPlayback", "default_dynamic_options", "dynamic_playback"),
+    "gl": ("BACKENDS", "GLBackendError", "GLUnavailableError", "available_backend",
+           "configure_backend", "probe_backend", "resolve_backend"),
+    "playback": ("ConsistencyReport", "SitePoses", "consistency_check", "kinematic_playback",
+                 "rotation_angle"),
+    "render": ("OffscreenRenderer",),
+    "video": ("PAPER_LEVELS", "VideoOptions", "VideoResult", "VideoWriteError",
+              "comparison_frames", "nice_factor", "render_comparison_video",
+              "render_paper_video", "render_teaching_sweep"),
+}
+_WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}
+
+__all__ = sorted(_WHERE)
+
+
+def __getattr__(name: str) -> Any:
+    mod = _WHERE.get(name)
+    if mod is None:
+        raise AttributeError(f"module 'sim' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{mod}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -30,6 +30,7 @@ __all__ = [
     "GLBackendError",
     "GLUnavailableError",
     "available_backend",
+    "configure_backend",
     "create_context",
     "probe_backend",
     "resolve_backend",
@@ -116,6 +117,19 @@ def available_backend() -> str:
         reasons.append(f"{name}: {why or 'failed'} (Debian: {PACKAGES[name]})")
     raise GLUnavailableError("no offscreen OpenGL backend works: " + "; ".join(reasons)
                              + f". {_INSTALL_HINT}")
+
+
+def configure_backend(requested: str | None = None) -> str:
+    """Resolve the backend and export ``MUJOCO_GL`` and ``PYOPENGL_PLATFORM`` for it.
+
+    Call before the first ``import mujoco`` of the process when ``mujoco.Renderer`` (which
+    reads ``MUJOCO_GL`` at import) must use the same backend; our own renderer does not need it.
+    """
+    name = resolve_backend(requested)
+    os.environ["MUJOCO_GL"] = name
+    if sys.modules.get("OpenGL") is None:
+        os.environ["PYOPENGL_PLATFORM"] = name
+    return name
 
 
 def _context_class(name: str) -> Any:

@@ -36,6 +36,7 @@ __all__ = [
     "VideoOptions",
     "VideoResult",
     "VideoWriteError",
+    "comparison_frames",
     "nice_factor",
     "render_comparison_video",
     "render_paper_video",
@@ -264,9 +265,9 @@ def _camera(r: OffscreenRenderer, segs: Sequence[_Segment], opts: VideoOptions) 
     r.look_at(centre, 1.7 * reach, opts.azimuth, opts.elevation)
 
 
-def _draw_segment(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: VideoOptions,
-                  write: Callable[[NDArray[np.uint8]], None], bar: tqdm, unit: str,
-                  title: str) -> None:
+def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: VideoOptions,
+                    unit: str, title: str, plot_top: float | None = None
+                    ) -> Iterator[NDArray[np.uint8]]:
     m_a, m_n = seg.actual.model, seg.nominal.model
     d_a, d_n = mujoco.MjData(m_a), mujoco.MjData(m_n)
     n_frames = len(seg.t)
@@ -285,8 +286,8 @@ def _draw_segment(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: Vid
         fig.title = f"delta_p ({unit})"
         fig.xlabel = "t (s)"
         fig.range[0][:] = [seg.t[0], seg.t[-1]]
-        top = float(seg.delta_p.max()) or 1e-12
-        fig.range[1][:] = [0.0, 1.1 * top]
+        top = plot_top if plot_top is not None else float(seg.delta_p.max())
+        fig.range[1][:] = [0.0, 1.1 * (top or 1e-12)]
         fig.linergb[0][:] = ACTUAL_RGBA[:3]
         fig.figurergba[:] = [0.05, 0.05, 0.08, 0.85]
         fig.panergba[:] = [0.12, 0.12, 0.15, 1.0]
@@ -325,8 +326,61 @@ def _draw_segment(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: Vid
                 fig.linedata[0][0:2 * len(shown):2] = seg.t[shown]
                 fig.linedata[0][1:2 * len(shown):2] = seg.delta_p[shown]
             r.figure(fig, opts.width - pw - 4, 4, pw, ph)
-        write(r.read())
-        bar.update(1)
+        yield r.read()
+
+
+def _prepare(segments_in: Sequence[tuple[Manipulator, Manipulator, ArrayLike, ArrayLike, str]],
+             opts: VideoOptions) -> tuple[list[_Segment], float, float]:
+    """Segments, the magnification and the common plot top (model unit)."""
+    size = (max(opts.width, 640), max(opts.height, 480))
+    segs = []
+    for nominal, perturbed, t, q, label in segments_in:
+        t_arr = np.asarray(t, dtype=float)
+        seconds = opts.seconds if opts.seconds is not None else float(t_arr[-1] - t_arr[0])
+        frames = max(2, round(seconds * opts.fps))
+        segs.append(_segment(nominal, perturbed, t, q, frames, label, opts.ghost_alpha, size))
+    magnify = opts.magnify
+    if magnify is None:
+        worst = max(float(np.max(s.delta_p)) * s.nominal.scale for s in segs)
+        span = max(float(np.linalg.norm(s.p_des.max(axis=0) - s.p_des.min(axis=0)))
+                   for s in segs) or 0.25
+        magnify = nice_factor(0.25 * span / worst) if worst > 0 else 1.0
+    top = max(float(np.max(s.delta_p)) for s in segs)
+    return segs, magnify, top
+
+
+def _frames(segs: Sequence[_Segment], magnify: float, top: float, opts: VideoOptions,
+            title: str, r: OffscreenRenderer) -> Iterator[NDArray[np.uint8]]:
+    unit = segs[0].nominal.manipulator.length_unit
+    _camera(r, segs, opts)
+    for seg in segs:
+        if seg.actual.model.nbody != r.model.nbody:
+            raise InputError("segments: every perturbed model must have the same structure "
+                             "as the first")
+        yield from _segment_frames(r, seg, magnify, opts, unit, title, top)
+
+
+def comparison_frames(
+    nominal: Manipulator,
+    perturbed: Manipulator,
+    t: ArrayLike,
+    q: ArrayLike,
+    *,
+    label: str = "",
+    title: str = "nominal vs perturbed",
+    options: VideoOptions | None = None,
+) -> Iterator[NDArray[np.uint8]]:
+    """The frames of :func:`render_comparison_video` without encoding, each shape
+    (height, width, 3) uint8 (e.g. for ``mediapy.show_video`` in a notebook).
+
+    The GL context is freed when the generator finishes or is closed; use
+    ``contextlib.closing(comparison_frames(...))`` when stopping early.
+    """
+    opts = options or VideoOptions()
+    segs, magnify, top = _prepare([(nominal, perturbed, t, q, label)], opts)
+    with OffscreenRenderer(segs[0].actual.model, opts.width, opts.height,
+                           backend=opts.backend) as r:
+        yield from _frames(segs, magnify, top, opts, title, r)
 
 
 def _render(segments_in: Sequence[tuple[Manipulator, Manipulator, ArrayLike, ArrayLike, str]],
@@ -340,33 +394,18 @@ def _render(segments_in: Sequence[tuple[Manipulator, Manipulator, ArrayLike, Arr
         if fmt == "gif" and path.suffix.lower() == ".mp4":
             path = path.with_suffix(".gif")
     _check_output(path, overwrite)
-    size = (max(opts.width, 640), max(opts.height, 480))
-    segs = []
-    for nominal, perturbed, t, q, label in segments_in:
-        t_arr = np.asarray(t, dtype=float)
-        seconds = opts.seconds if opts.seconds is not None else float(t_arr[-1] - t_arr[0])
-        frames = max(2, round(seconds * opts.fps))
-        segs.append(_segment(nominal, perturbed, t, q, frames, label, opts.ghost_alpha, size))
+    segs, magnify, top = _prepare(segments_in, opts)
     unit = segs[0].nominal.manipulator.length_unit
-    magnify = opts.magnify
-    if magnify is None:
-        worst = max(float(np.max(s.delta_p)) * s.nominal.scale for s in segs)
-        span = max(float(np.linalg.norm(s.p_des.max(axis=0) - s.p_des.min(axis=0)))
-                   for s in segs) or 0.25
-        magnify = nice_factor(0.25 * span / worst) if worst > 0 else 1.0
     total = sum(len(s.t) for s in segs)
     with OffscreenRenderer(segs[0].actual.model, opts.width, opts.height,
                            backend=opts.backend) as r:
-        _camera(r, segs, opts)
         try:
             with _writer(path, fmt, opts.width, opts.height, opts.fps) as write, \
                     tqdm(total=total, desc=f"render {path.name}", unit="frame",
                          disable=not progress) as bar:
-                for seg in segs:
-                    if seg.actual.model.nbody != r.model.nbody:
-                        raise InputError("segments: every perturbed model must have the same "
-                                         "structure as the first")
-                    _draw_segment(r, seg, magnify, opts, write, bar, unit, title)
+                for frame in _frames(segs, magnify, top, opts, title, r):
+                    write(frame)
+                    bar.update(1)
         except OSError as exc:
             raise VideoWriteError(f"output {str(path)!r}: cannot write ({exc})") from exc
         backend = r.backend

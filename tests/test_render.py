@@ -178,3 +178,30 @@ def test_nice_factor():
     assert sim.nice_factor(0.7) == 0.5
     assert sim.nice_factor(100.0) == 100.0
     assert sim.nice_factor(0.0) == 1.0
+
+
+def test_comparison_frames_generator_releases_context(backend, circle):
+    import contextlib
+
+    t, q = circle
+    gen = sim.comparison_frames(zrp.load_model("puma"), perturbed_puma(), t, q,
+                                options=_tiny(backend=backend))
+    with contextlib.closing(gen):
+        first = next(gen)
+        second = next(gen)
+    assert first.shape == (240, 320, 3)
+    assert np.any(first != second)
+    frames = list(sim.comparison_frames(zrp.load_model("puma"), perturbed_puma(), t, q,
+                                        options=_tiny(backend=backend)))
+    assert len(frames) == 5
+
+
+def test_lazy_import_and_configure_backend(monkeypatch):
+    import subprocess
+    import sys
+
+    code = ("import sys, sim.gl; assert 'mujoco' not in sys.modules; "
+            "print(sim.gl.configure_backend('osmesa'))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, env={**__import__("os").environ, "MUJOCO_GL": ""})
+    assert out.stdout.strip() == "osmesa"
