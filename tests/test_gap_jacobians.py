@@ -54,7 +54,7 @@ def test_effect_jacobian_matches_finite_differences(name, effect):
     Jfd = _fd(prob, theta)
     scale = np.abs(Jfd).max(axis=0) + 1e-9
     err = np.abs(J - Jfd).max(axis=0) / scale
-    assert err.max() < 1e-5, [s.name for s, e in zip(specs, err) if e >= 1e-5]
+    assert err.max() < 1e-5, [s.name for s, e in zip(specs, err, strict=False) if e >= 1e-5]
 
 
 def test_geometric_columns_agree_with_sensitivity_module():

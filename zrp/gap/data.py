@@ -147,7 +147,7 @@ class Measurements:
     def _check_structure(self) -> None:
         seen: dict[tuple[str, str], int] = {}
         first_row: dict[str, int] = {}
-        for i, (p, m) in enumerate(zip(self.pose, self.point)):
+        for i, (p, m) in enumerate(zip(self.pose, self.point, strict=False)):
             key = (p, m)
             if key in seen:
                 raise InputError(

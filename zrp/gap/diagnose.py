@@ -187,9 +187,12 @@ class Step:
     bic_delta: float
     candidates: tuple[Candidate, ...]
     aliased: tuple[Aliased, ...]
+    geometric_overlap: float = math.nan
 
     def to_dict(self) -> dict[str, Any]:
         return {"effect": self.effect, "joints": list(self.joints),
+                "geometric_overlap": (None if math.isnan(self.geometric_overlap)
+                                      else self.geometric_overlap),
                 "parameters": [p.to_dict() for p in self.parameters],
                 "rms": self.withheld.rms, "p95": self.withheld.p95, "max": self.withheld.max,
                 "withheld": self.withheld.to_dict(), "fitting": self.fitting.to_dict(),
@@ -322,7 +325,7 @@ def split_poses(meas: Measurements, rng: np.random.Generator, withheld_fraction:
     groups = meas.repeat_groups()
     ng = int(groups.max()) + 1
     order = rng.permutation(ng)
-    n_with = max(1, int(round(withheld_fraction * ng)))
+    n_with = max(1, round(withheld_fraction * ng))
     if ng - n_with < 2:
         raise InputError(f"only {ng} distinct poses: too few to withhold any; measure at least "
                          f"{MIN_POSES} distinct poses")
@@ -633,7 +636,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
               withheld_fraction: float, n_folds: int, alpha: float, min_gain: float,
               max_steps: int, noise_sigma: float | None, harmonics: tuple[int, ...],
               gravity_dir: tuple[float, float, float], progress: bool,
-              tqdm: Any) -> Diagnosis:  # noqa: ANN401
+              tqdm: Any) -> Diagnosis:
     P = len(meas.pose_ids)
     n_distinct = int(meas.repeat_groups().max()) + 1
     if P < MIN_POSES or n_distinct < MIN_POSES:
@@ -664,7 +667,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     theta0, rb0 = initial_registration(ctx, reg_specs, fitting)
     reg = fit(ctx, reg_specs, fitting, theta0, rb0)
     if not np.all(np.isfinite(reg.stderr)):
-        bad = [s.name for s, v in zip(reg.specs, reg.stderr) if not np.isfinite(v)]
+        bad = [s.name for s, v in zip(reg.specs, reg.stderr, strict=False) if not np.isfinite(v)]
         raise InputError(f"{meas.source}: the registration is not identifiable from these poses "
                          f"({', '.join(bad)} undetermined); the joints must move enough to "
                          "rotate the tool in several directions")
@@ -753,9 +756,11 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
         after = _withheld(ctx, f_new, withheld)
         weak_or_dropped = tuple(a for a in aliased)
         all_aliased += [a for a in aliased if a.name in {s.name for s in cache[cand.effect][0]}]
+        overlap = (_geometric_overlap(ctx, current, f_new.residual - current.residual)
+                   if cand.effect not in GEOMETRIC else math.nan)
         steps.append(Step(cand.effect, cand.joints, _estimates(f_new, nb), Metrics.of(after),
                           Metrics.of(f_new.residual), cand.cv_rms, cand.p_value, cand.bic_delta,
-                          tuple(c[0] for c in ranked), weak_or_dropped))
+                          tuple(c[0] for c in ranked), weak_or_dropped, overlap))
         current, current_cv = f_new, cand.cv_rms
     bar.close()
     after = _withheld(ctx, current, withheld)
@@ -788,6 +793,29 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
                      _estimates(reg, 0), tuple(steps), final, floor, unexplained, verdict,
                      split, where, tuple(all_aliased), (), reg, current, before, after, ctx,
                      fitting, withheld, settings)
+
+
+GEOMETRIC = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment")
+
+
+def _geometric_overlap(ctx: Context, current: FitResult, correction: F64) -> float:
+    """Share of a step's correction (change of the predicted positions on the fitting poses,
+    shape (3R,)) that the geometric effects together (offsets, scales, links, tilts) on top of
+    the current model could reproduce: 1 means the step is indistinguishable from geometry
+    over these poses, 0 that it is entirely non-geometric."""
+    geo: list[ParamSpec] = []
+    for eff in GEOMETRIC:
+        geo += effect_parameters(ctx, eff)[0]
+    have = {s.name for s in current.specs}
+    keep, _ = check_identifiable(ctx, current, [g for g in geo if g.name not in have])
+    prob = Problem(ctx, list(current.specs) + keep, current.poses, current.base_rotation)
+    _, J = prob.residual_and_jacobian(np.concatenate([current.theta, np.zeros(len(keep))]))
+    jn = np.linalg.norm(J, axis=0)
+    Q = orthonormal_basis(J / np.where(jn > 0, jn, 1.0))
+    cc = float(correction @ correction)
+    if cc <= 0:
+        return 0.0
+    return float(np.sum((Q.T @ correction) ** 2) / cc)
 
 
 def _verdict(steps: list[Step], nominal: Metrics, final: Metrics, floor: NoiseFloor,

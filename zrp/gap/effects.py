@@ -210,7 +210,7 @@ class Context:
             cols.append(fk.position if j == n else fk.points[:, j])
             owners.append(j)
         h = np.zeros((self.q.shape[0], n, len(cols)))
-        for jj, (pt, owner) in enumerate(zip(cols, owners)):
+        for jj, (pt, owner) in enumerate(zip(cols, owners, strict=False)):
             for k in range(n):
                 if k >= owner or self.model.prismatic[k]:
                     continue

@@ -105,7 +105,7 @@ class FitResult:
 
     def value(self, name: str) -> float:
         """The value of the parameter called ``name``."""
-        for s, v in zip(self.specs, self.theta):
+        for s, v in zip(self.specs, self.theta, strict=False):
             if s.name == name:
                 return float(v)
         raise InputError(f"no parameter {name!r}; fitted: {', '.join(s.name for s in self.specs)}")
