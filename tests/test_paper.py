@@ -1,0 +1,102 @@
+"""The numerical example against the published tables, and the three commands end to end."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from zrp.cli import main
+from zrp.errors import OutputExistsError
+from zrp.paper import (
+    PUBLISHED_ROWS,
+    PUBLISHED_TABLE2,
+    PUBLISHED_TABLE3,
+    implied_joint_angles,
+    output_names,
+    run_paper_example,
+    write_paper_outputs,
+)
+
+
+@pytest.fixture(scope="module")
+def example():
+    return run_paper_example(steps=120)
+
+
+def test_published_data_as_printed():
+    assert set(PUBLISHED_TABLE2) == {"LE2", "LE3", "LE4", "LE7", *(f"JE{k}" for k in range(1, 7))}
+    assert all(len(v) == len(PUBLISHED_ROWS) for v in PUBLISHED_TABLE2.values())
+    assert PUBLISHED_TABLE2["JE1"][3] == 7.88 and PUBLISHED_TABLE2["JE2"][3] == 0.133
+    assert PUBLISHED_TABLE3["JE4"] == (8.0e-4, 2.0e-3, 2.8e-3, 4.0e-3)
+
+
+def test_link_cells_match_except_le3(example):
+    by = {(c.table, c.column, c.xi_percent): c for c in example.cells}
+    for col in ("LE2", "LE4", "LE7"):
+        for xi in PUBLISHED_ROWS:
+            c = by[(2, col, xi)]
+            assert c.status == "match"
+            assert c.ratio == pytest.approx(1.0, abs=2e-3)
+    for xi in PUBLISHED_ROWS:
+        c = by[(2, "LE3", xi)]
+        assert c.status == "discrepancy"
+        implied = c.published / (xi / 100)
+        assert 443.5 < implied < 445.0  # ~17.5 in, not Table 1's 431.8 mm
+    assert by[(2, "JE1", 0.1)].status == "typo" and by[(2, "JE2", 0.1)].status == "typo"
+    assert all(c.status == "trajectory-dependent" for c in example.cells if c.table == 3)
+
+
+def test_checks_with_numbers(example):
+    ch = example.checks
+    assert ch["link_errors_max_angle_rad"] == 0.0
+    assert ch["zero_row"]["ours_max_delta_p"] == 0.0
+    assert ch["zero_row"]["published_table3_is_2^-24"]
+    ev = ch["sign_convention_evidence"]
+    assert ev["LE2_0.02pct_sign0_links_plus1"] == pytest.approx(np.sqrt(3) * 0.0508, rel=1e-9)
+    assert ev["JE_max_delta_p_sign0_axes_0"] == 0.0
+    # typos corrected, the published JE1/JE2 columns are linear again
+    pub = ch["linearity"]["published_table2"]
+    assert pub["JE1"]["r2_as_printed"] < 0.9 < 0.9999 < pub["JE1"]["r2_typos_corrected"]
+    assert pub["JE2"]["r2_as_printed"] < 0.9 < 0.9999 < pub["JE2"]["r2_typos_corrected"]
+    for p, v in ch["table3_closed_form"].items():
+        assert v["ours_delta_r_0.1pct"] == pytest.approx(v["closed_form_delta_r_0.1pct"],
+                                                         rel=1e-9), p
+
+
+def test_implied_joint_angles_reach_half_turns():
+    imp = implied_joint_angles()
+    assert imp["JE4"]["deg_max"] == pytest.approx(180.0)
+    assert imp["JE6"]["deg_max"] == pytest.approx(180.0)
+    assert 110 < imp["JE5"]["deg_min"] < imp["JE5"]["deg_max"] < 125
+
+
+def test_outputs_written_and_not_overwritten(example, tmp_path):
+    files = write_paper_outputs(example, tmp_path, figures=True)
+    assert {f.name for f in files} == set(output_names())
+    assert all(f.stat().st_size > 0 for f in files)
+    assert "LE3" in (tmp_path / "comparison.md").read_text()
+    with pytest.raises(OutputExistsError):
+        write_paper_outputs(example, tmp_path, figures=False)
+
+
+def test_cli_paper_study_tolerance(tmp_path, capsys):
+    assert main(["paper", "--out", str(tmp_path / "r"), "--no-video", "--no-figures",
+                 "--steps", "60", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["cell_status_counts"]["match"] == 12
+    assert "0 for link vectors" in out["sign_convention"]
+    assert main(["study", "--params", "LE2", "JE5", "--xi", "0.02", "0.1", "--steps", "60",
+                 "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["max_delta_p_mm"]["LE2"][1] == pytest.approx(0.254, rel=1e-9)
+    assert main(["tolerance", "-n", "300", "--steps", "60", "--no-progress", "--json",
+                 "--tol", "b1.*=0"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["tolerances"]["b1.x"] == 0 and out["n_robots"] == 300
+    assert out["worst_case_delta_p"] >= out["p99_max_delta_p"]
+    assert main(["study", "--params", "LE9"]) == 2
+    assert "LE9" in capsys.readouterr().err
+    assert main(["tolerance", "--tol", "nonsense", "-n", "10"]) == 2
+    assert "NAME=VALUE" in capsys.readouterr().err
