@@ -162,19 +162,23 @@ def nice_factor(x: float) -> float:
 
 
 # ---- output ------------------------------------------------------------------------------
-def _check_output(path: Path, overwrite: bool) -> None:
+def _check_output(path: Path, overwrite: bool) -> Path:
+    """Refuse to replace ``path`` unless ``overwrite``; create its folder; return the temporary
+    file the video is written to (renamed onto ``path`` only when complete)."""
     if path.exists() and not overwrite:
         raise OutputExistsError(f"output {str(path)!r} exists; pass overwrite=True (--force) "
                                 f"to replace it")
     if path.is_dir():
         raise InputError(f"output {str(path)!r} is a directory; expected a video file path")
+    part = path.with_name(f".{path.stem}.part{path.suffix}")
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "ab"):
+        with open(part, "wb"):
             pass
     except OSError as exc:
         raise VideoWriteError(f"output {str(path)!r}: cannot write ({exc.strerror or exc})") \
             from exc
+    return part
 
 
 def _ffmpeg_available() -> bool:
@@ -393,22 +397,25 @@ def _render(segments_in: Sequence[tuple[Manipulator, Manipulator, ArrayLike, Arr
         fmt = "mp4" if _ffmpeg_available() else "gif"
         if fmt == "gif" and path.suffix.lower() == ".mp4":
             path = path.with_suffix(".gif")
-    _check_output(path, overwrite)
     segs, magnify, top = _prepare(segments_in, opts)
     unit = segs[0].nominal.manipulator.length_unit
     total = sum(len(s.t) for s in segs)
-    with OffscreenRenderer(segs[0].actual.model, opts.width, opts.height,
-                           backend=opts.backend) as r:
-        try:
-            with _writer(path, fmt, opts.width, opts.height, opts.fps) as write, \
+    part = _check_output(path, overwrite)
+    try:
+        with OffscreenRenderer(segs[0].actual.model, opts.width, opts.height,
+                               backend=opts.backend) as r:
+            backend = r.backend
+            with _writer(part, fmt, opts.width, opts.height, opts.fps) as write, \
                     tqdm(total=total, desc=f"render {path.name}", unit="frame",
                          disable=not progress) as bar:
                 for frame in _frames(segs, magnify, top, opts, title, r):
                     write(frame)
                     bar.update(1)
-        except OSError as exc:
-            raise VideoWriteError(f"output {str(path)!r}: cannot write ({exc})") from exc
-        backend = r.backend
+        part.replace(path)
+    except OSError as exc:
+        raise VideoWriteError(f"output {str(path)!r}: cannot write ({exc})") from exc
+    finally:
+        part.unlink(missing_ok=True)
     return VideoResult(path, total, time.perf_counter() - start, magnify,
                        tuple(float(np.max(s.delta_p)) for s in segs),
                        tuple(float(np.max(s.delta_r)) for s in segs),

@@ -205,3 +205,19 @@ def test_lazy_import_and_configure_backend(monkeypatch):
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, env={**__import__("os").environ, "MUJOCO_GL": ""})
     assert out.stdout.strip() == "osmesa"
+
+
+def test_failed_render_leaves_no_partial_file(backend, circle, tmp_path, monkeypatch):
+    import sim.video
+
+    def broken(*args, **kwargs):
+        yield np.zeros((240, 320, 3), np.uint8)
+        raise RuntimeError("renderer exploded")
+
+    monkeypatch.setattr(sim.video, "_segment_frames", broken)
+    t, q = circle
+    out = tmp_path / "v.mp4"
+    with pytest.raises(RuntimeError, match="exploded"):
+        sim.render_comparison_video(zrp.load_model("puma"), perturbed_puma(), t, q, out,
+                                    options=_tiny(backend=backend), progress=False)
+    assert list(tmp_path.iterdir()) == []
