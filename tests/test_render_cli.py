@@ -1,0 +1,37 @@
+"""``zrp render``: the paper video, consistency numbers and dynamic playback from the CLI."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+import sim
+from zrp.cli import main
+
+
+@pytest.fixture(scope="module")
+def backend() -> str:
+    try:
+        return sim.resolve_backend()
+    except sim.GLUnavailableError as exc:
+        pytest.skip(f"no offscreen GL backend: {exc}")
+
+
+def test_render_command_writes_video_and_reports(backend, tmp_path, capsys):
+    code = main(["render", "--out-dir", str(tmp_path), "--width", "160", "--height", "120",
+                 "--fps", "10", "--seconds", "0.3", "--steps", "60", "--quiet", "--json",
+                 "--backend", backend])
+    assert code == 0
+    payload = json.loads(capsys.readouterr().out)
+    video = payload["videos"][0]
+    assert video["frames"] == 3
+    assert (tmp_path / "puma_circle_JE2_0.1pct.mp4").exists()
+    assert all(c["passed"] for c in payload["consistency"])
+    assert payload["dynamic_playback"]["max_tracking_error_mm"] > 0
+
+
+def test_render_unknown_backend(tmp_path, capsys):
+    assert main(["render", "--out-dir", str(tmp_path), "--backend", "vulkan", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert "vulkan" in err and "egl" in err and "osmesa" in err
