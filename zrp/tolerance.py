@@ -324,13 +324,11 @@ def _nonlinear_maxima(model: Manipulator, arrays: tuple[F64, F64, F64, F64, F64]
     q, ch, sh, pd, ed = arrays
     axes, bodies, off = perturbed_arrays(model, dx, joint_offsets=joint_offsets)
     n_r = dx.shape[0]
-    ax_t = np.ascontiguousarray(np.moveaxis(axes, 0, -1))
-    bd_t = np.ascontiguousarray(np.moveaxis(bodies, 0, -1))
-    off_t = np.ascontiguousarray(off.T)
     out_dp = np.empty(n_r)
     out_s = np.empty(n_r)
-    MK.mc_max_deviation(ch, sh, q, ax_t, bd_t, np.array(model.prismatic, dtype=np.bool_),
-                        off_t, bool(joint_offsets), pd, ed, out_dp, out_s)
+    MK.mc_max_deviation(ch, sh, q, np.ascontiguousarray(axes), np.ascontiguousarray(bodies),
+                        np.array(model.prismatic, dtype=np.bool_), np.ascontiguousarray(off),
+                        bool(joint_offsets), pd, ed, out_dp, out_s)
     return out_dp, 2.0 * np.arcsin(np.minimum(out_s, 1.0))
 
 
