@@ -39,9 +39,11 @@ __all__ = [
 #: Offscreen backends, in the order they are tried.
 BACKENDS = ("egl", "osmesa")
 #: Debian packages that provide each backend's system library.
-PACKAGES = {"egl": "libegl1 libgl1", "osmesa": "libosmesa6"}
-_INSTALL_HINT = ("install one with `apt-get install -y libegl1 libgl1` (EGL) or `apt-get "
-                 "install -y libosmesa6` (OSMesa), or set MUJOCO_GL to a backend that works")
+PACKAGES = {"egl": "libegl1 libgl1 libegl-mesa0 libgl1-mesa-dri", "osmesa": "libosmesa6"}
+_INSTALL_HINT = ("install one with `apt-get install -y libegl1 libgl1 libegl-mesa0 "
+                 "libgl1-mesa-dri` (EGL; Mesa's software rasteriser when there is no GPU) or "
+                 "`apt-get install -y libosmesa6` (OSMesa), or set MUJOCO_GL to a backend that "
+                 "works")
 
 _PROBE = """
 import mujoco
