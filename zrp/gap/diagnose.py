@@ -624,11 +624,14 @@ def _check_units(ctx: Context, poses: NDArray[np.int64]) -> None:
                          "joint values in degrees? then pass --deg)")
     ratio = sm / sp
     if not 1 / 3 < ratio < 3:
+        k = math.log10(ratio) if ratio > 0 else 0.0
+        hint = (f"; the positions look scaled by 1e{round(k):+03d} (e.g. m instead of mm)"
+                if abs(k - round(k)) < 0.2 and abs(round(k)) >= 1 else "")
         raise InputError(
             f"{meas.source}: units do not fit: the measured points spread {sm:.4g} around "
             f"their centre but the model's end effector spreads {sp:.4g} {unit} over the same "
-            f"poses (ratio {ratio:.3g}); x, y, z must be in {unit}, and q in rad (or deg with "
-            "--deg)")
+            f"poses (ratio {ratio:.3g}){hint}; x, y, z must be in {unit}, and q in rad (or deg "
+            "with --deg)")
 
 
 def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
@@ -690,6 +693,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     # greedy search
     cache: dict[str, tuple[list[ParamSpec], str | None]] = {
         e: effect_parameters(ctx, e) for e in effects}
+    where["identifiability"] = _survey(ctx, reg, cache, rng)
     current = reg
     current_cv = cv_rms(ctx, reg, folds)
     steps: list[Step] = []
@@ -767,11 +771,14 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     final = Metrics.of(after)
 
     # aliasing of the effects found (reported) and of joint 1 / last joint vs registration
-    for a in all_aliased:
-        if a.dropped:
-            warnings.warn(f"{a.name} ({a.effect}) cannot be told apart from "
-                          f"{', '.join(a.partners) or 'the registration'} with these data; it "
-                          "was not estimated separately", GapWarning, stacklevel=3)
+    for st in steps:
+        dropped = [a for a in all_aliased if a.dropped and a.effect == st.effect]
+        if dropped:
+            pairs = "; ".join(f"{a.name} ~ {'/'.join(a.partners) or 'nothing (no effect)'}"
+                              for a in dropped)
+            warnings.warn(f"{st.effect}: {len(dropped)} parameter(s) cannot be told apart from "
+                          f"others with these data and were not estimated separately: {pairs}",
+                          GapWarning, stacklevel=3)
     unexplained: bool | None
     if floor.rms is None:
         unexplained = None
@@ -793,6 +800,67 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
                      _estimates(reg, 0), tuple(steps), final, floor, unexplained, verdict,
                      split, where, tuple(all_aliased), (), reg, current, before, after, ctx,
                      fitting, withheld, settings)
+
+
+def _survey(ctx: Context, reg: FitResult,
+            cache: dict[str, tuple[list[ParamSpec], str | None]],
+            rng: np.random.Generator) -> dict[str, Any]:
+    """Which parameters of each effect these data cannot identify on top of the registration,
+    and which of those a rich random pose set would identify (so the data, not the model
+    structure, are to blame: a warning names them)."""
+    meas = ctx.meas
+    n = ctx.n
+    # joints that (almost) do not move
+    for k in range(n):
+        rng_k = float(np.ptp(ctx.q[reg.poses, k]))
+        small = 1e-3 if not ctx.model.prismatic[k] else 1e-3 * ctx.model.characteristic_length
+        if rng_k < small:
+            warnings.warn(f"{meas.source}: joint {k + 1} does not move in the fitting poses "
+                          f"(range {rng_k:.3g}); its offset, scale and other parameters cannot "
+                          "be told apart", GapWarning, stacklevel=4)
+    # reference: same model, tool and frame, random poses over +-2.5 rad (seeded, own stream)
+    ref_rng = np.random.default_rng(rng.integers(2**32))
+    P = 200
+    qref = ref_rng.uniform(-2.5, 2.5, (P, n))
+    M = len(meas.point_labels)
+    ref_meas = Measurements.from_arrays(np.repeat(np.arange(P), M), np.repeat(qref, M, 0),
+                                        np.zeros((P * M, 3)),
+                                        point=np.tile(list(meas.point_labels), P),
+                                        frame=meas.frame,
+                                        temp=None if meas.temp is None else
+                                        np.repeat(ref_rng.uniform(15, 30, P), M),
+                                        source="reference poses")
+    ref_ctx = Context(ctx.model, ref_meas, None, ctx.gravity_dir, ctx.harmonics)
+    ref_reg = FitResult(reg.specs, reg.theta, reg.cov, np.zeros(3 * P * M),
+                        np.zeros((3 * P * M, len(reg.specs))), reg.base_rotation,
+                        np.arange(P), True)
+    out: dict[str, Any] = {}
+    union: list[ParamSpec] = []
+    ref_union: list[ParamSpec] = []
+    for eff, (specs, _) in cache.items():
+        if not specs:
+            continue
+        _, rep = check_identifiable(ctx, reg, specs)
+        out[eff] = {"not_identifiable": [_alias_dict(a) for a in rep if a.dropped],
+                    "weak": [_alias_dict(a) for a in rep if not a.dropped],
+                    "limited_by_data": []}
+        union += specs
+        ref_union += effect_parameters(ref_ctx, eff)[0]
+    # all effects together, on the data and on the rich reference poses
+    _, rep = check_identifiable(ctx, reg, union)
+    _, ref_rep = check_identifiable(ref_ctx, ref_reg, ref_union)
+    structural = {a.name for a in ref_rep if a.dropped}
+    by_effect: dict[str, list[str]] = {}
+    for a in rep:
+        if a.dropped and a.name not in structural:
+            by_effect.setdefault(a.effect, []).append(
+                f"{a.name} ~ {'/'.join(a.partners) or 'nothing'}")
+            out[a.effect]["limited_by_data"].append(a.name)
+    for eff, items in by_effect.items():
+        warnings.warn(f"rank-deficient data: {'; '.join(items)} ({eff}) cannot be identified "
+                      "from these poses although richer poses would identify them; move the "
+                      "joints over wider ranges", GapWarning, stacklevel=4)
+    return out
 
 
 GEOMETRIC = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment")

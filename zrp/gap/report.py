@@ -39,16 +39,19 @@ def _jsonable(obj: Any) -> Any:
 
 
 def implicated_joint(diag: Diagnosis) -> int:
-    """The joint to plot the residual against: the first joint of the first effect found, else
-    the joint whose geometric parameters carry the largest share of the nominal residual."""
+    """The joint to plot the residual against: among the joints of the first effect found
+    (all joints when none was found), the one whose geometric parameters carry the largest
+    share of the nominal residual (the "where" projection)."""
+    n = diag.context.n
+    cands = set(range(1, n + 1))
     for st in diag.steps:
         if st.joints and st.effect != "link_length":
-            return int(st.joints[0])
-    proj = diag.where.get("projection") or []
-    proj = [p for p in proj if p["joint"] <= diag.context.n]
+            cands = {j for j in st.joints if j <= n}
+            break
+    proj = [p for p in diag.where.get("projection") or [] if p["joint"] in cands]
     if proj:
         return int(max(proj, key=lambda p: p["share"])["joint"])
-    return 1
+    return min(cands) if cands else 1
 
 
 def _rows(diag: Diagnosis) -> np.ndarray:
