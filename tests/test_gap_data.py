@@ -78,7 +78,7 @@ def test_bad_files_name_line_and_column(tmp_path, text, match):
 def test_missing_file_and_bad_frame(tmp_path):
     with pytest.raises(InputError, match="no such file"):
         load_measurements(tmp_path / "nope.csv", PUMA)
-    with pytest.raises(InputError, match="frame.*instrument"):
+    with pytest.raises(InputError, match=r"frame.*instrument"):
         load_measurements(_write(tmp_path, HEADER + _row(1)), PUMA, frame="tool")
 
 
@@ -114,11 +114,12 @@ def test_single_pose_is_an_error():
 def test_units_that_do_not_fit():
     meas = _synthetic(40)
     in_metres = Measurements.from_arrays(meas.pose, meas.q, meas.xyz / 1000.0, point=meas.point)
-    with pytest.raises(InputError, match=r"units do not fit.*scaled by 1e-03 \(e.g. m instead of mm\)"):
+    with pytest.raises(InputError,
+                       match=r"units do not fit.*scaled by 1e-03 \(e.g. m instead of mm\)"):
         diagnose(PUMA, in_metres)
     tiny_q = Measurements.from_arrays(meas.pose, np.radians(np.radians(meas.q)), meas.xyz,
                                       point=meas.point)
-    with pytest.raises(InputError, match="units do not fit|hardly moves"):
+    with pytest.raises(InputError, match=r"units do not fit|hardly moves"):
         diagnose(PUMA, tiny_q)
 
 
@@ -189,5 +190,5 @@ def test_split_is_seeded_and_disjoint():
 
 
 def test_unknown_effect_is_an_error():
-    with pytest.raises(InputError, match="unknown.*valid: joint_offset"):
+    with pytest.raises(InputError, match=r"unknown.*valid: joint_offset"):
         diagnose(PUMA, _synthetic(20), effects=("gremlins",))
