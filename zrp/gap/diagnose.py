@@ -679,8 +679,8 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
         raise InputError(
             f"{meas.source}: after registration the model still misses the measurements by "
             f"{nominal_fit_metrics.rms:.4g} {unit} RMS "
-            f"({100 * nominal_fit_metrics.rms / model.reach:.1f} % of the reach): the model, the joint order/signs or the units (--deg) do not "
-            "match the data")
+            f"({100 * nominal_fit_metrics.rms / model.reach:.1f} % of the reach): the model, "
+            "the joint order/signs or the units (--deg) do not match the data")
     if nominal_fit_metrics.rms > 0.02 * model.characteristic_length:
         warnings.warn(f"after registration the gap is {nominal_fit_metrics.rms:.4g} {unit} RMS, "
                       "more than 2 % of the reach: check the model, joint signs and units",
