@@ -91,6 +91,7 @@ class MJCFOptions:
         floor: add a floor and a pedestal under the base.
         alpha: opacity multiplier of every visual (e.g. 0.3 for a ghost arm).
         link_rgba: colour of the link capsules.
+        tint: if given, one colour for every visual of the arm (e.g. a pale "ghost" arm).
         link_radius: capsule radius, m; None picks 2.2 % of the arm's reach.
         prefix: prefix of every element name (to put several arms in one scene).
         offscreen_size: (width, height) of MuJoCo's offscreen framebuffer, pixels.
@@ -107,6 +108,7 @@ class MJCFOptions:
     floor: bool = True
     alpha: float = 1.0
     link_rgba: RGBA = LINK_RGBA
+    tint: RGBA | None = None
     link_radius: float | None = None
     prefix: str = ""
     offscreen_size: tuple[int, int] = (1280, 960)
@@ -126,6 +128,8 @@ class MJCFOptions:
         if a > 1:
             raise InputError(f"alpha: expected an opacity in (0, 1], got {self.alpha!r}")
         object.__setattr__(self, "link_rgba", _check_rgba(self.link_rgba, "link_rgba"))
+        if self.tint is not None:
+            object.__setattr__(self, "tint", _check_rgba(self.tint, "tint"))
         if self.link_radius is not None:
             _check_positive(self.link_radius, "link_radius", "m")
         if self.prefix and not _NAME_OK.match(self.prefix):
@@ -189,10 +193,6 @@ def _hand_quat(model: Manipulator) -> F64:
     return quat
 
 
-def _with_alpha(rgba: RGBA, alpha: float) -> list[float]:
-    return [rgba[0], rgba[1], rgba[2], rgba[3] * alpha]
-
-
 def _visual_geom(body: mujoco.MjsBody, kind: mujoco.mjtGeom, rgba: list[float], *,
                  size: ArrayLike, fromto: ArrayLike | None = None, pos: ArrayLike | None = None,
                  name: str = "", group: int = 0) -> mujoco.MjsGeom:
@@ -244,6 +244,12 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
     spec.stat.center = [0.0, 0.0, 0.0]
 
     alpha = options.alpha
+    tint = options.tint
+
+    def colour(rgba: RGBA | list[float]) -> list[float]:
+        base = tint if tint is not None else rgba
+        return [base[0], base[1], base[2], base[3] * alpha]
+
     world = spec.worldbody
     if options.visuals and options.floor:
         floor_z = -reach_m
@@ -251,21 +257,21 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
                                 dir=[0.0, 0.3, -1.0])
         light.type = mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
         light.castshadow = False
-        _visual_geom(world, mujoco.mjtGeom.mjGEOM_PLANE, _with_alpha(FLOOR_RGBA, alpha),
+        _visual_geom(world, mujoco.mjtGeom.mjGEOM_PLANE, colour(FLOOR_RGBA),
                      size=[2 * reach_m, 2 * reach_m, 0.05], pos=[0, 0, floor_z],
                      name=f"{pre}floor", group=2)
-        _visual_geom(world, mujoco.mjtGeom.mjGEOM_CYLINDER, _with_alpha(BASE_RGBA, alpha),
+        _visual_geom(world, mujoco.mjtGeom.mjGEOM_CYLINDER, colour(BASE_RGBA),
                      size=[2.5 * radius, 0], fromto=[0, 0, floor_z, 0, 0, -2 * radius],
                      name=f"{pre}pedestal", group=2)
     if options.visuals:
-        _visual_geom(world, mujoco.mjtGeom.mjGEOM_CYLINDER, _with_alpha(BASE_RGBA, alpha),
+        _visual_geom(world, mujoco.mjtGeom.mjGEOM_CYLINDER, colour(BASE_RGBA),
                      size=[2.5 * radius, 0], fromto=[0, 0, -2 * radius, 0, 0, 0],
                      name=f"{pre}base", group=1)
 
     inertias = _inertias(model, options, scale)
     joint_names: list[str] = []
     parent = world
-    link_rgba = _with_alpha(options.link_rgba, alpha)
+    link_rgba = colour(options.link_rgba)
     for k in range(model.n):
         b = bodies_m[k]
         if options.visuals and np.linalg.norm(b) > 1e-9:
@@ -286,12 +292,12 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
         if options.visuals:
             u = axes[k]
             if model.prismatic[k]:
-                _visual_geom(body, mujoco.mjtGeom.mjGEOM_BOX, _with_alpha(PRISMATIC_RGBA, alpha),
+                _visual_geom(body, mujoco.mjtGeom.mjGEOM_BOX, colour(PRISMATIC_RGBA),
                              size=[1.1 * radius] * 3, name=f"{pre}u{k + 1}")
             else:
                 h = 1.6 * radius
                 _visual_geom(body, mujoco.mjtGeom.mjGEOM_CYLINDER,
-                             _with_alpha(REVOLUTE_RGBA, alpha), size=[1.35 * radius, 0],
+                             colour(REVOLUTE_RGBA), size=[1.35 * radius, 0],
                              fromto=[*(-h * u), *(h * u)], name=f"{pre}u{k + 1}")
         joint_names.append(joint.name)
         parent = body
@@ -322,7 +328,7 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
         colours = ([0.9, 0.15, 0.15], [0.15, 0.8, 0.15], [0.15, 0.3, 0.95])
         for col, name in enumerate("xyz"):
             d = frame[:, col] * 3.0 * radius
-            _visual_geom(parent, mujoco.mjtGeom.mjGEOM_CAPSULE, [*colours[col], alpha],
+            _visual_geom(parent, mujoco.mjtGeom.mjGEOM_CAPSULE, colour([*colours[col], 1.0]),
                          size=[0.25 * radius, 0, 0], fromto=[*tip, *(tip + d)],
                          name=f"{pre}hand_{name}", group=1)
     return spec

@@ -124,11 +124,15 @@ class OffscreenRenderer:
         self.camera.elevation = float(elevation)
 
     def update_scene(self, data: mujoco.MjData,
-                     extra: Sequence[tuple[mujoco.MjModel, mujoco.MjData]] = ()) -> None:
-        """Rebuild the scene from ``data``, then add the geoms of each (model, data) in
-        ``extra`` (e.g. a translucent nominal "ghost" arm)."""
+                     extra: Sequence[tuple[mujoco.MjModel, mujoco.MjData]] = (),
+                     model: mujoco.MjModel | None = None) -> None:
+        """Rebuild the scene from ``data`` (of ``model``, default the renderer's model), then
+        add the geoms of each (model, data) in ``extra`` (e.g. a translucent "ghost" arm).
+
+        Another ``model`` must use no textures or meshes beyond the renderer's model's (true
+        of every model ``mjcf.build`` makes)."""
         self._require_open()
-        mujoco.mjv_updateScene(self.model, data, self.option, None, self.camera,
+        mujoco.mjv_updateScene(model or self.model, data, self.option, None, self.camera,
                                mujoco.mjtCatBit.mjCAT_ALL.value, self.scene)
         for m, d in extra:
             mujoco.mjv_addGeoms(m, d, self.option, self._pert,

@@ -16,7 +16,7 @@ import math
 import time
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import mujoco
@@ -37,6 +37,7 @@ __all__ = [
     "VideoResult",
     "VideoWriteError",
     "comparison_frames",
+    "exaggerated_model",
     "nice_factor",
     "render_comparison_video",
     "render_paper_video",
@@ -50,6 +51,7 @@ PAPER_LEVELS = (0.0, 0.02, 0.05, 0.07, 0.1)
 DESIRED_RGBA = (0.25, 0.55, 1.0, 1.0)
 ACTUAL_RGBA = (1.0, 0.25, 0.2, 1.0)
 ARROW_RGBA = (1.0, 0.85, 0.1, 1.0)
+GHOST_RGBA = (0.6, 0.9, 1.0, 1.0)
 
 
 class VideoWriteError(ZRPError, OSError):
@@ -72,6 +74,10 @@ class VideoOptions:
         ghost_alpha: opacity of the nominal arm.
         azimuth, elevation: camera angles, deg.
         plot: draw the live delta_p plot.
+        exaggerate_arm: draw the perturbed arm with its parameter errors multiplied by the
+            magnification too (see :func:`exaggerated_model`), so it visibly leaves the ghost
+            and its tool point follows the magnified red path (to first order). Numbers on
+            the video are always those of the true perturbation.
     """
 
     width: int = 640
@@ -82,10 +88,11 @@ class VideoOptions:
     format: str = "auto"
     backend: str | None = None
     trace_segments: int = 120
-    ghost_alpha: float = 0.3
+    ghost_alpha: float = 0.4
     azimuth: float = 150.0
     elevation: float = -15.0
     plot: bool = True
+    exaggerate_arm: bool = True
 
     def __post_init__(self) -> None:
         for name in ("width", "height", "fps", "trace_segments"):
@@ -148,6 +155,31 @@ class VideoResult:
             rows.append(f"  {lab}: max delta_p {dp:.4g} {self.length_unit}, max delta_R (eq 15) "
                         f"{dr:.4g}, max theta {th:.4g} rad")
         return "\n".join(rows)
+
+
+def exaggerated_model(nominal: Manipulator, perturbed: Manipulator, factor: float
+                      ) -> Manipulator:
+    """The perturbed model with its parameter errors multiplied by ``factor`` (for drawing).
+
+    b_k = b_k,nom + F (b_k,pert - b_k,nom); axes u_k = normalise(u_k,nom + F (u_k,pert -
+    u_k,nom)); the hand vectors likewise, u_t re-orthogonalised to u_a. To first order in the
+    errors the tool point moves F times as far from the nominal one as the perturbed arm's.
+    """
+    f = float(factor)
+
+    def mix(a: ArrayLike, b: ArrayLike) -> F64:
+        return np.asarray(a, dtype=float) + f * (np.asarray(b, dtype=float) - np.asarray(a))
+
+    axes = mix(nominal.axes, perturbed.axes)
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    ua = mix(nominal.end_effector.axial, perturbed.end_effector.axial)
+    ua /= np.linalg.norm(ua)
+    ut = mix(nominal.end_effector.transverse, perturbed.end_effector.transverse)
+    ut -= (ut @ ua) * ua
+    ut /= np.linalg.norm(ut)
+    return perturbed.with_arrays(axes=axes, bodies=mix(nominal.bodies, perturbed.bodies),
+                                 axial=ua, transverse=ut,
+                                 name=f"{perturbed.name} (errors x{f:g})")
 
 
 def nice_factor(x: float) -> float:
@@ -229,6 +261,7 @@ class _Segment:
     delta_r: F64  # (F,) eq 15
     theta: F64  # (F,) rad
     label: str
+    drawn: BuiltArm | None = None  # the opaque arm drawn (perturbed, maybe exaggerated)
 
 
 def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: ArrayLike,
@@ -249,7 +282,7 @@ def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: Arra
     qf = np.stack([np.interp(tf, t, q[:, j]) for j in range(nominal.n)], axis=1)
     arm_a = build(perturbed, MJCFOptions(offscreen_size=size))
     arm_n = build(nominal, MJCFOptions(alpha=ghost_alpha, floor=False, prefix="ghost_",
-                                       offscreen_size=size))
+                                       tint=GHOST_RGBA, offscreen_size=size))
     des = kinematic_playback(arm_n, qf)
     act = kinematic_playback(arm_a, qf)
     dp = np.linalg.norm(act.position - des.position, axis=-1)
@@ -266,13 +299,14 @@ def _camera(r: OffscreenRenderer, segs: Sequence[_Segment], opts: VideoOptions) 
     bodies = np.asarray(seg.nominal.manipulator.bodies) * seg.nominal.scale
     reach = max(float(np.sum(np.linalg.norm(bodies, axis=1))), 0.2)
     centre = 0.5 * path_c
-    r.look_at(centre, 1.7 * reach, opts.azimuth, opts.elevation)
+    r.look_at(centre, 1.5 * reach, opts.azimuth, opts.elevation)
 
 
 def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: VideoOptions,
                     unit: str, title: str, plot_top: float | None = None
                     ) -> Iterator[NDArray[np.uint8]]:
-    m_a, m_n = seg.actual.model, seg.nominal.model
+    drawn = seg.drawn or seg.actual
+    m_a, m_n = drawn.model, seg.nominal.model
     d_a, d_n = mujoco.MjData(m_a), mujoco.MjData(m_n)
     n_frames = len(seg.t)
     magnified = seg.p_des + magnify * (seg.p_act - seg.p_des)
@@ -301,12 +335,15 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
     plot_idx = np.linspace(0, n_frames - 1, min(n_frames, max_pts)).astype(int) if opts.plot \
         else np.zeros(0, int)
     pw, ph = int(opts.width * 0.36), int(opts.height * 0.27)
+    legend = "blue: desired (nominal)\nred: actual (perturbed)\npale ghost: nominal arm"
+    if seg.drawn is not None:
+        legend += f"\narm: perturbed, errors x{magnify:g}"
     for f in range(n_frames):
-        d_a.qpos[seg.actual.qpos_adr] = seg.actual.qpos(seg.q[f])
+        d_a.qpos[drawn.qpos_adr] = drawn.qpos(seg.q[f])
         d_n.qpos[seg.nominal.qpos_adr] = seg.nominal.qpos(seg.q[f])
         mujoco.mj_kinematics(m_a, d_a)
         mujoco.mj_kinematics(m_n, d_n)
-        r.update_scene(d_a, [(m_n, d_n)])
+        r.update_scene(d_a, [(m_n, d_n)], model=m_a)
         r.add_polyline(seg.p_des[idx_all], DESIRED_RGBA, 2.0)
         done = idx_all[idx_all <= f]
         if len(done) and done[-1] != f:
@@ -321,8 +358,7 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
         r.text("t\ndelta_p\ndelta_R (eq 15)\ntheta",
                f"{seg.t[f]:.2f} s\n{seg.delta_p[f]:.4g} {unit}\n{seg.delta_r[f]:.3e}\n"
                f"{seg.theta[f]:.3e} rad", corner=mujoco.mjtGridPos.mjGRID_BOTTOMLEFT)
-        r.text("blue: desired (nominal)\nred: actual (perturbed)\nghost: nominal arm",
-               corner=mujoco.mjtGridPos.mjGRID_TOPRIGHT)
+        r.text(legend, corner=mujoco.mjtGridPos.mjGRID_TOPRIGHT)
         if opts.plot:
             shown = plot_idx[plot_idx <= f]
             fig.linepnt[0] = len(shown)
@@ -350,6 +386,16 @@ def _prepare(segments_in: Sequence[tuple[Manipulator, Manipulator, ArrayLike, Ar
                    for s in segs) or 0.25
         magnify = nice_factor(0.25 * span / worst) if worst > 0 else 1.0
     top = max(float(np.max(s.delta_p)) for s in segs)
+    if opts.exaggerate_arm:
+        size = (max(opts.width, 640), max(opts.height, 480))
+        drawn = []
+        for s, (nominal, perturbed, *_rest) in zip(segs, segments_in, strict=True):
+            try:
+                shown = exaggerated_model(nominal, perturbed, magnify)
+            except ZRPError:  # a degenerate exaggeration: draw the true arm
+                shown = perturbed
+            drawn.append(replace(s, drawn=build(shown, MJCFOptions(offscreen_size=size))))
+        segs = drawn
     return segs, magnify, top
 
 
@@ -358,7 +404,7 @@ def _frames(segs: Sequence[_Segment], magnify: float, top: float, opts: VideoOpt
     unit = segs[0].nominal.manipulator.length_unit
     _camera(r, segs, opts)
     for seg in segs:
-        if seg.actual.model.nbody != r.model.nbody:
+        if (seg.drawn or seg.actual).model.nbody != r.model.nbody:
             raise InputError("segments: every perturbed model must have the same structure "
                              "as the first")
         yield from _segment_frames(r, seg, magnify, opts, unit, title, top)
@@ -382,7 +428,7 @@ def comparison_frames(
     """
     opts = options or VideoOptions()
     segs, magnify, top = _prepare([(nominal, perturbed, t, q, label)], opts)
-    with OffscreenRenderer(segs[0].actual.model, opts.width, opts.height,
+    with OffscreenRenderer((segs[0].drawn or segs[0].actual).model, opts.width, opts.height,
                            backend=opts.backend) as r:
         yield from _frames(segs, magnify, top, opts, title, r)
 
@@ -402,8 +448,8 @@ def _render(segments_in: Sequence[tuple[Manipulator, Manipulator, ArrayLike, Arr
     total = sum(len(s.t) for s in segs)
     part = _check_output(path, overwrite)
     try:
-        with OffscreenRenderer(segs[0].actual.model, opts.width, opts.height,
-                               backend=opts.backend) as r:
+        with OffscreenRenderer((segs[0].drawn or segs[0].actual).model, opts.width,
+                               opts.height, backend=opts.backend) as r:
             backend = r.backend
             with _writer(part, fmt, opts.width, opts.height, opts.fps) as write, \
                     tqdm(total=total, desc=f"render {path.name}", unit="frame",
@@ -500,8 +546,6 @@ def render_teaching_sweep(
 
     Writes ``<out_dir>/puma_sweep_<parameter>.mp4``.
     """
-    from dataclasses import replace
-
     from zrp.examples import puma_circle_ik
 
     if not levels:

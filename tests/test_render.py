@@ -221,3 +221,19 @@ def test_failed_render_leaves_no_partial_file(backend, circle, tmp_path, monkeyp
         sim.render_comparison_video(zrp.load_model("puma"), perturbed_puma(), t, q, out,
                                     options=_tiny(backend=backend), progress=False)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_exaggerated_model_scales_the_errors():
+    nominal = zrp.load_model("puma")
+    perturbed = perturbed_puma()
+    big = sim.video.exaggerated_model(nominal, perturbed, 10.0)
+    np.testing.assert_allclose(big.bodies - nominal.bodies,
+                               10.0 * (perturbed.bodies - nominal.bodies), atol=1e-9)
+    q = np.array([0.3, -0.5, 0.4, 0.2, 0.9, -0.3])
+    p0 = zrp.forward_kinematics(nominal, q).position
+    p1 = zrp.forward_kinematics(perturbed, q).position
+    p10 = zrp.forward_kinematics(big, q).position
+    # first order: the tool point moves ~10 times as far (errors here are ~1e-3)
+    assert np.linalg.norm(p10 - p0) == pytest.approx(10 * np.linalg.norm(p1 - p0), rel=0.05)
+    same = sim.video.exaggerated_model(nominal, perturbed, 1.0)
+    np.testing.assert_allclose(same.axes, perturbed.axes, atol=1e-15)
