@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from test_mjcf import perturbed_puma, random_arm
 
 import mjcf
@@ -123,3 +125,17 @@ def test_dynamic_playback_bad_inputs(puma_circle):
         sim.dynamic_playback(model, t, q, options=mjcf.MJCFOptions())
     with pytest.raises(InputError, match="settle_s"):
         sim.dynamic_playback(model, t, q, settle_s=-1)
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(1, 8), p_prismatic=st.sampled_from([0, 0.3]))
+def test_consistency_property_random_arms(seed, n, p_prismatic):
+    """Any arm the toolkit can represent: MuJoCo and ZRP agree to the stated bounds."""
+    from zrp.testing import random_arm as zrp_random_arm
+
+    rng = np.random.default_rng(seed)
+    model = zrp_random_arm(rng, n, p_prismatic=p_prismatic)
+    q = rng.uniform(-2 * np.pi, 2 * np.pi, size=(20, n))
+    q[:, model.prismatic] *= 100.0  # mm
+    report = sim.consistency_check(model, q)
+    assert report.passed(POS_TOL_MM, ROT_TOL_RAD), report.summary()
