@@ -48,6 +48,31 @@ def sincos(x):
     return ss, cc
 
 
+@njit(inline="always", fastmath=_FM)
+def rotate(e0, e1, e2, e3, x, y, z):
+    """Eq (2): the vector (x, y, z) rotated by unit parameters (e0, e1, e2, e3), written as
+    v + 2 e0 (e x v) + 2 e x (e x v)."""
+    cx = e2 * z - e3 * y
+    cy = e3 * x - e1 * z
+    cz = e1 * y - e2 * x
+    return (x + 2.0 * (e0 * cx + e2 * cz - e3 * cy),
+            y + 2.0 * (e0 * cy + e3 * cx - e1 * cz),
+            z + 2.0 * (e0 * cz + e1 * cy - e2 * cx))
+
+
+@njit(inline="always", fastmath=_FM)
+def turn(e0, e1, e2, e3, ux, uy, uz, q):
+    """Eqs (4)-(6): E * e(u, q), the composition with a turn by q (rad) about the unit u."""
+    s, c = sincos(0.5 * q)
+    f1 = ux * s
+    f2 = uy * s
+    f3 = uz * s
+    return (e0 * c - e1 * f1 - e2 * f2 - e3 * f3,
+            e0 * f1 + c * e1 + e2 * f3 - e3 * f2,
+            e0 * f2 + c * e2 + e3 * f1 - e1 * f3,
+            e0 * f3 + c * e3 + e1 * f2 - e2 * f1)
+
+
 @njit(cache=True)
 def all_finite(x):
     """True when every element of the contiguous array ``x`` is finite (stops at the first)."""
@@ -69,52 +94,22 @@ def sincos_batch(x, s, c):
 def fk_pose_one(q, axes, bodies, prism, out):
     """Eqs (1)-(6) for one joint vector: writes p and E_{n+1} into out[0:7]."""
     n = axes.shape[0]
-    e0 = 1.0
-    e1 = 0.0
-    e2 = 0.0
-    e3 = 0.0
-    px = 0.0
-    py = 0.0
-    pz = 0.0
+    e0, e1, e2, e3 = 1.0, 0.0, 0.0, 0.0
+    px, py, pz = 0.0, 0.0, 0.0
     for k in range(n + 1):
-        bx = bodies[k, 0]
-        by = bodies[k, 1]
-        bz = bodies[k, 2]
-        if bx != 0.0 or by != 0.0 or bz != 0.0:
-            # eq (2): b_k = R_{k-1} b_{k,0}, as v + 2 e0 (e x v) + 2 e x (e x v)
-            cx = e2 * bz - e3 * by
-            cy = e3 * bx - e1 * bz
-            cz = e1 * by - e2 * bx
-            px += bx + 2.0 * (e0 * cx + e2 * cz - e3 * cy)
-            py += by + 2.0 * (e0 * cy + e3 * cx - e1 * cz)
-            pz += bz + 2.0 * (e0 * cz + e1 * cy - e2 * cx)
+        bx, by, bz = rotate(e0, e1, e2, e3, bodies[k, 0], bodies[k, 1], bodies[k, 2])
+        px += bx
+        py += by
+        pz += bz
         if k == n:
             break
-        ux = axes[k, 0]
-        uy = axes[k, 1]
-        uz = axes[k, 2]
         if prism[k]:
-            cx = e2 * uz - e3 * uy
-            cy = e3 * ux - e1 * uz
-            cz = e1 * uy - e2 * ux
-            d = q[k]
-            px += d * (ux + 2.0 * (e0 * cx + e2 * cz - e3 * cy))
-            py += d * (uy + 2.0 * (e0 * cy + e3 * cx - e1 * cz))
-            pz += d * (uz + 2.0 * (e0 * cz + e1 * cy - e2 * cx))
+            wx, wy, wz = rotate(e0, e1, e2, e3, axes[k, 0], axes[k, 1], axes[k, 2])
+            px += q[k] * wx
+            py += q[k] * wy
+            pz += q[k] * wz
         else:
-            s, c = sincos(0.5 * q[k])
-            f1 = ux * s
-            f2 = uy * s
-            f3 = uz * s
-            # eqs (4)-(5): E <- E * e_k
-            n0 = e0 * c - e1 * f1 - e2 * f2 - e3 * f3
-            n1 = e0 * f1 + c * e1 + e2 * f3 - e3 * f2
-            n2 = e0 * f2 + c * e2 + e3 * f1 - e1 * f3
-            n3 = e0 * f3 + c * e3 + e1 * f2 - e2 * f1
-            e0 = n0
-            e1 = n1
-            e2 = n2
-            e3 = n3
+            e0, e1, e2, e3 = turn(e0, e1, e2, e3, axes[k, 0], axes[k, 1], axes[k, 2], q[k])
     out[0] = px
     out[1] = py
     out[2] = pz
@@ -140,67 +135,44 @@ def fk_pose_batch(q, axes, bodies, prism, out):
     px = np.empty(_BLOCK)
     py = np.empty(_BLOCK)
     pz = np.empty(_BLOCK)
-    qb = np.empty(_BLOCK)
+    qb = np.empty(_BLOCK)  # joint k's values, contiguous (a strided read stops SIMD)
     for start in range(0, N, _BLOCK):
         m = min(_BLOCK, N - start)
-        for i in range(m):
-            e0[i] = 1.0
-            e1[i] = 0.0
-            e2[i] = 0.0
-            e3[i] = 0.0
-            px[i] = 0.0
-            py[i] = 0.0
-            pz[i] = 0.0
+        e0[:m] = 1.0
+        e1[:m] = 0.0
+        e2[:m] = 0.0
+        e3[:m] = 0.0
+        px[:m] = 0.0
+        py[:m] = 0.0
+        pz[:m] = 0.0
         for k in range(n + 1):
             bx = bodies[k, 0]
             by = bodies[k, 1]
             bz = bodies[k, 2]
-            if bx != 0.0 or by != 0.0 or bz != 0.0:
+            if bx != 0.0 or by != 0.0 or bz != 0.0:  # zero body vectors (wrists) cost nothing
                 for i in range(m):
-                    a0 = e0[i]
-                    a1 = e1[i]
-                    a2 = e2[i]
-                    a3 = e3[i]
-                    cx = a2 * bz - a3 * by
-                    cy = a3 * bx - a1 * bz
-                    cz = a1 * by - a2 * bx
-                    px[i] += bx + 2.0 * (a0 * cx + a2 * cz - a3 * cy)
-                    py[i] += by + 2.0 * (a0 * cy + a3 * cx - a1 * cz)
-                    pz[i] += bz + 2.0 * (a0 * cz + a1 * cy - a2 * cx)
+                    x, y, z = rotate(e0[i], e1[i], e2[i], e3[i], bx, by, bz)
+                    px[i] += x
+                    py[i] += y
+                    pz[i] += z
             if k == n:
                 break
-            for i in range(m):
-                qb[i] = q[start + i, k]
             ux = axes[k, 0]
             uy = axes[k, 1]
             uz = axes[k, 2]
+            for i in range(m):
+                qb[i] = q[start + i, k]
             if prism[k]:
                 for i in range(m):
-                    a0 = e0[i]
-                    a1 = e1[i]
-                    a2 = e2[i]
-                    a3 = e3[i]
-                    cx = a2 * uz - a3 * uy
-                    cy = a3 * ux - a1 * uz
-                    cz = a1 * uy - a2 * ux
                     d = qb[i]
-                    px[i] += d * (ux + 2.0 * (a0 * cx + a2 * cz - a3 * cy))
-                    py[i] += d * (uy + 2.0 * (a0 * cy + a3 * cx - a1 * cz))
-                    pz[i] += d * (uz + 2.0 * (a0 * cz + a1 * cy - a2 * cx))
+                    x, y, z = rotate(e0[i], e1[i], e2[i], e3[i], ux, uy, uz)
+                    px[i] += d * x
+                    py[i] += d * y
+                    pz[i] += d * z
             else:
                 for i in range(m):
-                    s, c = sincos(0.5 * qb[i])
-                    f1 = ux * s
-                    f2 = uy * s
-                    f3 = uz * s
-                    a0 = e0[i]
-                    a1 = e1[i]
-                    a2 = e2[i]
-                    a3 = e3[i]
-                    e0[i] = a0 * c - a1 * f1 - a2 * f2 - a3 * f3
-                    e1[i] = a0 * f1 + c * a1 + a2 * f3 - a3 * f2
-                    e2[i] = a0 * f2 + c * a2 + a3 * f1 - a1 * f3
-                    e3[i] = a0 * f3 + c * a3 + a1 * f2 - a2 * f1
+                    e0[i], e1[i], e2[i], e3[i] = turn(e0[i], e1[i], e2[i], e3[i], ux, uy, uz,
+                                                      qb[i])
         for i in range(m):
             j = start + i
             out[j, 0] = px[i]
@@ -216,35 +188,17 @@ def fk_pose_batch(q, axes, bodies, prism, out):
 def fk_jac_one(q, axes, bodies, prism, pose, jac):
     """Pose (7,) and the eq (7) Jacobian [omega_h; V_p] (6, n) of one joint vector."""
     n = axes.shape[0]
-    e0 = 1.0
-    e1 = 0.0
-    e2 = 0.0
-    e3 = 0.0
-    px = 0.0
-    py = 0.0
-    pz = 0.0
+    e0, e1, e2, e3 = 1.0, 0.0, 0.0, 0.0
+    px, py, pz = 0.0, 0.0, 0.0
     # First pass stores current axes (rows 0-2) and joint points (rows 3-5, temporarily).
     for k in range(n + 1):
-        bx = bodies[k, 0]
-        by = bodies[k, 1]
-        bz = bodies[k, 2]
-        cx = e2 * bz - e3 * by
-        cy = e3 * bx - e1 * bz
-        cz = e1 * by - e2 * bx
-        px += bx + 2.0 * (e0 * cx + e2 * cz - e3 * cy)
-        py += by + 2.0 * (e0 * cy + e3 * cx - e1 * cz)
-        pz += bz + 2.0 * (e0 * cz + e1 * cy - e2 * cx)
+        bx, by, bz = rotate(e0, e1, e2, e3, bodies[k, 0], bodies[k, 1], bodies[k, 2])
+        px += bx
+        py += by
+        pz += bz
         if k == n:
             break
-        ux = axes[k, 0]
-        uy = axes[k, 1]
-        uz = axes[k, 2]
-        cx = e2 * uz - e3 * uy
-        cy = e3 * ux - e1 * uz
-        cz = e1 * uy - e2 * ux
-        wx = ux + 2.0 * (e0 * cx + e2 * cz - e3 * cy)
-        wy = uy + 2.0 * (e0 * cy + e3 * cx - e1 * cz)
-        wz = uz + 2.0 * (e0 * cz + e1 * cy - e2 * cx)
+        wx, wy, wz = rotate(e0, e1, e2, e3, axes[k, 0], axes[k, 1], axes[k, 2])
         jac[0, k] = wx
         jac[1, k] = wy
         jac[2, k] = wz
@@ -252,23 +206,11 @@ def fk_jac_one(q, axes, bodies, prism, pose, jac):
         jac[4, k] = py
         jac[5, k] = pz
         if prism[k]:
-            d = q[k]
-            px += d * wx
-            py += d * wy
-            pz += d * wz
+            px += q[k] * wx
+            py += q[k] * wy
+            pz += q[k] * wz
         else:
-            s, c = sincos(0.5 * q[k])
-            f1 = ux * s
-            f2 = uy * s
-            f3 = uz * s
-            n0 = e0 * c - e1 * f1 - e2 * f2 - e3 * f3
-            n1 = e0 * f1 + c * e1 + e2 * f3 - e3 * f2
-            n2 = e0 * f2 + c * e2 + e3 * f1 - e1 * f3
-            n3 = e0 * f3 + c * e3 + e1 * f2 - e2 * f1
-            e0 = n0
-            e1 = n1
-            e2 = n2
-            e3 = n3
+            e0, e1, e2, e3 = turn(e0, e1, e2, e3, axes[k, 0], axes[k, 1], axes[k, 2], q[k])
     pose[0] = px
     pose[1] = py
     pose[2] = pz
@@ -277,23 +219,27 @@ def fk_jac_one(q, axes, bodies, prism, pose, jac):
     pose[5] = e2
     pose[6] = e3
     for k in range(n):
-        wx = jac[0, k]
-        wy = jac[1, k]
-        wz = jac[2, k]
-        if prism[k]:
-            jac[0, k] = 0.0
-            jac[1, k] = 0.0
-            jac[2, k] = 0.0
-            jac[3, k] = wx
-            jac[4, k] = wy
-            jac[5, k] = wz
-        else:
-            rx = px - jac[3, k]
-            ry = py - jac[4, k]
-            rz = pz - jac[5, k]
-            jac[3, k] = wy * rz - wz * ry
-            jac[4, k] = wz * rx - wx * rz
-            jac[5, k] = wx * ry - wy * rx
+        _jac_column(prism[k], jac[0, k], jac[1, k], jac[2, k], px - jac[3, k], py - jac[4, k],
+                    pz - jac[5, k], jac[:, k])
+
+
+@njit(inline="always", fastmath=_FM)
+def _jac_column(prismatic, wx, wy, wz, rx, ry, rz, col):
+    """Eq (7) column from the current axis w and r = p - p_k: [w; w x r] or [0; w]."""
+    if prismatic:
+        col[0] = 0.0
+        col[1] = 0.0
+        col[2] = 0.0
+        col[3] = wx
+        col[4] = wy
+        col[5] = wz
+    else:
+        col[0] = wx
+        col[1] = wy
+        col[2] = wz
+        col[3] = wy * rz - wz * ry
+        col[4] = wz * rx - wx * rz
+        col[5] = wx * ry - wy * rx
 
 
 @njit(cache=True, fastmath=_FM)
@@ -312,34 +258,27 @@ def jac_batch(q, axes, bodies, prism, pose, jac):
     px = np.empty(_BLOCK)
     py = np.empty(_BLOCK)
     pz = np.empty(_BLOCK)
-    qb = np.empty(_BLOCK)
-    w = np.empty((n, 3, _BLOCK))
-    o = np.empty((n, 3, _BLOCK))
+    w = np.empty((n, 3, _BLOCK))  # current axes u_k
+    o = np.empty((n, 3, _BLOCK))  # current joint points p_k
+    qb = np.empty(_BLOCK)  # joint k's values, contiguous (a strided read stops SIMD)
     for start in range(0, N, _BLOCK):
         m = min(_BLOCK, N - start)
-        for i in range(m):
-            e0[i] = 1.0
-            e1[i] = 0.0
-            e2[i] = 0.0
-            e3[i] = 0.0
-            px[i] = 0.0
-            py[i] = 0.0
-            pz[i] = 0.0
+        e0[:m] = 1.0
+        e1[:m] = 0.0
+        e2[:m] = 0.0
+        e3[:m] = 0.0
+        px[:m] = 0.0
+        py[:m] = 0.0
+        pz[:m] = 0.0
         for k in range(n + 1):
             bx = bodies[k, 0]
             by = bodies[k, 1]
             bz = bodies[k, 2]
             for i in range(m):
-                a0 = e0[i]
-                a1 = e1[i]
-                a2 = e2[i]
-                a3 = e3[i]
-                cx = a2 * bz - a3 * by
-                cy = a3 * bx - a1 * bz
-                cz = a1 * by - a2 * bx
-                px[i] += bx + 2.0 * (a0 * cx + a2 * cz - a3 * cy)
-                py[i] += by + 2.0 * (a0 * cy + a3 * cx - a1 * cz)
-                pz[i] += bz + 2.0 * (a0 * cz + a1 * cy - a2 * cx)
+                x, y, z = rotate(e0[i], e1[i], e2[i], e3[i], bx, by, bz)
+                px[i] += x
+                py[i] += y
+                pz[i] += z
             if k == n:
                 break
             ux = axes[k, 0]
@@ -347,16 +286,9 @@ def jac_batch(q, axes, bodies, prism, pose, jac):
             uz = axes[k, 2]
             for i in range(m):
                 qb[i] = q[start + i, k]
-                a0 = e0[i]
-                a1 = e1[i]
-                a2 = e2[i]
-                a3 = e3[i]
-                cx = a2 * uz - a3 * uy
-                cy = a3 * ux - a1 * uz
-                cz = a1 * uy - a2 * ux
-                w[k, 0, i] = ux + 2.0 * (a0 * cx + a2 * cz - a3 * cy)
-                w[k, 1, i] = uy + 2.0 * (a0 * cy + a3 * cx - a1 * cz)
-                w[k, 2, i] = uz + 2.0 * (a0 * cz + a1 * cy - a2 * cx)
+            for i in range(m):
+                w[k, 0, i], w[k, 1, i], w[k, 2, i] = rotate(e0[i], e1[i], e2[i], e3[i], ux, uy,
+                                                            uz)
                 o[k, 0, i] = px[i]
                 o[k, 1, i] = py[i]
                 o[k, 2, i] = pz[i]
@@ -368,18 +300,8 @@ def jac_batch(q, axes, bodies, prism, pose, jac):
                     pz[i] += d * w[k, 2, i]
             else:
                 for i in range(m):
-                    s, c = sincos(0.5 * qb[i])
-                    f1 = ux * s
-                    f2 = uy * s
-                    f3 = uz * s
-                    a0 = e0[i]
-                    a1 = e1[i]
-                    a2 = e2[i]
-                    a3 = e3[i]
-                    e0[i] = a0 * c - a1 * f1 - a2 * f2 - a3 * f3
-                    e1[i] = a0 * f1 + c * a1 + a2 * f3 - a3 * f2
-                    e2[i] = a0 * f2 + c * a2 + a3 * f1 - a1 * f3
-                    e3[i] = a0 * f3 + c * a3 + a1 * f2 - a2 * f1
+                    e0[i], e1[i], e2[i], e3[i] = turn(e0[i], e1[i], e2[i], e3[i], ux, uy, uz,
+                                                      qb[i])
         if pose.shape[0] == N:  # the caller may pass an empty array to skip the poses
             for i in range(m):
                 j = start + i
@@ -391,30 +313,10 @@ def jac_batch(q, axes, bodies, prism, pose, jac):
                 pose[j, 5] = e2[i]
                 pose[j, 6] = e3[i]
         for k in range(n):
-            if prism[k]:
-                for i in range(m):
-                    j = start + i
-                    jac[j, 0, k] = 0.0
-                    jac[j, 1, k] = 0.0
-                    jac[j, 2, k] = 0.0
-                    jac[j, 3, k] = w[k, 0, i]
-                    jac[j, 4, k] = w[k, 1, i]
-                    jac[j, 5, k] = w[k, 2, i]
-            else:
-                for i in range(m):
-                    j = start + i
-                    wx = w[k, 0, i]
-                    wy = w[k, 1, i]
-                    wz = w[k, 2, i]
-                    rx = px[i] - o[k, 0, i]
-                    ry = py[i] - o[k, 1, i]
-                    rz = pz[i] - o[k, 2, i]
-                    jac[j, 0, k] = wx
-                    jac[j, 1, k] = wy
-                    jac[j, 2, k] = wz
-                    jac[j, 3, k] = wy * rz - wz * ry
-                    jac[j, 4, k] = wz * rx - wx * rz
-                    jac[j, 5, k] = wx * ry - wy * rx
+            pk = prism[k]
+            for i in range(m):
+                _jac_column(pk, w[k, 0, i], w[k, 1, i], w[k, 2, i], px[i] - o[k, 0, i],
+                            py[i] - o[k, 1, i], pz[i] - o[k, 2, i], jac[start + i, :, k])
 
 
 def kernel_arrays(axes: np.ndarray, bodies: np.ndarray, prism: np.ndarray) -> tuple:
