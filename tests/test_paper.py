@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import warnings
 
 import numpy as np
 import pytest
@@ -54,7 +55,8 @@ def test_checks_with_numbers(example):
     assert ch["zero_row"]["ours_max_delta_p"] == 0.0
     assert ch["zero_row"]["published_table3_is_2^-24"]
     ev = ch["sign_convention_evidence"]
-    assert ev["LE2_0.02pct_sign0_links_plus1"] == pytest.approx(np.sqrt(3) * 0.0508, rel=1e-9)
+    assert ev["link"] == "LE2"
+    assert ev["link_0.02pct_sign0_links_plus1"] == pytest.approx(np.sqrt(3) * 0.0508, rel=1e-9)
     assert ev["JE_max_delta_p_sign0_axes_0"] == 0.0
     # typos corrected, the published JE1/JE2 columns are linear again
     pub = ch["linearity"]["published_table2"]
@@ -70,6 +72,25 @@ def test_implied_joint_angles_reach_half_turns():
     assert imp["JE4"]["deg_max"] == pytest.approx(180.0)
     assert imp["JE6"]["deg_max"] == pytest.approx(180.0)
     assert 110 < imp["JE5"]["deg_min"] < imp["JE5"]["deg_max"] < 125
+
+
+def test_other_model_runs_without_published_values(tmp_path):
+    from zrp import load_model
+    from zrp.study import circle_joint_path
+
+    model = load_model("stanford")
+    q0 = np.radians([10.0, 60.0, 0.0, 20.0, 40.0, 10.0])
+    q0[2] = 300.0 if model.prismatic[2] else q0[2]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the Stanford arm's circle passes near a singularity
+        path = circle_joint_path(model, q0=q0, radius=50.0, steps=80)
+    ex = run_paper_example(model, path)
+    assert ex.cells == [] and not ex.checks["published_values_apply"]
+    assert "LE1" not in ex.study.parameters or np.linalg.norm(model.bodies[0]) > 0
+    assert ex.checks["link_errors_max_angle_rad"] == 0.0
+    files = write_paper_outputs(ex, tmp_path, figures=False)
+    assert "no published values" in (tmp_path / "comparison.md").read_text()
+    assert len(files) == 9
 
 
 def test_outputs_written_and_not_overwritten(example, tmp_path):

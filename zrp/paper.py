@@ -103,6 +103,29 @@ LE_PARAMS = ("LE2", "LE3", "LE4", "LE7")
 JE_PARAMS = ("JE1", "JE2", "JE3", "JE4", "JE5", "JE6")
 
 
+def is_paper_model(model: Manipulator) -> bool:
+    """Whether ``model`` has the geometry of the paper's Table 1 PUMA (the published tables
+    apply only to it)."""
+    puma = load_model("puma")
+    return (model.n == puma.n and not model.prismatic.any()
+            and np.allclose(model.axes, puma.axes, atol=1e-9)
+            and np.allclose(model.bodies, puma.bodies, atol=1e-9))
+
+
+def default_parameters(model: Manipulator) -> tuple[str, ...]:
+    """The paper's ten parameters for the Table 1 PUMA; otherwise every nonzero link vector
+    LE{k} and every joint axis JE{k}."""
+    if is_paper_model(model):
+        return PAPER_PARAMETERS
+    le = [f"LE{k}" for k in range(1, model.n + 2)
+          if np.linalg.norm(model.bodies[k - 1]) > 0]
+    return (*le, *(f"JE{k}" for k in range(1, model.n + 1)))
+
+
+def _kind(study: StudyResult, kind: str) -> list[str]:
+    return [p for p in study.parameters if p.startswith(kind)]
+
+
 def _half_ulp(value: float, digits: int = 3) -> float:
     """Half a unit in the last printed digit of a value printed with ``digits`` digits."""
     if value == 0:
@@ -230,9 +253,9 @@ class PaperExample:
     timings_s: dict[str, float] = field(default_factory=dict)
 
 
-def _claims(study: StudyResult, path: JointPath) -> dict[str, Any]:
-    le = [p for p in LE_PARAMS if p in study.parameters]
-    je = [p for p in JE_PARAMS if p in study.parameters]
+def _claims(study: StudyResult, path: JointPath, published: bool = True) -> dict[str, Any]:
+    le = _kind(study, "LE")
+    je = _kind(study, "JE")
     out: dict[str, Any] = {}
     # 1. linearity (fit and R^2 per column), ours and published (as printed / typos corrected)
     lin = {p: vars(v) for p, v in study.linearity("delta_p").items()}
@@ -248,7 +271,8 @@ def _claims(study: StudyResult, path: JointPath) -> dict[str, Any]:
     pub_lin3 = {col: {"r2": fit_linearity(xs, np.array((PUBLISHED_TABLE3_ZERO, *v))).r2}
                 for col, v in PUBLISHED_TABLE3.items()}
     out["linearity"] = {"ours_delta_p": lin, "ours_delta_r": lin_r,
-                        "published_table2": pub_lin, "published_table3": pub_lin3}
+                        "published_table2": pub_lin if published else {},
+                        "published_table3": pub_lin3 if published else {}}
     # 2. joint-axis errors give larger positional deviations than link errors
     j01 = int(np.argmin(np.abs(study.xi_percent - 0.1)))
     ours_le = {p: float(study.max_delta_p[study.index(p), j01]) for p in le}
@@ -268,7 +292,7 @@ def _claims(study: StudyResult, path: JointPath) -> dict[str, Any]:
 
     out["je_greater_than_le_at_0.1pct"] = {
         "ours": _cmp(ours_le, ours_je) if le and je else None,
-        "published_typos_corrected": _cmp(pub_le, pub_je),
+        "published_typos_corrected": _cmp(pub_le, pub_je) if published else None,
     }
     # 3. link errors leave the orientation unchanged
     if le:
@@ -299,7 +323,7 @@ def _claims(study: StudyResult, path: JointPath) -> dict[str, Any]:
                      "closed_form_delta_r_0.1pct": float(np.sqrt(8.0) * np.sin(theta / 2.0)),
                      "ours_delta_r_0.1pct": float(study.max_delta_r[study.index(p), j01])}
     out["table3_closed_form"] = closed
-    out["paper_implied_max_abs_q_deg"] = implied_joint_angles()
+    out["paper_implied_max_abs_q_deg"] = implied_joint_angles() if published else {}
     return out
 
 
@@ -319,25 +343,30 @@ def run_paper_example(model: Manipulator | None = None, path: JointPath | None =
         path = circle_joint_path(model, steps=steps)
     timings["inverse_kinematics"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    study = one_at_a_time(model, path, PAPER_PARAMETERS, PAPER_XI)
+    published = is_paper_model(model)
+    study = one_at_a_time(model, path, default_parameters(model), PAPER_XI)
     timings["study"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    alt_l = one_at_a_time(model, path, LE_PARAMS, PUBLISHED_ROWS, sign_zero_links=1,
+    le, je = _kind(study, "LE"), _kind(study, "JE")
+    alt_l = one_at_a_time(model, path, le, PUBLISHED_ROWS, sign_zero_links=1,
                           sign_zero_axes=PAPER_SIGN_ZERO["axes"])
     import warnings
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        alt_a = one_at_a_time(model, path, JE_PARAMS, PUBLISHED_ROWS,
+        alt_a = one_at_a_time(model, path, je, PUBLISHED_ROWS,
                               sign_zero_links=PAPER_SIGN_ZERO["links"], sign_zero_axes=0)
     timings["alternative_conventions"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    cells = compare_with_published(study, model)
-    checks = _claims(study, path)
+    cells = compare_with_published(study, model) if published else []
+    checks = _claims(study, path, published)
+    first = le[0]
+    checks["published_values_apply"] = published
     checks["sign_convention_evidence"] = {
-        "LE2_0.02pct_sign0_links_0": _table_value(study, "delta_p", "LE2", 0.02),
-        "LE2_0.02pct_sign0_links_plus1": _table_value(alt_l, "delta_p", "LE2", 0.02),
-        "LE2_0.02pct_published": PUBLISHED_TABLE2["LE2"][0],
+        "link": first,
+        "link_0.02pct_sign0_links_0": _table_value(study, "delta_p", first, 0.02),
+        "link_0.02pct_sign0_links_plus1": _table_value(alt_l, "delta_p", first, 0.02),
+        "link_0.02pct_published": PUBLISHED_TABLE2[first][0] if published else None,
         "JE_max_delta_p_sign0_axes_0": float(alt_a.max_delta_p.max()),
         "JE_max_delta_r_sign0_axes_0": float(alt_a.max_delta_r.max()),
     }
@@ -356,56 +385,72 @@ def _check_writable(paths: list[Path], overwrite: bool) -> None:
 
 
 def comparison_markdown(ex: PaperExample) -> str:
-    """The comparison report (Markdown)."""
+    """The comparison report (Markdown); without published values for other models."""
     st = ex.study
     ch = ex.checks
+    pub = bool(ex.cells)
+    u = st.unit
     lines = [
-        "# Numerical example: comparison with the published Tables 2 and 3",
+        "# Numerical example: comparison with the published Tables 2 and 3" if pub else
+        "# One-at-a-time study (the paper's numerical example applied to another model)",
         "",
         f"Model: {ex.model.name}. Trajectory: {ex.path.label} ({st.t.size} samples).",
         f"Sign convention: {st.convention} (the defaults the published numbers imply).",
-        "Ratio = ours / published. Table 2 in mm; Table 3 is delta_R of eq (15) as the paper "
+        "Table 2 quantities in mm (model length unit); Table 3 is delta_R of eq (15) as the paper "
         "defines it (2 sqrt(2) sin(theta/2), ~ sqrt(2) x the error angle in rad).",
         "",
-        "## Cells",
-        "",
-        "| table | column | xi (%) | ours | published | ratio | status | note |",
-        "|---:|---|---:|---:|---:|---:|---|---|",
     ]
-    for c in ex.cells:
-        lines.append(f"| {c.table} | {c.column} | {c.xi_percent:g} | {c.ours:.3E} | "
-                     f"{c.published:.2E} | {c.ratio:.3f} | {c.status} | {c.note} |")
-    counts: dict[str, int] = {}
-    for c in ex.cells:
-        counts[c.status] = counts.get(c.status, 0) + 1
-    lines += ["", "Status counts: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())),
-              ""]
+    if pub:
+        lines += ["## Cells", "", "Ratio = ours / published.", "",
+                  "| table | column | xi (%) | ours | published | ratio | status | note |",
+                  "|---:|---|---:|---:|---:|---:|---|---|"]
+        for c in ex.cells:
+            lines.append(f"| {c.table} | {c.column} | {c.xi_percent:g} | {c.ours:.3E} | "
+                         f"{c.published:.2E} | {c.ratio:.3f} | {c.status} | {c.note} |")
+        counts: dict[str, int] = {}
+        for c in ex.cells:
+            counts[c.status] = counts.get(c.status, 0) + 1
+        lines += ["", "Status counts: " + ", ".join(f"{k} {v}" for k, v in
+                                                    sorted(counts.items())), ""]
+    else:
+        lines += ["The published Tables 2-3 belong to the paper's Table 1 PUMA; this model has "
+                  "no published values, so only the paper's checks are repeated.", ""]
     z = ch["zero_row"]
     ev = ch["sign_convention_evidence"]
+    ik_p = z["ik_max_position_error"]
+    ik_r = z["ik_max_orientation_error_rad"]
     lines += [
         "## The 0 % rows",
         "",
-        f"- Ours: max delta_p = {z['ours_max_delta_p']:.3g} mm and max delta_R = "
+        f"- Ours: max delta_p = {z['ours_max_delta_p']:.3g} {u} and max delta_R = "
         f"{z['ours_max_delta_r']:.3g}: with no perturbation the actual and desired poses are the "
         "same computation.",
-        f"- The paper's 1.07E-8 mm is its inverse-kinematics error. Ours: max position error "
-        f"{z['ik_max_position_error']:.3g} mm, orientation {z['ik_max_orientation_error_rad']:.3g}"
-        " rad (Newton-corrected predictor-corrector).",
-        f"- The paper's Table 3 5.96E-8 equals 2^-24 = {2.0**-24:.4E} (is 2^-24 within the "
-        f"printed digits: {z['published_table3_is_2^-24']}): the rounding floor of eq (15) "
-        "evaluated literally, sqrt(4 (1 - e0^2 + e.e)) with e0^2 ~ 1. This toolkit evaluates "
-        "the algebraically identical sqrt(8 e.e), which has no floor.",
+        "- Our inverse kinematics' own error against the commanded trajectory: "
+        + (f"{ik_p:.3g} {u}, orientation {ik_r:.3g} rad." if ik_p is not None
+           else "unknown (joint trajectory read from a file)."),
+    ]
+    if pub:
+        lines += [
+            "- The paper's 1.07E-8 mm is its inverse-kinematics error.",
+            f"- The paper's Table 3 5.96E-8 equals 2^-24 = {2.0**-24:.4E} (within the printed "
+            f"digits: {z['published_table3_is_2^-24']}): the rounding floor of eq (15) evaluated "
+            "literally, sqrt(4 (1 - e0^2 + e.e)) with e0^2 ~ 1. This toolkit evaluates the "
+            "algebraically identical sqrt(8 e.e), which has no floor.",
+        ]
+    lk = ev["link"]
+    lines += [
         "",
         "## Sign of zero (eqs 10-11)",
         "",
-        f"- LE2 at 0.02 %: sign(0) = 0 gives {ev['LE2_0.02pct_sign0_links_0']:.4E} mm, sign(0) = "
-        f"+1 gives {ev['LE2_0.02pct_sign0_links_plus1']:.4E} mm; published "
-        f"{ev['LE2_0.02pct_published']:.2E}. So links use sign(0) = 0.",
+        f"- {lk} at 0.02 %: sign(0) = 0 gives {ev['link_0.02pct_sign0_links_0']:.4E} {u}, "
+        f"sign(0) = +1 gives {ev['link_0.02pct_sign0_links_plus1']:.4E} {u}"
+        + (f"; published {ev['link_0.02pct_published']:.2E}. So links use sign(0) = 0."
+           if pub else "."),
         f"- Joint axes with sign(0) = 0: max delta_p over all JE cells = "
-        f"{ev['JE_max_delta_p_sign0_axes_0']:.3g} mm, max delta_R = "
-        f"{ev['JE_max_delta_r_sign0_axes_0']:.3g} (every PUMA axis has one nonzero component, "
-        "which eq 9 renormalises back); the published JE values are nonzero. So axes use "
-        "sign(0) = +1.",
+        f"{ev['JE_max_delta_p_sign0_axes_0']:.3g} {u}, max delta_R = "
+        f"{ev['JE_max_delta_r_sign0_axes_0']:.3g} (an axis with one nonzero component is "
+        "renormalised back to itself by eq 9)"
+        + ("; the published JE values are nonzero. So axes use sign(0) = +1." if pub else "."),
         "",
         "## The paper's claims, checked",
         "",
@@ -416,73 +461,70 @@ def comparison_markdown(ex: PaperExample) -> str:
         "|---|---:|---:|---:|---:|---:|",
     ]
     lin = ch["linearity"]
+    nan = float("nan")
     for p in st.parameters:
         o = lin["ours_delta_p"][p]
-        pub = lin["published_table2"].get(p, {})
+        pl = lin["published_table2"].get(p, {})
         lines.append(f"| {p} (delta_p) | {o['slope']:.5g} | {o['r2']:.8f} | "
                      f"{o['slope_pos']:.5g} / {o['slope_neg']:.5g} | "
-                     f"{pub.get('r2_as_printed', float('nan')):.8f} | "
-                     f"{pub.get('r2_typos_corrected', float('nan')):.8f} |")
+                     f"{pl.get('r2_as_printed', nan):.8f} | "
+                     f"{pl.get('r2_typos_corrected', nan):.8f} |")
     for p, o in lin["ours_delta_r"].items():
         pub3 = lin["published_table3"].get(p, {})
         lines.append(f"| {p} (delta_R) | {o['slope']:.5g} | {o['r2']:.8f} | "
                      f"{o['slope_pos']:.5g} / {o['slope_neg']:.5g} | "
-                     f"{pub3.get('r2', float('nan')):.8f} | - |")
+                     f"{pub3.get('r2', nan):.8f} | - |")
     lines += ["", "Link errors are exactly linear (a pure translation xi ||b_k||); axis errors are "
-              "linear to first order (R^2 > 0.9999 here; the small +/- slope asymmetry is the "
-              "second-order term, from the 1/(1 + xi) of eq (9) and the curvature of the "
-              "rotation).", ""]
+              "linear to first order; the small +/- slope asymmetry is the second-order term, "
+              "from the 1/(1 + xi) of eq (9) and the curvature of the rotation.", ""]
     jl = ch["je_greater_than_le_at_0.1pct"]
     lines += ["### Joint-axis errors vs link errors (max delta_p at 0.1 %)", ""]
-    for who, v in (("ours", jl["ours"]), ("published (typos corrected)",
-                                         jl["published_typos_corrected"])):
-        if v is None:
-            continue
-        lines.append(f"- {who}: mean JE = {v['mean_JE']:.4g} mm, mean LE = {v['mean_LE']:.4g} "
-                     f"mm, ratio {v['mean_ratio_JE_over_LE']:.3g}; JE > LE in "
-                     f"{v['pairs_JE_greater']} (JE, LE) pairs; JE columns below the largest LE: "
-                     f"{', '.join(v['JE_below_max_LE']) or 'none'}.")
-    pub_v = jl["published_typos_corrected"]
-    ours_v = jl["ours"]
     verdict = []
-    for who, v in (("in the paper's own table", pub_v), ("on our circle", ours_v)):
+    for who, v in (("in the paper's own table (typos corrected)",
+                    jl["published_typos_corrected"]), ("on our trajectory", jl["ours"])):
         if v is None:
             continue
+        lines.append(f"- {who}: mean JE = {v['mean_JE']:.4g} {u}, mean LE = "
+                     f"{v['mean_LE']:.4g} {u}, ratio {v['mean_ratio_JE_over_LE']:.3g}; JE > LE "
+                     f"in {v['pairs_JE_greater']} (JE, LE) pairs; JE columns below the largest "
+                     f"LE: {', '.join(v['JE_below_max_LE']) or 'none'}.")
         avg = "holds on average" if v["mean_ratio_JE_over_LE"] > 1 else "fails on average"
         col = ("and column by column" if not v["JE_below_max_LE"]
                else "but not column by column")
         verdict.append(f"{who} the claim {avg} {col}")
-    lines += ["", "; ".join(verdict).capitalize() + ". How large an axis error is depends on "
-              "the lever arm from the axis to the tool and on how far that joint turns (below), "
-              "so it is trajectory-dependent, while a link error is not.", ""]
+    if verdict:
+        lines += ["", "; ".join(verdict).capitalize() + ". How large an axis error is depends "
+                  "on the lever arm from the axis to the tool and on how far that joint turns "
+                  "(below), so it is trajectory-dependent, while a link error is not.", ""]
     if "link_errors_max_angle_rad" in ch:
         lines += ["### Link errors leave the orientation unchanged", "",
                   f"Max error angle over all LE cells: {ch['link_errors_max_angle_rad']:.3g} rad "
                   f"(delta_R {ch['link_errors_max_delta_r']:.3g}). Exact: body vectors are "
                   "rotated but never rotate anything (the identification Jacobian's orientation "
                   "rows are identically zero for them).", ""]
-    lines += ["## Why the JE columns differ: joint angles", "",
+    imp = ch["paper_implied_max_abs_q_deg"]
+    lines += ["## Joint angles decide the JE rotations", "",
               "For JE_k only the joint's own angle matters for the rotation: with the sign(0) = +1"
               " tilt alpha = atan(sqrt(2) xi / (1 + xi)), sin(theta/4) = |sin(q_k/2)| "
-              "sin(alpha/2). Inverting the published Table 3 gives how far each joint turned in "
-              "the paper's run:", "",
+              "sin(alpha/2)." + (" Inverting the published Table 3 gives how far each joint "
+                                 "turned in the paper's run:" if pub else ""), "",
               "| column | paper: implied max abs(q_k) (deg) | ours: max abs(q_k) (deg) | ours "
               "delta_R 0.1 % | closed form from max abs(q_k) |",
               "|---|---:|---:|---:|---:|"]
-    imp = ch["paper_implied_max_abs_q_deg"]
     for p, v in ch["table3_closed_form"].items():
-        lo, hi = imp[p]["deg_min"], imp[p]["deg_max"]
-        lines.append(f"| {p} | {lo:.1f} - {hi:.1f} | {v['max_abs_q_deg']:.2f} | "
+        rng = (f"{imp[p]['deg_min']:.1f} - {imp[p]['deg_max']:.1f}" if p in imp else "-")
+        lines.append(f"| {p} | {rng} | {v['max_abs_q_deg']:.2f} | "
                      f"{v['ours_delta_r_0.1pct']:.4E} | {v['closed_form_delta_r_0.1pct']:.4E} |")
-    lo_all = min(v["deg_min"] for v in imp.values())
-    ours_max = max(v["max_abs_q_deg"] for v in ch["table3_closed_form"].values())
-    lines += ["", f"The paper's joints reach {lo_all:.0f}-180 deg from the zero reference "
-              f"position; ours stay within {ours_max:.0f} deg (trajectory: {ex.path.label}). "
-              "The closed form reproduces our column exactly, so the difference is the "
-              "trajectory, not the model. The paper does not publish its circle's centre, "
-              "plane, orientation law or start configuration, so the JE cells are flagged as "
-              "trajectory-dependent rather than tuned.", "",
-              "## Compute time", "",
+    if pub and imp:
+        lo_all = min(v["deg_min"] for v in imp.values())
+        ours_max = max(v["max_abs_q_deg"] for v in ch["table3_closed_form"].values())
+        lines += ["", f"The paper's joints reach {lo_all:.0f}-180 deg from the zero reference "
+                  f"position; ours stay within {ours_max:.0f} deg (trajectory: {ex.path.label})."
+                  " The closed form reproduces our column exactly, so the difference is the "
+                  "trajectory, not the model. The paper does not publish its circle's centre, "
+                  "plane, orientation law or start configuration, so the JE cells are flagged as "
+                  "trajectory-dependent rather than tuned."]
+    lines += ["", "## Compute time", "",
               *(f"- {k}: {v * 1e3:.1f} ms" for k, v in ex.timings_s.items()), ""]
     return "\n".join(lines)
 
@@ -496,8 +538,10 @@ def _figures(ex: PaperExample, out: Path, overwrite: bool) -> list[Path]:
     st = ex.study
     conv = f"sign(0): links {st.sign_zero_links:+d}, axes {st.sign_zero_axes:+d}".replace(
         "+0", "0")
-    je = [p for p in JE_PARAMS if p in st.parameters]
-    le = [p for p in LE_PARAMS if p in st.parameters]
+    je = _kind(st, "JE")
+    le = _kind(st, "LE")
+    pub2 = PUBLISHED_TABLE2 if ex.cells else None
+    pub3 = PUBLISHED_TABLE3 if ex.cells else None
     colors = plt.rcParams["axes.prop_cycle"].by_key()["color"]
     files: list[Path] = []
 
@@ -543,14 +587,15 @@ def _figures(ex: PaperExample, out: Path, overwrite: bool) -> list[Path]:
 
     u = st.unit
     if je:
-        sweep(je, st.max_delta_p, PUBLISHED_TABLE2, 2, f"max positional deviation ({u})",
-              "Fig. 2: joint-axis misalignments vs max positional deviation\n(published typos "
-              "JE1, JE2 at 0.1 % omitted)", "fig2_je_max_position.png")
-        sweep(je, st.max_delta_r, PUBLISHED_TABLE3, 3, "max rotational deviation, eq (15)",
+        sweep(je, st.max_delta_p, pub2, 2, f"max positional deviation ({u})",
+              "Fig. 2: joint-axis misalignments vs max positional deviation"
+              + ("\n(published typos JE1, JE2 at 0.1 % omitted)" if pub2 else ""),
+              "fig2_je_max_position.png")
+        sweep(je, st.max_delta_r, pub3, 3, "max rotational deviation, eq (15)",
               "Fig. 3: joint-axis misalignments vs max rotational deviation",
               "fig3_je_max_rotation.png")
     if le:
-        sweep(le, st.max_delta_p, PUBLISHED_TABLE2, 2, f"max positional deviation ({u})",
+        sweep(le, st.max_delta_p, pub2, 2, f"max positional deviation ({u})",
               "Fig. 4: link-dimension perturbations vs max positional deviation",
               "fig4_le_max_position.png")
     if je:
@@ -590,7 +635,7 @@ def write_paper_outputs(ex: PaperExample, out_dir: str | Path = "renders", *,
     st = ex.study
     files: list[Path] = []
     rows = (0.0, *PUBLISHED_ROWS)
-    je = [p for p in JE_PARAMS if p in st.parameters]
+    je = _kind(st, "JE")
     ik_p = ex.path.ik_position_error
     cap2 = ("Table 2: link-dimension errors and joint-axis misalignments, maximum positional "
             f"deviations ({st.unit}). The 0 % row is identically zero (actual = desired); the "
