@@ -182,9 +182,14 @@ class OffscreenRenderer:
         return True
 
     # ---- drawing -----------------------------------------------------------------------------
+    def _current(self) -> mujoco.MjrContext:
+        con = self._require_open()
+        self._ctx.make_current()  # several renderers may live in one process
+        return con
+
     def render(self) -> None:
         """Draw the scene into the offscreen buffer (overlays may be drawn after it)."""
-        mujoco.mjr_render(self.rect, self.scene, self._require_open())
+        mujoco.mjr_render(self.rect, self.scene, self._current())
 
     def text(self, text: str, text2: str = "", *,
              corner: mujoco.mjtGridPos = mujoco.mjtGridPos.mjGRID_TOPLEFT,
@@ -200,7 +205,7 @@ class OffscreenRenderer:
 
     def read(self, flip: bool = True) -> U8:
         """The RGB image, shape (height, width, 3), top row first (a fresh array)."""
-        mujoco.mjr_readPixels(self._rgb, None, self.rect, self._require_open())
+        mujoco.mjr_readPixels(self._rgb, None, self.rect, self._current())
         return np.flipud(self._rgb).copy() if flip else self._rgb.copy()
 
     def render_image(self, data: mujoco.MjData,

@@ -237,3 +237,16 @@ def test_exaggerated_model_scales_the_errors():
     assert np.linalg.norm(p10 - p0) == pytest.approx(10 * np.linalg.norm(p1 - p0), rel=0.05)
     same = sim.video.exaggerated_model(nominal, perturbed, 1.0)
     np.testing.assert_allclose(same.axes, perturbed.axes, atol=1e-15)
+
+
+def test_two_renderers_in_one_process(backend, puma_arm):
+    q = [0.9, -0.6, 0.8, 0.3, 1.0, 0.2]
+    with sim.OffscreenRenderer(puma_arm.model, 160, 120, backend=backend) as a, \
+            sim.OffscreenRenderer(puma_arm.model, 160, 120, backend=backend) as b:
+        for r in (a, b):
+            r.look_at([0.3, 0.1, -0.3], 2.5)
+        img_a = a.render_image(_pose(puma_arm, np.zeros(6)))
+        img_b = b.render_image(_pose(puma_arm, q))
+        img_a2 = a.render_image(_pose(puma_arm, np.zeros(6)))
+    np.testing.assert_array_equal(img_a, img_a2)
+    assert np.any(img_a != img_b)
