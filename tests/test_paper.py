@@ -90,7 +90,7 @@ def test_other_model_runs_without_published_values(tmp_path):
     assert ex.checks["link_errors_max_angle_rad"] == 0.0
     files = write_paper_outputs(ex, tmp_path, figures=False)
     assert "no published values" in (tmp_path / "comparison.md").read_text()
-    assert len(files) == 9
+    assert len(files) == 11
 
 
 def test_outputs_written_and_not_overwritten(example, tmp_path):
@@ -121,3 +121,13 @@ def test_cli_paper_study_tolerance(tmp_path, capsys):
     assert "LE9" in capsys.readouterr().err
     assert main(["tolerance", "--tol", "nonsense", "-n", "10"]) == 2
     assert "NAME=VALUE" in capsys.readouterr().err
+    bad = tmp_path / "bad.toml"
+    bad.write_text('name = "x"\n[[joint]]\ntype = "revolute"\naxis = [0, 0, 0]\n'
+                   'body = [0, 0, 1]\n[end_effector]\nbody = [0, 0, 1]\naxial = [0, 0, 1]\n'
+                   'transverse = [1, 0, 0]\n')
+    assert main(["study", "--model", str(bad), "--params", "LE1"]) == 2
+    err = capsys.readouterr().err
+    assert "bad.toml" in err and "axis" in err
+    assert main(["study", "--params", "LE2", "--xi", "0.05", "0.1", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)  # strict JSON: no NaN for the missing - side
+    assert out["linearity_delta_p"]["LE2"]["slope_neg"] is None

@@ -87,3 +87,54 @@ def test_unknown_names_and_bad_sign():
     with pytest.raises(InputError, match="given twice"):
         Perturbation({"LE2": 0.01, "le2": 0.02})
     assert perturbation_names(model)[:1] == ("LE1",) and perturbation_names(model)[-1] == "JE6"
+
+
+# ---- properties (hypothesis) -------------------------------------------------------------
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+_comp = st.one_of(st.just(0.0), st.floats(-500, 500, allow_nan=False).filter(
+    lambda x: abs(x) > 1e-3))
+_vec = st.tuples(_comp, _comp, _comp).map(np.array)
+_xi = st.floats(-0.99, 0.99, allow_nan=False)
+
+
+@settings(max_examples=60, deadline=None)
+@given(v=_vec, xi=_xi, s0=st.sampled_from([-1, 0, 1]))
+def test_eq11_change_has_closed_form_norm(v, xi, s0):
+    """v' - v has |xi| ||v|| in every component that eq (11) touches, so ||v' - v|| =
+    |xi|/100 ||v|| sqrt(m), m = nonzero components (all 3 when sign(0) != 0)."""
+    d = perturb_components(v, xi, s0) - v
+    m = 3 if s0 != 0 else np.count_nonzero(v)
+    expected = abs(xi) / 100 * np.linalg.norm(v) * np.sqrt(m)
+    assert np.linalg.norm(d) == pytest.approx(expected, rel=1e-9, abs=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(v=_vec.filter(lambda v: np.linalg.norm(v) > 1e-2), xi=_xi, s0=st.sampled_from([1, -1]))
+def test_eq9_axis_is_unit(v, xi, s0):
+    u = v / np.linalg.norm(v)
+    up = perturb_axis(u, xi, s0)
+    assert np.linalg.norm(up) == pytest.approx(1.0, abs=1e-14)
+
+
+@settings(max_examples=25, deadline=None)
+@given(k=st.integers(1, 7), v=_vec, xi=_xi, seed=st.integers(0, 10_000))
+def test_link_error_is_a_constant_translation_on_any_arm(k, v, xi, seed):
+    """Whatever the arm and the joints, LE_k moves the tool by ||b_k' - b_k|| (eq 2 rotates
+    b_k rigidly) and never rotates it."""
+    from zrp.deviation import trajectory_deviation
+    from zrp.model import Manipulator
+
+    rng = np.random.default_rng(seed)
+    axes = rng.normal(size=(6, 3))
+    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
+    bodies = rng.uniform(-300, 300, size=(7, 3))
+    bodies[k - 1] = v
+    model = Manipulator.from_arrays(axes, bodies, axial=[0, 0, 1], transverse=[1, 0, 0])
+    q = rng.uniform(-np.pi, np.pi, size=(20, 6))
+    dev = trajectory_deviation(model, Perturbation.single(f"LE{k}", xi), q)
+    step = np.linalg.norm(perturb_components(v, xi, 0) - v)
+    np.testing.assert_allclose(dev.delta_p, step, rtol=1e-7, atol=1e-9)
+    # from_arrays renormalises the (unchanged) axes, which may move their last bit
+    assert dev.max_angle_rad < 1e-14

@@ -616,6 +616,7 @@ def output_names() -> list[str]:
     """File names :func:`write_paper_outputs` writes (figures, tables, report, summary)."""
     return ["table2_max_position.csv", "table2_max_position.md", "table2_full.csv",
             "table3_max_rotation.csv", "table3_max_rotation.md", "table3_full.csv",
+            "table3_angle_rad.csv", "table3_angle_rad.md",
             "comparison.md", "comparison.csv", "paper_example.json",
             "fig2_je_max_position.png", "fig3_je_max_rotation.png", "fig4_le_max_position.png",
             "fig5_je_position_time.png", "fig6_je_rotation_time.png",
@@ -655,6 +656,12 @@ def write_paper_outputs(ex: PaperExample, out_dir: str | Path = "renders", *,
         files.append(st.write_table(out / "table3_max_rotation.md", "delta_r", je,
                                     xi_rows=rows, overwrite=True, caption=cap3))
         files.append(st.write_table(out / "table3_full.csv", "delta_r", je, overwrite=True))
+        files.append(st.write_table(out / "table3_angle_rad.csv", "angle_rad", je,
+                                    xi_rows=rows, overwrite=True))
+        files.append(st.write_table(
+            out / "table3_angle_rad.md", "angle_rad", je, xi_rows=rows, overwrite=True,
+            caption="Table 3 as plain error angles theta (rad) of E_a conj(E_d); eq (15) "
+                    "above is 2 sqrt(2) sin(theta/2)."))
     p = out / "comparison.md"
     p.write_text(comparison_markdown(ex), encoding="utf-8")
     files.append(p)

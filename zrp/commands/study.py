@@ -111,7 +111,9 @@ def _study(args: argparse.Namespace) -> int:
                 files.append(str(st.write_table(out / f"study_{q}.{ext}", q,
                                                 overwrite=args.force)))
     payload = st.summary()
-    payload["linearity_delta_p"] = {k: vars(v) for k, v in st.linearity().items()}
+    payload["linearity_delta_p"] = {
+        k: {f: (None if isinstance(x, float) and not np.isfinite(x) else x)
+            for f, x in vars(v).items()} for k, v in st.linearity().items()}
     payload["files"] = files
     u = st.unit
     lines = [f"{model.name}: {path.label} ({st.t.size} samples)",

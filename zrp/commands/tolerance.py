@@ -164,9 +164,11 @@ def _tolerance(args: argparse.Namespace) -> int:
         + ", ".join(f"{p.upper()} {v:.4g}" for p, v in payload["max_angle_rad"].items()),
         f"P{pct:g} delta_p = {dp:.4g} {u} (95 % CI {lo:.4g}..{hi:.4g}); first-order model "
         f"with the same draws: {fo_p:.4g} {u}",
-        f"first-order worst case: {rep['worst_case_delta_p']:.4g} {u}, "
+        f"first-order worst case over the +-tol box: {rep['worst_case_delta_p']:.4g} {u}, "
         f"{rep['worst_case_angle_rad']:.3g} rad; Monte Carlo max reached "
-        f"{rep['mc_over_worst_case_p']:.2f} of it",
+        f"{rep['mc_over_worst_case_p']:.2f} of it"
+        + (" (normal draws can leave the 3-sigma box)" if args.distribution == "normal"
+           else ""),
         "",
         rep["contribution"].markdown(u, top=args.top),
     ]
