@@ -36,6 +36,7 @@ from .fit import (
     initial_registration,
     orthonormal_basis,
     point_errors,
+    group_key,
     wald_groups,
 )
 from .problem import Problem
@@ -269,16 +270,31 @@ class Diagnosis:
         """Final over nominal withheld RMS (1: no improvement)."""
         return self.final.rms / self.nominal.rms if self.nominal.rms > 0 else 1.0
 
+    @property
+    def final_parameters(self) -> tuple[ParameterEstimate, ...]:
+        """All effect parameters of the final model, estimated jointly (after the backward
+        pass), with 95 % intervals. The per-step values are each estimated without the effects
+        added later, so these are the ones to use."""
+        nreg = len(self.registration)
+        return _estimates(self.final_fit, nreg)
+
+    @property
+    def final_joints(self) -> dict[str, tuple[int, ...]]:
+        """Effect -> joints (body-vector indices for link_length) in the final model."""
+        out: dict[str, set[int]] = {}
+        for s in self.final_fit.specs[len(self.registration):]:
+            out.setdefault(s.effect, set())
+            if s.joint > 0:
+                out[s.effect].add(s.joint)
+        return {e: tuple(sorted(j)) for e, j in out.items()}
+
     def parameter(self, name: str) -> ParameterEstimate:
-        """The final estimate of one parameter (from the last step that carries it)."""
-        for st in reversed(self.steps):
-            for p in st.parameters:
-                if p.name == name:
-                    return p
-        for p in self.registration:
+        """The final estimate of one parameter (registration or effect)."""
+        for p in self.final_parameters + self.registration:
             if p.name == name:
                 return p
-        raise InputError(f"no identified parameter {name!r}")
+        raise InputError(f"no identified parameter {name!r}; identified: "
+                         f"{', '.join(p.name for p in self.final_parameters)}")
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON document (schema in docs/diagnosis.md)."""
@@ -295,6 +311,9 @@ class Diagnosis:
             "steps": [s.to_dict() for s in self.steps],
             "effects": list(self.effects),
             "final": {**self.final.to_dict(), "shrink": self.shrink,
+                      "effects": [{"effect": e, "joints": list(j)}
+                                  for e, j in self.final_joints.items()],
+                      "parameters": [p.to_dict() for p in self.final_parameters],
                       "ratio_to_noise_floor": (None if nf.rms is None or nf.rms == 0
                                                else self.final.rms / nf.rms)},
             "noise_floor": nf.to_dict(),
@@ -724,14 +743,14 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
             pv = wald_groups(f1, nb)
             thr = alpha / max(len(pv), 1)
             sig = {g for g, p in pv.items() if p < thr}
-            kept = [s for s in keep if s.group in sig]
+            kept = [s for s in keep if group_key(s) in sig]
             if not kept:
                 cands.append((Candidate(eff, (), 0, cv_rms(ctx, f1, folds),
                                         f1.bic - current.bic, f_test(current, f1), False,
                                         "no joint significant"), None, aliased))
                 continue
             if len(kept) < len(keep):
-                idx = [nb + i for i, s in enumerate(keep) if s.group in sig]
+                idx = [nb + i for i, s in enumerate(keep) if group_key(s) in sig]
                 f1 = fit(ctx, list(current.specs) + kept, fitting,
                          np.concatenate([f1.theta[:nb], f1.theta[idx]]), rb0)
             cv = cv_rms(ctx, f1, folds)
@@ -767,6 +786,23 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
                           tuple(c[0] for c in ranked), weak_or_dropped, overlap))
         current, current_cv = f_new, cand.cv_rms
     bar.close()
+    # backward pass: joints that an effect picked up while another effect was still missing
+    # are dropped when the final model no longer needs them
+    nreg = len(reg.specs)
+    pruned: list[str] = []
+    while len(current.specs) > nreg:
+        pv = wald_groups(current, nreg)
+        thr = alpha / max(len(pv), 1)
+        drop = {g for g, p in pv.items() if p >= thr}
+        if not drop:
+            break
+        keep_idx = [i for i, s in enumerate(current.specs)
+                    if i < nreg or group_key(s) not in drop]
+        pruned += sorted(drop)
+        current = fit(ctx, [current.specs[i] for i in keep_idx], fitting,
+                      current.theta[keep_idx], rb0)
+    if pruned:
+        where["backward_pruned"] = pruned
     after = _withheld(ctx, current, withheld)
     final = Metrics.of(after)
 

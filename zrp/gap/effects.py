@@ -131,7 +131,8 @@ class Context:
             (then the lumped-mass model is used).
         gravity_dir: unit direction of gravity in the base frame, shape (3,).
         harmonics: harmonics of ``cyclic_error`` (periods 2 pi / h in the joint angle).
-        t_ref_degC: reference temperature of ``thermal_expansion`` (default: mean of the data).
+        t_ref_degC: reference temperature of ``thermal_expansion``, deg C (default 20, the
+            ISO 1 reference temperature at which the nominal lengths are taken to hold).
     """
 
     model: Manipulator
@@ -139,7 +140,7 @@ class Context:
     gravity_torque: F64 | None = None
     gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0)
     harmonics: tuple[int, ...] = (1, 2)
-    t_ref_degC: float | None = None
+    t_ref_degC: float = 20.0
 
     def __post_init__(self) -> None:
         if self.meas.n_joints != self.model.n:
@@ -174,7 +175,7 @@ class Context:
         temp = self.meas.per_pose("temp")
         if temp is None:
             return None
-        return float(np.mean(temp)) if self.t_ref_degC is None else float(self.t_ref_degC)
+        return float(self.t_ref_degC)
 
     @cached_property
     def dtemp(self) -> F64 | None:

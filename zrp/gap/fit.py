@@ -24,6 +24,7 @@ __all__ = [
     "check_identifiable",
     "cv_rms",
     "f_test",
+    "group_key",
     "fit",
     "initial_registration",
     "orthonormal_basis",
@@ -306,12 +307,17 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
     return keep, report
 
 
+def group_key(spec: ParamSpec) -> str:
+    """The significance group of a parameter, unique across effects ("effect:group")."""
+    return f"{spec.effect}:{spec.group}"
+
+
 def wald_groups(result: FitResult, first: int) -> dict[str, float]:
-    """p-value of the Wald test (all parameters of a group zero) per group, for the parameters
-    from index ``first`` on."""
+    """p-value of the Wald test (all parameters of a group zero) per :func:`group_key`, for
+    the parameters from index ``first`` on."""
     groups: dict[str, list[int]] = {}
     for i in range(first, len(result.specs)):
-        groups.setdefault(result.specs[i].group, []).append(i)
+        groups.setdefault(group_key(result.specs[i]), []).append(i)
     out: dict[str, float] = {}
     for g, idx in groups.items():
         th = result.theta[idx]
