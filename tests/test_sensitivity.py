@@ -130,3 +130,22 @@ def test_bad_input():
         apply_parameters(model, np.zeros(32))
     with pytest.raises(InputError, match="finite"):
         apply_parameters(model, np.full(33, np.nan))
+
+
+def test_pose_error_is_first_order_in_dx():
+    """pose_error - J dx shrinks quadratically with the step (second-order remainder)."""
+    from zrp.sensitivity import pose_error
+
+    model = load_model("puma")
+    q = np.random.default_rng(0).uniform(-2, 2, (5, 6))
+    space = parameter_space(model)
+    base = np.random.default_rng(1).normal(size=space.size) * np.where(
+        np.array(space.units) == "rad", 1e-3, 1.0)
+    jac = parameter_jacobian(model, q)
+    res = []
+    for h in (1.0, 0.5, 0.25):
+        actual, _ = apply_parameters(model, h * base)
+        res.append(np.abs(pose_error(model, actual, q) - jac @ (h * base)).max())
+    assert res[0] > 1e-9
+    assert res[1] / res[0] == pytest.approx(0.25, rel=0.05)
+    assert res[2] / res[1] == pytest.approx(0.25, rel=0.05)

@@ -99,6 +99,7 @@ LIKELY_TYPOS: dict[tuple[int, str, float], float] = {
     (2, "JE1", 0.1): 7.88e-1,
     (2, "JE2", 0.1): 1.33e0,
 }
+CELL_STATUSES = ("match", "discrepancy", "typo", "trajectory-dependent")
 LE_PARAMS = ("LE2", "LE3", "LE4", "LE7")
 JE_PARAMS = ("JE1", "JE2", "JE3", "JE4", "JE5", "JE6")
 
@@ -153,6 +154,13 @@ class Cell:
     ratio: float
     status: str
     note: str
+
+    def __post_init__(self) -> None:
+        if self.table not in (2, 3):
+            raise InputError(f"Cell.table: expected 2 or 3, got {self.table!r}")
+        if self.status not in CELL_STATUSES:
+            raise InputError(f"Cell.status: expected one of {CELL_STATUSES}, got "
+                             f"{self.status!r}")
 
 
 def implied_joint_angles(table3: dict[str, tuple[float, ...]] | None = None,
@@ -251,6 +259,10 @@ class PaperExample:
     cells: list[Cell]
     checks: dict[str, Any]
     timings_s: dict[str, float] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.study, StudyResult) or not isinstance(self.path, JointPath):
+            raise InputError("PaperExample: study must be a StudyResult and path a JointPath")
 
 
 def _claims(study: StudyResult, path: JointPath, published: bool = True) -> dict[str, Any]:

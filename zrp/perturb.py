@@ -127,7 +127,7 @@ def parameter_label(kind: str, k: int) -> str:
     return f"{kind}{k}"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Perturbation:
     """A set of percentage perturbations (eqs 8-12) and the sign(0) convention.
 

@@ -58,6 +58,7 @@ __all__ = [
     "parameter_names",
     "parameter_space",
     "perturbed_arrays",
+    "pose_error",
     "tilt_axes",
     "worst_case_bound",
 ]
@@ -276,6 +277,27 @@ def parameter_jacobian(model: Manipulator, q: ArrayLike, *,
     return jac
 
 
+def pose_error(nominal: Manipulator, actual: Manipulator, q: ArrayLike, *,
+               q_offset: ArrayLike | None = None) -> F64:
+    """Pose error of ``actual`` against ``nominal`` at the same joints, in Jacobian row order.
+
+    Returns ``[rotvec(E_a * conj(E_d)) (rad, base frame); p_a - p_d (length unit)]``, shape
+    (..., 6) for q of shape (..., n); to first order it equals
+    ``parameter_jacobian(nominal, q) @ dx`` (the residual used for identification).
+    """
+    from .kinematics import end_effector_pose
+    from .rodrigues import er_conjugate, er_to_rotvec
+
+    if actual.n != nominal.n:
+        raise InputError(f"actual: has {actual.n} joints, the nominal model {nominal.n}")
+    q = check_q(nominal, q)
+    qa = q if q_offset is None else q + check_q(nominal, q_offset, "q_offset")
+    p_d, e_d = end_effector_pose(nominal, q)
+    p_a, e_a = end_effector_pose(actual, qa)
+    rv = er_to_rotvec(er_multiply(e_a, er_conjugate(e_d)))
+    return np.concatenate([rv, p_a - p_d], axis=-1)
+
+
 def worst_case_bound(jac: ArrayLike, tolerances: ArrayLike) -> tuple[F64, F64]:
     """First-order worst case over the tolerance box |dx_i| <= tol_i, per trajectory point.
 
@@ -322,6 +344,16 @@ class Contribution:
     worst_r: F64
     share_p: F64
     share_r: F64
+
+    def __post_init__(self) -> None:
+        p = len(self.names)
+        for name in ("tolerance", "sens_p_max", "sens_r_max", "worst_p", "worst_r", "share_p",
+                     "share_r"):
+            if np.shape(getattr(self, name)) != (p,):
+                raise InputError(f"Contribution.{name}: expected shape ({p},), got "
+                                 f"{np.shape(getattr(self, name))}")
+        if len(self.units) != p:
+            raise InputError(f"Contribution.units: expected {p} entries, got {len(self.units)}")
 
     def rows(self) -> list[dict[str, float | str]]:
         return [
