@@ -439,6 +439,13 @@ class Allocation:
     worst_case_angle_rad: float
     scale_rounds: int
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.tolerances, Tolerances) or not isinstance(self.baseline,
+                                                                          Tolerances):
+            raise InputError("Allocation: tolerances and baseline must be Tolerances")
+        if not isinstance(self.verification, MonteCarloResult):
+            raise InputError("Allocation.verification: expected a MonteCarloResult")
+
     def summary(self) -> dict[str, Any]:
         pct = float(self.requirement["percentile"] or 99.0)
         dp, ang = self.verification.percentile(pct)
