@@ -33,10 +33,10 @@ from .fit import (
     cv_rms,
     f_test,
     fit,
+    group_key,
     initial_registration,
     orthonormal_basis,
     point_errors,
-    group_key,
     wald_groups,
 )
 from .problem import Problem

@@ -174,21 +174,33 @@ def _markdown(diag: Diagnosis) -> str:
     L.append("\n![shrink](shrink.png)\n")
     L.append("![residuals](residuals_before_after.png)\n")
     L.append("![residual vs joint](residual_vs_joint.png)\n")
-    L.append("## Identified parameters (95 % intervals)\n")
-    for i, st in enumerate(diag.steps, 1):
-        L.append(f"### Step {i}: {st.effect}\n")
+    L.append("## Identified parameters (final model, 95 % intervals)\n")
+    L.append("Estimated jointly in the final model (the per-step values in diagnosis.json were "
+             "each estimated before the later effects were added).\n")
+    by_eff: dict[str, list[Any]] = {}
+    for p in diag.final_parameters:
+        by_eff.setdefault(p.effect, []).append(p)
+    for eff, params in by_eff.items():
+        L.append(f"### {eff} (joints {', '.join(map(str, diag.final_joints.get(eff, ()))) or '-'})"
+                 "\n")
         L.append("| parameter | value | 95 % interval |")
         L.append("|---|---|---|")
-        for p in st.parameters:
+        for p in params:
             L.append(f"| {p.name} | {_val(p.value, p.unit)} | {_ci(p, p.unit)} |")
+        L.append("")
+    for i, st in enumerate(diag.steps, 1):
         if not math.isnan(st.geometric_overlap):
-            L.append(f"Geometric overlap: {100 * st.geometric_overlap:.0f} % of this step's "
-                     "correction could also be produced by joint offsets, encoder scales, link "
-                     "and axis errors over these poses"
+            L.append(f"Step {i} ({st.effect}): geometric overlap "
+                     f"{100 * st.geometric_overlap:.0f} %: that share of the step's correction "
+                     "could also be produced by joint offsets, encoder scales, link and axis "
+                     "errors over these poses"
                      + (" (so it is only weakly distinguishable from geometry; e.g. a first "
                         "harmonic overlaps an offset and a scale when a joint turns less than a "
                         "full turn)." if st.geometric_overlap > 0.5 else "."))
-        L.append("")
+            L.append("")
+    if diag.where.get("backward_pruned"):
+        L.append("Dropped in the backward pass (no longer significant in the final model): "
+                 + ", ".join(diag.where["backward_pruned"]) + ".\n")
     L.append("Registration:\n")
     L.append("| parameter | value | 95 % interval |")
     L.append("|---|---|---|")
