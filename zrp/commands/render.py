@@ -70,8 +70,8 @@ def _run(args: argparse.Namespace) -> int:
     payload = {
         "videos": [{"path": str(r.path), "frames": r.frames, "wall_seconds": r.wall_seconds,
                     "magnify": r.magnify, "backend": r.backend,
-                    "segments": [{"label": lab, "max_delta_p_mm": dp, "max_delta_R_eq15": dr,
-                                  "max_theta_rad": th}
+                    "segments": [{"label": lab.replace("\n", "; "), "max_delta_p_mm": dp,
+                                  "max_delta_R_eq15": dr, "max_theta_rad": th}
                                  for lab, dp, dr, th in zip(r.labels, r.max_delta_p,
                                                             r.max_delta_r, r.max_theta,
                                                             strict=True)]}
