@@ -63,6 +63,14 @@ class DynamicPlayback:
     options: MJCFOptions
     velocity_feedforward: bool = True
 
+    def __post_init__(self) -> None:
+        n_t = np.asarray(self.t).shape
+        if len(n_t) != 1 or np.asarray(self.tracking_error).shape != n_t \
+                or np.asarray(self.position_dynamic).shape != (*n_t, 3) \
+                or np.asarray(self.q_actual).shape != np.asarray(self.q_command).shape:
+            raise InputError("DynamicPlayback: inconsistent array shapes (expected t (N,), "
+                             "tracking_error (N,), positions (N, 3), q (N, n))")
+
     @property
     def max_tracking_error(self) -> float:
         """Largest end-effector tracking error, model length unit."""

@@ -123,6 +123,13 @@ class ConsistencyReport:
     length_unit: str
     model_name: str
 
+    def __post_init__(self) -> None:
+        dp, dr = np.asarray(self.position_error), np.asarray(self.orientation_error)
+        if dp.ndim != 1 or dr.shape != dp.shape or len(dp) == 0:
+            raise InputError(f"position_error/orientation_error: expected two equal shapes "
+                             f"(N,) with N >= 1, got {dp.shape} and {dr.shape}")
+        metres_per_unit(self.length_unit)
+
     @property
     def max_position_error(self) -> float:
         """Largest position error, model length unit."""
