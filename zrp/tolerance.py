@@ -472,7 +472,7 @@ class Allocation:
 def _scale_to_requirement(model: Manipulator, arrays: tuple[F64, F64, F64, F64, F64],
                           shape: F64, caps: F64, fixed: F64, free: NDArray[np.bool_], z: F64,
                           pct: float, req_p: float | None, req_r: float | None,
-                          joint_offsets: bool) -> float:
+                          joint_offsets: bool, rel_tol: float = 1e-4) -> float:
     """Largest alpha with percentile(max(dp/req_p, ang/req_r)) <= 1, tol = min(alpha shape, cap)
     on the free parameters (bisection in log alpha on common random numbers ``z``)."""
 
@@ -507,7 +507,7 @@ def _scale_to_requirement(model: Manipulator, arrays: tuple[F64, F64, F64, F64, 
             lo = mid
         else:
             hi = mid
-        if hi / lo < 1.0 + 1e-4:
+        if hi / lo < 1.0 + rel_tol:
             break
     return lo
 
@@ -528,6 +528,7 @@ def allocate_tolerances(
     n_search: int = 4000,
     n_verify: int = 20000,
     margin: float = 0.01,
+    refine: bool = True,
     progress: bool = False,
 ) -> Allocation:
     """Loosest tolerances (reciprocal cost model, see the module docstring) meeting a
@@ -544,6 +545,9 @@ def allocate_tolerances(
         n_search, n_verify: robots used by the bisection and by the verification.
         margin: the search aims at (1 - margin) times the requirement, to absorb the
             sampling noise of the verification.
+        refine: also tune the split between length and angle tolerances (one factor on all
+            body components, golden-section search in [1/4, 4] on the nonlinear percentile):
+            the RSS shape is optimal within each kind only to first order.
     """
     if max_delta_p is None and max_angle_rad is None:
         raise InputError("requirement: give max_delta_p and/or max_angle_rad")
@@ -595,6 +599,34 @@ def allocate_tolerances(
     target_r = None if req_r is None else req_r * (1 - margin)
     alpha = _scale_to_requirement(model, arrays, shape, caps, fixed_vals, free, z, pct,
                                   target_p, target_r, False)
+    if refine and is_ang.any() and (~is_ang).any():
+        def score(log_g: float) -> tuple[float, float, F64]:
+            sh = shape * np.where(is_ang, 1.0, np.exp(log_g))
+            a = _scale_to_requirement(model, arrays, sh, caps, fixed_vals, free, z, pct,
+                                      target_p, target_r, False, rel_tol=1e-3)
+            tol_g = Tolerances(np.where(free, np.minimum(a * sh, caps), fixed_vals),
+                               space.names, space.units)
+            return tol_g.looseness(angle_scale_mm), a, sh
+
+        best = (Tolerances(np.where(free, np.minimum(alpha * shape, caps), fixed_vals),
+                           space.names, space.units).looseness(angle_scale_mm), alpha, shape)
+        lo_g, hi_g = np.log(0.25), np.log(4.0)
+        gr = (np.sqrt(5.0) - 1.0) / 2.0
+        x1, x2 = hi_g - gr * (hi_g - lo_g), lo_g + gr * (hi_g - lo_g)
+        f1, f2 = score(x1), score(x2)
+        for _ in range(8):
+            if f1[0] >= f2[0]:
+                hi_g, x2, f2 = x2, x1, f1
+                x1 = hi_g - gr * (hi_g - lo_g)
+                f1 = score(x1)
+            else:
+                lo_g, x1, f1 = x1, x2, f2
+                x2 = lo_g + gr * (hi_g - lo_g)
+                f2 = score(x2)
+        for cand in (f1, f2):
+            if cand[0] > best[0]:
+                best = cand
+        _, alpha, shape = best
     equal_shape = 1.0 / c
     beta = _scale_to_requirement(model, arrays, equal_shape, caps, fixed_vals, free, z, pct,
                                  target_p, target_r, False)
