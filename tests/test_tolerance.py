@@ -129,6 +129,8 @@ def test_report_and_errors():
         monte_carlo(model, q, tol, 0, rng=np.random.default_rng(0))
     with pytest.raises(InputError, match="another model"):
         monte_carlo(load_model("scara"), _path(4), tol, 10, rng=np.random.default_rng(0))
+    with pytest.raises(InputError, match="percentile"):
+        monte_carlo(model, q, tol, 10, rng=np.random.default_rng(0)).percentile(150)
     with pytest.raises(InputError, match="rng"):
         draw_parameters(tol, 3, "uniform", 42)
     with pytest.raises(InputError, match="requirement"):

@@ -71,6 +71,16 @@ DISTRIBUTIONS = ("uniform", "normal")
 DEFAULT_PERCENTILES = (50.0, 90.0, 95.0, 99.0, 99.9)
 
 
+def _check_percentile(pct: float, name: str = "percentile") -> float:
+    try:
+        v = float(pct)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: expected a number in [0, 100], got {pct!r}") from exc
+    if not 0.0 <= v <= 100.0:
+        raise InputError(f"{name}: expected a number in [0, 100] (e.g. 99), got {pct!r}")
+    return v
+
+
 def _check_distribution(distribution: str) -> str:
     if distribution not in DISTRIBUTIONS:
         raise InputError(f"distribution: {distribution!r} is unknown; expected one of "
@@ -251,7 +261,8 @@ class MonteCarloResult:
         return self.n_robots * self.n_points / max(self.elapsed_s, 1e-12)
 
     def percentile(self, pct: float) -> tuple[float, float]:
-        """(delta_p, angle_rad) percentiles of the per-robot maxima."""
+        """(delta_p, angle_rad) percentiles of the per-robot maxima; 0 <= pct <= 100."""
+        _check_percentile(pct)
         return (float(np.percentile(self.max_delta_p, pct)),
                 float(np.percentile(self.max_angle_rad, pct)))
 
@@ -373,6 +384,8 @@ def monte_carlo(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robo
         first_order: also evaluate the first-order model with the same draws.
     """
     _check_distribution(distribution)
+    for pct in percentiles:
+        _check_percentile(pct, "percentiles")
     n_robots = _positive_int(n_robots, "n_robots")
     chunk = _positive_int(chunk, "chunk")
     if not isinstance(tolerances, Tolerances):

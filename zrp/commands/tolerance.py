@@ -82,6 +82,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _tolerance(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     path = path_from_args(args, model)
+    if not 0.0 < args.percentile < 100.0:
+        raise InputError(f"--percentile: expected 0 < P < 100 (e.g. 99), got {args.percentile}")
     rng = np.random.default_rng(args.seed)
     u = model.length_unit
     if args.hist and Path(args.hist).exists() and not args.force:
