@@ -131,7 +131,8 @@ def circle_joint_path(model: Manipulator, *, q0: ArrayLike | None = None,
 
 def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
     """Read a joint trajectory CSV: a header row, time (s) in the first column and the n joint
-    values in the next n columns (the layout ``zrp ik`` writes; rad / length unit)."""
+    values in the next n columns (the layout ``zrp ik`` writes; rad / length unit). The IK
+    errors are taken from ``position_error`` / ``orientation_error_rad`` columns if present."""
     p = Path(path)
     try:
         with p.open(newline="") as fh:
@@ -150,7 +151,18 @@ def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
         except ValueError as exc:
             raise InputError(f"{p}, line {i}: not a number: {exc}") from exc
     arr = np.array(data)
-    return JointPath(arr[:, 0], arr[:, 1:], f"joint trajectory {p.name}")
+    header = [h.strip() for h in rows[0]]
+    errs: list[float | None] = []
+    for col in ("position_error", "orientation_error_rad"):
+        if col in header:  # written by `zrp ik` (IKResult.save_csv)
+            j = header.index(col)
+            try:
+                errs.append(max(float(r[j]) for r in rows[1:]))
+            except (ValueError, IndexError):
+                errs.append(None)
+        else:
+            errs.append(None)
+    return JointPath(arr[:, 0], arr[:, 1:], f"joint trajectory {p.name}", errs[0], errs[1])
 
 
 @dataclass(frozen=True)

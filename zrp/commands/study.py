@@ -118,7 +118,9 @@ def _study(args: argparse.Namespace) -> int:
     u = st.unit
     lines = [f"{model.name}: {path.label} ({st.t.size} samples)",
              f"convention: {st.convention}",
-             f"IK error of the nominal path: {path.ik_position_error or 0:.3g} {u}",
+             "IK error of the nominal path: " + (f"{path.ik_position_error:.3g} {u}"
+                                                 if path.ik_position_error is not None
+                                                 else "unknown (not in the joint file)"),
              "",
              f"{'param':6s} {'xi %':>7s} {'max dp ' + u:>12s} {'max dR eq15':>12s} "
              f"{'max angle rad':>14s}"]
