@@ -1,5 +1,6 @@
 """zrp: zero-reference-position kinematics and robot-accuracy analysis."""
 
+from .deviation import Deviation, pose_deviation, trajectory_deviation
 from .dh import DHRow, from_dh, from_mdh
 from .errors import (
     IKError,
@@ -18,13 +19,27 @@ from .ik import IKResult, track_trajectory
 from .kinematics import FKResult, end_effector_pose, forward_kinematics, jacobian
 from .model import EndEffector, Joint, Manipulator, hand_frame
 from .modelfile import builtin_models, dumps_model, load_model, loads_model, save_model
+from .paper import run_paper_example, write_paper_outputs
+from .perturb import PAPER_SIGN_ZERO, Perturbation
+from .sensitivity import (
+    apply_parameters,
+    parameter_jacobian,
+    parameter_names,
+    parameter_space,
+    pose_error,
+)
+from .study import JointPath, StudyResult, circle_joint_path, load_joint_csv, one_at_a_time
+from .tolerance import Allocation, MonteCarloResult, Tolerances, allocate_tolerances, monte_carlo
 from .trajectory import Circle, FunctionTrajectory, Line, TimeLaw, Trajectory, TrajectorySample
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "PAPER_SIGN_ZERO",
+    "Allocation",
     "Circle",
     "DHRow",
+    "Deviation",
     "EndEffector",
     "FKResult",
     "FunctionTrajectory",
@@ -32,20 +47,28 @@ __all__ = [
     "IKResult",
     "InputError",
     "Joint",
+    "JointPath",
     "Line",
     "Manipulator",
     "ModelError",
     "ModelFileError",
+    "MonteCarloResult",
     "OutputExistsError",
+    "Perturbation",
     "SingularityWarning",
+    "StudyResult",
     "TimeLaw",
+    "Tolerances",
     "TrackingWarning",
     "Trajectory",
     "TrajectorySample",
     "UnreachableError",
     "ZRPError",
     "ZRPWarning",
+    "allocate_tolerances",
+    "apply_parameters",
     "builtin_models",
+    "circle_joint_path",
     "dumps_model",
     "end_effector_pose",
     "forward_kinematics",
@@ -53,10 +76,21 @@ __all__ = [
     "from_mdh",
     "hand_frame",
     "jacobian",
+    "load_joint_csv",
     "load_model",
     "loads_model",
+    "monte_carlo",
+    "one_at_a_time",
+    "parameter_jacobian",
+    "parameter_names",
+    "parameter_space",
+    "pose_deviation",
+    "pose_error",
     "puma_circle",
     "puma_circle_ik",
+    "run_paper_example",
     "save_model",
     "track_trajectory",
+    "trajectory_deviation",
+    "write_paper_outputs",
 ]
