@@ -59,6 +59,9 @@ SCHEMA_VERSION = 1
 MIN_POSES = 8
 #: final withheld RMS above this multiple of the noise-floor RMS counts as unexplained.
 UNEXPLAINED_RATIO = 1.5
+#: candidates whose cross-validated RMS is within this fraction of the winner's are reported
+#: as indistinguishable from it.
+TIE_TOL = 0.01
 #: 95th percentile of |r| for isotropic Gaussian noise, in units of sigma (chi, 3 dof).
 CHI3_P95 = 2.7954834829151074
 
@@ -189,9 +192,10 @@ class Step:
     candidates: tuple[Candidate, ...]
     aliased: tuple[Aliased, ...]
     geometric_overlap: float = math.nan
+    ties: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        return {"effect": self.effect, "joints": list(self.joints),
+        return {"effect": self.effect, "joints": list(self.joints), "ties": list(self.ties),
                 "geometric_overlap": (None if math.isnan(self.geometric_overlap)
                                       else self.geometric_overlap),
                 "parameters": [p.to_dict() for p in self.parameters],
@@ -629,6 +633,71 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
     return result
 
 
+def _sequential_alias(J: F64, names: Sequence[str], fixed: int) -> list[tuple[int, str]]:
+    """Columns (from index ``fixed`` on) that are combinations of the columns before them:
+    (index, partners) pairs (Gram-Schmidt on normalised columns, tolerance ALIAS_TOL)."""
+    from .fit import ALIAS_TOL
+
+    norms = np.linalg.norm(J, axis=0)
+    A = J / np.where(norms > 0, norms, 1.0)
+    Q = orthonormal_basis(A[:, :fixed])
+    accepted = list(range(fixed))
+    out: list[tuple[int, str]] = []
+    for i in range(fixed, J.shape[1]):
+        c = A[:, i]
+        r = c - Q @ (Q.T @ c)
+        r = r - Q @ (Q.T @ r)
+        f = float(np.linalg.norm(r))
+        if norms[i] == 0 or f < ALIAS_TOL:
+            corr = np.abs(A[:, accepted].T @ c) if accepted else np.zeros(0)
+            partners = [names[accepted[o]] for o in np.argsort(-corr)[:3]
+                        if corr[o] >= 0.5 * corr.max()] if corr.size else []
+            out.append((i, "/".join(partners)))
+            continue
+        accepted.append(i)
+        Q = np.column_stack([Q, r / f])
+    return out
+
+
+def _registration_identifiable(ctx: Context, specs: list[ParamSpec], poses: NDArray[np.int64],
+                               theta0: F64, rb0: F64, rng: np.random.Generator
+                               ) -> tuple[list[ParamSpec], F64]:
+    """Drop registration parameters that no pose set could identify (e.g. the tool offsets
+    along the common axis of a SCARA, which trade against the base translation), with a
+    warning; raise when these data cannot identify one that richer poses would."""
+    names = [s.name for s in specs]
+    fixed = 6 if ctx.meas.frame == "instrument" else 0
+    _, J = Problem(ctx, specs, poses, rb0).residual_and_jacobian(theta0)
+    # the base frame itself must be identifiable
+    base_bad = _sequential_alias(J[:, :fixed], names[:fixed], 0) if fixed else []
+    data_bad = base_bad + _sequential_alias(J, names, fixed)
+    if not data_bad:
+        return specs, theta0
+    ref_rng = np.random.default_rng(rng.integers(2**32))
+    P, M, n = 200, len(ctx.meas.point_labels), ctx.n
+    lim = np.where(ctx.model.prismatic[:, None], [[0.0, 0.3 * ctx.model.reach]], [[-2.5, 2.5]])
+    qref = ref_rng.uniform(lim[:, 0], lim[:, 1], (P, n))
+    ref = Context(ctx.model, Measurements.from_arrays(
+        np.repeat(np.arange(P), M), np.repeat(qref, M, 0), np.zeros((P * M, 3)),
+        point=np.tile(list(ctx.meas.point_labels), P), frame=ctx.meas.frame,
+        source="reference poses"))
+    _, Jr = Problem(ref, specs, np.arange(P), rb0).residual_and_jacobian(theta0)
+    structural = {i for i, _ in _sequential_alias(Jr, names, fixed)}
+    limited = [(i, p) for i, p in data_bad if i not in structural or i < fixed]
+    if limited:
+        what = ", ".join(f"{names[i]} ~ {p or 'nothing'}" for i, p in limited)
+        raise InputError(
+            f"{ctx.meas.source}: the registration is not identifiable from these poses "
+            f"({what}); the joints must move enough to rotate the tool in several directions")
+    drop = {i for i, _ in data_bad}
+    warnings.warn(f"registration: {', '.join(names[i] for i in sorted(drop))} cannot be told "
+                  "apart from the other registration parameters for this robot (structural); "
+                  "fixed at 0 and carried by " + ", ".join(sorted({p for _, p in data_bad})),
+                  GapWarning, stacklevel=4)
+    keep = [i for i in range(len(specs)) if i not in drop]
+    return [specs[i] for i in keep], theta0[keep]
+
+
 def _check_units(ctx: Context, poses: NDArray[np.int64]) -> None:
     meas = ctx.meas
     rows = np.isin(meas.pose_index, poses)
@@ -687,6 +756,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     # registration
     reg_specs = registration_parameters(ctx)
     theta0, rb0 = initial_registration(ctx, reg_specs, fitting)
+    reg_specs, theta0 = _registration_identifiable(ctx, reg_specs, fitting, theta0, rb0, rng)
     reg = fit(ctx, reg_specs, fitting, theta0, rb0)
     if not np.all(np.isfinite(reg.stderr)):
         bad = [s.name for s, v in zip(reg.specs, reg.stderr, strict=False) if not np.isfinite(v)]
@@ -781,9 +851,15 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
         all_aliased += [a for a in aliased if a.name in {s.name for s in cache[cand.effect][0]}]
         overlap = (_geometric_overlap(ctx, current, f_new.residual - current.residual)
                    if cand.effect not in GEOMETRIC else math.nan)
+        ties = tuple(c[0].effect for c in ranked[1:] if c[0].significant
+                     and c[0].cv_rms <= cand.cv_rms * (1.0 + TIE_TOL))
+        if ties:
+            warnings.warn(f"step {len(steps) + 1}: {', '.join(ties)} fit(s) the data as well as "
+                          f"{cand.effect} (cross-validated RMS within {TIE_TOL:.0%}); these "
+                          "data cannot tell the effects apart", GapWarning, stacklevel=3)
         steps.append(Step(cand.effect, cand.joints, _estimates(f_new, nb), Metrics.of(after),
                           Metrics.of(f_new.residual), cand.cv_rms, cand.p_value, cand.bic_delta,
-                          tuple(c[0] for c in ranked), weak_or_dropped, overlap))
+                          tuple(c[0] for c in ranked), weak_or_dropped, overlap, ties))
         current, current_cv = f_new, cand.cv_rms
     bar.close()
     # backward pass: joints that an effect picked up while another effect was still missing
@@ -929,6 +1005,11 @@ def _verdict(steps: list[Step], nominal: Metrics, final: Metrics, floor: NoiseFl
         names = ", ".join(f"{s.effect} (joints {', '.join(map(str, s.joints)) or '-'})"
                           for s in steps)
         parts.append(f"Effects found, in order: {names}.")
+        for i, s in enumerate(steps, 1):
+            if s.ties:
+                parts.append(f"At step {i} {', '.join(s.ties)} explain(s) the data equally well; "
+                             f"the data cannot tell {'them' if len(s.ties) > 1 else 'it'} apart "
+                             f"from {s.effect}.")
     else:
         parts.append("No effect in the library improves the model significantly (none).")
     parts.append(f"Withheld RMS {nominal.rms:.4g} {unit} after registration, "

@@ -220,14 +220,26 @@ def _markdown(diag: Diagnosis) -> str:
                      f"{cv} | {db} | {c.p_value:.2g} | {'yes' if c.significant else 'no'} | "
                      f"{c.note} |")
         L.append("")
+    L.append("## Parameters the data cannot tell apart\n")
     if diag.aliased:
-        L.append("## Parameters the data cannot tell apart\n")
         L.append("Reported, never absorbed silently: a dropped parameter is not estimated; "
                  "its effect is carried by its partners.\n")
         for a in diag.aliased:
             L.append(f"- {a.name} ({a.effect}) vs {', '.join(a.partners) or 'registration'}: "
                      f"{'not identifiable (dropped)' if a.dropped else 'weakly identifiable'}"
                      f" (independent share {a.fraction:.2g})")
+        L.append("")
+    surv = diag.where.get("identifiability", {})
+    rows = [(eff, v) for eff, v in surv.items() if v["not_identifiable"]]
+    if rows:
+        L.append("Not identifiable on top of the registration, per effect (robot structure or "
+                 "these poses; 'limited by data' means richer poses would identify it):\n")
+        for eff, v in rows:
+            items = ", ".join(f"{a['name']} ~ {'/'.join(a['partners']) or 'no effect'}"
+                              for a in v["not_identifiable"])
+            L.append(f"- {eff}: {items}")
+            if v["limited_by_data"]:
+                L.append(f"  - limited by data: {', '.join(v['limited_by_data'])}")
         L.append("")
     w = d["where"]
     L.append("## Where the gap lies (fitting poses, after registration)\n")
