@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import argparse
+import sys
+from pathlib import Path
 
 from ..cli import emit
 from ..errors import InputError
@@ -42,14 +44,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="known instrument noise per coordinate (length unit); default: "
                         "estimated from rigidly linked points or repeats")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
-    p.add_argument("--progress", action="store_true", help="show a progress bar")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
+                   help="show a progress bar (default: when stderr is a terminal)")
     p.add_argument("--json", action="store_true", help="print diagnosis.json to stdout")
     p.set_defaults(func=_run)
 
 
 def _run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
     from ..gap import diagnose, load_measurements
     from ..gap.report import OUTPUT_FILES, write_outputs
 
@@ -65,7 +66,8 @@ def _run(args: argparse.Namespace) -> int:
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)
     diag = diagnose(model, meas, mjcf=args.mjcf, effects=args.effects, seed=args.seed,
                     withheld_fraction=args.withheld, folds=args.folds, alpha=args.alpha,
-                    max_steps=args.max_steps, noise_sigma=args.noise, progress=args.progress)
+                    max_steps=args.max_steps, noise_sigma=args.noise,
+                    progress=sys.stderr.isatty() if args.progress is None else args.progress)
     files = write_outputs(diag, out, force=args.force, plots=not args.no_plots)
     text = diag.verdict + "\n" + "\n".join(f"wrote {f}" for f in files)
     emit(args, diag.to_dict(), text)
