@@ -138,6 +138,19 @@ def _ci(p: Any, unit: str) -> str:
     return f"[{lo:.4g}, {hi:.4g}] {unit}"
 
 
+def _candidate_table(cands: list[dict[str, Any]], u: str) -> list[str]:
+    out = [f"| effect | joints | params | CV RMS ({u}) | dBIC | p | added? | note |",
+           "|---|---|---|---|---|---|---|---|"]
+    for c in cands:
+        cv = "" if c["cv_rms"] is None else f"{c['cv_rms']:.4g}"
+        db = "" if c["bic_delta"] is None else f"{c['bic_delta']:.1f}"
+        out.append(f"| {c['effect']} | {', '.join(map(str, c['joints'])) or '-'} | "
+                   f"{c['n_params']} | {cv} | {db} | {c['p_value']:.2g} | "
+                   f"{'yes' if c['significant'] else 'no'} | {c['note']} |")
+    out.append("")
+    return out
+
+
 def _markdown(diag: Diagnosis) -> str:
     u = diag.length_unit
     d = diag.to_dict()
@@ -207,19 +220,18 @@ def _markdown(diag: Diagnosis) -> str:
     for p in diag.registration:
         L.append(f"| {p.name} | {_val(p.value, p.unit)} | {_ci(p, p.unit)} |")
     L.append("")
+    L.append("## Which effect: ranking of the candidates\n")
+    L.append("Ranked by cross-validated RMS within the fitting set; an effect is added when "
+             "its F test is significant (p < alpha), its BIC falls and its CV RMS improves by at "
+             "least 1 %.\n")
     if diag.steps:
-        L.append("## Which effect: ranking of the candidates at step 1\n")
-        L.append("Ranked by cross-validated RMS within the fitting set; an effect is added when "
-                 "its F test is significant, its BIC falls and its CV RMS improves.\n")
-        L.append(f"| effect | joints | params | CV RMS ({u}) | dBIC | p | added? | note |")
-        L.append("|---|---|---|---|---|---|---|---|")
-        for c in diag.steps[0].candidates:
-            cv = "" if math.isnan(c.cv_rms) else f"{c.cv_rms:.4g}"
-            db = "" if math.isnan(c.bic_delta) else f"{c.bic_delta:.1f}"
-            L.append(f"| {c.effect} | {', '.join(map(str, c.joints)) or '-'} | {c.n_params} | "
-                     f"{cv} | {db} | {c.p_value:.2g} | {'yes' if c.significant else 'no'} | "
-                     f"{c.note} |")
-        L.append("")
+        L.append("At step 1:\n")
+        L.extend(_candidate_table([c.to_dict() for c in diag.steps[0].candidates], u))
+    last = diag.where.get("last_candidates")
+    if last:
+        L.append(f"After step {len(diag.steps)} (none added):\n" if diag.steps
+                 else "On top of the registration (none added):\n")
+        L.extend(_candidate_table(last, u))
     L.append("## Parameters the data cannot tell apart\n")
     if diag.aliased:
         L.append("Reported, never absorbed silently: a dropped parameter is not estimated; "
