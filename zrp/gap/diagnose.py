@@ -698,6 +698,35 @@ def _registration_identifiable(ctx: Context, specs: list[ParamSpec], poses: NDAr
     return [specs[i] for i in keep], theta0[keep]
 
 
+def _with_gravity_side(ctx: Context, reg: FitResult, fitting: NDArray[np.int64], rb0: F64,
+                       alpha: float) -> Context:
+    """Without MJCF inertias, which side of its play a gravity-loaded joint rests against is
+    taken from the sign of the gravity torque of a lumped-mass compliance fit (fitting poses
+    only), for the joints where that fit is significant; elsewhere equal unit masses decide."""
+    import dataclasses
+
+    specs, _ = effect_parameters(ctx, "joint_compliance")
+    keep, _ = check_identifiable(ctx, reg, specs)
+    side = ctx.gravity_side_torque()
+    if not keep:
+        return ctx
+    nreg = len(reg.specs)
+    fc = fit(ctx, list(reg.specs) + keep, fitting,
+             np.concatenate([reg.theta, np.zeros(len(keep))]), rb0)
+    pv = wald_groups(fc, nreg)
+    thr = alpha / max(len(pv), 1)
+    tau = np.zeros_like(side)
+    sig_joint = np.zeros(ctx.n, dtype=bool)
+    for i, s in enumerate(keep):
+        if pv[group_key(s)] < thr:
+            assert s.basis is not None
+            tau += fc.theta[nreg + i] * s.basis
+            sig_joint[s.joint - 1] = True
+    if not sig_joint.any():
+        return ctx
+    return dataclasses.replace(ctx, gravity_side=np.where(sig_joint, tau, side))
+
+
 def _check_units(ctx: Context, poses: NDArray[np.int64]) -> None:
     meas = ctx.meas
     rows = np.isin(meas.pose_index, poses)
@@ -779,6 +808,8 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     floor = noise_floor(meas, fitting, noise_sigma)
     where = where_analysis(ctx, reg)
 
+    if gravity_torque is None and "backlash" in effects:
+        ctx = _with_gravity_side(ctx, reg, fitting, rb0, alpha)
     # greedy search
     cache: dict[str, tuple[list[ParamSpec], str | None]] = {
         e: effect_parameters(ctx, e) for e in effects}

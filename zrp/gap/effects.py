@@ -10,7 +10,9 @@ corrected model (see :mod:`zrp.gap.problem`, which also gives the analytic Jacob
 * ``dq``: a joint correction q_actual = q + sum_i theta_i B_i(pose), with a fixed basis B of
   shape (P, n) per parameter. ``joint_offset`` (B = 1), ``encoder_scale`` (B = q),
   ``joint_compliance`` (B = gravity torque or a lumped-mass moment arm), ``backlash``
-  (B = -approach direction), ``cyclic_error`` (B = sin(h q), cos(h q)) are all of this kind.
+  (B = -approach direction, and B = sign of the gravity torque for the side of the play a
+  gravity-loaded joint rests against), ``cyclic_error`` (B = sin(h q), cos(h q)) are all of
+  this kind.
 * ``link``: one component of a body-vector correction db_{k,0} (length unit).
 * ``tilt``: a tilt of a joint axis towards one of its tangents t1, t2 (rad), exact:
   u' = (u + a t1 + b t2) / |u + a t1 + b t2| (tangents from :func:`zrp.sensitivity.axis_tangents`).
@@ -89,13 +91,13 @@ class ParamSpec:
             object.__setattr__(self, "group", self.name)
 
 
-def gravity_torques_mjcf(path: str, q_pose: F64, load_kg: F64 | None = None,
-                         tool_arm: F64 | None = None) -> F64:
+def gravity_torques_mjcf(path: str, q_pose: F64) -> F64:
     """Gravity torque on each joint from an MJCF model's inertias, shape (P, n).
 
     The MJCF must have exactly n hinge/slide joints in the model's order with the same zero
-    (as the project's MJCF export writes them). Returns ``qfrc_bias`` at zero velocity (the
-    generalised gravity force, N m for hinges, in the MJCF's units).
+    (as the project's MJCF export writes them). Returns the generalised force gravity exerts on
+    each joint, -``qfrc_bias`` at zero velocity (N m for hinges, in the MJCF's units; positive
+    when gravity turns the joint positively).
 
     Args:
         q_pose: joint values, rad, shape (P, n).
@@ -116,7 +118,7 @@ def gravity_torques_mjcf(path: str, q_pose: F64, load_kg: F64 | None = None,
         d.qpos[:] = q
         d.qvel[:] = 0.0
         mujoco.mj_forward(m, d)
-        out[i] = d.qfrc_bias
+        out[i] = -d.qfrc_bias  # the generalised force gravity exerts (qfrc_bias holds it)
     return out
 
 
@@ -133,6 +135,9 @@ class Context:
         harmonics: harmonics of ``cyclic_error`` (periods 2 pi / h in the joint angle).
         t_ref_degC: reference temperature of ``thermal_expansion``, deg C (default 20, the
             ISO 1 reference temperature at which the nominal lengths are taken to hold).
+        gravity_side: a torque per pose and joint whose sign tells which side of its play a
+            gravity-loaded joint rests against, shape (P, n), or None (see
+            :meth:`gravity_side_torque`).
     """
 
     model: Manipulator
@@ -141,6 +146,7 @@ class Context:
     gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0)
     harmonics: tuple[int, ...] = (1, 2)
     t_ref_degC: float = 20.0
+    gravity_side: F64 | None = None
 
     def __post_init__(self) -> None:
         if self.meas.n_joints != self.model.n:
@@ -186,6 +192,31 @@ class Context:
     @cached_property
     def nominal_fk(self):  # noqa: ANN201
         return forward_kinematics(self.model, self.q)
+
+    def gravity_side_torque(self) -> F64:
+        """A gravity torque per pose and joint whose sign is trusted, shape (P, n): the MJCF
+        torque when given, else ``gravity_side`` (the diagnosis sets it from a lumped-mass
+        compliance fit), else equal unit masses at the lumped mass points (length unit);
+        values below 1e-6 of the largest are set to 0 (no load)."""
+        if self.gravity_torque is not None:
+            tau = np.array(self.gravity_torque, dtype=float)
+        elif self.gravity_side is not None:
+            tau = np.array(self.gravity_side, dtype=float)
+        else:
+            _, h = self.moment_arms()
+            tau = h.sum(axis=2)
+        big = np.abs(tau).max(axis=0, keepdims=True)
+        return np.where(np.abs(tau) > 1e-6 * np.where(big > 0, big, 1.0), tau, 0.0)
+
+    def end_effector_arms(self) -> F64:
+        """Moment arm of the end-effector point about each joint, u_k . ((p - p_k) x g_dir),
+        shape (P, n) (length unit; 0 for prismatic joints and below 1e-9 of the reach)."""
+        fk = self.nominal_fk
+        g = np.asarray(self.gravity_dir, dtype=float)
+        arm = np.cross(fk.position[:, None, :] - fk.points, g)
+        h = np.einsum("pki,pki->pk", fk.axes, arm)
+        h[:, np.asarray(self.model.prismatic)] = 0.0
+        return np.where(np.abs(h) > 1e-9 * self.model.characteristic_length, h, 0.0)
 
     def moment_arms(self) -> tuple[list[str], F64]:
         """Lumped-mass moment arms h[p, k, j] = u_k . ((P_j - p_k) x g_dir) (length unit).
@@ -269,23 +300,31 @@ def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str |
                 for k in rev for h in ctx.harmonics for fn in ("sin", "cos")], None
     if effect == "backlash":
         d = ctx.meas.approach_direction()
-        ks = [k for k in range(n) if np.any(d[:, k] > 0) and np.any(d[:, k] < 0)]
-        if not ks:
-            return [], "no joint approaches its poses from both directions"
-        return [_dq(ctx, f"q{k + 1}.backlash", junit[k], effect, k, -d[:, k])
-                for k in ks], None
+        specs = [_dq(ctx, f"q{k + 1}.backlash", junit[k], effect, k, -d[:, k])
+                 for k in range(n) if np.any(d[:, k] > 0) and np.any(d[:, k] < 0)]
+        # a joint loaded by gravity rests against the side of its play that gravity pushes it
+        # to, whatever the direction of approach
+        side = np.sign(ctx.gravity_side_torque())
+        for k in range(n):
+            pos, neg = np.mean(side[:, k] > 0), np.mean(side[:, k] < 0)
+            if min(pos, neg) >= 0.05:
+                specs.append(_dq(ctx, f"q{k + 1}.backlash_g", junit[k], effect, k, side[:, k]))
+        if not specs:
+            return [], ("no joint approaches its poses from both directions or sees gravity "
+                        "torques of both signs")
+        return specs, None
     if effect == "joint_compliance":
         specs: list[ParamSpec] = []
         load = ctx.meas.per_pose("load")
         if ctx.gravity_torque is not None:
             tau = np.array(ctx.gravity_torque, dtype=float)
             if load is not None:
-                _, h = ctx.moment_arms()
+                h_ee = ctx.end_effector_arms()
                 to_m = LENGTH_TO_M.get(unit)
                 if to_m is None:
                     raise InputError(f"length_unit {unit!r}: cannot convert to m for the load "
                                      f"torque; known: {', '.join(LENGTH_TO_M)}")
-                tau = tau + G_STANDARD * load[:, None] * h[:, :, -1] * to_m
+                tau = tau + G_STANDARD * load[:, None] * h_ee * to_m
             for k in range(n):
                 if np.ptp(tau[:, k]) > 0 or np.any(tau[:, k] != 0):
                     specs.append(_dq(ctx, f"q{k + 1}.compliance", f"{junit[k]}/(N m)", effect,
@@ -298,9 +337,10 @@ def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str |
                 if np.any(h[:, k, jj] != 0.0):
                     specs.append(_dq(ctx, f"q{k + 1}.w_{lab}", f"rad/{unit}", effect, k,
                                      h[:, k, jj]))
-            if load is not None and np.ptp(load) > 0 and np.any(h[:, k, -1] != 0.0):
+            h_ee = ctx.end_effector_arms()
+            if load is not None and np.ptp(load) > 0 and np.any(h_ee[:, k] != 0.0):
                 specs.append(_dq(ctx, f"q{k + 1}.w_load", f"rad/({unit} kg)", effect, k,
-                                 load * h[:, k, -1]))
+                                 load * h_ee[:, k]))
         return specs, (None if specs else "no joint carries a gravity torque")
     if effect == "link_length":
         return [ParamSpec(f"b{k + 1}.{c}", unit, effect, "link", k + 1, i, group=f"b{k + 1}")

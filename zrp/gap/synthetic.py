@@ -34,6 +34,8 @@ class Injection:
         joint_offset: rad (length unit for prismatic joints) per joint.
         encoder_scale: dimensionless scale error per joint (q_actual = q (1 + s)).
         backlash: rad per joint; the joint lags against its direction of approach.
+        backlash_gravity: rad per joint; the joint rests against the side of its play that the
+            gravity torque of ``masses`` pushes it to.
         cyclic_error: per joint, (harmonic h, sin amplitude rad, cos amplitude rad).
         compliance: rad per (N m) per joint; deflection = c tau with tau the gravity torque of
             the point masses ``masses``.
@@ -47,6 +49,7 @@ class Injection:
     joint_offset: Mapping[int, float] = field(default_factory=dict)
     encoder_scale: Mapping[int, float] = field(default_factory=dict)
     backlash: Mapping[int, float] = field(default_factory=dict)
+    backlash_gravity: Mapping[int, float] = field(default_factory=dict)
     cyclic_error: Mapping[int, tuple[int, float, float]] = field(default_factory=dict)
     compliance: Mapping[int, float] = field(default_factory=dict)
     masses: Mapping[str, float] = field(default_factory=lambda: {"p3": 8.0, "p5": 4.0,
@@ -126,10 +129,12 @@ def synthesize(model: Manipulator, q: ArrayLike, injection: Injection, *,
             qa[:, k - 1] -= v * d[:, k - 1]
     for k, (h, a, b) in inj.cyclic_error.items():
         qa[:, k - 1] += a * np.sin(h * q[:, k - 1]) + b * np.cos(h * q[:, k - 1])
-    if inj.compliance:
+    if inj.compliance or inj.backlash_gravity:
         tau = _gravity_torque(model, q, inj.masses, np.array([0.0, 0.0, -1.0]))
         for k, c in inj.compliance.items():
             qa[:, k - 1] += c * tau[:, k - 1]
+        for k, b in inj.backlash_gravity.items():
+            qa[:, k - 1] += b * np.sign(tau[:, k - 1])
     bodies = np.array(model.bodies, dtype=float)
     for k, db in inj.link.items():
         bodies[k - 1] += np.asarray(db, dtype=float)
