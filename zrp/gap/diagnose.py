@@ -496,6 +496,16 @@ def where_analysis(ctx: Context, result: FitResult, max_components: int = 5) -> 
                                 "rms": float(np.sqrt(np.mean(e[sel] ** 2))),
                                 "n_points": int(sel.sum())})
     out["regions"] = regions
+    M = len(meas.point_labels)
+    if M >= 2:
+        R = np.full((len(meas.pose_ids), M, 3), np.nan)
+        R[pose_of_row, meas.point_index[rows]] = r
+        full = np.all(np.isfinite(R.reshape(len(R), -1)), axis=1)
+        if full.any():
+            Rf = R[full]
+            tot = float(np.sum(Rf**2))
+            out["common_share"] = (float(M * np.sum(Rf.mean(axis=1) ** 2) / tot)
+                                   if tot > 0 else 0.0)
     out.update(_projection(ctx, result, max_components))
     return out
 
@@ -927,7 +937,12 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
         unexplained = None
     else:
         unexplained = bool(final.rms > UNEXPLAINED_RATIO * floor.rms)
-    verdict = _verdict(steps, nominal, final, floor, unexplained, unit)
+    where_final = where_analysis(ctx, current) if steps else where
+    verdict = _verdict(steps, nominal, final, floor, unexplained, unit, where_final)
+    if steps:
+        where["after_final_model"] = {k: v for k, v in where_final.items()
+                                      if k not in ("identifiability", "last_candidates",
+                                                   "backward_pruned")}
     pid = meas.pose_ids
     split = {"seed_note": "split drawn from the rng passed to diagnose()",
              "withheld_fraction": withheld_fraction,
@@ -1029,8 +1044,41 @@ def _geometric_overlap(ctx: Context, current: FitResult, correction: F64) -> flo
     return float(np.sum((Q.T @ correction) ** 2) / cc)
 
 
+def _remains(w: dict[str, Any], unit: str) -> str:
+    """Plain words on the structure of what remains (from a where analysis)."""
+    r2_joint = max((j["r2"] for j in w["joints"]), default=0.0)
+    r2_other = max([w["order"]["r2"]] + [w[k]["r2"] for k in ("time", "temperature") if k in w])
+    regions = w["regions"]
+    inner = [g["rms"] for g in regions if g is regions[0] or g["radius"] == regions[0]["radius"]]
+    outer = [g["rms"] for g in regions if g["radius"] == regions[-1]["radius"]]
+    txt = []
+    common = w.get("common_share")
+    if common is not None:
+        txt.append(f"{100 * common:.0f} % of what remains moves all points of a pose together")
+    if r2_joint < 0.1 and r2_other < 0.1:
+        txt.append(f"it depends on no single joint angle, the measurement order, time or "
+                   f"temperature (R^2 <= {max(r2_joint, r2_other):.2f})")
+    else:
+        j = max(w["joints"], key=lambda j: j["r2"])
+        txt.append(f"it still depends on q{j['joint']} (R^2 {j['r2']:.2f})"
+                   if j["r2"] >= r2_other else
+                   f"it still depends on measurement order/time/temperature (R^2 "
+                   f"{r2_other:.2f})")
+    if inner and outer:
+        txt.append(f"RMS {np.mean(inner):.3g} {unit} in the inner and {np.mean(outer):.3g} "
+                   f"{unit} in the outer third of the reach")
+    out = "What remains: " + "; ".join(txt) + "."
+    if common is not None and common > 0.8 and r2_joint < 0.1 and r2_other < 0.1:
+        out += (" This behaves like a pose-to-pose positioning error of the robot that no "
+                "model correction of the joint angles or geometry reproduces (e.g. poor "
+                "repeatability or settling); measuring repeated poses would tell the robot's "
+                "own floor, which the rigid-link estimate (instrument noise only) does not.")
+    return out
+
+
 def _verdict(steps: list[Step], nominal: Metrics, final: Metrics, floor: NoiseFloor,
-             unexplained: bool | None, unit: str) -> str:
+             unexplained: bool | None, unit: str, where_final: dict[str, Any] | None = None
+             ) -> str:
     parts = []
     if steps:
         names = ", ".join(f"{s.effect} (joints {', '.join(map(str, s.joints)) or '-'})"
@@ -1057,6 +1105,8 @@ def _verdict(steps: list[Step], nominal: Metrics, final: Metrics, floor: NoiseFl
         if unexplained:
             parts.append(f"A gap of {final.rms:.4g} {unit} RMS remains that no effect in the "
                          "library explains.")
+            if where_final is not None:
+                parts.append(_remains(where_final, unit))
         else:
             parts.append("What remains is at the noise floor.")
     return " ".join(parts)

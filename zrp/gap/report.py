@@ -277,6 +277,21 @@ def _markdown(diag: Diagnosis) -> str:
     for r in w["regions"]:
         L.append(f"- radius {r['radius'][0]:.0f}-{r['radius'][1]:.0f} {u}, {r['height']}: RMS "
                  f"{r['rms']:.4g} {u} ({r['n_points']} points)")
+    wf = w.get("after_final_model")
+    if wf:
+        L.append("\n## What remains after the final model (fitting poses)\n")
+        L.append("Share explained by a smooth function of each joint angle (R^2): "
+                 + ", ".join(f"q{j['joint']} {j['r2']:.2f}" for j in wf["joints"])
+                 + f"; measurement order {wf['order']['r2']:.2f}.\n")
+        if "common_share" in wf:
+            L.append(f"Common to all points of a pose (a shift of the whole tool): "
+                     f"{100 * wf['common_share']:.0f} % of the remaining energy.\n")
+        L.append("Workspace regions:\n")
+        for r in wf["regions"]:
+            L.append(f"- radius {r['radius'][0]:.0f}-{r['radius'][1]:.0f} {u}, {r['height']}: "
+                     f"RMS {r['rms']:.4g} {u} ({r['n_points']} points)")
+        L.append(f"\nGeometric parameters could still explain "
+                 f"{100 * wf['geometric_share']:.0f} % of it.")
     if diag.warnings:
         L.append("\n## Warnings\n")
         L.extend(f"- {m}" for m in diag.warnings)
