@@ -75,6 +75,13 @@ def test_bad_files_name_line_and_column(tmp_path, text, match):
         load_measurements(_write(tmp_path, text), PUMA)
 
 
+def test_comment_lines_are_not_dropped_silently(tmp_path):
+    text = "# tracker export\n" + HEADER + _row(1) + "#" + _row(2) + _row(3)
+    with pytest.warns(DataWarning, match=r"1 comment line\(s\).*lines 4"):
+        m = load_measurements(_write(tmp_path, text), PUMA)
+    assert m.pose_ids == ("1", "3")
+
+
 def test_missing_file_and_bad_frame(tmp_path):
     with pytest.raises(InputError, match="no such file"):
         load_measurements(tmp_path / "nope.csv", PUMA)
@@ -192,3 +199,31 @@ def test_split_is_seeded_and_disjoint():
 def test_unknown_effect_is_an_error():
     with pytest.raises(InputError, match=r"unknown.*valid: joint_offset"):
         diagnose(PUMA, _synthetic(20), effects=("gremlins",))
+
+
+def test_loader_never_fails_with_anything_but_input_error(tmp_path):
+    """Fuzz: any mangling of a valid file is either read or rejected with InputError."""
+    from hypothesis import HealthCheck, given, settings
+    from hypothesis import strategies as st
+
+    good = HEADER + "".join(_row(i, p, xyz=(1.0 + i, 2.0, 3.0)) for i in range(3)
+                            for p in ("a", "b"))
+    junk = st.sampled_from(["", "nan", "inf", "1e400", "x", ",", "\"", "-", "1,2", "\n", " ",
+                            "#", "é", "0x10", "1_0", "--1"])
+
+    @settings(max_examples=150, deadline=None,
+              suppress_health_check=[HealthCheck.function_scoped_fixture])
+    @given(pos=st.integers(0, len(good) - 1), cut=st.integers(0, 5), ins=junk)
+    def run(pos, cut, ins):
+        text = good[:pos] + ins + good[pos + cut:]
+        p = tmp_path / "fuzz.csv"
+        p.write_text(text, encoding="utf-8")
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", DataWarning)
+                m = load_measurements(p, PUMA)
+        except InputError:
+            return
+        assert np.all(np.isfinite(m.q)) and np.all(np.isfinite(m.xyz))
+
+    run()

@@ -333,14 +333,23 @@ def load_measurements(path: str | Path, model: Manipulator, *, deg: bool = False
     reader = csv.reader(text.splitlines())
     header: list[str] | None = None
     rows: list[tuple[int, list[str]]] = []
+    comments: list[int] = []
     for lineno, rec in enumerate(reader, start=1):
-        if not rec or all(not c.strip() for c in rec) or rec[0].lstrip().startswith("#"):
+        if not rec or all(not c.strip() for c in rec):
+            continue
+        if rec[0].lstrip().startswith("#"):
+            if header is not None:
+                comments.append(lineno)
             continue
         if header is None:
             header = [c.strip() for c in rec]
             continue
         rows.append((lineno, rec))
     assert header is not None
+    if comments:
+        shown = ", ".join(map(str, comments[:10])) + (" ..." if len(comments) > 10 else "")
+        warnings.warn(f"{src}: {len(comments)} comment line(s) starting with # skipped (lines "
+                      f"{shown})", DataWarning, stacklevel=2)
     dup = sorted({c for c in header if header.count(c) > 1})
     if dup:
         raise InputError(f"{src} line 1: column(s) {', '.join(dup)} appear more than once")
