@@ -288,8 +288,16 @@ def trajectory_poses(model: Manipulator, count: int, trajectory: str = "circle")
         raise InputError(f"trajectory 'circle' is the PUMA's; the model {model.name!r} has "
                          f"{model.n} joints")
     setup = puma_circle(model)
-    res = track_trajectory(model, setup.trajectory, setup.q0, max(400, 4 * count))
-    idx = np.linspace(0, len(res.t) - 1, count + 1)[:-1].round().astype(int)
+    res = track_trajectory(model, setup.trajectory, setup.q0, max(2000, 40 * count))
+    # evenly spaced along the arc (the time law is slow at both ends)
+    c = setup.trajectory
+    r = np.asarray(res.desired_position) - np.asarray(c.center)
+    e1 = np.asarray(c.start_point) - np.asarray(c.center)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(np.asarray(c.normal), e1)
+    ang = np.unwrap(np.arctan2(r @ e2, r @ e1))
+    want = ang[0] + (ang[-1] - ang[0]) * np.arange(count) / count
+    idx = np.argmin(np.abs(ang[None, :] - want[:, None]), axis=1)
     return np.array(res.q[idx])
 
 
