@@ -205,7 +205,7 @@ def test_compliance_with_given_gravity_torques():
 
 def test_gravity_loaded_backlash():
     """A joint loaded by gravity rests against one side of its play whatever the approach
-    direction: found as backlash (q.backlash_g). With the exact gravity torques (as an MJCF
+    direction: found as backlash on the loaded flank. With the exact gravity torques (as an MJCF
     gives them) the play is recovered; with the lumped-mass proxy the sign of the torque can
     differ from the true one in a few poses, so only the effect and joint are checked."""
     rng = np.random.default_rng(13)
@@ -218,9 +218,30 @@ def test_gravity_loaded_backlash():
         exact = diagnose(PUMA, meas, gravity_torque=tau, seed=0)
         lumped = diagnose(PUMA, meas, seed=0)
     assert exact.top_effect == "backlash" and exact.steps[0].joints == (2,)
-    _check_values(exact, {"q2.backlash_g": 6e-4})
+    _check_values(exact, {"q2.backlash": 6e-4})
+    assert exact.where["backlash_switch"][1] == 0.0  # always on the loaded flank
     assert exact.final.rms <= 1.5 * np.sqrt(3.0) * SIGMA
     assert lumped.top_effect == "backlash" and lumped.steps[0].joints == (2,)
+
+
+def test_backlash_held_by_friction_until_gravity_wins():
+    """Physical play: the load lags against the approach direction unless the gravity torque
+    beats the load's Coulomb friction, then it rests on the loaded flank (as in the MuJoCo
+    real robot). The switching torque is profiled; the play is recovered."""
+    rng = np.random.default_rng(14)
+    q = random_poses(PUMA, 300, rng)
+    tau = _gravity_torque(PUMA, q, MASSES, np.array([0.0, 0.0, -1.0]))
+    friction = float(np.quantile(np.abs(tau[:, 2]), 0.5))  # half the poses each way
+    inj = Injection(backlash={3: 8e-4}, backlash_friction={3: friction}, masses=MASSES)
+    meas = synthesize(PUMA, q, inj, rng=rng, noise_sigma=SIGMA)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = diagnose(PUMA, meas, gravity_torque=tau, seed=0)
+    assert d.top_effect == "backlash" and d.steps[0].joints == (3,)
+    _check_values(d, {"q3.backlash": 8e-4})
+    assert d.final.rms <= 1.5 * np.sqrt(3.0) * SIGMA
+    sw = d.where["backlash_switch"][2]
+    assert 0.5 * friction < sw < 2.0 * friction
 
 
 def test_gravity_torques_from_mjcf(tmp_path):

@@ -737,6 +737,70 @@ def _with_gravity_side(ctx: Context, reg: FitResult, fitting: NDArray[np.int64],
     return dataclasses.replace(ctx, gravity_side=np.where(sig_joint, tau, side))
 
 
+def _with_backlash_switch(ctx: Context, reg: FitResult, fitting: NDArray[np.int64],
+                          rb0: F64, sweeps: int = 3) -> Context:
+    """Per joint, the gravity torque above which a joint with play rests on the loaded flank
+    instead of lagging against its approach direction (Coulomb friction of the load holds it
+    below). Chosen on the fitting poses by profiling, joint by joint with the other joints'
+    play in the model (a few coordinate sweeps): for thresholds at 0, every |torque| of the
+    data (at most 400 quantiles) and infinity, the play fit on top of the registration that removes the most residual wins;
+    infinity (the plain approach-direction model) unless another threshold removes clearly
+    more (by 25 sigma^2)."""
+    import dataclasses
+
+    d = ctx.meas.approach_direction()[fitting]
+    tau = ctx.gravity_side_torque()[fitting]
+    n = ctx.n
+    unit = [ParamSpec(f"q{k + 1}.unit", "rad", "joint_offset", "dq", k + 1, 0,
+                      np.eye(n)[k][None, :].repeat(len(ctx.q), 0)) for k in range(n)]
+    prob = Problem(ctx, list(reg.specs) + unit, fitting, reg.base_rotation)
+    r, J = prob.residual_and_jacobian(np.concatenate([reg.theta, np.zeros(n)]))
+    nb = len(reg.specs)
+    jn = np.linalg.norm(J[:, :nb], axis=0)
+    Areg = J[:, :nb] / np.where(jn > 0, jn, 1.0)
+    G = J[:, nb:].reshape(-1, 3, n)  # dx/dq_k per row
+    pose = prob.row_pose
+    s2 = reg.rss / reg.dof
+
+    def column(k: int, F: float) -> F64:
+        B = np.where(np.abs(tau[:, k]) > F, np.sign(tau[:, k]), -d[:, k])
+        return (G[:, :, k] * B[pose][:, None]).ravel()
+
+    grids: dict[int, list[float]] = {}
+    for k in range(n):
+        a = np.abs(tau[:, k])
+        has_play = (np.any(d[:, k] > 0) and np.any(d[:, k] < 0)) or np.any(a > 0)
+        if not has_play:
+            continue
+        # the basis only changes at the data's |torque| values: try them all (at most 400)
+        qs = np.unique(a[a > 0])
+        if qs.size > 400:
+            qs = np.unique(np.quantile(qs, np.linspace(0.0, 1.0, 400)))
+        grids[k] = [np.inf, *qs.tolist(), 0.0] if np.any(a > 0) else [np.inf]
+    switch = np.full(n, np.inf)
+    for _ in range(sweeps):
+        changed = False
+        for k, grid in grids.items():
+            others = [column(j, switch[j]) for j in grids if j != k]
+            A = np.column_stack([Areg, *[c / max(np.linalg.norm(c), 1e-300) for c in others]])
+            Q = orthonormal_basis(A)
+            rp = r - Q @ (Q.T @ r)
+            gains = []
+            for F in grid:
+                col = column(k, F)
+                col = col - Q @ (Q.T @ col)
+                cc = float(col @ col)
+                gains.append(float(col @ rp) ** 2 / cc if cc > 0 else 0.0)
+            i = int(np.argmax(gains))
+            best = grid[i] if gains[i] > gains[0] + 25.0 * s2 else np.inf
+            if best != switch[k]:
+                switch[k] = best
+                changed = True
+        if not changed:
+            break
+    return dataclasses.replace(ctx, backlash_switch=tuple(float(v) for v in switch))
+
+
 def _check_units(ctx: Context, poses: NDArray[np.int64]) -> None:
     meas = ctx.meas
     rows = np.isin(meas.pose_index, poses)
@@ -818,8 +882,12 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     floor = noise_floor(meas, fitting, noise_sigma)
     where = where_analysis(ctx, reg)
 
-    if gravity_torque is None and "backlash" in effects:
-        ctx = _with_gravity_side(ctx, reg, fitting, rb0, alpha)
+    if "backlash" in effects:
+        if gravity_torque is None:
+            ctx = _with_gravity_side(ctx, reg, fitting, rb0, alpha)
+        ctx = _with_backlash_switch(ctx, reg, fitting, rb0)
+        where["backlash_switch"] = [None if not np.isfinite(v) else v
+                                    for v in ctx.backlash_switch or ()]
     # greedy search
     cache: dict[str, tuple[list[ParamSpec], str | None]] = {
         e: effect_parameters(ctx, e) for e in effects}

@@ -10,9 +10,9 @@ corrected model (see :mod:`zrp.gap.problem`, which also gives the analytic Jacob
 * ``dq``: a joint correction q_actual = q + sum_i theta_i B_i(pose), with a fixed basis B of
   shape (P, n) per parameter. ``joint_offset`` (B = 1), ``encoder_scale`` (B = q),
   ``joint_compliance`` (B = gravity torque or a lumped-mass moment arm), ``backlash``
-  (B = -approach direction, and B = sign of the gravity torque for the side of the play a
-  gravity-loaded joint rests against), ``cyclic_error`` (B = sin(h q), cos(h q)) are all of
-  this kind.
+  (B = -approach direction, or the sign of the gravity torque where it exceeds a per-joint
+  threshold so that the joint rests on the loaded flank of its play), ``cyclic_error``
+  (B = sin(h q), cos(h q)) are all of this kind.
 * ``link``: one component of a body-vector correction db_{k,0} (length unit).
 * ``tilt``: a tilt of a joint axis towards one of its tangents t1, t2 (rad), exact:
   u' = (u + a t1 + b t2) / |u + a t1 + b t2| (tangents from :func:`zrp.sensitivity.axis_tangents`).
@@ -138,6 +138,10 @@ class Context:
         gravity_side: a torque per pose and joint whose sign tells which side of its play a
             gravity-loaded joint rests against, shape (P, n), or None (see
             :meth:`gravity_side_torque`).
+        backlash_switch: per joint, the gravity torque (units of
+            :meth:`gravity_side_torque`) above which the joint rests on the loaded flank of its
+            play instead of lagging against its approach direction; inf (the default) means
+            always the approach direction, 0 always the loaded flank.
     """
 
     model: Manipulator
@@ -147,6 +151,7 @@ class Context:
     harmonics: tuple[int, ...] = (1, 2)
     t_ref_degC: float = 20.0
     gravity_side: F64 | None = None
+    backlash_switch: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.meas.n_joints != self.model.n:
@@ -192,6 +197,16 @@ class Context:
     @cached_property
     def nominal_fk(self):  # noqa: ANN201
         return forward_kinematics(self.model, self.q)
+
+    def backlash_basis(self) -> F64:
+        """Which side of its play each joint sits on in each pose, shape (P, n), -1/0/+1 per
+        unit play: -approach direction where |gravity torque| <= the joint's
+        :attr:`backlash_switch`, else the sign of the gravity torque."""
+        d = self.meas.approach_direction()
+        tau = self.gravity_side_torque()
+        sw = (np.full(self.n, np.inf) if self.backlash_switch is None
+              else np.asarray(self.backlash_switch, dtype=float))
+        return np.where(np.abs(tau) > sw, np.sign(tau), -d)
 
     def gravity_side_torque(self) -> F64:
         """A gravity torque per pose and joint whose sign is trusted, shape (P, n): the MJCF
@@ -299,16 +314,12 @@ def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str |
                     np.sin(h * q[:, k]) if fn == "sin" else np.cos(h * q[:, k]))
                 for k in rev for h in ctx.harmonics for fn in ("sin", "cos")], None
     if effect == "backlash":
-        d = ctx.meas.approach_direction()
-        specs = [_dq(ctx, f"q{k + 1}.backlash", junit[k], effect, k, -d[:, k])
-                 for k in range(n) if np.any(d[:, k] > 0) and np.any(d[:, k] < 0)]
-        # a joint loaded by gravity rests against the side of its play that gravity pushes it
-        # to, whatever the direction of approach
-        side = np.sign(ctx.gravity_side_torque())
+        basis = ctx.backlash_basis()
+        specs = []
         for k in range(n):
-            pos, neg = np.mean(side[:, k] > 0), np.mean(side[:, k] < 0)
-            if min(pos, neg) >= 0.05:
-                specs.append(_dq(ctx, f"q{k + 1}.backlash_g", junit[k], effect, k, side[:, k]))
+            b = basis[:, k]
+            if np.any(b > 0) and np.any(b < 0):
+                specs.append(_dq(ctx, f"q{k + 1}.backlash", junit[k], effect, k, b))
         if not specs:
             return [], ("no joint approaches its poses from both directions or sees gravity "
                         "torques of both signs")

@@ -36,6 +36,9 @@ class Injection:
         backlash: rad per joint; the joint lags against its direction of approach.
         backlash_gravity: rad per joint; the joint rests against the side of its play that the
             gravity torque of ``masses`` pushes it to.
+        backlash_friction: N m per joint (with ``backlash``): where the gravity torque of
+            ``masses`` exceeds it, the joint rests on the loaded flank instead of lagging
+            against its approach direction.
         cyclic_error: per joint, (harmonic h, sin amplitude rad, cos amplitude rad).
         compliance: rad per (N m) per joint; deflection = c tau with tau the gravity torque of
             the point masses ``masses``.
@@ -50,6 +53,7 @@ class Injection:
     encoder_scale: Mapping[int, float] = field(default_factory=dict)
     backlash: Mapping[int, float] = field(default_factory=dict)
     backlash_gravity: Mapping[int, float] = field(default_factory=dict)
+    backlash_friction: Mapping[int, float] = field(default_factory=dict)
     cyclic_error: Mapping[int, tuple[int, float, float]] = field(default_factory=dict)
     compliance: Mapping[int, float] = field(default_factory=dict)
     masses: Mapping[str, float] = field(default_factory=lambda: {"p3": 8.0, "p5": 4.0,
@@ -125,8 +129,11 @@ def synthesize(model: Manipulator, q: ArrayLike, injection: Injection, *,
         for i in range(1, P):
             s = np.sign(q[i] - q[i - 1])
             d[i] = np.where(s != 0, s, d[i - 1])
+        tau_b = _gravity_torque(model, q, inj.masses, np.array([0.0, 0.0, -1.0]))
         for k, v in inj.backlash.items():
-            qa[:, k - 1] -= v * d[:, k - 1]
+            f = inj.backlash_friction.get(k, np.inf)
+            t = tau_b[:, k - 1]
+            qa[:, k - 1] += v * np.where(np.abs(t) > f, np.sign(t), -d[:, k - 1])
     for k, (h, a, b) in inj.cyclic_error.items():
         qa[:, k - 1] += a * np.sin(h * q[:, k - 1]) + b * np.cos(h * q[:, k - 1])
     if inj.compliance or inj.backlash_gravity:
