@@ -55,7 +55,7 @@ __all__ = [
 ]
 
 F64 = NDArray[np.float64]
-APPROACHES = ("random", "order")
+APPROACHES = ("random", "order", "gravity")
 TRUTH_FORMAT = "zrp-real-robot-truth"
 
 
@@ -202,7 +202,11 @@ class Procedure:
 
     Attributes:
         approach: "random" (final slow approach of every joint from a random side, written as
-            dir columns) or "order" (straight from pose to pose; direction from the order).
+            dir columns), "gravity" (joints that carry a gravity torque approach against
+            gravity, i.e. lifting, so that a backlash rests on the same flank whether gravity
+            or the approach decides; the others from a random side; the torque comes from the
+            nominal model and the known payload) or "order" (straight from pose to pose;
+            direction from the order).
         approach_step: length of the final approach, rad (longer than any backlash).
         approach_time: duration of the final approach, s.
         speed: peak joint speed of the transfer moves, rad/s.
@@ -342,6 +346,7 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
     P = q.shape[0]
     M = len(robot.tool_points)
     step = proc.approach_step
+    lift = (_nominal_static_torque(robot, q) if proc.approach == "gravity" else None)
     session = robot.session(q[0] - step, proc.temperature(0.0)[()])
     session.settle(max_time=proc.settle_time)
     clock = 0.0
@@ -356,8 +361,10 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
     speed = np.empty(P)
     motor_err = np.empty(P)
     for i in tqdm(range(P), desc="measure", unit="pose", disable=not progress, leave=False):
-        if proc.approach == "random":
+        if proc.approach in ("random", "gravity"):
             d = rng.choice([-1.0, 1.0], size=n)
+            if lift is not None:
+                d = np.where(np.abs(lift[i]) > 1e-3, np.sign(lift[i]), d)
             pre = q[i] - d * step
             dist = float(np.max(np.abs(pre - prev)))
             if dist > 0:
@@ -395,7 +402,7 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
     temp_log = np.round(temp_log, 3)
     load = np.full(P, robot.effects.payload)
     labels = [f"smr{j + 1}" for j in range(M)]
-    direction = dirs if proc.approach == "random" else None
+    direction = dirs if proc.approach != "order" else None
     meas = Measurements.from_arrays(
         np.repeat([f"P{i + 1:04d}" for i in range(P)], M), np.repeat(q, M, axis=0),
         xyz.reshape(-1, 3), point=np.tile(labels, P), frame="instrument",
@@ -426,6 +433,26 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
         },
     }
     return MeasurementRun(meas, direction, truth)
+
+
+def _nominal_static_torque(robot: RealRobot, q: F64) -> F64:
+    """Torque each servo must supply to hold the NOMINAL arm (with the known payload) at the
+    poses ``q``, N m, shape (P, n) (``qfrc_bias``: positive means the joint is held against
+    gravity turning it negatively). Uses only what a user knows: the nominal model, its
+    inertias and the payload."""
+    import mujoco
+
+    from .real_robot import HiddenEffects as _HE
+
+    nominal = RealRobot(robot.nominal, _HE(payload=robot.effects.payload), robot.options)
+    d = mujoco.MjData(nominal.model)
+    ids = nominal._ids
+    out = np.empty(q.shape)
+    for i, qi in enumerate(q):
+        d.qpos[ids["motor_q"]] = qi
+        mujoco.mj_forward(nominal.model, d)
+        out[i] = d.qfrc_bias[ids["motor_v"]]
+    return out
 
 
 def _check_out(path: Path, force: bool, what: str) -> None:

@@ -217,6 +217,21 @@ def test_order_approach_writes_no_direction_columns(puma, tmp_path):
     assert "dir1" not in header
 
 
+def test_gravity_approach_puts_the_backlash_on_the_gravity_flank(puma):
+    """Approaching against gravity, the load lags onto the flank gravity loads anyway: the
+    approach direction and the gravity side then agree in every pose."""
+    b = 1e-3
+    rng = np.random.default_rng(4)
+    q = random_poses(puma, 16, rng)
+    run = measure(RealRobot(puma, HiddenEffects(backlash={2: b})), q, EXACT, rng,
+                  Procedure(approach="gravity"))
+    play = _truth(run, "q_link")[:, 1] - _truth(run, "q_motor")[:, 1]
+    np.testing.assert_allclose(play, -run.direction[:, 1] * b / 2, atol=0.02 * b)
+    assert 0 < np.mean(run.direction[:, 1] > 0) < 1  # both directions occur
+    # joint 1 carries no gravity torque: random approach side
+    assert set(np.unique(run.direction[:, 0])) == {-1.0, 1.0}
+
+
 def test_circle_poses_follow_the_paper_circle(puma):
     q = trajectory_poses(puma, 24)
     p, _ = zrp.end_effector_pose(puma, q)
