@@ -599,7 +599,8 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         measurements: measured tool points (see :func:`zrp.gap.load_measurements`).
         mjcf: an MJCF file with the robot's inertias (gravity torques for
             ``joint_compliance``); without it a lumped-mass model is identified.
-        gravity_torque: gravity torque per pose and joint, shape (P, n), instead of ``mjcf``.
+        gravity_torque: the torque gravity exerts on each joint in each pose (positive when
+            it turns the joint positively; N m), shape (P, n), instead of ``mjcf``.
         effects: candidate effects (subset of :data:`zrp.gap.EFFECTS`).
         rng: random generator for the split (default ``np.random.default_rng(seed)``).
         withheld_fraction: share of the (distinct) poses withheld from fitting and selection.
