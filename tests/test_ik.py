@@ -112,6 +112,10 @@ def test_position_task_for_four_joint_scara():
     r = zrp.track_trajectory(scara, c, q0, 400)
     assert r.task == "position"
     assert r.position_error.max() < 1e-9
+    # prismatic columns are scaled like revolute ones: a healthy SCARA is not "near a
+    # singularity" (it was, on every sample, when the quill's column was left in mm per mm)
+    assert r.damping.max() == 0.0
+    assert r.manipulability.min() > 0.01
 
 
 def _well_conditioned_arm(rng, n, pp):

@@ -45,11 +45,13 @@ def _pose_error(pose, pd, erd, err):
 
 
 @njit(cache=True)
-def _dls_solve(jac, rhs, m, inv_l, w0, lam_max, out, info):
-    """qdot = Js^T (Js Js^T + lam^2 I)^-1 rhs on the scaled task rows.
+def _dls_solve(jac, rhs, m, inv_l, cscale, w0, lam_max, out, info):
+    """qdot = S Js^T (Js Js^T + lam^2 I)^-1 rhs with the dimensionless Js = T J S.
 
-    Task rows: m = 6 -> [omega; v / L], m = 3 -> [v / L]. ``rhs`` is already scaled.
-    info[0] <- manipulability sqrt(det(Js Js^T)), info[1] <- lam^2 used.
+    Task rows T: m = 6 -> [omega; v / L], m = 3 -> [v / L]; ``rhs`` is already scaled.
+    Joint columns S: 1 for revolute joints (rad), L for prismatic ones (length), so that every
+    entry of Js is dimensionless. info[0] <- manipulability sqrt(det(Js Js^T)),
+    info[1] <- lam^2 used.
     """
     n = jac.shape[1]
     off = 6 - m
@@ -57,7 +59,7 @@ def _dls_solve(jac, rhs, m, inv_l, w0, lam_max, out, info):
     for i in range(m):
         sc = 1.0 if (i + off) < 3 else inv_l
         for j in range(n):
-            js[i, j] = jac[i + off, j] * sc
+            js[i, j] = jac[i + off, j] * sc * cscale[j]
     a = np.zeros((m, m))
     for i in range(m):
         for j in range(i + 1):
@@ -113,13 +115,13 @@ def _dls_solve(jac, rhs, m, inv_l, w0, lam_max, out, info):
         acc = 0.0
         for i in range(m):
             acc += js[i, j] * y[i]
-        out[j] = acc
+        out[j] = acc * cscale[j]
     info[0] = w
     info[1] = lam2
 
 
 @njit(cache=True)
-def _rate(q, pd, vd, erd, wd, axes, bodies, prism, m, inv_l, kp, w0, lam_max,
+def _rate(q, pd, vd, erd, wd, axes, bodies, prism, m, inv_l, cscale, kp, w0, lam_max,
           pose, jac, err, rhs, out, info):
     """f(t, q): joint rates tracking the desired velocity (+ kp times the pose error)."""
     fk_jac_one(q, axes, bodies, prism, pose, jac)
@@ -131,7 +133,7 @@ def _rate(q, pd, vd, erd, wd, axes, bodies, prism, m, inv_l, kp, w0, lam_max,
     else:
         for i in range(3):
             rhs[i] = (vd[i] + kp * err[3 + i]) * inv_l
-    _dls_solve(jac, rhs, m, inv_l, w0, lam_max, out, info)
+    _dls_solve(jac, rhs, m, inv_l, cscale, w0, lam_max, out, info)
 
 
 @njit(cache=True)
@@ -142,8 +144,8 @@ def _errnorms(err, m):
 
 
 @njit(cache=True)
-def _newton(q, pd, erd, axes, bodies, prism, m, inv_l, w0, lam_max, tol_p, tol_o, max_iter,
-            pose, jac, err, rhs, dq, info, res):
+def _newton(q, pd, erd, axes, bodies, prism, m, inv_l, cscale, w0, lam_max, tol_p, tol_o,
+            max_iter, pose, jac, err, rhs, dq, info, res):
     """Project q onto the desired pose. res <- [ep0, eo0, ep, eo, |dq| total, iterations]."""
     n = q.shape[0]
     fk_jac_one(q, axes, bodies, prism, pose, jac)
@@ -170,7 +172,7 @@ def _newton(q, pd, erd, axes, bodies, prism, m, inv_l, w0, lam_max, tol_p, tol_o
                 rhs[i] = err[3 + i] * inv_l
         # Newton steps are small: damp only very close to the singularity (w < w0 / 100),
         # so that the projection still converges quadratically where the rates were damped.
-        _dls_solve(jac, rhs, m, inv_l, 0.01 * w0, lam_max, dq, info)
+        _dls_solve(jac, rhs, m, inv_l, cscale, 0.01 * w0, lam_max, dq, info)
         s = 0.0
         for j in range(n):
             q[j] += dq[j]
@@ -187,7 +189,7 @@ def _newton(q, pd, erd, axes, bodies, prism, m, inv_l, w0, lam_max, tol_p, tol_o
 
 
 @njit(cache=True)
-def integrate(q0, h, pd, vd, erd, wd, pm, vm, erm, wm, axes, bodies, prism, m, inv_l, kp,
+def integrate(q0, h, pd, vd, erd, wd, pm, vm, erm, wm, axes, bodies, prism, m, inv_l, cscale, kp,
               w0, lam_max, newton, tol_p, tol_o, max_iter,
               q_out, qd_out, manip, lam_out, drift_p, drift_o, err_p, err_o, corr, iters):
     """Integrate N = len(pd) - 1 steps. Midpoint data (pm, vm, erm, wm; 3 rows) serve RK4.
@@ -208,8 +210,8 @@ def integrate(q0, h, pd, vd, erd, wd, pm, vm, erm, wm, axes, bodies, prism, m, i
 
     def finish_step(k):
         if newton:
-            _newton(q, pd[k], erd[k], axes, bodies, prism, m, inv_l, w0, lam_max, tol_p, tol_o,
-                    max_iter, pose, jac, err, rhs, dq, info, res)
+            _newton(q, pd[k], erd[k], axes, bodies, prism, m, inv_l, cscale, w0, lam_max, tol_p,
+                    tol_o, max_iter, pose, jac, err, rhs, dq, info, res)
         else:
             fk_jac_one(q, axes, bodies, prism, pose, jac)
             _pose_error(pose, pd[k], erd[k], err)
@@ -226,8 +228,8 @@ def integrate(q0, h, pd, vd, erd, wd, pm, vm, erm, wm, axes, bodies, prism, m, i
         err_o[k] = res[3]
         corr[k] = res[4]
         iters[k] = int(res[5])
-        _rate(q, pd[k], vd[k], erd[k], wd[k], axes, bodies, prism, m, inv_l, kp, w0, lam_max,
-              pose, jac, err, rhs, f[k], info)
+        _rate(q, pd[k], vd[k], erd[k], wd[k], axes, bodies, prism, m, inv_l, cscale, kp, w0,
+              lam_max, pose, jac, err, rhs, f[k], info)
         manip[k] = info[0]
         lam_out[k] = math.sqrt(info[1])
         for j in range(n):
@@ -246,16 +248,16 @@ def integrate(q0, h, pd, vd, erd, wd, pm, vm, erm, wm, axes, bodies, prism, m, i
             for j in range(n):
                 k1[j] = f[k, j]
                 tmp[j] = q[j] + 0.5 * h * k1[j]
-            _rate(tmp, pm[k], vm[k], erm[k], wm[k], axes, bodies, prism, m, inv_l, kp, w0,
+            _rate(tmp, pm[k], vm[k], erm[k], wm[k], axes, bodies, prism, m, inv_l, cscale, kp, w0,
                   lam_max, pose, jac, err, rhs, k2, info)
             for j in range(n):
                 tmp[j] = q[j] + 0.5 * h * k2[j]
-            _rate(tmp, pm[k], vm[k], erm[k], wm[k], axes, bodies, prism, m, inv_l, kp, w0,
+            _rate(tmp, pm[k], vm[k], erm[k], wm[k], axes, bodies, prism, m, inv_l, cscale, kp, w0,
                   lam_max, pose, jac, err, rhs, k3, info)
             for j in range(n):
                 tmp[j] = q[j] + h * k3[j]
             _rate(tmp, pd[k + 1], vd[k + 1], erd[k + 1], wd[k + 1], axes, bodies, prism, m,
-                  inv_l, kp, w0, lam_max, pose, jac, err, rhs, k4, info)
+                  inv_l, cscale, kp, w0, lam_max, pose, jac, err, rhs, k4, info)
             for j in range(n):
                 q[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j])
         else:  # Adams-Bashforth-Moulton 4, PECE
@@ -263,7 +265,7 @@ def integrate(q0, h, pd, vd, erd, wd, pm, vm, erm, wm, axes, bodies, prism, m, i
                 tmp[j] = q[j] + h / 24.0 * (55.0 * f[k, j] - 59.0 * f[k - 1, j]
                                             + 37.0 * f[k - 2, j] - 9.0 * f[k - 3, j])
             _rate(tmp, pd[k + 1], vd[k + 1], erd[k + 1], wd[k + 1], axes, bodies, prism, m,
-                  inv_l, kp, w0, lam_max, pose, jac, err, rhs, fp, info)
+                  inv_l, cscale, kp, w0, lam_max, pose, jac, err, rhs, fp, info)
             for j in range(n):
                 q[j] += h / 24.0 * (9.0 * fp[j] + 19.0 * f[k, j] - 5.0 * f[k - 1, j]
                                     + f[k - 2, j])

@@ -57,7 +57,9 @@ class IKResult:
             the predictor-corrector alone left, shape (N+1,).
         correction: |delta q| applied by the correction at each step, shape (N+1,).
         iterations: Newton iterations per step, shape (N+1,).
-        manipulability: sqrt(det(Js Js^T)) of the row-scaled Jacobian, shape (N+1,).
+        manipulability: sqrt(det(Js Js^T)) of the dimensionless Jacobian Js (velocity rows
+            divided and prismatic columns multiplied by the characteristic length), shape
+            (N+1,).
         damping: damped-least-squares factor lambda used, shape (N+1,) (0 away from
             singularities).
     """
@@ -246,7 +248,8 @@ def track_trajectory(
         np.ascontiguousarray(erd), np.ascontiguousarray(wd),
         np.ascontiguousarray(mid.position), np.ascontiguousarray(mid.velocity),
         np.ascontiguousarray(erm), np.ascontiguousarray(wm), *_karrays(model), m,
-        1.0 / length, float(gain), float(manipulability_threshold), float(max_damping),
+        1.0 / length, np.where(model.prismatic, length, 1.0), float(gain),
+        float(manipulability_threshold), float(max_damping),
         use_newton, float(position_tol), float(orientation_tol_rad), int(max_iter),
         q_out, qd_out, out["manip"], out["lam"], out["drift_p"], out["drift_o"], out["err_p"],
         out["err_o"], out["corr"], iters)
