@@ -738,15 +738,15 @@ def _with_gravity_side(ctx: Context, reg: FitResult, fitting: NDArray[np.int64],
     return dataclasses.replace(ctx, gravity_side=np.where(sig_joint, tau, side))
 
 
-def _with_backlash_switch(ctx: Context, reg: FitResult, fitting: NDArray[np.int64],
-                          rb0: F64, sweeps: int = 3) -> Context:
+def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int64],
+                          sweeps: int = 3, max_candidates: int = 60) -> Context:
     """Per joint, the gravity torque above which a joint with play rests on the loaded flank
     instead of lagging against its approach direction (Coulomb friction of the load holds it
-    below). Chosen on the fitting poses by profiling, joint by joint with the other joints'
-    play in the model (a few coordinate sweeps): for thresholds at 0, every |torque| of the
-    data (at most 400 quantiles) and infinity, the play fit on top of the registration that removes the most residual wins;
-    infinity (the plain approach-direction model) unless another threshold removes clearly
-    more (by 25 sigma^2)."""
+    below). Chosen on the fitting poses by profiling on top of the current model ``base``,
+    joint by joint with the other joints' play in the model (a few coordinate sweeps): for
+    thresholds at 0, the data's |torque| values (at most ``max_candidates`` quantiles) and
+    infinity, the play fit that removes the most residual wins; infinity (the plain
+    approach-direction model) unless another threshold removes clearly more (by 25 sigma^2)."""
     import dataclasses
 
     d = ctx.meas.approach_direction()[fitting]
@@ -754,46 +754,47 @@ def _with_backlash_switch(ctx: Context, reg: FitResult, fitting: NDArray[np.int6
     n = ctx.n
     unit = [ParamSpec(f"q{k + 1}.unit", "rad", "joint_offset", "dq", k + 1, 0,
                       np.eye(n)[k][None, :].repeat(len(ctx.q), 0)) for k in range(n)]
-    prob = Problem(ctx, list(reg.specs) + unit, fitting, reg.base_rotation)
-    r, J = prob.residual_and_jacobian(np.concatenate([reg.theta, np.zeros(n)]))
-    nb = len(reg.specs)
+    prob = Problem(ctx, list(base.specs) + unit, fitting, base.base_rotation)
+    r, J = prob.residual_and_jacobian(np.concatenate([base.theta, np.zeros(n)]))
+    nb = len(base.specs)
     jn = np.linalg.norm(J[:, :nb], axis=0)
-    Areg = J[:, :nb] / np.where(jn > 0, jn, 1.0)
+    Abase = J[:, :nb] / np.where(jn > 0, jn, 1.0)
     G = J[:, nb:].reshape(-1, 3, n)  # dx/dq_k per row
     pose = prob.row_pose
-    s2 = reg.rss / reg.dof
+    s2 = base.rss / base.dof
 
-    def column(k: int, F: float) -> F64:
-        B = np.where(np.abs(tau[:, k]) > F, np.sign(tau[:, k]), -d[:, k])
-        return (G[:, :, k] * B[pose][:, None]).ravel()
+    def columns(k: int, grid: F64) -> F64:
+        """Basis columns for thresholds ``grid`` (m,): shape (3R, m)."""
+        B = np.where(np.abs(tau[:, k])[:, None] > grid[None, :], np.sign(tau[:, k])[:, None],
+                     -d[:, k][:, None])  # (S, m)
+        return (G[:, :, k][:, :, None] * B[pose][:, None, :]).reshape(-1, grid.size)
 
-    grids: dict[int, list[float]] = {}
+    grids: dict[int, F64] = {}
     for k in range(n):
         a = np.abs(tau[:, k])
-        has_play = (np.any(d[:, k] > 0) and np.any(d[:, k] < 0)) or np.any(a > 0)
-        if not has_play:
+        approach = bool(np.any(d[:, k] > 0) and np.any(d[:, k] < 0))
+        if not (approach or np.any(a > 0)):
             continue
-        # the basis only changes at the data's |torque| values: try them all (at most 400)
         qs = np.unique(a[a > 0])
-        if qs.size > 400:
-            qs = np.unique(np.quantile(qs, np.linspace(0.0, 1.0, 400)))
-        grids[k] = [np.inf, *qs.tolist(), 0.0] if np.any(a > 0) else [np.inf]
+        if qs.size > max_candidates:
+            qs = np.unique(np.quantile(qs, np.linspace(0.0, 1.0, max_candidates)))
+        grids[k] = np.array([np.inf, *qs.tolist(), 0.0]) if qs.size else np.array([np.inf])
     switch = np.full(n, np.inf)
     for _ in range(sweeps):
         changed = False
         for k, grid in grids.items():
-            others = [column(j, switch[j]) for j in grids if j != k]
-            A = np.column_stack([Areg, *[c / max(np.linalg.norm(c), 1e-300) for c in others]])
+            if grid.size == 1:
+                continue
+            others = [columns(j, switch[j:j + 1])[:, 0] for j in grids if j != k]
+            A = np.column_stack([Abase, *[c / max(np.linalg.norm(c), 1e-300) for c in others]])
             Q = orthonormal_basis(A)
             rp = r - Q @ (Q.T @ r)
-            gains = []
-            for F in grid:
-                col = column(k, F)
-                col = col - Q @ (Q.T @ col)
-                cc = float(col @ col)
-                gains.append(float(col @ rp) ** 2 / cc if cc > 0 else 0.0)
+            C = columns(k, grid)
+            C = C - Q @ (Q.T @ C)
+            cc = np.einsum("ij,ij->j", C, C)
+            gains = np.where(cc > 0, (C.T @ rp) ** 2 / np.where(cc > 0, cc, 1.0), 0.0)
             i = int(np.argmax(gains))
-            best = grid[i] if gains[i] > gains[0] + 25.0 * s2 else np.inf
+            best = float(grid[i]) if gains[i] > gains[0] + 25.0 * s2 else np.inf
             if best != switch[k]:
                 switch[k] = best
                 changed = True
@@ -886,9 +887,6 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     if "backlash" in effects:
         if gravity_torque is None:
             ctx = _with_gravity_side(ctx, reg, fitting, rb0, alpha)
-        ctx = _with_backlash_switch(ctx, reg, fitting, rb0)
-        where["backlash_switch"] = [None if not np.isfinite(v) else v
-                                    for v in ctx.backlash_switch or ()]
     # greedy search
     cache: dict[str, tuple[list[ParamSpec], str | None]] = {
         e: effect_parameters(ctx, e) for e in effects}
@@ -898,6 +896,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     steps: list[Step] = []
     all_aliased: list[Aliased] = []
     used: set[str] = set()
+    switch_now: tuple[float, ...] | None = None
     bar = tqdm(total=max_steps * len(effects), desc="diagnose", disable=not progress,
                leave=False)
     for _ in range(max_steps):
@@ -906,6 +905,10 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
             bar.update(1)
             if eff in used:
                 continue
+            if eff == "backlash":  # which flank: profiled on top of the current model
+                ctx_b = _with_backlash_switch(ctx, current, fitting)
+                cache[eff] = effect_parameters(ctx_b, eff)
+                switch_now = ctx_b.backlash_switch
             specs, why = cache[eff]
             if not specs:
                 cands.append((Candidate(eff, (), 0, math.nan, math.nan, 1.0, False,
@@ -955,6 +958,8 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
         cand, f_new, aliased = best
         assert f_new is not None
         used.add(cand.effect)
+        if cand.effect == "backlash" and switch_now is not None:
+            where["backlash_switch"] = [None if not np.isfinite(v) else v for v in switch_now]
         nb = len(current.specs)
         after = _withheld(ctx, f_new, withheld)
         weak_or_dropped = tuple(a for a in aliased)
