@@ -239,9 +239,17 @@ def test_backlash_held_by_friction_until_gravity_wins():
         d = diagnose(PUMA, meas, gravity_torque=tau, seed=0)
     assert d.top_effect == "backlash" and d.steps[0].joints == (3,)
     _check_values(d, {"q3.backlash": 8e-4})
-    assert d.final.rms <= 1.5 * np.sqrt(3.0) * SIGMA
     sw = d.where["backlash_switch"][2]
-    assert 0.5 * friction < sw < 2.0 * friction
+    assert 0.9 * friction < sw < 1.1 * friction
+    # A withheld pose whose torque falls between the true and the estimated switching torque
+    # (between two fitting poses) can be put on the wrong flank; every other one is at noise.
+    err = np.linalg.norm(d.withheld_residual_after.reshape(-1, 3), axis=1)
+    rows = np.flatnonzero(np.isin(meas.pose_index, d.withheld_poses))
+    wrong = err > 6 * SIGMA
+    t_wrong = np.abs(tau[meas.pose_index[rows[wrong]], 2])
+    assert np.all((t_wrong >= min(sw, friction)) & (t_wrong <= max(sw, friction)))
+    assert np.sqrt(np.mean(err[~wrong] ** 2)) <= 1.5 * np.sqrt(3.0) * SIGMA
+    assert wrong.sum() <= 3 * 3  # at most a few poses (3 points each)
 
 
 def test_gravity_torques_from_mjcf(tmp_path):

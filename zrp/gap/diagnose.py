@@ -789,12 +789,32 @@ def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int
             A = np.column_stack([Abase, *[c / max(np.linalg.norm(c), 1e-300) for c in others]])
             Q = orthonormal_basis(A)
             rp = r - Q @ (Q.T @ r)
-            C = columns(k, grid)
-            C = C - Q @ (Q.T @ C)
-            cc = np.einsum("ij,ij->j", C, C)
-            gains = np.where(cc > 0, (C.T @ rp) ** 2 / np.where(cc > 0, cc, 1.0), 0.0)
+            def gains_of(g: F64, Q: F64 = Q, rp: F64 = rp, k: int = k) -> F64:
+                C = columns(k, g)
+                C = C - Q @ (Q.T @ C)
+                cc = np.einsum("ij,ij->j", C, C)
+                return np.where(cc > 0, (C.T @ rp) ** 2 / np.where(cc > 0, cc, 1.0), 0.0)
+
+            gains = gains_of(grid)
             i = int(np.argmax(gains))
             best = float(grid[i]) if gains[i] > gains[0] + 25.0 * s2 else np.inf
+            if np.isfinite(best) and best > 0:
+                # refine between the neighbouring grid values with every data value, and put
+                # the threshold half-way to the next lower |torque| of the data
+                # (grid: inf, ascending |torque| quantiles, 0)
+                a = np.unique(np.abs(tau[:, k]))
+                lo = grid[i - 1] if i - 1 >= 1 else 0.0
+                hi = grid[i + 1] if i + 1 <= grid.size - 2 else a.max()
+                fine = a[(a >= lo) & (a <= hi)]
+                if fine.size:
+                    g2 = gains_of(fine)
+                    j = int(np.argmax(g2))
+                    if g2[j] >= gains[i]:
+                        best = float(fine[j])
+                # |torque| <= best keeps the approach side: put the threshold half-way to the
+                # next larger |torque| of the data
+                above = a[a > best]
+                best = 0.5 * (best + above.min()) if above.size else best
             if best != switch[k]:
                 switch[k] = best
                 changed = True
