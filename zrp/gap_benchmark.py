@@ -515,22 +515,33 @@ def score(model: Manipulator, truth: dict[str, Any], diagnosis: dict[str, Any],
                 named = set(found_joints[found.index(e)])
                 joints_ok = set(hj[e]) <= named if hj[e] else True
                 break
-    all_found = all(e in found for e in expected) if expected != ("none",) else \
-        found == ("none",)
+    if expected != ("none",):
+        all_found = all(e in found for e in expected)
+    else:  # nothing visible: nothing, or only hidden effects, may be named
+        all_found = set(found) <= {"none", *hidden}
     nominal = float(diagnosis["nominal"]["rms"])
     final = float(diagnosis["final"]["rms"])
     ratio = final / noise_rms
-    note = ""
+    notes = []
     hid = [e for e in hidden if e not in visible]
     if hid:
-        note = f"hidden effect not visible (SNR {min(snr.get(e, 0.0) for e in hid):.2g}); "
+        notes.append(f"{', '.join(hid)} not visible (SNR "
+                     f"{min(snr.get(e, 0.0) for e in hid):.2g})")
     if not top_correct:
         if found[0] == "none":
-            note += "missed: nothing significant found"
+            notes.append("missed: nothing significant found")
         else:
-            note += f"look-alike: named {found[0]}"
+            lk = f"look-alike: named {found[0]}"
             if any(e in tied for e in accept):
-                note += " (the diagnosis reports the hidden effect as fitting equally well)"
+                lk += " (the diagnosis reports the hidden effect as fitting equally well)"
+            notes.append(lk)
+    elif not joints_ok:
+        notes.append("joints not located")
+    if ratio > config.ratio_target:
+        notes.append(f"withheld RMS {ratio:.2f}x the noise"
+                     + (" (the diagnosis says unexplained)" if diagnosis.get("unexplained")
+                        else ""))
+    note = "; ".join(notes)
     values = {"success": bool(top_correct and joints_ok and ratio <= config.ratio_target)}
     return ScenarioScore(int(scn.get("index", -1)), str(scn.get("kind", "")), hidden, hj, snr,
                          expected, found, found_joints, bool(top_correct), tied,
@@ -727,8 +738,7 @@ def render_text(result: BenchmarkResult) -> str:
                         for e in s.hidden) or "none",
               ", ".join(f"{e} {list(j)}" for e, j in zip(s.found, s.found_joints,
                                                           strict=False)) or "none",
-              s.ratio, s.note or ("joints not located" if not s.joints_correct else
-                                  "RMS above target" if s.ratio > cfg.ratio_target else "")]
+              s.ratio, s.note]
              for s in bad])]
     out += ["", f"Wall time {result.wall_s:.1f} s: simulation {result.sim_s:.1f} s, diagnosis "
             f"{result.diag_s:.1f} s ({result.wall_s / max(len(sc), 1):.2f} s per scenario)."]
