@@ -16,6 +16,10 @@ from zrp.gap import Injection, diagnose, load_measurements, random_poses, synthe
 REAL = Path("/work/shared/data/irb120-lasertracker")
 
 
+def _no_nan(name):
+    raise AssertionError(f"diagnosis JSON contains {name}; it must be strict JSON")
+
+
 @pytest.fixture(scope="module")
 def csv_file(tmp_path_factory):
     model = zrp.load_model("puma")
@@ -34,7 +38,7 @@ def test_cli_writes_json_report_and_plots(csv_file, tmp_path, capsys):
         rc = main(["diagnose", "--model", "puma", "--data", str(csv_file), "--deg",
                    "--out", str(out), "--seed", "4"])
     assert rc == 0
-    doc = json.loads((out / "diagnosis.json").read_text())
+    doc = json.loads((out / "diagnosis.json").read_text(), parse_constant=_no_nan)
     for key in ("nominal", "steps", "final", "noise_floor", "unexplained", "split"):
         assert key in doc
     step = doc["steps"][0]
@@ -74,7 +78,7 @@ def test_cli_json_output(csv_file, tmp_path, capsys):
                    str(tmp_path / "j"), "--json", "--no-plots", "--effects", "joint_offset",
                    "encoder_scale"])
     assert rc == 0
-    doc = json.loads(capsys.readouterr().out)
+    doc = json.loads(capsys.readouterr().out, parse_constant=_no_nan)
     assert doc["effects"] == ["joint_offset"]
     assert not (tmp_path / "j" / "shrink.png").exists()
 

@@ -52,7 +52,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     from ..gap import diagnose, load_measurements
-    from ..gap.report import OUTPUT_FILES, write_outputs
+    from ..gap.report import OUTPUT_FILES, jsonable, write_outputs
 
     out = Path(args.out)
     if not args.force:
@@ -70,5 +70,5 @@ def _run(args: argparse.Namespace) -> int:
                     progress=sys.stderr.isatty() if args.progress is None else args.progress)
     files = write_outputs(diag, out, force=args.force, plots=not args.no_plots)
     text = diag.verdict + "\n" + "\n".join(f"wrote {f}" for f in files)
-    emit(args, diag.to_dict(), text)
+    emit(args, jsonable(diag.to_dict()), text)
     return 0

@@ -15,19 +15,19 @@ import numpy as np
 from ..errors import OutputExistsError
 from .diagnose import Diagnosis
 
-__all__ = ["OUTPUT_FILES", "implicated_joint", "write_outputs"]
+__all__ = ["OUTPUT_FILES", "implicated_joint", "jsonable", "write_outputs"]
 
 OUTPUT_FILES = ("diagnosis.json", "report.md", "residuals.csv", "residuals_before_after.png",
                 "residual_vs_joint.png", "shrink.png")
 
 
-def _jsonable(obj: Any) -> Any:
+def jsonable(obj: Any) -> Any:
     if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
+        return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
+        return [jsonable(v) for v in obj]
     if isinstance(obj, np.ndarray):
-        return _jsonable(obj.tolist())
+        return jsonable(obj.tolist())
     if isinstance(obj, (np.floating, float)):
         v = float(obj)
         return v if math.isfinite(v) else None
@@ -321,7 +321,7 @@ def write_outputs(diag: Diagnosis, out_dir: str | Path, *, force: bool = False,
     out.mkdir(parents=True, exist_ok=True)
     written = []
     p = out / "diagnosis.json"
-    p.write_text(json.dumps(_jsonable(diag.to_dict()), indent=2) + "\n")
+    p.write_text(json.dumps(jsonable(diag.to_dict()), indent=2) + "\n")
     written.append(p)
     meas = diag.context.meas
     rows = _rows(diag)
