@@ -22,6 +22,7 @@ OUTPUT_FILES = ("diagnosis.json", "report.md", "residuals.csv", "residuals_befor
 
 
 def jsonable(obj: Any) -> Any:
+    """``obj`` with NumPy values as Python ones and non-finite floats as None (strict JSON)."""
     if isinstance(obj, dict):
         return {str(k): jsonable(v) for k, v in obj.items()}
     if isinstance(obj, (list, tuple)):
