@@ -2,11 +2,13 @@
 
 The procedure (:func:`measure`): for each commanded pose, in order,
 
-1. move there (a joint-space quintic at a bounded joint speed) - with ``approach="random"``
-   to a pre-pose offset by ``approach_step`` on a random side of each joint, then slowly the
-   last ``approach_step`` (so every joint's approach direction is known and independent of
-   where the pose is; written as the ``dir1..dirn`` columns), with ``approach="order"``
-   straight from the previous pose (the direction then follows from the measurement order);
+1. move there (a joint-space quintic at a bounded joint speed) - with ``approach="gravity"``
+   (default) or ``"random"`` to a pre-pose offset by ``approach_step`` on one side of each
+   joint, then slowly the last ``approach_step`` (so every joint's approach direction is known;
+   written as the ``dir1..dirn`` columns): against gravity for the joints that carry a gravity
+   torque (so a backlash rests on the flank gravity loads whatever the torque), on a random
+   side for the others (or for all with "random"); with ``approach="order"`` straight from the
+   previous pose (the direction then follows from the measurement order);
 2. let the servos settle (their integral action trims the motors onto their targets);
 3. read the tool points (reflectors), add the tracker's noise, express them in the
    instrument's frame; log the time, the robot's temperature (warm-up curve, sensor noise)
@@ -201,12 +203,12 @@ class Procedure:
     """How the poses are approached and logged.
 
     Attributes:
-        approach: "random" (final slow approach of every joint from a random side, written as
-            dir columns), "gravity" (joints that carry a gravity torque approach against
-            gravity, i.e. lifting, so that a backlash rests on the same flank whether gravity
-            or the approach decides; the others from a random side; the torque comes from the
-            nominal model and the known payload) or "order" (straight from pose to pose;
-            direction from the order).
+        approach: "gravity" (default: a final slow approach, written as dir columns; joints
+            that carry a gravity torque approach against gravity, i.e. lifting, so that a
+            backlash rests on the same flank whether gravity or the approach decides; the
+            others from a random side; the torque comes from the nominal model and the known
+            payload), "random" (every joint from a random side) or "order" (straight from
+            pose to pose; direction from the order).
         approach_step: length of the final approach, rad (longer than any backlash).
         approach_time: duration of the final approach, s.
         speed: peak joint speed of the transfer moves, rad/s.
@@ -218,7 +220,7 @@ class Procedure:
         temp_noise: temperature sensor noise (standard deviation), K.
     """
 
-    approach: str = "random"
+    approach: str = "gravity"
     approach_step: float = 0.02
     approach_time: float = 0.5
     speed: float = 2.5

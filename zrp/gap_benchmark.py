@@ -100,7 +100,7 @@ class BenchmarkConfig:
     effects: tuple[str, ...] = ()
     noise: tuple[float, float] = (0.01, 0.03)
     poses_from: str = "random"
-    approach: str = "random"
+    approach: str = "gravity"
     payload_probability: float = 0.5
     use_mjcf: bool = True
     excitation_threshold: float = 1.0

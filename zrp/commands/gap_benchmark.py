@@ -38,10 +38,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="range of the tracker noise sigma per coordinate (default 0.01 0.03)")
     p.add_argument("--poses-from", choices=("random", "circle"), default="random",
                    help="random reachable poses (default) or the PUMA circle")
-    p.add_argument("--approach", choices=("random", "gravity", "order"), default="random",
-                   help="final approach from a random side per joint (default), against "
-                        "gravity for the gravity-loaded joints, or straight moves in "
-                        "measurement order")
+    p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
+                   help="final approach against gravity for the gravity-loaded joints and "
+                        "from a random side for the others (default), from a random side for "
+                        "all, or straight moves in measurement order")
     p.add_argument("--no-mjcf", action="store_true",
                    help="do not give the diagnosis the nominal MJCF (lumped-mass compliance)")
     p.add_argument("--out", default=None, metavar="DIR",

@@ -34,11 +34,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--poses", type=int, default=200, help="number of poses (default 200)")
     p.add_argument("--trajectory", choices=("random", "circle"), default="random",
                    help="random reachable poses (default) or poses along the PUMA circle")
-    p.add_argument("--approach", choices=("random", "gravity", "order"), default="random",
-                   help="final approach of each joint from a random side (written as dir "
-                        "columns; default), against gravity for the joints that carry a "
-                        "gravity torque (the rest random), or straight moves in measurement "
-                        "order")
+    p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
+                   help="final approach against gravity for the joints that carry a "
+                        "gravity torque, the others from a random side (default; written as "
+                        "dir columns), every joint from a random side, or straight moves in "
+                        "measurement order")
     p.add_argument("--noise", type=float, default=0.02, metavar="SIGMA",
                    help="tracker noise per coordinate, model length unit (default 0.02)")
     p.add_argument("--temp-rise", type=float, default=10.0, metavar="K",
