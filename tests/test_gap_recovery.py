@@ -203,6 +203,24 @@ def test_compliance_with_given_gravity_torques():
     assert d.settings["compliance_model"] == "mjcf"
 
 
+def test_compliance_with_an_unknown_payload():
+    """The MJCF knows the arm but not the 3 kg payload at the tool: the payload's share of the
+    deflection is identified as compliance x payload mass (rad/kg)."""
+    rng = np.random.default_rng(10)
+    q = random_poses(PUMA, 300, rng)
+    inj = Injection(compliance={2: 2e-5, 3: 3e-5}, masses=MASSES)
+    meas = synthesize(PUMA, q, inj, rng=rng, noise_sigma=SIGMA)
+    arm_only = _gravity_torque(PUMA, meas.q_pose, {"p3": 8.0}, np.array([0.0, 0.0, -1.0]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = diagnose(PUMA, meas, gravity_torque=arm_only, seed=0)
+    assert d.top_effect == "joint_compliance" and d.steps[0].joints == (2, 3)
+    # (the arm's mass at p3 loads joint 2 only; joint 3 carries just the payload)
+    _check_values(d, {"q2.compliance": 2e-5, "q2.compliance_payload": 2e-5 * 3.0,
+                      "q3.compliance_payload": 3e-5 * 3.0})
+    assert d.final.rms <= 1.5 * np.sqrt(3.0) * SIGMA
+
+
 def test_gravity_loaded_backlash():
     """A joint loaded by gravity rests against one side of its play whatever the approach
     direction: found as backlash on the loaded flank. With the exact gravity torques (as an MJCF

@@ -20,6 +20,8 @@ from ..model import Manipulator
 from .data import DataWarning, Measurements
 from .effects import (
     EFFECTS,
+    G_STANDARD,
+    LENGTH_TO_M,
     Context,
     ParamSpec,
     effect_parameters,
@@ -738,6 +740,9 @@ def _with_gravity_side(ctx: Context, reg: FitResult, fitting: NDArray[np.int64],
     return dataclasses.replace(ctx, gravity_side=np.where(sig_joint, tau, side))
 
 
+PAYLOAD_GRID_KG = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0)
+
+
 def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int64],
                           sweeps: int = 3, max_candidates: int = 60) -> Context:
     """Per joint, the gravity torque above which a joint with play rests on the loaded flank
@@ -746,11 +751,12 @@ def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int
     joint by joint with the other joints' play in the model (a few coordinate sweeps): for
     thresholds at 0, the data's |torque| values (at most ``max_candidates`` quantiles) and
     infinity, the play fit that removes the most residual wins; infinity (the plain
-    approach-direction model) unless another threshold removes clearly more (by 25 sigma^2)."""
+    approach-direction model) unless another threshold removes clearly more (by 25 sigma^2).
+    With MJCF torques, an unknown payload at the tool (which shifts the torques) is profiled
+    too, over :data:`PAYLOAD_GRID_KG`, kept when it removes clearly more (25 sigma^2)."""
     import dataclasses
 
     d = ctx.meas.approach_direction()[fitting]
-    tau = ctx.gravity_side_torque()[fitting]
     n = ctx.n
     unit = [ParamSpec(f"q{k + 1}.unit", "rad", "joint_offset", "dq", k + 1, 0,
                       np.eye(n)[k][None, :].repeat(len(ctx.q), 0)) for k in range(n)]
@@ -759,68 +765,93 @@ def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int
     nb = len(base.specs)
     jn = np.linalg.norm(J[:, :nb], axis=0)
     Abase = J[:, :nb] / np.where(jn > 0, jn, 1.0)
+    Qbase = orthonormal_basis(Abase)
     G = J[:, nb:].reshape(-1, 3, n)  # dx/dq_k per row
     pose = prob.row_pose
     s2 = base.rss / base.dof
 
-    def columns(k: int, grid: F64) -> F64:
-        """Basis columns for thresholds ``grid`` (m,): shape (3R, m)."""
-        B = np.where(np.abs(tau[:, k])[:, None] > grid[None, :], np.sign(tau[:, k])[:, None],
-                     -d[:, k][:, None])  # (S, m)
-        return (G[:, :, k][:, :, None] * B[pose][:, None, :]).reshape(-1, grid.size)
+    def select(tau: F64) -> tuple[F64, float]:
+        """Thresholds per joint and the residual they remove together (length unit^2)."""
 
-    grids: dict[int, F64] = {}
-    for k in range(n):
-        a = np.abs(tau[:, k])
-        approach = bool(np.any(d[:, k] > 0) and np.any(d[:, k] < 0))
-        if not (approach or np.any(a > 0)):
-            continue
-        qs = np.unique(a[a > 0])
-        if qs.size > max_candidates:
-            qs = np.unique(np.quantile(qs, np.linspace(0.0, 1.0, max_candidates)))
-        grids[k] = np.array([np.inf, *qs.tolist(), 0.0]) if qs.size else np.array([np.inf])
-    switch = np.full(n, np.inf)
-    for _ in range(sweeps):
-        changed = False
-        for k, grid in grids.items():
-            if grid.size == 1:
+        def columns(k: int, grid: F64) -> F64:
+            """Basis columns for thresholds ``grid`` (m,): shape (3R, m)."""
+            B = np.where(np.abs(tau[:, k])[:, None] > grid[None, :],
+                         np.sign(tau[:, k])[:, None], -d[:, k][:, None])  # (S, m)
+            return (G[:, :, k][:, :, None] * B[pose][:, None, :]).reshape(-1, grid.size)
+
+        grids: dict[int, F64] = {}
+        for k in range(n):
+            a = np.abs(tau[:, k])
+            approach = bool(np.any(d[:, k] > 0) and np.any(d[:, k] < 0))
+            if not (approach or np.any(a > 0)):
                 continue
-            others = [columns(j, switch[j:j + 1])[:, 0] for j in grids if j != k]
-            A = np.column_stack([Abase, *[c / max(np.linalg.norm(c), 1e-300) for c in others]])
-            Q = orthonormal_basis(A)
-            rp = r - Q @ (Q.T @ r)
-            def gains_of(g: F64, Q: F64 = Q, rp: F64 = rp, k: int = k) -> F64:
-                C = columns(k, g)
-                C = C - Q @ (Q.T @ C)
-                cc = np.einsum("ij,ij->j", C, C)
-                return np.where(cc > 0, (C.T @ rp) ** 2 / np.where(cc > 0, cc, 1.0), 0.0)
+            qs = np.unique(a[a > 0])
+            if qs.size > max_candidates:
+                qs = np.unique(np.quantile(qs, np.linspace(0.0, 1.0, max_candidates)))
+            grids[k] = np.array([np.inf, *qs.tolist(), 0.0]) if qs.size else np.array([np.inf])
+        switch = np.full(n, np.inf)
+        for _ in range(sweeps):
+            changed = False
+            for k, grid in grids.items():
+                if grid.size == 1:
+                    continue
+                others = [columns(j, switch[j:j + 1])[:, 0] for j in grids if j != k]
+                A = np.column_stack([Abase, *[c / max(np.linalg.norm(c), 1e-300)
+                                              for c in others]])
+                Q = orthonormal_basis(A)
+                rp = r - Q @ (Q.T @ r)
 
-            gains = gains_of(grid)
-            i = int(np.argmax(gains))
-            best = float(grid[i]) if gains[i] > gains[0] + 25.0 * s2 else np.inf
-            if np.isfinite(best) and best > 0:
-                # refine between the neighbouring grid values with every data value, and put
-                # the threshold half-way to the next lower |torque| of the data
-                # (grid: inf, ascending |torque| quantiles, 0)
-                a = np.unique(np.abs(tau[:, k]))
-                lo = grid[i - 1] if i - 1 >= 1 else 0.0
-                hi = grid[i + 1] if i + 1 <= grid.size - 2 else a.max()
-                fine = a[(a >= lo) & (a <= hi)]
-                if fine.size:
-                    g2 = gains_of(fine)
-                    j = int(np.argmax(g2))
-                    if g2[j] >= gains[i]:
-                        best = float(fine[j])
-                # |torque| <= best keeps the approach side: put the threshold half-way to the
-                # next larger |torque| of the data
-                above = a[a > best]
-                best = 0.5 * (best + above.min()) if above.size else best
-            if best != switch[k]:
-                switch[k] = best
-                changed = True
-        if not changed:
-            break
-    return dataclasses.replace(ctx, backlash_switch=tuple(float(v) for v in switch))
+                def gains_of(g: F64, Q: F64 = Q, rp: F64 = rp, k: int = k) -> F64:
+                    C = columns(k, g)
+                    C = C - Q @ (Q.T @ C)
+                    cc = np.einsum("ij,ij->j", C, C)
+                    return np.where(cc > 0, (C.T @ rp) ** 2 / np.where(cc > 0, cc, 1.0), 0.0)
+
+                gains = gains_of(grid)
+                i = int(np.argmax(gains))
+                best = float(grid[i]) if gains[i] > gains[0] + 25.0 * s2 else np.inf
+                if np.isfinite(best) and best > 0:
+                    # refine between the neighbouring grid values with every data value
+                    # (grid: inf, ascending |torque| quantiles, 0)
+                    a = np.unique(np.abs(tau[:, k]))
+                    lo = grid[i - 1] if i - 1 >= 1 else 0.0
+                    hi = grid[i + 1] if i + 1 <= grid.size - 2 else a.max()
+                    fine = a[(a >= lo) & (a <= hi)]
+                    if fine.size:
+                        g2 = gains_of(fine)
+                        j = int(np.argmax(g2))
+                        if g2[j] >= gains[i]:
+                            best = float(fine[j])
+                    # |torque| <= best keeps the approach side: put the threshold half-way to
+                    # the next larger |torque| of the data
+                    above = a[a > best]
+                    best = 0.5 * (best + above.min()) if above.size else best
+                if best != switch[k]:
+                    switch[k] = best
+                    changed = True
+            if not changed:
+                break
+        if not grids:
+            return switch, 0.0
+        C = np.column_stack([columns(k, switch[k:k + 1])[:, 0] for k in grids])
+        C = C - Qbase @ (Qbase.T @ C)
+        cn = np.linalg.norm(C, axis=0)
+        Qc = orthonormal_basis(C / np.where(cn > 0, cn, 1.0))
+        rp = r - Qbase @ (Qbase.T @ r)
+        return switch, float(np.sum((Qc.T @ rp) ** 2))
+
+    tau0 = ctx.gravity_side_torque()[fitting]
+    switch, gain = select(tau0)
+    payload = 0.0
+    if ctx.gravity_torque is not None:
+        h_ee = ctx.end_effector_arms()[fitting]
+        to_m = LENGTH_TO_M.get(ctx.model.length_unit, 1e-3)
+        for m in PAYLOAD_GRID_KG[1:]:
+            sw_m, g_m = select(tau0 + G_STANDARD * m * h_ee * to_m)
+            if g_m > gain + 25.0 * s2:
+                switch, gain, payload = sw_m, g_m, m
+    return dataclasses.replace(ctx, backlash_switch=tuple(float(v) for v in switch),
+                               payload_kg=payload)
 
 
 def _check_units(ctx: Context, poses: NDArray[np.int64]) -> None:
@@ -917,6 +948,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     all_aliased: list[Aliased] = []
     used: set[str] = set()
     switch_now: tuple[float, ...] | None = None
+    payload_now = 0.0
     bar = tqdm(total=max_steps * len(effects), desc="diagnose", disable=not progress,
                leave=False)
     for _ in range(max_steps):
@@ -929,6 +961,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
                 ctx_b = _with_backlash_switch(ctx, current, fitting)
                 cache[eff] = effect_parameters(ctx_b, eff)
                 switch_now = ctx_b.backlash_switch
+                payload_now = ctx_b.payload_kg
             specs, why = cache[eff]
             if not specs:
                 cands.append((Candidate(eff, (), 0, math.nan, math.nan, 1.0, False,
@@ -980,6 +1013,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
         used.add(cand.effect)
         if cand.effect == "backlash" and switch_now is not None:
             where["backlash_switch"] = [None if not np.isfinite(v) else v for v in switch_now]
+            where["backlash_payload_kg"] = payload_now
         nb = len(current.specs)
         after = _withheld(ctx, f_new, withheld)
         weak_or_dropped = tuple(a for a in aliased)

@@ -35,7 +35,9 @@ from .data import Measurements
 
 __all__ = [
     "EFFECTS",
+    "G_STANDARD",
     "KINDS",
+    "LENGTH_TO_M",
     "REGISTRATION",
     "Context",
     "ParamSpec",
@@ -142,6 +144,8 @@ class Context:
             :meth:`gravity_side_torque`) above which the joint rests on the loaded flank of its
             play instead of lagging against its approach direction; inf (the default) means
             always the approach direction, 0 always the loaded flank.
+        payload_kg: a payload at the tool that the MJCF torques lack, kg (added to them for
+            the backlash flank; the diagnosis profiles it).
     """
 
     model: Manipulator
@@ -152,6 +156,7 @@ class Context:
     t_ref_degC: float = 20.0
     gravity_side: F64 | None = None
     backlash_switch: tuple[float, ...] | None = None
+    payload_kg: float = 0.0
 
     def __post_init__(self) -> None:
         if self.meas.n_joints != self.model.n:
@@ -215,6 +220,9 @@ class Context:
         values below 1e-6 of the largest are set to 0 (no load)."""
         if self.gravity_torque is not None:
             tau = np.array(self.gravity_torque, dtype=float)
+            if self.payload_kg:
+                tau = tau + (G_STANDARD * self.payload_kg * self.end_effector_arms()
+                             * LENGTH_TO_M.get(self.model.length_unit, 1e-3))
         elif self.gravity_side is not None:
             tau = np.array(self.gravity_side, dtype=float)
         else:
@@ -329,17 +337,21 @@ def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str |
         load = ctx.meas.per_pose("load")
         if ctx.gravity_torque is not None:
             tau = np.array(ctx.gravity_torque, dtype=float)
+            h_ee = ctx.end_effector_arms()
+            to_m = LENGTH_TO_M.get(unit)
+            if to_m is None:
+                raise InputError(f"length_unit {unit!r}: cannot convert to m for the payload "
+                                 f"torque; known: {', '.join(LENGTH_TO_M)}")
             if load is not None:
-                h_ee = ctx.end_effector_arms()
-                to_m = LENGTH_TO_M.get(unit)
-                if to_m is None:
-                    raise InputError(f"length_unit {unit!r}: cannot convert to m for the load "
-                                     f"torque; known: {', '.join(LENGTH_TO_M)}")
                 tau = tau + G_STANDARD * load[:, None] * h_ee * to_m
             for k in range(n):
                 if np.ptp(tau[:, k]) > 0 or np.any(tau[:, k] != 0):
                     specs.append(_dq(ctx, f"q{k + 1}.compliance", f"{junit[k]}/(N m)", effect,
                                      k, tau[:, k]))
+                # an unknown payload at the tool adds c_k m g h_ee: linear in c_k m
+                if np.any(h_ee[:, k] != 0.0):
+                    specs.append(_dq(ctx, f"q{k + 1}.compliance_payload", f"{junit[k]}/kg",
+                                     effect, k, G_STANDARD * h_ee[:, k] * to_m))
             return specs, None
         labels, h = ctx.moment_arms()
         h = np.where(np.abs(h) > 1e-9 * model.characteristic_length, h, 0.0)
