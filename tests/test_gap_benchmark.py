@@ -181,6 +181,13 @@ def test_scoring_rules(puma):
     assert score(puma, hidden, _diag([]), cfg).top_correct
     assert score(puma, hidden, _diag([("joint_offset", [1])]), cfg).top_correct
     assert not score(puma, hidden, _diag([("backlash", [2])]), cfg).top_correct
+    # a refusal (e.g. poses that cannot register the data) is reported, never counted right
+    refused = score(puma, truth, {"steps": [], "nominal": {"rms": float("nan")},
+                                  "final": {"rms": float("nan")}, "unexplained": None,
+                                  "error": "x.csv: the registration is not identifiable"},
+                    cfg)
+    assert refused.found == ("refused",) and not refused.top_correct and not refused.success
+    assert "refused the data: the registration is not identifiable" in refused.note
     # pairs: first named must be one of them; both found is reported separately
     pair = _fake_truth(puma, HiddenEffects(joint_offset={3: 1e-3},
                                            encoder_scale={2: 5e-4}), q)

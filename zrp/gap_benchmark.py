@@ -492,7 +492,8 @@ def score(model: Manipulator, truth: dict[str, Any], diagnosis: dict[str, Any],
     visible = tuple(e for e in hidden if snr.get(e, 0.0) >= config.excitation_threshold)
     expected = visible or ("none",)
     steps = diagnosis.get("steps", [])
-    found = tuple(s["effect"] for s in steps) or ("none",)
+    refused = diagnosis.get("error")
+    found = ("refused",) if refused else (tuple(s["effect"] for s in steps) or ("none",))
     found_joints = tuple(tuple(int(j) for j in s.get("joints", [])) for s in steps)
     # an effect hidden below the excitation threshold may still be found: naming it is right
     # too (but not required)
@@ -508,7 +509,7 @@ def score(model: Manipulator, truth: dict[str, Any], diagnosis: dict[str, Any],
                          and c["effect"] != found[0])
     hj = {e: eff.joints(e) for e in hidden}
     joints_ok = True
-    if found[0] != "none":
+    if found[0] not in ("none", "refused"):
         joints_ok = False
         for e in accept:
             if e in found:
@@ -523,11 +524,13 @@ def score(model: Manipulator, truth: dict[str, Any], diagnosis: dict[str, Any],
     final = float(diagnosis["final"]["rms"])
     ratio = final / noise_rms
     notes = []
+    if refused:
+        notes.append(f"the diagnosis refused the data: {str(refused).split(': ', 1)[-1]}")
     hid = [e for e in hidden if e not in visible]
     if hid:
         notes.append(f"{', '.join(hid)} not visible (SNR "
                      f"{min(snr.get(e, 0.0) for e in hid):.2g})")
-    if not top_correct:
+    if not top_correct and not refused:
         if found[0] == "none":
             notes.append("missed: nothing significant found")
         else:
@@ -535,7 +538,7 @@ def score(model: Manipulator, truth: dict[str, Any], diagnosis: dict[str, Any],
             if any(e in tied for e in accept):
                 lk += " (the diagnosis reports the hidden effect as fitting equally well)"
             notes.append(lk)
-    elif not joints_ok:
+    elif not joints_ok and not refused:
         notes.append("joints not located")
     if ratio > config.ratio_target:
         notes.append(f"withheld RMS {ratio:.2f}x the noise"
