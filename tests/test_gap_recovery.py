@@ -270,6 +270,26 @@ def test_backlash_held_by_friction_until_gravity_wins():
     assert wrong.sum() <= 3 * 3  # at most a few poses (3 points each)
 
 
+def test_backlash_flank_with_an_unknown_payload():
+    """The MJCF torques lack a 3 kg payload, which decides the flank in some poses: the
+    payload is profiled (grid 0-10 kg) and found; the play is recovered at noise level."""
+    rng = np.random.default_rng(15)
+    q = random_poses(PUMA, 300, rng)
+    masses = {"p3": 8.0, "ee": 3.0}
+    tau_true = _gravity_torque(PUMA, q, masses, np.array([0.0, 0.0, -1.0]))
+    tau_arm = _gravity_torque(PUMA, q, {"p3": 8.0}, np.array([0.0, 0.0, -1.0]))
+    friction = float(np.quantile(np.abs(tau_true[:, 1]), 0.3))
+    inj = Injection(backlash={2: 8e-4}, backlash_friction={2: friction}, masses=masses)
+    meas = synthesize(PUMA, q, inj, rng=rng, noise_sigma=SIGMA)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = diagnose(PUMA, meas, gravity_torque=tau_arm, seed=0)
+    assert d.top_effect == "backlash" and d.steps[0].joints == (2,)
+    assert d.where["backlash_payload_kg"] == 3.0
+    _check_values(d, {"q2.backlash": 8e-4})
+    assert d.final.rms <= 1.5 * np.sqrt(3.0) * SIGMA
+
+
 def test_gravity_torques_from_mjcf(tmp_path):
     xml = """<mujoco><option gravity="0 0 -9.81"/><worldbody>
       <body><joint name="j1" type="hinge" axis="0 1 0"/>
