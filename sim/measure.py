@@ -439,22 +439,11 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
 
 def _nominal_static_torque(robot: RealRobot, q: F64) -> F64:
     """Torque each servo must supply to hold the NOMINAL arm (with the known payload) at the
-    poses ``q``, N m, shape (P, n) (``qfrc_bias``: positive means the joint is held against
-    gravity turning it negatively). Uses only what a user knows: the nominal model, its
-    inertias and the payload."""
-    import mujoco
-
-    from .real_robot import HiddenEffects as _HE
-
-    nominal = RealRobot(robot.nominal, _HE(payload=robot.effects.payload), robot.options)
-    d = mujoco.MjData(nominal.model)
-    ids = nominal._ids
-    out = np.empty(q.shape)
-    for i, qi in enumerate(q):
-        d.qpos[ids["motor_q"]] = qi
-        mujoco.mj_forward(nominal.model, d)
-        out[i] = d.qfrc_bias[ids["motor_v"]]
-    return out
+    poses ``q``, N m, shape (P, n) (positive: held against gravity turning the joint
+    negatively). Uses only what a user knows: the nominal model, its inertias, the payload."""
+    nominal = RealRobot(robot.nominal, HiddenEffects(payload=robot.effects.payload),
+                        robot.options)
+    return nominal.static_torque(q)
 
 
 def _check_out(path: Path, force: bool, what: str) -> None:

@@ -598,6 +598,24 @@ class RealRobot:
         return fk.position[..., None, :] + np.einsum("...ij,mj->...mi", fk.rotation,
                                                      self.tool_points)
 
+    def static_torque(self, q: ArrayLike) -> F64:
+        """Torque each servo must supply to hold the arm at rest at joint values ``q`` (rad,
+        model unit for prismatic joints), N m (N), shape (P, n): MuJoCo's ``qfrc_bias`` of
+        the motor-side joints with the load hinges (if any) at the middle of their play and
+        the geometry at t_ref. Positive: gravity would turn the joint negatively."""
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        if q.shape[-1] != self.n:
+            raise InputError(f"q: expected shape (P, {self.n}), got {q.shape}")
+        d = mujoco.MjData(self.model)
+        ids = self._ids
+        qs = np.where(self.true_model.prismatic, self.scale, 1.0)
+        out = np.empty(q.shape)
+        for i, qi in enumerate(q):
+            d.qpos[ids["motor_q"]] = qi * qs
+            mujoco.mj_forward(self.model, d)
+            out[i] = d.qfrc_bias[ids["motor_v"]]
+        return out
+
     def describe(self) -> dict[str, Any]:
         """The build (servo gains, time step, friction, inertias) for the truth file."""
         return {"timestep_s": self.timestep, "servo_kp_Nm_per_rad": self._ids["kp"].tolist(),

@@ -32,7 +32,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from numpy.typing import NDArray
@@ -56,6 +56,9 @@ __all__ = [
     "summary_rows",
     "write_outputs",
 ]
+
+if TYPE_CHECKING:
+    from sim.real_robot import HiddenEffects
 
 F64 = NDArray[np.float64]
 KINDS = ("none", "single", "pair")
@@ -160,7 +163,7 @@ class Scenario:
     index: int
     seed: int
     kind: str
-    effects: Any  # sim.real_robot.HiddenEffects
+    effects: HiddenEffects
     labels: tuple[str, ...]
     noise_sigma: float
 
@@ -173,19 +176,11 @@ def typical_gravity_torque(model: Manipulator, payload: float,
                            rng: np.random.Generator, count: int = 64) -> F64:
     """RMS over random poses of the static torque each joint carries (arm and payload), N m,
     shape (n,) (nominal model, PUMA 560 or rod inertias)."""
-    import mujoco
-
     from sim.real_robot import HiddenEffects, RealRobot
 
     robot = RealRobot(model, HiddenEffects(payload=payload))
-    d = mujoco.MjData(robot.model)
-    q = rng.uniform(-2.5, 2.5, (count, model.n))
-    out = np.empty((count, model.n))
-    for i in range(count):
-        d.qpos[robot._ids["motor_q"]] = q[i]
-        mujoco.mj_forward(robot.model, d)
-        out[i] = d.qfrc_bias[robot._ids["motor_v"]]
-    return np.sqrt(np.mean(out**2, axis=0))
+    tau = robot.static_torque(rng.uniform(-2.5, 2.5, (count, model.n)))
+    return np.sqrt(np.mean(tau**2, axis=0))
 
 
 def _draw_effect(name: str, model: Manipulator, rng: np.random.Generator, payload: float,
