@@ -50,6 +50,7 @@ def main() -> None:
     ap.add_argument("--scenarios", type=int, default=50)
     ap.add_argument("--poses", type=int, default=200)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--jobs", type=int, default=1, help="worker processes (default 1)")
     ap.add_argument("--out", default=str(ROOT / "renders" / "gap_benchmark_bench"))
     args = ap.parse_args()
     model = zrp.load_model("puma")
@@ -58,7 +59,7 @@ def main() -> None:
     out = Path(args.out)
     base = kinematic_baseline(model, cfg)
     t0 = time.perf_counter()
-    res = run_benchmark(model, cfg, out / "work", progress=True)
+    res = run_benchmark(model, cfg, out / "work", progress=True, jobs=args.jobs)
     wall = time.perf_counter() - t0
     write_outputs(res, out, force=True)
     print(render_text(res))
@@ -69,8 +70,9 @@ def main() -> None:
         lines = f.read_text().strip().splitlines()
         simulated += float(lines[-1].split(",")[lines[0].split(",").index("t")])
     n = len(res.scores)
-    print(f"{n} scenarios x {args.poses} poses: wall {wall:.1f} s (target <= {TARGET_S:.0f} s: "
-          f"{'met' if wall <= TARGET_S else 'MISSED'}), {wall / n:.2f} s per scenario")
+    print(f"{n} scenarios x {args.poses} poses, {args.jobs} process(es): wall {wall:.1f} s "
+          f"(target <= {TARGET_S:.0f} s: {'met' if wall <= TARGET_S else 'MISSED'}), "
+          f"{wall / n:.2f} s per scenario")
     print(f"  simulation {res.sim_s:.1f} s ({res.sim_s / n:.2f} s per session), diagnosis "
           f"{res.diag_s:.1f} s ({res.diag_s / n:.2f} s per run), scoring and I/O "
           f"{wall - res.sim_s - res.diag_s:.1f} s")

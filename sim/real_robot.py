@@ -201,6 +201,10 @@ class HiddenEffects:
                 raise InputError(f"encoder_scale[{k}]: {s!r} is not a small scale error; "
                                  "expected |s| < 0.1")
 
+    def __reduce__(self) -> tuple[Any, tuple[dict[str, Any]]]:
+        # the mappings are read-only proxies, which do not pickle: go through the plain form
+        return (HiddenEffects.from_dict, (self.to_dict(),))
+
     @property
     def active(self) -> tuple[str, ...]:
         """Names of the effects switched on (in :data:`EFFECT_NAMES` order)."""

@@ -103,6 +103,10 @@ def test_benchmark_runs_are_reproducible_from_the_seed(puma, tmp_path):
     for name in ("scenario_000.csv", "scenario_001.csv"):
         assert (tmp_path / "a/measurements" / name).read_bytes() == \
             (tmp_path / "b/measurements" / name).read_bytes()
+    # worker processes give the same results
+    c = run_benchmark(puma, cfg, tmp_path / "c", progress=False, jobs=2)
+    assert _strip_times([s.to_dict() for s in c.scores]) == \
+        _strip_times([s.to_dict() for s in a.scores])
     # a different seed gives different scenarios and measurements
     other = draw_scenarios(puma, BenchmarkConfig(scenarios=2, seed=12, **SMALL))
     mine = draw_scenarios(puma, cfg)

@@ -573,22 +573,44 @@ class BenchmarkResult:
                 "scenarios": [s.to_dict() for s in self.scores]}
 
 
+def _scenario(model: Manipulator, scn: Scenario, config: BenchmarkConfig, work: Path,
+              mjcf_path: Path | None) -> ScenarioScore:
+    """Simulate, diagnose blind, then score one scenario (in this process or a worker)."""
+    csv_path, truth_path, sim_s = simulate_scenario(model, scn, config, work / "measurements",
+                                                    work / "truth")
+    t1 = time.perf_counter()
+    try:
+        diag = diagnose_blind(csv_path, model, mjcf_path=mjcf_path, seed=scn.index)
+    except InputError as exc:  # the diagnosis refused the data: report, do not crash
+        diag = {"steps": [], "nominal": {"rms": math.nan}, "final": {"rms": math.nan},
+                "unexplained": None, "error": str(exc)}
+    diag_s = time.perf_counter() - t1
+    (work / "diagnoses" / f"{csv_path.stem}.diagnosis.json").write_text(
+        json.dumps(diag, default=str))
+    # only now, after the diagnosis has answered, is the truth read
+    truth = json.loads(truth_path.read_text(encoding="utf-8"))
+    sc = score(model, truth, diag, config)
+    return ScenarioScore(**{**sc.__dict__, "sim_s": sim_s, "diag_s": diag_s})
+
+
 def run_benchmark(model: Manipulator, config: BenchmarkConfig, workdir: str | Path, *,
-                  progress: bool = True) -> BenchmarkResult:
+                  progress: bool = True, jobs: int = 1) -> BenchmarkResult:
     """Draw, simulate, diagnose blind and score ``config.scenarios`` scenarios.
 
     Files: ``workdir/measurements/*.csv`` (what the diagnosis sees), ``workdir/truth/*.json``
     (what only the scorer reads, after the diagnosis), ``workdir/diagnoses/*.json`` and the
-    nominal MJCF ``workdir/nominal.xml``.
+    nominal MJCF ``workdir/nominal.xml``. ``jobs`` > 1 runs scenarios in that many worker
+    processes (results are identical: each scenario has its own seed).
     """
     from tqdm.auto import tqdm
 
     import mjcf
 
+    if isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1:
+        raise InputError(f"jobs: expected a positive number of worker processes, got {jobs!r}")
     work = Path(workdir)
-    mdir, tdir, ddir = work / "measurements", work / "truth", work / "diagnoses"
-    for d in (mdir, tdir, ddir):
-        d.mkdir(parents=True, exist_ok=True)
+    for d in ("measurements", "truth", "diagnoses"):
+        (work / d).mkdir(parents=True, exist_ok=True)
     mjcf_path: Path | None = None
     if config.use_mjcf:
         inertia = "puma560" if model.n == 6 and not model.prismatic.any() else "rods"
@@ -596,29 +618,32 @@ def run_benchmark(model: Manipulator, config: BenchmarkConfig, workdir: str | Pa
             inertia=inertia, visuals=False, floor=False)), work / "nominal.xml", overwrite=True)
     t0 = time.perf_counter()
     scenarios = draw_scenarios(model, config)
-    scores = []
-    sim_total = diag_total = 0.0
-    bar = tqdm(scenarios, desc="gap-benchmark", unit="scenario", disable=not progress)
-    for scn in bar:
-        csv_path, truth_path, sim_s = simulate_scenario(model, scn, config, mdir, tdir)
-        t1 = time.perf_counter()
-        try:
-            diag = diagnose_blind(csv_path, model, mjcf_path=mjcf_path, seed=scn.index)
-        except InputError as exc:  # the diagnosis refused the data: report, do not crash
-            diag = {"steps": [], "nominal": {"rms": math.nan}, "final": {"rms": math.nan},
-                    "unexplained": None, "error": str(exc)}
-        diag_s = time.perf_counter() - t1
-        (ddir / f"{csv_path.stem}.diagnosis.json").write_text(json.dumps(diag, default=str))
-        truth = json.loads(truth_path.read_text(encoding="utf-8"))
-        sc = score(model, truth, diag, config)
-        sc = ScenarioScore(**{**sc.__dict__, "sim_s": sim_s, "diag_s": diag_s})
+    scores: list[ScenarioScore] = []
+    bar = tqdm(total=len(scenarios), desc="gap-benchmark", unit="scenario",
+               disable=not progress)
+
+    def done(sc: ScenarioScore) -> None:
         scores.append(sc)
-        sim_total += sim_s
-        diag_total += diag_s
+        bar.update(1)
         bar.set_postfix(ok=f"{sum(s.success for s in scores)}/{len(scores)}")
+
+    if jobs == 1:
+        for scn in scenarios:
+            done(_scenario(model, scn, config, work, mjcf_path))
+    else:
+        import multiprocessing as mp
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=mp.get_context("spawn")) as ex:
+            futs = [ex.submit(_scenario, model, scn, config, work, mjcf_path)
+                    for scn in scenarios]
+            for f in as_completed(futs):
+                done(f.result())
     bar.close()
+    scores.sort(key=lambda s: s.index)
     return BenchmarkResult(config, model.name, tuple(scores), time.perf_counter() - t0,
-                           sim_total, diag_total, str(work))
+                           sum(s.sim_s for s in scores), sum(s.diag_s for s in scores),
+                           str(work))
 
 
 # ---- tables ------------------------------------------------------------------------------

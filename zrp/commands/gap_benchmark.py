@@ -50,6 +50,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workdir", default=None, metavar="DIR",
                    help="where the measurement CSVs, truth files and diagnoses go (default "
                         "OUT/work)")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="worker processes (default 1; results are the same for any N)")
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
     p.add_argument("--no-plots", action="store_true", help="skip confusion.png")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
@@ -82,7 +84,9 @@ def _run(args: argparse.Namespace) -> int:
                           use_mjcf=not args.no_mjcf)
     model = load_model(args.model)
     work = Path(args.workdir) if args.workdir else out / "work"
-    result = run_benchmark(model, cfg, work, progress=not args.no_progress)
+    if args.jobs < 1:
+        raise InputError(f"--jobs: expected at least 1 worker, got {args.jobs}")
+    result = run_benchmark(model, cfg, work, progress=not args.no_progress, jobs=args.jobs)
     files = write_outputs(result, out, force=True, plots=not args.no_plots)
     text = render_text(result) + "\n" + "\n".join(f"wrote {f}" for f in files)
     emit(args, result.to_dict(), text)
