@@ -258,14 +258,16 @@ def test_backlash_held_by_friction_until_gravity_wins():
     assert d.top_effect == "backlash" and d.steps[0].joints == (3,)
     _check_values(d, {"q3.backlash": 8e-4})
     sw = d.where["backlash_switch"][2]
+    lo, hi = d.where["backlash_switch_band"][2]
     assert 0.9 * friction < sw < 1.1 * friction
-    # A withheld pose whose torque falls between the true and the estimated switching torque
-    # (between two fitting poses) can be put on the wrong flank; every other one is at noise.
+    assert lo <= friction <= hi  # the band of plausible switching torques holds the truth
+    # A withheld pose whose torque falls in that band (where the fitting poses cannot tell
+    # the flank) gets a hedged prediction and may miss; every other one is at noise.
     err = np.linalg.norm(d.withheld_residual_after.reshape(-1, 3), axis=1)
     rows = np.flatnonzero(np.isin(meas.pose_index, d.withheld_poses))
     wrong = err > 6 * SIGMA
     t_wrong = np.abs(tau[meas.pose_index[rows[wrong]], 2])
-    assert np.all((t_wrong >= min(sw, friction)) & (t_wrong <= max(sw, friction)))
+    assert np.all((t_wrong >= min(lo, friction)) & (t_wrong <= max(hi, friction)))
     assert np.sqrt(np.mean(err[~wrong] ** 2)) <= 1.5 * np.sqrt(3.0) * SIGMA
     assert wrong.sum() <= 3 * 3  # at most a few poses (3 points each)
 

@@ -740,11 +740,58 @@ def _with_gravity_side(ctx: Context, reg: FitResult, fitting: NDArray[np.int64],
     return dataclasses.replace(ctx, gravity_side=np.where(sig_joint, tau, side))
 
 
+def _gain_function(Q: F64, rp: F64, Gk: F64, pose: NDArray[np.int64], S: int, tau_k: F64,
+                   d_k: F64) -> Any:
+    """Residual removed by one play parameter of joint k for switching torques F, with the
+    columns projected off span(Q): gain(F) = (c.r)^2 / (|c|^2 - |Q^T c|^2) where the column
+    c = sum over rows of G_k B_F(pose). Everything is reduced per pose first, so a candidate
+    costs O(S q) instead of O(R q) (rp must already be orthogonal to Q).
+
+    Args:
+        Q: orthonormal columns (3R, q); rp: residual (3R,); Gk: dx/dq_k per row (R, 3);
+        pose: pose of each row (R,) in 0..S-1; tau_k, d_k: torque and approach per pose (S,).
+    """
+    R = Gk.shape[0]
+    q = Q.shape[1]
+    QtG = np.einsum("rcq,rc->rq", Q.reshape(R, 3, q), Gk)
+    M = np.zeros((S, q))
+    np.add.at(M, pose, QtG)
+    u = np.bincount(pose, weights=np.einsum("rc,rc->r", rp.reshape(R, 3), Gk), minlength=S)
+    nv = np.bincount(pose, weights=np.einsum("rc,rc->r", Gk, Gk), minlength=S)
+
+    def gains(grid: F64) -> F64:
+        B = np.where(np.abs(tau_k)[:, None] > grid[None, :], np.sign(tau_k)[:, None],
+                     -d_k[:, None])  # (S, m)
+        den = nv @ B**2 - np.sum((M.T @ B) ** 2, axis=0)
+        num = (u @ B) ** 2
+        return np.where(den > 1e-12 * max(float(nv.sum()), 1e-300), num / np.where(
+            den > 0, den, 1.0), 0.0)
+
+    return gains
+
+
+def _switch_bands(dists: tuple | None, mass: float = 0.99) -> list[list[float] | None]:
+    """Per joint, the range of switching torques holding ``mass`` of the profile weight
+    (None for joints modelled by the approach direction only)."""
+    out: list[list[float] | None] = []
+    for thr, w in dists or ():
+        t = np.asarray(thr, dtype=float)
+        if t.size == 1 and not np.isfinite(t[0]):
+            out.append(None)
+            continue
+        order = np.argsort(t)
+        t, cw = t[order], np.cumsum(np.asarray(w, dtype=float)[order])
+        lo = t[np.searchsorted(cw, (1.0 - mass) / 2)]
+        hi = t[min(np.searchsorted(cw, 1.0 - (1.0 - mass) / 2), t.size - 1)]
+        out.append([float(lo), float(hi)])
+    return out
+
+
 PAYLOAD_GRID_KG = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0)
 
 
 def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int64],
-                          sweeps: int = 3, max_candidates: int = 60) -> Context:
+                          sweeps: int = 2, max_candidates: int = 40) -> Context:
     """Per joint, the gravity torque above which a joint with play rests on the loaded flank
     instead of lagging against its approach direction (Coulomb friction of the load holds it
     below). Chosen on the fitting poses by profiling on top of the current model ``base``,
@@ -770,8 +817,9 @@ def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int
     pose = prob.row_pose
     s2 = base.rss / base.dof
 
-    def select(tau: F64) -> tuple[F64, float]:
-        """Thresholds per joint and the residual they remove together (length unit^2)."""
+    def select(tau: F64) -> tuple[F64, float, tuple]:
+        """Thresholds per joint, the residual they remove together (length unit^2) and per
+        joint the plausible thresholds with their weights."""
 
         def columns(k: int, grid: F64) -> F64:
             """Basis columns for thresholds ``grid`` (m,): shape (3R, m)."""
@@ -801,11 +849,8 @@ def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int
                 Q = orthonormal_basis(A)
                 rp = r - Q @ (Q.T @ r)
 
-                def gains_of(g: F64, Q: F64 = Q, rp: F64 = rp, k: int = k) -> F64:
-                    C = columns(k, g)
-                    C = C - Q @ (Q.T @ C)
-                    cc = np.einsum("ij,ij->j", C, C)
-                    return np.where(cc > 0, (C.T @ rp) ** 2 / np.where(cc > 0, cc, 1.0), 0.0)
+                gains_of = _gain_function(Q, rp, G[:, :, k], pose, len(fitting),
+                                          tau[:, k], d[:, k])
 
                 gains = gains_of(grid)
                 i = int(np.argmax(gains))
@@ -832,26 +877,46 @@ def _with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int
             if not changed:
                 break
         if not grids:
-            return switch, 0.0
+            return switch, 0.0, ()
         C = np.column_stack([columns(k, switch[k:k + 1])[:, 0] for k in grids])
         C = C - Qbase @ (Qbase.T @ C)
         cn = np.linalg.norm(C, axis=0)
         Qc = orthonormal_basis(C / np.where(cn > 0, cn, 1.0))
         rp = r - Qbase @ (Qbase.T @ r)
-        return switch, float(np.sum((Qc.T @ rp) ** 2))
+        total = float(np.sum((Qc.T @ rp) ** 2))
+        # how sure is each threshold? profile-likelihood weights exp(-d(RSS) / 2 sigma^2) with
+        # sigma^2 from the residual left after the play is modelled
+        s2a = max((base.rss - total) / max(base.dof - len(grids), 1), 1e-30)
+        dists: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
+        for k in range(n):
+            if k not in grids or not np.isfinite(switch[k]):
+                dists.append(((float(switch[k]),), (1.0,)))
+                continue
+            others = [columns(j, switch[j:j + 1])[:, 0] for j in grids if j != k]
+            A = np.column_stack([Abase, *[c / max(np.linalg.norm(c), 1e-300) for c in others]])
+            Q = orthonormal_basis(A)
+            rpk = r - Q @ (Q.T @ r)
+            a = np.unique(np.abs(tau[:, k]))
+            a = a[a > 0]
+            cand = np.array([*a.tolist(), 0.0, float(switch[k])])
+            g = _gain_function(Q, rpk, G[:, :, k], pose, len(fitting), tau[:, k], d[:, k])(cand)
+            w = np.exp(-(g.max() - g) / (2.0 * s2a))
+            keep = w > 1e-6 * w.max()
+            dists.append((tuple(cand[keep].tolist()), tuple((w[keep] / w[keep].sum()).tolist())))
+        return switch, total, tuple(dists)
 
     tau0 = ctx.gravity_side_torque()[fitting]
-    switch, gain = select(tau0)
+    switch, gain, dists = select(tau0)
     payload = 0.0
     if ctx.gravity_torque is not None:
         h_ee = ctx.end_effector_arms()[fitting]
         to_m = LENGTH_TO_M.get(ctx.model.length_unit, 1e-3)
         for m in PAYLOAD_GRID_KG[1:]:
-            sw_m, g_m = select(tau0 + G_STANDARD * m * h_ee * to_m)
+            sw_m, g_m, d_m = select(tau0 + G_STANDARD * m * h_ee * to_m)
             if g_m > gain + 25.0 * s2:
-                switch, gain, payload = sw_m, g_m, m
+                switch, gain, dists, payload = sw_m, g_m, d_m, m
     return dataclasses.replace(ctx, backlash_switch=tuple(float(v) for v in switch),
-                               payload_kg=payload)
+                               backlash_switch_weights=dists or None, payload_kg=payload)
 
 
 def _check_units(ctx: Context, poses: NDArray[np.int64]) -> None:
@@ -948,6 +1013,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
     all_aliased: list[Aliased] = []
     used: set[str] = set()
     switch_now: tuple[float, ...] | None = None
+    bands_now: tuple | None = None
     payload_now = 0.0
     bar = tqdm(total=max_steps * len(effects), desc="diagnose", disable=not progress,
                leave=False)
@@ -961,6 +1027,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
                 ctx_b = _with_backlash_switch(ctx, current, fitting)
                 cache[eff] = effect_parameters(ctx_b, eff)
                 switch_now = ctx_b.backlash_switch
+                bands_now = ctx_b.backlash_switch_weights
                 payload_now = ctx_b.payload_kg
             specs, why = cache[eff]
             if not specs:
@@ -1013,6 +1080,7 @@ def _diagnose(model: Manipulator, meas: Measurements, mjcf: str | None,
         used.add(cand.effect)
         if cand.effect == "backlash" and switch_now is not None:
             where["backlash_switch"] = [None if not np.isfinite(v) else v for v in switch_now]
+            where["backlash_switch_band"] = _switch_bands(bands_now)
             where["backlash_payload_kg"] = payload_now
         nb = len(current.specs)
         after = _withheld(ctx, f_new, withheld)

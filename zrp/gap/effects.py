@@ -144,6 +144,9 @@ class Context:
             :meth:`gravity_side_torque`) above which the joint rests on the loaded flank of its
             play instead of lagging against its approach direction; inf (the default) means
             always the approach direction, 0 always the loaded flank.
+        backlash_switch_weights: per joint, plausible switching torques and their weights
+            (profile likelihood); poses whose torque lies among them get the weighted mean of
+            the two flanks instead of a hard choice. None: use ``backlash_switch`` alone.
         payload_kg: a payload at the tool that the MJCF torques lack, kg (added to them for
             the backlash flank; the diagnosis profiles it).
     """
@@ -156,6 +159,7 @@ class Context:
     t_ref_degC: float = 20.0
     gravity_side: F64 | None = None
     backlash_switch: tuple[float, ...] | None = None
+    backlash_switch_weights: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None = None
     payload_kg: float = 0.0
 
     def __post_init__(self) -> None:
@@ -204,14 +208,21 @@ class Context:
         return forward_kinematics(self.model, self.q)
 
     def backlash_basis(self) -> F64:
-        """Which side of its play each joint sits on in each pose, shape (P, n), -1/0/+1 per
+        """Which side of its play each joint sits on in each pose, shape (P, n), in [-1, 1] per
         unit play: -approach direction where |gravity torque| <= the joint's
-        :attr:`backlash_switch`, else the sign of the gravity torque."""
+        :attr:`backlash_switch`, else the sign of the gravity torque; with
+        :attr:`backlash_switch_weights`, the weighted mean over the plausible switches."""
         d = self.meas.approach_direction()
         tau = self.gravity_side_torque()
         sw = (np.full(self.n, np.inf) if self.backlash_switch is None
               else np.asarray(self.backlash_switch, dtype=float))
-        return np.where(np.abs(tau) > sw, np.sign(tau), -d)
+        out = np.where(np.abs(tau) > sw, np.sign(tau), -d)
+        if self.backlash_switch_weights is not None:
+            for k, (thr, w) in enumerate(self.backlash_switch_weights):
+                t = np.asarray(thr, dtype=float)
+                p_g = (np.abs(tau[:, k])[:, None] > t[None, :]) @ np.asarray(w, dtype=float)
+                out[:, k] = p_g * np.sign(tau[:, k]) - (1.0 - p_g) * d[:, k]
+        return out
 
     def gravity_side_torque(self) -> F64:
         """A gravity torque per pose and joint whose sign is trusted, shape (P, n): the MJCF
