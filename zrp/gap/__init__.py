@@ -7,6 +7,7 @@ In-process use::
     meas = load_measurements("D.csv", model, deg=True)
     diag = diagnose(model, meas, seed=0)
     diag.top_effect, diag.final.rms, diag.to_dict()
+    write_outputs(diag, "DIR")  # diagnosis.json, report.md, residuals.csv, plots
 """
 
 from .data import DataWarning, Measurements, load_measurements
@@ -24,6 +25,7 @@ from .diagnose import (
 )
 from .effects import EFFECTS, REGISTRATION, Context, ParamSpec, effect_parameters
 from .fit import Aliased, FitResult, FitWarning
+from .report import write_outputs
 from .synthetic import Injection, random_poses, synthesize
 
 __all__ = [
@@ -51,4 +53,5 @@ __all__ = [
     "random_poses",
     "split_poses",
     "synthesize",
+    "write_outputs",
 ]
