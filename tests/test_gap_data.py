@@ -227,3 +227,16 @@ def test_loader_never_fails_with_anything_but_input_error(tmp_path):
         assert np.all(np.isfinite(m.q)) and np.all(np.isfinite(m.xyz))
 
     run()
+
+
+def test_result_dataclasses_validate():
+    from zrp.gap import Candidate, Metrics, NoiseFloor
+
+    with pytest.raises(InputError, match="method"):
+        NoiseFloor(0.01, "guess")
+    with pytest.raises(InputError, match="sigma must be None"):
+        NoiseFloor(None, "rigid_links")
+    with pytest.raises(InputError, match="finite non-negative"):
+        Metrics(float("nan"), 0.1, 0.2, 3)
+    with pytest.raises(InputError, match="not in"):
+        Candidate("gremlins", (), 0, 0.1, 0.0, 0.5, False)

@@ -66,6 +66,7 @@ UNEXPLAINED_RATIO = 1.5
 TIE_TOL = 0.01
 #: 95th percentile of |r| for isotropic Gaussian noise, in units of sigma (chi, 3 dof).
 CHI3_P95 = 2.7954834829151074
+NOISE_METHODS = ("rigid_links", "repeats", "given", "none")
 
 
 class GapWarning(ZRPWarning):
@@ -87,6 +88,13 @@ class Metrics:
     p95: float
     max: float
     n_points: int
+
+    def __post_init__(self) -> None:
+        vals = (self.rms, self.p95, self.max)
+        if self.n_points < 1 or not all(math.isfinite(v) and v >= 0 for v in vals):
+            raise InputError(f"Metrics: expected finite non-negative errors over >= 1 point, "
+                             f"got rms={self.rms}, p95={self.p95}, max={self.max}, "
+                             f"n_points={self.n_points}")
 
     @classmethod
     def of(cls, residual: F64) -> Metrics:
@@ -116,6 +124,14 @@ class NoiseFloor:
     n_samples: int = 0
     detail: dict[str, Any] = field(default_factory=dict)
 
+    def __post_init__(self) -> None:
+        if self.method not in NOISE_METHODS:
+            raise InputError(f"NoiseFloor.method: {self.method!r} not in {NOISE_METHODS}")
+        if (self.sigma is None) != (self.method == "none"):
+            raise InputError("NoiseFloor: sigma must be None exactly when method is 'none'")
+        if self.sigma is not None and not (math.isfinite(self.sigma) and self.sigma >= 0):
+            raise InputError(f"NoiseFloor.sigma: expected a finite value >= 0, got {self.sigma}")
+
     @property
     def rms(self) -> float | None:
         """Expected 3-D RMS of pure noise, sqrt(3) sigma."""
@@ -141,6 +157,12 @@ class ParameterEstimate:
     value: float
     stderr: float
     ci95: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.value):
+            raise InputError(f"ParameterEstimate {self.name}: value {self.value} is not finite")
+        if not (self.stderr >= 0):
+            raise InputError(f"ParameterEstimate {self.name}: stderr {self.stderr} < 0")
 
     def to_dict(self) -> dict[str, Any]:
         return {"name": self.name, "effect": self.effect, "joint": self.joint,
@@ -172,6 +194,12 @@ class Candidate:
     significant: bool
     note: str = ""
 
+    def __post_init__(self) -> None:
+        if self.effect not in EFFECTS:
+            raise InputError(f"Candidate.effect: {self.effect!r} not in {EFFECTS}")
+        if not 0.0 <= self.p_value <= 1.0:
+            raise InputError(f"Candidate {self.effect}: p_value {self.p_value} not in [0, 1]")
+
     def to_dict(self) -> dict[str, Any]:
         return {"effect": self.effect, "joints": list(self.joints), "n_params": self.n_params,
                 "cv_rms": None if math.isnan(self.cv_rms) else self.cv_rms,
@@ -195,6 +223,13 @@ class Step:
     aliased: tuple[Aliased, ...]
     geometric_overlap: float = math.nan
     ties: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.effect not in EFFECTS:
+            raise InputError(f"Step.effect: {self.effect!r} not in {EFFECTS}")
+        bad = [t for t in self.ties if t not in EFFECTS]
+        if bad:
+            raise InputError(f"Step.ties: {bad} not in {EFFECTS}")
 
     def to_dict(self) -> dict[str, Any]:
         return {"effect": self.effect, "joints": list(self.joints), "ties": list(self.ties),
@@ -260,6 +295,15 @@ class Diagnosis:
     fitting_poses: NDArray[np.int64]
     withheld_poses: NDArray[np.int64]
     settings: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not all(isinstance(st, Step) for st in self.steps):
+            raise InputError("Diagnosis.steps: expected Step objects")
+        if self.unexplained is not None and not isinstance(self.unexplained, bool):
+            raise InputError(f"Diagnosis.unexplained: expected True, False or None, got "
+                             f"{self.unexplained!r}")
+        if np.intersect1d(self.fitting_poses, self.withheld_poses).size:
+            raise InputError("Diagnosis: fitting and withheld poses overlap")
 
     @property
     def effects(self) -> tuple[str, ...]:
