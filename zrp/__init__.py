@@ -15,6 +15,7 @@ from .errors import (
     ZRPWarning,
 )
 from .examples import puma_circle, puma_circle_ik
+from .gap import Diagnosis, Measurements, diagnose, load_measurements, write_outputs
 from .ik import IKResult, track_trajectory
 from .kinematics import FKResult, end_effector_pose, forward_kinematics, jacobian
 from .model import EndEffector, Joint, Manipulator, hand_frame
@@ -40,6 +41,7 @@ __all__ = [
     "Circle",
     "DHRow",
     "Deviation",
+    "Diagnosis",
     "EndEffector",
     "FKResult",
     "FunctionTrajectory",
@@ -50,6 +52,7 @@ __all__ = [
     "JointPath",
     "Line",
     "Manipulator",
+    "Measurements",
     "ModelError",
     "ModelFileError",
     "MonteCarloResult",
@@ -69,6 +72,7 @@ __all__ = [
     "apply_parameters",
     "builtin_models",
     "circle_joint_path",
+    "diagnose",
     "dumps_model",
     "end_effector_pose",
     "forward_kinematics",
@@ -77,6 +81,7 @@ __all__ = [
     "hand_frame",
     "jacobian",
     "load_joint_csv",
+    "load_measurements",
     "load_model",
     "loads_model",
     "monte_carlo",
@@ -92,5 +97,6 @@ __all__ = [
     "save_model",
     "track_trajectory",
     "trajectory_deviation",
+    "write_outputs",
     "write_paper_outputs",
 ]
