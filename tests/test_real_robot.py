@@ -63,6 +63,18 @@ def test_nominal_robot_settles_on_the_nominal_kinematics(puma, poses):
     np.testing.assert_allclose(run.measurements.xyz.reshape(-1, 3, 3), pts, atol=1e-12)
 
 
+def test_any_arm_with_a_prismatic_joint_settles_on_its_kinematics():
+    model = zrp.load_model("stanford")
+    lim = np.array([[-1.5, 1.5], [-1.5, 1.5], [0.0, 200.0], [-1.5, 1.5], [-1.5, 1.5],
+                    [-1.5, 1.5]])
+    q = random_poses(model, 4, np.random.default_rng(1), limits=lim, min_height=-1e9)
+    robot, run = _run(model, HiddenEffects(link_length={3: (0.0, 0.2, 0.0)}), q)
+    pts = _truth(run, "points_base_noisefree")
+    geo = true_geometry(model, robot.effects)
+    np.testing.assert_allclose(pts, _fk_points(geo, q, robot.tool_points), atol=3e-4)
+    assert np.max(np.abs(_truth(run, "q_link")[:, 2] - q[:, 2])) < 3e-4  # mm (slide)
+
+
 def test_compliance_deflection_grows_with_gravity_torque(puma):
     c = 2e-5  # rad/(N m)
     q = random_poses(puma, 10, np.random.default_rng(3))
