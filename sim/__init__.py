@@ -18,10 +18,15 @@ from typing import Any
 
 _EXPORTS = {
     "dynamics": ("DynamicPlayback", "default_dynamic_options", "dynamic_playback"),
+    "measure": ("Instrument", "MeasurementRun", "Procedure", "measure", "parse_effects",
+                "random_instrument", "random_poses", "trajectory_poses", "write_measurements",
+                "write_truth"),
     "gl": ("BACKENDS", "GLBackendError", "GLUnavailableError", "available_backend",
            "configure_backend", "probe_backend", "resolve_backend"),
     "playback": ("ConsistencyReport", "SitePoses", "consistency_check", "kinematic_playback",
                  "rotation_angle"),
+    "real_robot": ("EFFECT_NAMES", "HiddenEffects", "RealRobot", "RealRobotOptions", "Reading",
+                   "Session", "default_tool_points", "motor_map", "true_geometry"),
     "render": ("OffscreenRenderer",),
     "video": ("PAPER_LEVELS", "VideoOptions", "VideoResult", "VideoWriteError",
               "comparison_frames", "nice_factor", "render_comparison_video",
