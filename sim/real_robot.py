@@ -49,6 +49,7 @@ from numpy.typing import ArrayLike, NDArray
 from mjcf.inertia import BodyInertia, puma560_inertias, rod_inertias
 from mjcf.units import metres_per_unit
 from zrp.errors import InputError
+from zrp.gap.effects import EFFECTS as GAP_EFFECTS
 from zrp.model import Manipulator
 from zrp.sensitivity import axis_tangents, tilt_axes
 
@@ -67,9 +68,8 @@ __all__ = [
 
 F64 = NDArray[np.float64]
 
-#: Effects the real robot can hide (the names of :data:`zrp.gap.EFFECTS`).
-EFFECT_NAMES = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment",
-                "joint_compliance", "backlash", "thermal_expansion", "cyclic_error")
+#: Effects the real robot can hide: exactly the diagnosis's candidates (one list for both).
+EFFECT_NAMES: tuple[str, ...] = GAP_EFFECTS
 
 #: Coulomb friction of the load side of each PUMA 560 joint against its parent, N m: 20 % of
 #: the drive's total Coulomb friction, i.e. of the motor-side values of Armstrong et al.
