@@ -83,6 +83,7 @@ class IKResult:
     length_unit: str
     elapsed_s: float = 0.0
     notes: tuple[str, ...] = field(default=())
+    includes_compilation: bool = False
 
     @property
     def steps(self) -> int:
@@ -106,6 +107,7 @@ class IKResult:
             "damped_steps": int(np.count_nonzero(self.damping)),
             "length_unit": self.length_unit,
             "elapsed_s": self.elapsed_s,
+            "elapsed_includes_compilation": self.includes_compilation,
             "notes": list(self.notes),
         }
 
@@ -242,6 +244,7 @@ def track_trajectory(
     q_out = np.zeros((n_steps + 1, model.n))
     qd_out = np.zeros((n_steps + 1, model.n))
     use_newton = correction == "newton"
+    first_call = not IKK.integrate.signatures  # compiles (or loads from cache) on this call
     started = time.perf_counter()
     status, k_fail = IKK.integrate(
         q0, h, np.ascontiguousarray(sample.position), np.ascontiguousarray(sample.velocity),
@@ -296,4 +299,4 @@ def track_trajectory(
         correction=out["corr"], iterations=iters, manipulability=out["manip"],
         damping=out["lam"], task=task, method=f"ABM4-PECE (RK4 start), correction={correction}",
         joint_names=model.joint_names, length_unit=model.length_unit, elapsed_s=elapsed,
-        notes=tuple(notes))
+        notes=tuple(notes), includes_compilation=first_call)

@@ -137,7 +137,9 @@ def _ik(args: argparse.Namespace) -> int:
         f"{s['max_drift_orientation_rad']:.3e} rad (removed by the correction)",
         f"  min manipulability     {s['min_manipulability']:.4f} at t = "
         f"{s['min_manipulability_t_s']:.3f} s ({s['damped_steps']} damped samples)",
-        f"  solve time             {s['elapsed_s'] * 1e3:.2f} ms",
+        f"  solve time             {s['elapsed_s'] * 1e3:.2f} ms"
+        + (" (first call: includes compiling the kernels)"
+           if s["elapsed_includes_compilation"] else ""),
         *[f"  warning: {w}" for w in s["warnings"]],
         f"  joint trajectory -> {out}",
     ])
