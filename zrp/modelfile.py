@@ -107,42 +107,42 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
         raise fail(f"length_unit: expected a string such as \"mm\", got {unit!r}",
                    _line_of(text, r"length_unit\s*="))
 
+    def check_table(label: str, table: dict[str, Any], allowed: set[str],
+                    required: tuple[str, ...], tline: int | None) -> None:
+        bad = set(table) - allowed
+        if bad:
+            key = sorted(bad)[0]
+            raise fail(f"{label}: unknown key {key!r}; expected one of {sorted(allowed)}",
+                       _key_line(text, tline, key) or tline)
+        for key in required:
+            if key not in table:
+                raise fail(f"{label}: missing {key!r}", tline)
+
+    def line_of_error(exc: ModelError, fields: tuple[str, ...], tline: int | None) -> int | None:
+        """The line of the field a validation message names (its text before the colon)."""
+        head = str(exc).split(":")[0]
+        field = next((f for f in fields if f in head), None)
+        return (_key_line(text, tline, field) if field else None) or tline
+
+    joint_fields = ("type", "axis", "body")
     joints = []
     for k, jd in enumerate(joints_raw, start=1):
         tline = _line_of(text, r"\[\[\s*joint\s*\]\]", k - 1)
-        bad = set(jd) - _JOINT_KEYS
-        if bad:
-            key = sorted(bad)[0]
-            raise fail(f"joint {k}: unknown key {key!r}; expected one of {sorted(_JOINT_KEYS)}",
-                       _key_line(text, tline, key) or tline)
-        for key in ("type", "axis", "body"):
-            if key not in jd:
-                raise fail(f"joint {k}: missing {key!r}", tline)
+        check_table(f"joint {k}", jd, _JOINT_KEYS, joint_fields, tline)
         try:
             joints.append(Joint(type=jd["type"], axis=jd["axis"], body=jd["body"],
                                 name=str(jd.get("name", "")), index=k))
         except ModelError as exc:
-            field = next((f for f in ("type", "axis", "body") if f in str(exc).split(":")[0]),
-                         None)
-            line = _key_line(text, tline, field) if field else tline
-            raise fail(str(exc), line or tline) from exc
+            raise fail(str(exc), line_of_error(exc, joint_fields, tline)) from exc
 
     ed = data["end_effector"]
     eline = _line_of(text, r"\[\s*end_effector\s*\]")
-    bad = set(ed) - _EE_KEYS
-    if bad:
-        key = sorted(bad)[0]
-        raise fail(f"end_effector: unknown key {key!r}; expected one of {sorted(_EE_KEYS)}",
-                   _key_line(text, eline, key) or eline)
-    for key in ("body", "axial", "transverse"):
-        if key not in ed:
-            raise fail(f"end_effector: missing {key!r}", eline)
+    ee_fields = ("axial", "transverse", "body")
+    check_table("end_effector", ed, _EE_KEYS, ee_fields, eline)
     try:
         ee = EndEffector(body=ed["body"], axial=ed["axial"], transverse=ed["transverse"])
     except ModelError as exc:
-        head = str(exc).split(":")[0]
-        field = next((f for f in ("axial", "transverse", "body") if f in head), None)
-        raise fail(str(exc), (_key_line(text, eline, field) if field else None) or eline) from exc
+        raise fail(str(exc), line_of_error(exc, ee_fields, eline)) from exc
     return Manipulator(tuple(joints), ee, name=str(data.get("name", Path(source).stem)),
                        length_unit=unit)
 
