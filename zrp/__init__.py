@@ -1,5 +1,8 @@
 """zrp: zero-reference-position kinematics and robot-accuracy analysis."""
 
+import importlib
+from typing import Any
+
 from .deviation import Deviation, pose_deviation, trajectory_deviation
 from .dh import DHRow, from_dh, from_mdh
 from .errors import (
@@ -15,7 +18,6 @@ from .errors import (
     ZRPWarning,
 )
 from .examples import puma_circle, puma_circle_ik
-from .gap import Diagnosis, Measurements, diagnose, load_measurements, write_outputs
 from .ik import IKResult, track_trajectory
 from .kinematics import FKResult, end_effector_pose, forward_kinematics, jacobian
 from .model import EndEffector, Joint, Manipulator, hand_frame
@@ -34,6 +36,19 @@ from .tolerance import Allocation, MonteCarloResult, Tolerances, allocate_tolera
 from .trajectory import Circle, FunctionTrajectory, Line, TimeLaw, Trajectory, TrajectorySample
 
 __version__ = "0.1.0"
+
+# The gap diagnosis pulls in scipy.stats (about 1 s): load it on first use, not with `import zrp`.
+_LAZY = {name: "gap" for name in
+         ("Diagnosis", "Measurements", "diagnose", "load_measurements", "write_outputs")}
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'zrp' has no attribute {name!r}")
+
 
 __all__ = [
     "PAPER_SIGN_ZERO",

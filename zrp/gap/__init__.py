@@ -10,23 +10,38 @@ In-process use::
     write_outputs(diag, "DIR")  # diagnosis.json, report.md, residuals.csv, plots
 """
 
-from .data import DataWarning, Measurements, load_measurements
-from .diagnose import (
-    Candidate,
-    Diagnosis,
-    GapWarning,
-    Metrics,
-    NoiseFloor,
-    ParameterEstimate,
-    Step,
-    diagnose,
-    noise_floor,
-    split_poses,
-)
-from .effects import EFFECTS, REGISTRATION, Context, ParamSpec, effect_parameters
-from .fit import Aliased, FitResult, FitWarning
-from .report import write_outputs
-from .synthetic import Injection, random_poses, synthesize
+import importlib
+from typing import Any
+
+# Submodules load on first use: `zrp.gap.effects` (needed to list the effects when the CLI
+# builds its parser) must not pull in the fitting code and scipy.stats (about 1 s).
+_WHERE = {
+    "DataWarning": "data",
+    "Measurements": "data",
+    "load_measurements": "data",
+    "Candidate": "diagnose",
+    "Diagnosis": "diagnose",
+    "GapWarning": "diagnose",
+    "Metrics": "diagnose",
+    "NoiseFloor": "diagnose",
+    "ParameterEstimate": "diagnose",
+    "Step": "diagnose",
+    "diagnose": "diagnose",
+    "noise_floor": "diagnose",
+    "split_poses": "diagnose",
+    "EFFECTS": "effects",
+    "REGISTRATION": "effects",
+    "Context": "effects",
+    "ParamSpec": "effects",
+    "effect_parameters": "effects",
+    "Aliased": "fit",
+    "FitResult": "fit",
+    "FitWarning": "fit",
+    "write_outputs": "report",
+    "Injection": "synthetic",
+    "random_poses": "synthetic",
+    "synthesize": "synthetic",
+}
 
 __all__ = [
     "EFFECTS",
@@ -55,3 +70,16 @@ __all__ = [
     "synthesize",
     "write_outputs",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    mod = _WHERE.get(name)
+    if mod is None:
+        raise AttributeError(f"module 'zrp.gap' has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.{mod}"), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))
