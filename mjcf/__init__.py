@@ -5,11 +5,12 @@
 * :func:`manipulator_from_mujoco` / :func:`from_mjcf` read a serial arm from MJCF or URDF.
 """
 
-from .build import BuiltArm, MJCFOptions, build, build_spec, mjcf_xml, save_mjcf
-from .errors import MJCFCompileError, MJCFImportError, MJCFOutputError
-from .importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
-from .inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
-from .units import LENGTH_UNITS, metres_per_unit
+from mjcf.builder import BuiltArm, MJCFOptions, build, build_spec, mjcf_xml, save_mjcf
+from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
+from mjcf.gravity import gravity_torques
+from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
+from mjcf.inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
+from zrp.units import LENGTH_UNITS, metres_per_unit
 
 __all__ = [
     "INERTIA_MODELS",
@@ -23,6 +24,7 @@ __all__ = [
     "build",
     "build_spec",
     "from_mjcf",
+    "gravity_torques",
     "load_mujoco_model",
     "manipulator_from_mujoco",
     "metres_per_unit",

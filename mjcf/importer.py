@@ -17,11 +17,10 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
-from zrp.model import Manipulator
-
-from .errors import MJCFImportError
-from .units import metres_per_unit
+from zrp.model.manipulator import Manipulator
+from zrp.units import metres_per_unit
 
 __all__ = ["from_mjcf", "load_mujoco_model", "manipulator_from_mujoco"]
 

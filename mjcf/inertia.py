@@ -31,7 +31,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.model import Manipulator
+from zrp.model.manipulator import Manipulator
 
 __all__ = ["INERTIA_MODELS", "BodyInertia", "puma560_inertias", "rod_inertias"]
 

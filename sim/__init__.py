@@ -1,14 +1,16 @@
-"""MuJoCo playback, consistency checks and offscreen rendering of ZRP manipulators.
+"""Simulation layer: MuJoCo playback and consistency checks against ZRP (:mod:`.playback`),
+servo dynamics (:mod:`.dynamics`), offscreen rendering and video (:mod:`.gl`, :mod:`.render`,
+:mod:`.video`), the physics "real" robot (:mod:`.real_robot`), its measuring procedure
+(:mod:`.measurement`) and the blind benchmark of the gap diagnosis (:mod:`.benchmark`).
 
-* :func:`kinematic_playback` / :func:`consistency_check`: MuJoCo site poses along a joint
-  trajectory, and their agreement with :func:`zrp.forward_kinematics`.
-* :func:`dynamic_playback`: PD servos tracking the trajectory under gravity.
-* :class:`OffscreenRenderer`: EGL/OSMesa rendering with overlays, released deterministically.
-* :func:`render_comparison_video`, :func:`render_paper_video`, :func:`render_teaching_sweep`.
+MuJoCo fixes its GL backend when it is first imported; :mod:`sim.gl` imports
+``mujoco.egl``/``mujoco.osmesa`` directly, so :class:`OffscreenRenderer` works whatever was
+imported first.
 
-Names are loaded lazily, so ``import sim`` does not import ``mujoco``: call
-:func:`configure_backend` first when ``mujoco.Renderer`` should use the chosen backend too
-(MuJoCo fixes its GL backend when it is first imported).
+Names load on first use (PEP 562), so ``import sim`` does not import ``mujoco``: that lets
+:func:`configure_backend` choose the backend before MuJoCo fixes it at its first import, for
+``mujoco.Renderer`` too. No submodule shares a name with a function, so ``from sim import X``
+gives the same object whatever was imported before (tested).
 """
 
 from __future__ import annotations
@@ -17,20 +19,62 @@ import importlib
 from typing import Any
 
 _EXPORTS = {
-    "dynamics": ("DynamicPlayback", "default_dynamic_options", "dynamic_playback"),
-    "measure": ("Instrument", "MeasurementRun", "Procedure", "measure", "parse_effects",
-                "random_instrument", "random_poses", "trajectory_poses", "write_measurements",
-                "write_truth"),
-    "gl": ("BACKENDS", "GLBackendError", "GLUnavailableError", "available_backend",
-           "configure_backend", "probe_backend", "resolve_backend"),
-    "playback": ("ConsistencyReport", "SitePoses", "consistency_check", "kinematic_playback",
-                 "rotation_angle"),
-    "real_robot": ("EFFECT_NAMES", "HiddenEffects", "RealRobot", "RealRobotOptions", "Reading",
-                   "Session", "default_tool_points", "motor_map", "true_geometry"),
-    "render": ("OffscreenRenderer",),
-    "video": ("PAPER_LEVELS", "VideoOptions", "VideoResult", "VideoWriteError",
-              "comparison_frames", "nice_factor", "render_comparison_video",
-              "render_paper_video", "render_teaching_sweep"),
+    "dynamics": (
+        "DynamicPlayback",
+        "default_dynamic_options",
+        "dynamic_playback",
+    ),
+    "gl": (
+        "BACKENDS",
+        "GLBackendError",
+        "GLUnavailableError",
+        "available_backend",
+        "configure_backend",
+        "probe_backend",
+        "resolve_backend",
+    ),
+    "measurement": (
+        "Instrument",
+        "MeasurementRun",
+        "Procedure",
+        "measure",
+        "parse_effects",
+        "random_instrument",
+        "trajectory_poses",
+        "write_measurements",
+        "write_truth",
+    ),
+    "playback": (
+        "ConsistencyReport",
+        "SitePoses",
+        "consistency_check",
+        "kinematic_playback",
+    ),
+    "real_robot": (
+        "EFFECT_NAMES",
+        "HiddenEffects",
+        "Reading",
+        "RealRobot",
+        "RealRobotOptions",
+        "Session",
+        "default_tool_points",
+        "motor_map",
+        "true_geometry",
+    ),
+    "render": (
+        "OffscreenRenderer",
+    ),
+    "video": (
+        "PAPER_LEVELS",
+        "VideoOptions",
+        "VideoResult",
+        "VideoWriteError",
+        "comparison_frames",
+        "nice_factor",
+        "render_comparison_video",
+        "render_paper_video",
+        "render_teaching_sweep",
+    ),
 }
 _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}
 

@@ -17,10 +17,9 @@ from tqdm import tqdm
 
 from mjcf import MJCFOptions, build
 from zrp.errors import InputError
-from zrp.kinematics import check_q, forward_kinematics
-from zrp.model import Manipulator
-
-from .playback import rotation_angle
+from zrp.kinematics.forward import check_q, forward_kinematics
+from zrp.model.manipulator import Manipulator
+from zrp.rotations import rotation_angle
 
 __all__ = ["DynamicPlayback", "default_dynamic_options", "dynamic_playback"]
 

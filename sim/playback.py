@@ -10,8 +10,9 @@ from numpy.typing import ArrayLike, NDArray
 
 from mjcf import BuiltArm, MJCFOptions, build, metres_per_unit
 from zrp.errors import InputError
-from zrp.kinematics import check_q, forward_kinematics
-from zrp.model import Manipulator
+from zrp.kinematics.forward import check_q, forward_kinematics
+from zrp.model.manipulator import Manipulator
+from zrp.rotations import rotation_angle
 
 __all__ = [
     "ConsistencyReport",
@@ -19,7 +20,6 @@ __all__ = [
     "as_built",
     "consistency_check",
     "kinematic_playback",
-    "rotation_angle",
 ]
 
 F64 = NDArray[np.float64]
@@ -91,20 +91,6 @@ def kinematic_playback(arm: BuiltArm | Manipulator, q: ArrayLike) -> SitePoses:
         pos[i] = data.site_xpos[arm.site_id]
         frame[i] = data.site_xmat[arm.site_id].reshape(3, 3)
     return SitePoses(pos / arm.scale, frame, arm.manipulator.length_unit)
-
-
-def rotation_angle(a: ArrayLike, b: ArrayLike) -> F64:
-    """Angle of the rotation between frames ``a`` and ``b`` (rad), shapes (..., 3, 3) -> (...).
-
-    Uses atan2(|vee(E - E^T)| / 2, (tr E - 1) / 2) with E = a^T b, accurate near zero (no
-    arccos of a number close to 1).
-    """
-    e = np.swapaxes(np.asarray(a, dtype=float), -1, -2) @ np.asarray(b, dtype=float)
-    w = np.stack([e[..., 2, 1] - e[..., 1, 2], e[..., 0, 2] - e[..., 2, 0],
-                  e[..., 1, 0] - e[..., 0, 1]], axis=-1)
-    s = 0.5 * np.linalg.norm(w, axis=-1)
-    c = 0.5 * (np.trace(e, axis1=-2, axis2=-1) - 1.0)
-    return np.arctan2(s, c)
 
 
 @dataclass(frozen=True, eq=False)

@@ -27,7 +27,7 @@ the nominal model does not know about, each switched on with a magnitude in
 
 Link inertias: the PUMA 560 literature values (:func:`mjcf.puma560_inertias`, Armstrong,
 Khatib & Burdick 1986 via Corke & Armstrong-Hélouvry 1994) for 6R PUMA-type models, uniform
-rods otherwise (:func:`mjcf.rod_inertias`). Layout as in :mod:`mjcf.build`: body frames are
+rods otherwise (:func:`mjcf.rod_inertias`). Layout as in :mod:`mjcf.builder`: body frames are
 world-aligned at q = 0, body k sits at b_{k,0} (metres), joint k turns about u_{k,0}.
 
 Units: joint values rad (model length unit for prismatic joints), positions in the model's
@@ -47,11 +47,11 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from mjcf.inertia import BodyInertia, puma560_inertias, rod_inertias
-from mjcf.units import metres_per_unit
 from zrp.errors import InputError
 from zrp.gap.effects import EFFECTS as GAP_EFFECTS
-from zrp.model import Manipulator
-from zrp.sensitivity import axis_tangents, tilt_axes
+from zrp.manufacturing.sensitivity import axis_tangents, tilt_axes
+from zrp.model.manipulator import Manipulator
+from zrp.units import metres_per_unit
 
 __all__ = [
     "EFFECT_NAMES",
@@ -78,7 +78,6 @@ EFFECT_NAMES: tuple[str, ...] = GAP_EFFECTS
 #: 20 % (bearing and output-stage share, our assumption) only matters inside the backlash: it
 #: holds the load where the last slow approach left it unless gravity is stronger.
 PUMA560_LOAD_FRICTION = (4.94, 2.72, 1.42, 0.170, 0.133, 0.0607)
-G_STANDARD = 9.80665
 
 
 def _freeze(a: ArrayLike) -> F64:
@@ -152,7 +151,7 @@ class HiddenEffects:
         link_length: body-vector error db_k (model length unit, zero-reference base frame) per
             body k = 1..n+1 (n+1: the end effector's).
         axis_misalignment: per joint, tilt (a, b) in rad of the axis towards its tangents t1,
-            t2 (:func:`zrp.sensitivity.axis_tangents`), applied exactly (rotation by |w|).
+            t2 (:func:`zrp.manufacturing.axis_tangents`), applied exactly (rotation by |w|).
         joint_compliance: per joint, rad/(N m): the servo stiffness is 1/c and has no integral
             action, so the joint deflects by -c tau under the static torque tau it carries.
         backlash: per joint, the total free play b between motor and load, rad; the load lags
@@ -282,7 +281,7 @@ def motor_map(effects: HiddenEffects, q: ArrayLike) -> F64:
 
 def true_geometry(model: Manipulator, effects: HiddenEffects) -> Manipulator:
     """The real robot's geometry at t_ref: body vectors + link_length errors, axes tilted
-    exactly by axis_misalignment (:func:`zrp.sensitivity.tilt_axes`)."""
+    exactly by axis_misalignment (:func:`zrp.manufacturing.sensitivity.tilt_axes`)."""
     bodies = np.array(model.bodies, dtype=float)
     for k, db in effects.link_length.items():
         bodies[k - 1] += np.asarray(db)
@@ -390,7 +389,7 @@ class RealRobot:
         effects: what the real robot hides.
         options: build and drive options.
 
-    Use :meth:`session` to drive it (the measuring procedure in :mod:`sim.measure` does).
+    Use :meth:`session` to drive it (the measuring procedure in :mod:`sim.measurement` does).
     """
 
     def __init__(self, model: Manipulator, effects: HiddenEffects | None = None,
@@ -594,7 +593,7 @@ class RealRobot:
     def kinematic_points(self, q_link: ArrayLike, temperature: float | None = None) -> F64:
         """Tool points of the true geometry at true link angles (no dynamics), model unit,
         shape (..., M, 3); used to check the simulation against kinematics."""
-        from zrp.kinematics import forward_kinematics
+        from zrp.kinematics.forward import forward_kinematics
 
         s = self.thermal_scale(self.options.t_ref if temperature is None else temperature)
         tm = self.true_model.with_arrays(bodies=np.asarray(self.true_model.bodies) * s)

@@ -15,9 +15,8 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from sim.gl import create_context
 from zrp.errors import InputError
-
-from .gl import create_context
 
 __all__ = ["OffscreenRenderer"]
 

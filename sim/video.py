@@ -25,14 +25,15 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
 from mjcf import BuiltArm, MJCFOptions, build
+from sim.playback import kinematic_playback
+from sim.render import OffscreenRenderer
 from zrp.errors import InputError, OutputExistsError, ZRPError
-from zrp.kinematics import check_q
-from zrp.model import Manipulator
-
-from .playback import kinematic_playback, rotation_angle
-from .render import OffscreenRenderer
+from zrp.kinematics.forward import check_q
+from zrp.model.manipulator import Manipulator
+from zrp.rotations import rotation_angle
 
 __all__ = [
+    "PAPER_LEVELS",
     "VideoOptions",
     "VideoResult",
     "VideoWriteError",
@@ -112,7 +113,7 @@ class VideoOptions:
             raise InputError(f"ghost_alpha: expected an opacity in (0, 1], got "
                              f"{self.ghost_alpha!r}")
         if self.backend is not None:
-            from .gl import _check_name
+            from sim.gl import _check_name
 
             _check_name(self.backend, "backend")
 
@@ -497,8 +498,8 @@ def render_comparison_video(
 
 
 def _perturbed_puma(parameter: str, xi_percent: float) -> tuple[Manipulator, Manipulator, str]:
-    from zrp import load_model
-    from zrp.perturb import Perturbation
+    from zrp.manufacturing.perturb import Perturbation
+    from zrp.model.files import load_model
 
     nominal = load_model("puma")
     pert = Perturbation.single(parameter, xi_percent)
@@ -521,7 +522,7 @@ def render_paper_video(
     Writes ``<out_dir>/puma_circle_<parameter>_<xi>.mp4`` (``renders/`` is generated output,
     replaced by default).
     """
-    from zrp.examples import puma_circle_ik
+    from zrp.paper.scenario import puma_circle_ik
 
     ik = puma_circle_ik(steps=steps)
     nominal, perturbed, label = _perturbed_puma(parameter, xi_percent)
@@ -546,7 +547,7 @@ def render_teaching_sweep(
 
     Writes ``<out_dir>/puma_sweep_<parameter>.mp4``.
     """
-    from zrp.examples import puma_circle_ik
+    from zrp.paper.scenario import puma_circle_ik
 
     if not levels:
         raise InputError("levels: expected at least one perturbation level (percent)")

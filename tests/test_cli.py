@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 
-from zrp.cli import main
+from zrp.cli.main import main
 
 
 def test_help_lists_subcommands(capsys):

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from zrp import load_model
-from zrp.deviation import pose_deviation, trajectory_deviation
 from zrp.errors import InputError
-from zrp.perturb import Perturbation
+from zrp.manufacturing.deviation import pose_deviation, trajectory_deviation
+from zrp.manufacturing.perturb import Perturbation
 
 
 def _joint_path(n: int, steps: int = 200, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
@@ -59,8 +59,8 @@ def test_literal_eq15_has_a_rounding_floor():
     """The literal eq (15) cannot resolve an exactly-zero error (cf. the paper's 5.96E-8 =
     2^-24 at 0 %); the rounding-free form used for delta_R returns 0."""
     from zrp import end_effector_pose
-    from zrp.deviation import delta_r_eq15, delta_r_literal
-    from zrp.rodrigues import er_conjugate, er_multiply
+    from zrp.manufacturing.deviation import delta_r_eq15, delta_r_literal
+    from zrp.rotations.rodrigues import er_conjugate, er_multiply
 
     model = load_model("puma")
     _, q = _joint_path(6)

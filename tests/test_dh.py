@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.dh import DHRow, dh_forward, from_dh, from_mdh, mdh_forward
+from zrp.model.dh import DHRow, dh_forward, from_dh, from_mdh, mdh_forward
 
 # PUMA 560, standard DH (Corke & Armstrong-Helouvry), mm.
 PUMA_DH = [DHRow(0, np.pi / 2, 0), DHRow(431.8, 0, 0), DHRow(20.3, -np.pi / 2, 150.05),
@@ -26,7 +26,7 @@ def _random_rows(rng, n):
 
 def _tool(rng):
     t = np.eye(4)
-    t[:3, :3] = zrp.rodrigues.er_to_matrix(zrp.rodrigues.er_from_rotvec(rng.normal(size=3)))
+    t[:3, :3] = zrp.rotations.er_to_matrix(zrp.rotations.er_from_rotvec(rng.normal(size=3)))
     t[:3, 3] = rng.normal(size=3) * 100
     return t
 

@@ -10,12 +10,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+import sim.benchmark as gb
 import zrp
-import zrp.gap_benchmark as gb
-from sim.real_robot import HiddenEffects
-from zrp.cli import main
-from zrp.errors import InputError
-from zrp.gap_benchmark import (
+from sim.benchmark import (
     BenchmarkConfig,
     confusion_matrix,
     draw_scenarios,
@@ -26,6 +23,9 @@ from zrp.gap_benchmark import (
     summary_rows,
     write_outputs,
 )
+from sim.real_robot import HiddenEffects
+from zrp.cli.main import main
+from zrp.errors import InputError
 
 SMALL = {"poses": 40, "none_fraction": 0.0, "pair_fraction": 0.0}
 
@@ -265,12 +265,13 @@ def test_blind_diagnosis_names_a_physical_backlash(puma, tmp_path):
     """End to end through files: a 1 mrad play on joint 1 (no gravity torque), 80 poses,
     measured and written; the blind diagnosis of the CSV alone names backlash on joint 1
     and ends at the noise floor."""
-    from sim.measure import Instrument, measure, random_poses, write_measurements
+    from sim.measurement import Instrument, measure, write_measurements
     from sim.real_robot import RealRobot
+    from zrp.kinematics import reachable_poses
 
     rng = np.random.default_rng(21)
     run = measure(RealRobot(puma, HiddenEffects(backlash={1: 1e-3})),
-                  random_poses(puma, 80, rng), Instrument(noise_sigma=0.015), rng)
+                  reachable_poses(puma, 80, rng), Instrument(noise_sigma=0.015), rng)
     csv_path = write_measurements(run, tmp_path / "m.csv")
     diag = gb.diagnose_blind(csv_path, puma, mjcf_path=None, seed=0)
     assert diag["steps"][0]["effect"] == "backlash"

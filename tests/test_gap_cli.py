@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.cli import main
-from zrp.gap import Injection, diagnose, load_measurements, random_poses, synthesize
+from zrp.cli.main import main
+from zrp.gap import Injection, diagnose, load_measurements, synthesize
+from zrp.kinematics import uniform_joint_values
 
 REAL = Path("/work/shared/data/irb120-lasertracker")
 
@@ -24,7 +25,7 @@ def _no_nan(name):
 def csv_file(tmp_path_factory):
     model = zrp.load_model("puma")
     rng = np.random.default_rng(21)
-    meas = synthesize(model, random_poses(model, 150, rng),
+    meas = synthesize(model, uniform_joint_values(model, 150, rng),
                       Injection(joint_offset={3: 1.5e-3}), rng=rng)
     path = tmp_path_factory.mktemp("cli") / "d.csv"
     meas.to_csv(path, deg=True)

@@ -17,10 +17,10 @@ from zrp.gap import (
     diagnose,
     load_measurements,
     noise_floor,
-    random_poses,
     split_poses,
     synthesize,
 )
+from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")
 HEADER = "pose,point,q1,q2,q3,q4,q5,q6,x,y,z\n"
@@ -38,7 +38,7 @@ def _row(pose, point="a", q=(0.1, 0.2, 0.3, 0.4, 0.5, 0.6), xyz=(1.0, 2.0, 3.0))
 
 def test_valid_file_round_trip(tmp_path):
     rng = np.random.default_rng(0)
-    meas = synthesize(PUMA, random_poses(PUMA, 5, rng), Injection(), rng=rng,
+    meas = synthesize(PUMA, uniform_joint_values(PUMA, 5, rng), Injection(), rng=rng,
                       temp=rng.uniform(18, 22, 5))
     meas.to_csv(tmp_path / "m.csv", deg=True)
     back = load_measurements(tmp_path / "m.csv", PUMA, deg=True)
@@ -109,7 +109,7 @@ def test_orientation_columns_warn_that_they_are_unused(tmp_path):
 
 def _synthetic(n_poses=40, seed=0, **kw):
     rng = np.random.default_rng(seed)
-    return synthesize(PUMA, random_poses(PUMA, n_poses, rng), Injection(), rng=rng, **kw)
+    return synthesize(PUMA, uniform_joint_values(PUMA, n_poses, rng), Injection(), rng=rng, **kw)
 
 
 def test_single_pose_is_an_error():
@@ -140,7 +140,7 @@ def test_wrong_model_is_an_error_not_an_answer():
 
 def test_duplicate_poses_warn_and_feed_the_noise_floor():
     rng = np.random.default_rng(4)
-    q = random_poses(PUMA, 30, rng)
+    q = uniform_joint_values(PUMA, 30, rng)
     q = np.concatenate([q, q[:10]])  # ten poses measured twice
     meas = synthesize(PUMA, q, Injection(), rng=rng, noise_sigma=0.02,
                       tool_offsets=((0.0, 0.0, 50.0),))
@@ -158,7 +158,7 @@ def test_duplicate_poses_warn_and_feed_the_noise_floor():
 def test_rank_deficient_data_are_reported():
     """Joint 3 never moves: its scale cannot be told from its offset; said so, not absorbed."""
     rng = np.random.default_rng(5)
-    q = random_poses(PUMA, 120, rng)
+    q = uniform_joint_values(PUMA, 120, rng)
     q[:, 2] = 0.7
     meas = synthesize(PUMA, q, Injection(joint_offset={2: 1e-3}), rng=rng)
     with warnings.catch_warnings(record=True) as w:

@@ -8,8 +8,9 @@ import pytest
 import zrp
 from zrp.gap.data import Measurements
 from zrp.gap.effects import EFFECTS, Context, effect_parameters, registration_parameters
-from zrp.gap.problem import Problem, rotation_matrix
-from zrp.sensitivity import parameter_jacobian
+from zrp.gap.problem import Problem
+from zrp.manufacturing.sensitivity import parameter_jacobian
+from zrp.rotations import matrix_from_rotvec
 
 
 def _data(model, rng, frame="instrument", poses=12, points=2):
@@ -44,7 +45,7 @@ def test_effect_jacobian_matches_finite_differences(name, effect):
     assert specs, why
     specs = registration_parameters(ctx) + specs
     prob = Problem(ctx, specs, np.arange(len(meas.pose_ids)),
-                   base_rotation=rotation_matrix([0.3, -0.2, 1.0]))
+                   base_rotation=matrix_from_rotvec([0.3, -0.2, 1.0]))
     # a generic, non-zero parameter point (exactness away from zero matters for the solver)
     theta = rng.normal(size=len(specs)) * 1e-2
     for i, s in enumerate(specs):
@@ -59,7 +60,7 @@ def test_effect_jacobian_matches_finite_differences(name, effect):
 
 def test_geometric_columns_agree_with_sensitivity_module():
     """At theta = 0 (flange point, no tool offset, base frame) the link and tilt columns equal
-    the position rows of zrp.sensitivity.parameter_jacobian."""
+    the position rows of zrp.manufacturing.sensitivity.parameter_jacobian."""
     rng = np.random.default_rng(3)
     model = zrp.load_model("puma")
     meas = _data(model, rng, frame="base", poses=5, points=1)

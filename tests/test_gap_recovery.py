@@ -16,9 +16,10 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.gap import Injection, Measurements, diagnose, random_poses, synthesize
-from zrp.gap.effects import gravity_torques_mjcf
+from mjcf.gravity import gravity_torques as gravity_torques_mjcf
+from zrp.gap import Injection, Measurements, diagnose, synthesize
 from zrp.gap.synthetic import _gravity_torque
+from zrp.kinematics import uniform_joint_values
 
 SIGMA = 0.02  # mm, per coordinate
 G = 9.80665e-3  # N per kg, times mm -> N m
@@ -58,7 +59,7 @@ SINGLE = {
 def _measure(robot, injection, seed, poses=300):
     rng = np.random.default_rng(seed)
     model = MODELS[robot]
-    q = random_poses(model, poses, rng, LIMITS[robot])
+    q = uniform_joint_values(model, poses, rng, LIMITS[robot])
     temp = rng.uniform(10.0, 40.0, poses)
     return model, synthesize(model, q, injection, rng=rng, noise_sigma=SIGMA, temp=temp)
 
@@ -135,7 +136,7 @@ def test_equivalent_effects_are_reported_as_ties():
     rng = np.random.default_rng(12)
     lim = np.tile([-2.5, 2.5], (6, 1))
     lim[2] = [50.0, 300.0]
-    meas = synthesize(model, random_poses(model, 200, rng, lim),
+    meas = synthesize(model, uniform_joint_values(model, 200, rng, lim),
                       Injection(joint_offset={3: 0.3}), rng=rng)
     with pytest.warns(zrp.ZRPWarning, match="cannot tell the effects apart"):
         d = diagnose(model, meas, seed=0)
@@ -190,7 +191,7 @@ def test_compliance_with_given_gravity_torques():
     """With gravity torques given (as an MJCF provides them), one compliance per joint (rad per
     N m) is identified instead of lumped weights."""
     rng = np.random.default_rng(9)
-    q = random_poses(PUMA, 300, rng)
+    q = uniform_joint_values(PUMA, 300, rng)
     inj = Injection(compliance={2: 2e-5, 3: 3e-5}, masses=MASSES)
     meas = synthesize(PUMA, q, inj, rng=rng, noise_sigma=SIGMA)
     tau = _gravity_torque(PUMA, meas.q_pose, MASSES, np.array([0.0, 0.0, -1.0]))
@@ -207,7 +208,7 @@ def test_compliance_with_an_unknown_payload():
     """The MJCF knows the arm but not the 3 kg payload at the tool: the payload's share of the
     deflection is identified as compliance x payload mass (rad/kg)."""
     rng = np.random.default_rng(10)
-    q = random_poses(PUMA, 300, rng)
+    q = uniform_joint_values(PUMA, 300, rng)
     inj = Injection(compliance={2: 2e-5, 3: 3e-5}, masses=MASSES)
     meas = synthesize(PUMA, q, inj, rng=rng, noise_sigma=SIGMA)
     arm_only = _gravity_torque(PUMA, meas.q_pose, {"p3": 8.0}, np.array([0.0, 0.0, -1.0]))
@@ -227,7 +228,7 @@ def test_gravity_loaded_backlash():
     gives them) the play is recovered; with the lumped-mass proxy the sign of the torque can
     differ from the true one in a few poses, so only the effect and joint are checked."""
     rng = np.random.default_rng(13)
-    q = random_poses(PUMA, 300, rng)
+    q = uniform_joint_values(PUMA, 300, rng)
     inj = Injection(backlash_gravity={2: 6e-4}, masses=MASSES)
     meas = synthesize(PUMA, q, inj, rng=rng, noise_sigma=SIGMA)
     tau = _gravity_torque(PUMA, meas.q_pose, MASSES, np.array([0.0, 0.0, -1.0]))
@@ -247,7 +248,7 @@ def test_backlash_held_by_friction_until_gravity_wins():
     beats the load's Coulomb friction, then it rests on the loaded flank (as in the MuJoCo
     real robot). The switching torque is profiled; the play is recovered."""
     rng = np.random.default_rng(14)
-    q = random_poses(PUMA, 300, rng)
+    q = uniform_joint_values(PUMA, 300, rng)
     tau = _gravity_torque(PUMA, q, MASSES, np.array([0.0, 0.0, -1.0]))
     friction = float(np.quantile(np.abs(tau[:, 2]), 0.5))  # half the poses each way
     inj = Injection(backlash={3: 8e-4}, backlash_friction={3: friction}, masses=MASSES)
@@ -276,7 +277,7 @@ def test_backlash_flank_with_an_unknown_payload():
     """The MJCF torques lack a 3 kg payload, which decides the flank in some poses: the
     payload is profiled (grid 0-10 kg) and found; the play is recovered at noise level."""
     rng = np.random.default_rng(15)
-    q = random_poses(PUMA, 300, rng)
+    q = uniform_joint_values(PUMA, 300, rng)
     masses = {"p3": 8.0, "ee": 3.0}
     tau_true = _gravity_torque(PUMA, q, masses, np.array([0.0, 0.0, -1.0]))
     tau_arm = _gravity_torque(PUMA, q, {"p3": 8.0}, np.array([0.0, 0.0, -1.0]))

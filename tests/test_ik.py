@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.rodrigues import er_angle, er_conjugate, er_multiply
+from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply
 from zrp.testing import random_arm
 
 
@@ -93,7 +93,7 @@ def test_prescribed_orientation_law(puma):
     rate = 0.2  # rad/s about the tool axis (+x in the base frame)
 
     def law(t):
-        twist = zrp.rodrigues.er_from_axis_angle(axis, rate * t)
+        twist = zrp.rotations.rodrigues.er_from_axis_angle(axis, rate * t)
         return er_multiply(twist, er0), np.tile(axis * rate, (t.size, 1))
 
     traj = zrp.Circle(setup.trajectory.center, setup.trajectory.normal,

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 import zrp
-from zrp.rodrigues import er_to_matrix
+from zrp.rotations.rodrigues import er_to_matrix
 from zrp.testing import random_arm
 
 
@@ -175,7 +175,7 @@ def test_bad_joint_values_are_named(puma):
 
 
 def test_vectorised_sincos_matches_libm():
-    from zrp import _kernels as K
+    from zrp.kinematics import _kernels as K
 
     x = np.concatenate([np.linspace(-100, 100, 200_001), [0.0, -0.0, 1e-300, np.pi / 4,
                                                           np.pi / 2, np.pi, -np.pi, 1e5]])
@@ -186,7 +186,7 @@ def test_vectorised_sincos_matches_libm():
 
 
 def test_blocked_batch_kernels_match_single_pose_kernels(rng):
-    from zrp import _kernels as K
+    from zrp.kinematics import _kernels as K
 
     model = random_arm(rng, 7, 0.3)
     q = rng.uniform(-4, 4, (1000, 7))  # spans several blocks

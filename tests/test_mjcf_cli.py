@@ -6,7 +6,7 @@ import mujoco
 import numpy as np
 
 import zrp
-from zrp.cli import main
+from zrp.cli.main import main
 
 
 def test_writes_perturbed_model_and_refuses_overwrite(tmp_path, capsys):

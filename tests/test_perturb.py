@@ -7,7 +7,7 @@ import pytest
 
 from zrp import load_model
 from zrp.errors import InputError
-from zrp.perturb import (
+from zrp.manufacturing.perturb import (
     PAPER_SIGN_ZERO,
     Perturbation,
     check_xi_percent,
@@ -123,8 +123,8 @@ def test_eq9_axis_is_unit(v, xi, s0):
 def test_link_error_is_a_constant_translation_on_any_arm(k, v, xi, seed):
     """Whatever the arm and the joints, LE_k moves the tool by ||b_k' - b_k|| (eq 2 rotates
     b_k rigidly) and never rotates it."""
-    from zrp.deviation import trajectory_deviation
-    from zrp.model import Manipulator
+    from zrp.manufacturing.deviation import trajectory_deviation
+    from zrp.model.manipulator import Manipulator
 
     rng = np.random.default_rng(seed)
     axes = rng.normal(size=(6, 3))

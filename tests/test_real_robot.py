@@ -9,13 +9,12 @@ import numpy as np
 import pytest
 
 import zrp
-from sim.measure import (
+from sim.measurement import (
     Instrument,
     Procedure,
     measure,
     parse_effects,
     random_instrument,
-    random_poses,
     trajectory_poses,
     write_measurements,
     write_truth,
@@ -29,13 +28,14 @@ from sim.real_robot import (
 )
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap import load_measurements
+from zrp.kinematics import reachable_poses
 
 EXACT = Instrument(noise_sigma=0.0, rotvec=(0.0, 0.0, 0.0), translation=(0.0, 0.0, 0.0))
 
 
 @pytest.fixture(scope="module")
 def poses(puma):
-    return random_poses(puma, 8, np.random.default_rng(7))
+    return reachable_poses(puma, 8, np.random.default_rng(7))
 
 
 def _run(model, effects, q, rng_seed=0, procedure=None):
@@ -67,7 +67,7 @@ def test_any_arm_with_a_prismatic_joint_settles_on_its_kinematics():
     model = zrp.load_model("stanford")
     lim = np.array([[-1.5, 1.5], [-1.5, 1.5], [0.0, 200.0], [-1.5, 1.5], [-1.5, 1.5],
                     [-1.5, 1.5]])
-    q = random_poses(model, 4, np.random.default_rng(1), limits=lim, min_height=-1e9)
+    q = reachable_poses(model, 4, np.random.default_rng(1), limits=lim, min_height=-1e9)
     robot, run = _run(model, HiddenEffects(link_length={3: (0.0, 0.2, 0.0)}), q)
     pts = _truth(run, "points_base_noisefree")
     geo = true_geometry(model, robot.effects)
@@ -77,7 +77,7 @@ def test_any_arm_with_a_prismatic_joint_settles_on_its_kinematics():
 
 def test_compliance_deflection_grows_with_gravity_torque(puma):
     c = 2e-5  # rad/(N m)
-    q = random_poses(puma, 10, np.random.default_rng(3))
+    q = reachable_poses(puma, 10, np.random.default_rng(3))
     for payload in (0.0, 3.0):
         _, run = _run(puma, HiddenEffects(joint_compliance={2: c}, payload=payload), q)
         defl = _truth(run, "q_link")[:, 1] - q[:, 1]
@@ -188,7 +188,7 @@ def test_thermal_growth_scales_the_links(puma, poses):
 
 def test_csv_has_what_a_user_has_and_the_truth_is_separate(puma, tmp_path):
     rng = np.random.default_rng(11)
-    q = random_poses(puma, 20, rng)
+    q = reachable_poses(puma, 20, rng)
     inst = Instrument(noise_sigma=0.02)
     robot = RealRobot(puma, HiddenEffects(backlash={4: 8e-4}, payload=1.5))
     run = measure(robot, q, inst, rng)
@@ -221,7 +221,7 @@ def test_csv_has_what_a_user_has_and_the_truth_is_separate(puma, tmp_path):
 
 def test_order_approach_writes_no_direction_columns(puma, tmp_path):
     rng = np.random.default_rng(2)
-    q = random_poses(puma, 10, rng)
+    q = reachable_poses(puma, 10, rng)
     run = measure(RealRobot(puma), q, random_instrument(puma, rng, 0.01), rng,
                   Procedure(approach="order"))
     assert run.direction is None
@@ -234,7 +234,7 @@ def test_gravity_approach_puts_the_backlash_on_the_gravity_flank(puma):
     approach direction and the gravity side then agree in every pose."""
     b = 1e-3
     rng = np.random.default_rng(4)
-    q = random_poses(puma, 16, rng)
+    q = reachable_poses(puma, 16, rng)
     run = measure(RealRobot(puma, HiddenEffects(backlash={2: b})), q, EXACT, rng,
                   Procedure(approach="gravity"))
     play = _truth(run, "q_link")[:, 1] - _truth(run, "q_motor")[:, 1]
@@ -258,14 +258,14 @@ def test_circle_poses_follow_the_paper_circle(puma):
 
 def test_random_poses_respect_limits_and_floor(puma):
     lim = np.tile([-1.0, 1.0], (6, 1))
-    q = random_poses(puma, 50, np.random.default_rng(0), limits=lim, min_height=-500.0)
+    q = reachable_poses(puma, 50, np.random.default_rng(0), limits=lim, min_height=-500.0)
     assert q.shape == (50, 6) and np.all(np.abs(q) <= 1.0)
     p, _ = zrp.end_effector_pose(puma, q)
     assert np.all(p[:, 2] >= -500.0)
     with pytest.raises(InputError, match="limits"):
-        random_poses(puma, 5, np.random.default_rng(0), limits=np.ones((6, 2)))
+        reachable_poses(puma, 5, np.random.default_rng(0), limits=np.ones((6, 2)))
     with pytest.raises(InputError, match="count"):
-        random_poses(puma, 0, np.random.default_rng(0))
+        reachable_poses(puma, 0, np.random.default_rng(0))
 
 
 @pytest.mark.parametrize(("kwargs", "match"), [

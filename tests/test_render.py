@@ -29,7 +29,7 @@ def puma_arm() -> mjcf.BuiltArm:
 
 @pytest.fixture(scope="module")
 def circle():
-    from zrp.examples import puma_circle_ik
+    from zrp.paper.scenario import puma_circle_ik
 
     ik = puma_circle_ik(steps=60)
     return ik.t, ik.q

@@ -7,7 +7,7 @@ import json
 import pytest
 
 import sim
-from zrp.cli import main
+from zrp.cli.main import main
 
 
 @pytest.fixture(scope="module")

@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 from scipy.spatial.transform import Rotation
 
-from zrp import rodrigues as er
+from zrp.rotations import rodrigues as er
 
 finite = st.floats(-10, 10, allow_nan=False, allow_infinity=False)
 

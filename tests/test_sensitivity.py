@@ -7,9 +7,7 @@ import pytest
 
 from zrp import end_effector_pose, jacobian, load_model
 from zrp.errors import InputError
-from zrp.model import Manipulator
-from zrp.rodrigues import er_conjugate, er_multiply, er_to_rotvec
-from zrp.sensitivity import (
+from zrp.manufacturing.sensitivity import (
     apply_parameters,
     axis_tangents,
     parameter_jacobian,
@@ -17,6 +15,8 @@ from zrp.sensitivity import (
     parameter_space,
     perturbed_arrays,
 )
+from zrp.model.manipulator import Manipulator
+from zrp.rotations.rodrigues import er_conjugate, er_multiply, er_to_rotvec
 
 
 def _pose_error(model, model_a, q, off=None):
@@ -134,7 +134,7 @@ def test_bad_input():
 
 def test_pose_error_is_first_order_in_dx():
     """pose_error - J dx shrinks quadratically with the step (second-order remainder)."""
-    from zrp.sensitivity import pose_error
+    from zrp.manufacturing.sensitivity import pose_error
 
     model = load_model("puma")
     q = np.random.default_rng(0).uniform(-2, 2, (5, 6))

@@ -11,6 +11,7 @@ from test_mjcf import perturbed_puma, random_arm
 import mjcf
 import sim
 import zrp
+import zrp.rotations
 from zrp.errors import InputError
 
 POS_TOL_MM = 1e-9
@@ -19,7 +20,7 @@ ROT_TOL_RAD = 1e-12
 
 @pytest.fixture(scope="module")
 def puma_circle():
-    from zrp.examples import puma_circle_ik
+    from zrp.paper.scenario import puma_circle_ik
 
     ik = puma_circle_ik(steps=180)
     return ik.t, ik.q
@@ -84,11 +85,12 @@ def test_playback_bad_inputs():
 
 
 def test_rotation_angle_small_angles():
-    from zrp.rodrigues import er_from_axis_angle, er_to_matrix
+    from zrp.rotations.rodrigues import er_from_axis_angle, er_to_matrix
 
     for angle in (1e-14, 1e-9, 1e-3, 1.0, 3.0):
         r = er_to_matrix(er_from_axis_angle([0.0, 0.6, 0.8], angle))
-        assert sim.rotation_angle(np.eye(3), r) == pytest.approx(angle, rel=1e-9, abs=1e-16)
+        assert zrp.rotations.rotation_angle(np.eye(3), r) == pytest.approx(angle, rel=1e-9,
+                                                                            abs=1e-16)
 
 
 def test_dynamic_playback_gravity_and_compensation(puma_circle):

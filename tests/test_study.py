@@ -9,10 +9,10 @@ import numpy as np
 import pytest
 
 from zrp import load_model, puma_circle_ik
-from zrp.deviation import trajectory_deviation
 from zrp.errors import InputError, OutputExistsError, ZRPWarning
-from zrp.perturb import Perturbation
-from zrp.study import (
+from zrp.manufacturing.deviation import trajectory_deviation
+from zrp.manufacturing.perturb import Perturbation
+from zrp.manufacturing.study import (
     PAPER_PARAMETERS,
     PAPER_XI,
     JointPath,

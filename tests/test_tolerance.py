@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from zrp import load_model
-from zrp.deviation import pose_deviation
 from zrp.errors import InputError
-from zrp.sensitivity import apply_parameters, parameter_jacobian, worst_case_bound
-from zrp.tolerance import (
+from zrp.manufacturing.deviation import pose_deviation
+from zrp.manufacturing.sensitivity import apply_parameters, parameter_jacobian, worst_case_bound
+from zrp.manufacturing.tolerance import (
     Tolerances,
     allocate_tolerances,
     draw_parameters,

@@ -1,11 +1,6 @@
 """zrp: zero-reference-position kinematics and robot-accuracy analysis."""
 
-import importlib
-from typing import Any
-
-from .deviation import Deviation, pose_deviation, trajectory_deviation
-from .dh import DHRow, from_dh, from_mdh
-from .errors import (
+from zrp.errors import (
     IKError,
     InputError,
     ModelError,
@@ -17,38 +12,48 @@ from .errors import (
     ZRPError,
     ZRPWarning,
 )
-from .examples import puma_circle, puma_circle_ik
-from .ik import IKResult, track_trajectory
-from .kinematics import FKResult, end_effector_pose, forward_kinematics, jacobian
-from .model import EndEffector, Joint, Manipulator, hand_frame
-from .modelfile import builtin_models, dumps_model, load_model, loads_model, save_model
-from .paper import run_paper_example, write_paper_outputs
-from .perturb import PAPER_SIGN_ZERO, Perturbation
-from .sensitivity import (
+from zrp.gap import Diagnosis, Measurements, diagnose, load_measurements, write_outputs
+from zrp.kinematics.forward import FKResult, end_effector_pose, forward_kinematics, jacobian
+from zrp.kinematics.ik import IKResult, track_trajectory
+from zrp.kinematics.sampling import reachable_poses, uniform_joint_values
+from zrp.kinematics.trajectory import (
+    Circle,
+    FunctionTrajectory,
+    Line,
+    TimeLaw,
+    Trajectory,
+    TrajectorySample,
+)
+from zrp.manufacturing.deviation import Deviation, pose_deviation, trajectory_deviation
+from zrp.manufacturing.perturb import PAPER_SIGN_ZERO, Perturbation
+from zrp.manufacturing.sensitivity import (
     apply_parameters,
     parameter_jacobian,
     parameter_names,
     parameter_space,
     pose_error,
 )
-from .study import JointPath, StudyResult, circle_joint_path, load_joint_csv, one_at_a_time
-from .tolerance import Allocation, MonteCarloResult, Tolerances, allocate_tolerances, monte_carlo
-from .trajectory import Circle, FunctionTrajectory, Line, TimeLaw, Trajectory, TrajectorySample
+from zrp.manufacturing.study import (
+    JointPath,
+    StudyResult,
+    circle_joint_path,
+    load_joint_csv,
+    one_at_a_time,
+)
+from zrp.manufacturing.tolerance import (
+    Allocation,
+    MonteCarloResult,
+    Tolerances,
+    allocate_tolerances,
+    monte_carlo,
+)
+from zrp.model.dh import DHRow, from_dh, from_mdh
+from zrp.model.files import builtin_models, dumps_model, load_model, loads_model, save_model
+from zrp.model.manipulator import EndEffector, Joint, Manipulator, hand_frame
+from zrp.paper.example import run_paper_example, write_paper_outputs
+from zrp.paper.scenario import puma_circle, puma_circle_ik
 
 __version__ = "0.1.0"
-
-# The gap diagnosis pulls in scipy.stats (about 1 s): load it on first use, not with `import zrp`.
-_LAZY = {name: "gap" for name in
-         ("Diagnosis", "Measurements", "diagnose", "load_measurements", "write_outputs")}
-
-
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        value = getattr(importlib.import_module(f"{__name__}.{_LAZY[name]}"), name)
-        globals()[name] = value
-        return value
-    raise AttributeError(f"module 'zrp' has no attribute {name!r}")
-
 
 __all__ = [
     "PAPER_SIGN_ZERO",
@@ -108,10 +113,12 @@ __all__ = [
     "pose_error",
     "puma_circle",
     "puma_circle_ik",
+    "reachable_poses",
     "run_paper_example",
     "save_model",
     "track_trajectory",
     "trajectory_deviation",
+    "uniform_joint_values",
     "write_outputs",
     "write_paper_outputs",
 ]

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .model import Manipulator
+from zrp.model.manipulator import Manipulator
 
 __all__ = ["random_arm"]
 

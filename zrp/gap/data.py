@@ -31,8 +31,8 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError, ZRPWarning
-from ..model import Manipulator
+from zrp.errors import InputError, ZRPWarning
+from zrp.model.manipulator import Manipulator
 
 __all__ = [
     "FRAMES",
@@ -270,7 +270,7 @@ class Measurements:
 
     def to_csv(self, path: str | Path, *, deg: bool = False, overwrite: bool = False) -> None:
         """Write in the CSV format :func:`load_measurements` reads (q in deg with ``deg``)."""
-        from ..errors import OutputExistsError
+        from zrp.errors import OutputExistsError
 
         path = Path(path)
         if path.exists() and not overwrite:

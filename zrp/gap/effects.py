@@ -15,7 +15,8 @@ corrected model (see :mod:`zrp.gap.problem`, which also gives the analytic Jacob
   (B = sin(h q), cos(h q)) are all of this kind.
 * ``link``: one component of a body-vector correction db_{k,0} (length unit).
 * ``tilt``: a tilt of a joint axis towards one of its tangents t1, t2 (rad), exact:
-  u' = (u + a t1 + b t2) / |u + a t1 + b t2| (tangents from :func:`zrp.sensitivity.axis_tangents`).
+  u' = (u + a t1 + b t2) / |u + a t1 + b t2| (tangents from
+  :func:`zrp.manufacturing.axis_tangents`).
 * ``thermal``: all body vectors scale by (1 + kappa (temp - T_ref)), kappa in 1/deg C.
 """
 
@@ -27,22 +28,20 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
-from ..errors import InputError
-from ..kinematics import forward_kinematics
-from ..model import Manipulator
-from ..sensitivity import axis_tangents
-from .data import Measurements
+from zrp.errors import InputError
+from zrp.gap.data import Measurements
+from zrp.kinematics.forward import forward_kinematics
+from zrp.manufacturing.sensitivity import axis_tangents
+from zrp.model.manipulator import Manipulator
+from zrp.units import G_STANDARD, metres_per_unit
 
 __all__ = [
     "EFFECTS",
-    "G_STANDARD",
     "KINDS",
-    "LENGTH_TO_M",
     "REGISTRATION",
     "Context",
     "ParamSpec",
     "effect_parameters",
-    "gravity_torques_mjcf",
     "registration_parameters",
 ]
 
@@ -53,8 +52,6 @@ EFFECTS = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment",
            "joint_compliance", "backlash", "thermal_expansion", "cyclic_error")
 REGISTRATION = ("base_frame", "tool_offset")
 KINDS = ("rot", "trans", "tool", "dq", "link", "tilt", "thermal")
-G_STANDARD = 9.80665  # m/s^2
-LENGTH_TO_M = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6, "in": 0.0254}
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,37 +88,6 @@ class ParamSpec:
             raise InputError(f"ParamSpec {self.name}: a basis is required for kind 'dq' only")
         if not self.group:
             object.__setattr__(self, "group", self.name)
-
-
-def gravity_torques_mjcf(path: str, q_pose: F64) -> F64:
-    """Gravity torque on each joint from an MJCF model's inertias, shape (P, n).
-
-    The MJCF must have exactly n hinge/slide joints in the model's order with the same zero
-    (as the project's MJCF export writes them). Returns the generalised force gravity exerts on
-    each joint, -``qfrc_bias`` at zero velocity (N m for hinges, in the MJCF's units; positive
-    when gravity turns the joint positively).
-
-    Args:
-        q_pose: joint values, rad, shape (P, n).
-    """
-    import mujoco
-
-    try:
-        m = mujoco.MjModel.from_xml_path(str(path))
-    except Exception as exc:  # mujoco raises ValueError with its own message
-        raise InputError(f"--mjcf {path}: cannot load: {exc}") from exc
-    n = q_pose.shape[1]
-    if m.nq != n or m.nv != n:
-        raise InputError(f"--mjcf {path}: has {m.nq} position coordinates, but the model has {n} "
-                         "joints; the MJCF must have one hinge/slide joint per model joint")
-    d = mujoco.MjData(m)
-    out = np.empty(q_pose.shape)
-    for i, q in enumerate(q_pose):
-        d.qpos[:] = q
-        d.qvel[:] = 0.0
-        mujoco.mj_forward(m, d)
-        out[i] = -d.qfrc_bias  # the generalised force gravity exerts (qfrc_bias holds it)
-    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -233,7 +199,7 @@ class Context:
             tau = np.array(self.gravity_torque, dtype=float)
             if self.payload_kg:
                 tau = tau + (G_STANDARD * self.payload_kg * self.end_effector_arms()
-                             * LENGTH_TO_M.get(self.model.length_unit, 1e-3))
+                             * metres_per_unit(self.model.length_unit, "model.length_unit"))
         elif self.gravity_side is not None:
             tau = np.array(self.gravity_side, dtype=float)
         else:
@@ -349,10 +315,7 @@ def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str |
         if ctx.gravity_torque is not None:
             tau = np.array(ctx.gravity_torque, dtype=float)
             h_ee = ctx.end_effector_arms()
-            to_m = LENGTH_TO_M.get(unit)
-            if to_m is None:
-                raise InputError(f"length_unit {unit!r}: cannot convert to m for the payload "
-                                 f"torque; known: {', '.join(LENGTH_TO_M)}")
+            to_m = metres_per_unit(unit, "model.length_unit")
             if load is not None:
                 tau = tau + G_STANDARD * load[:, None] * h_ee * to_m
             for k in range(n):

@@ -24,41 +24,13 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError
-from .effects import Context, ParamSpec
+from zrp.errors import InputError
+from zrp.gap.effects import Context, ParamSpec
+from zrp.rotations import left_jacobian, matrix_from_rotvec, skew
 
-__all__ = ["Problem", "left_jacobian", "rotation_matrix", "skew"]
+__all__ = ["Problem"]
 
 F64 = NDArray[np.float64]
-
-
-def skew(v: ArrayLike) -> F64:
-    """Cross-product matrices, shape (..., 3) -> (..., 3, 3)."""
-    v = np.asarray(v, dtype=float)
-    z = np.zeros(v.shape[:-1])
-    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
-                     np.stack([v[..., 2], z, -v[..., 0]], -1),
-                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
-
-
-def rotation_matrix(rotvec: ArrayLike) -> F64:
-    """exp([phi]_x) for a rotation vector phi (rad), shape (3,) -> (3, 3)."""
-    phi = np.asarray(rotvec, dtype=float)
-    th = float(np.linalg.norm(phi))
-    k = skew(phi)
-    if th < 1e-8:
-        return np.eye(3) + k + 0.5 * k @ k
-    return np.eye(3) + np.sin(th) / th * k + (1.0 - np.cos(th)) / th**2 * k @ k
-
-
-def left_jacobian(rotvec: ArrayLike) -> F64:
-    """Left Jacobian of SO(3): d exp(phi) = [J_l(phi) dphi]_x exp(phi), shape (3, 3)."""
-    phi = np.asarray(rotvec, dtype=float)
-    th = float(np.linalg.norm(phi))
-    k = skew(phi)
-    if th < 1e-6:
-        return np.eye(3) + 0.5 * k + k @ k / 6.0
-    return (np.eye(3) + (1.0 - np.cos(th)) / th**2 * k + (th - np.sin(th)) / th**3 * k @ k)
 
 
 def _axis_rotations(u: F64, q: F64) -> F64:
@@ -147,7 +119,7 @@ class Problem:
         """R_b (3, 3) and t_b (3,)."""
         if not self.instrument:
             return np.eye(3), np.zeros(3)
-        return (rotation_matrix(theta[self.idx["rot"]]) @ self.base_rotation,
+        return (matrix_from_rotvec(theta[self.idx["rot"]]) @ self.base_rotation,
                 np.asarray(theta[self.idx["trans"]], dtype=float))
 
     def joint_values(self, theta: F64) -> F64:

@@ -12,8 +12,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import OutputExistsError
-from .diagnose import Diagnosis
+from zrp.errors import OutputExistsError
+from zrp.gap.pipeline import Diagnosis
 
 __all__ = ["OUTPUT_FILES", "implicated_joint", "jsonable", "write_outputs"]
 

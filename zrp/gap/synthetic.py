@@ -14,14 +14,14 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ..errors import InputError
-from ..kinematics import forward_kinematics
-from ..model import Manipulator
-from ..sensitivity import axis_tangents, tilt_axes
-from .data import Measurements
-from .problem import rotation_matrix
+from zrp.errors import InputError
+from zrp.gap.data import Measurements
+from zrp.kinematics.forward import forward_kinematics
+from zrp.manufacturing.sensitivity import axis_tangents, tilt_axes
+from zrp.model.manipulator import Manipulator
+from zrp.rotations import matrix_from_rotvec
 
-__all__ = ["Injection", "random_poses", "synthesize"]
+__all__ = ["Injection", "synthesize"]
 
 F64 = NDArray[np.float64]
 
@@ -44,7 +44,7 @@ class Injection:
             the point masses ``masses``.
         masses: kg at mass points: "p{k}" (point on joint k) or "ee".
         link: body-vector corrections (length unit), shape (3,) per body index 1..n+1.
-        tilt: axis tilts (rad) towards the tangents t1, t2 (zrp.sensitivity.axis_tangents).
+        tilt: axis tilts (rad) towards the tangents t1, t2 (zrp.manufacturing.axis_tangents).
         thermal: kappa, 1/deg C (bodies scale by 1 + kappa (temp - t_ref)).
         t_ref: reference temperature, deg C.
     """
@@ -62,17 +62,6 @@ class Injection:
     tilt: Mapping[int, tuple[float, float]] = field(default_factory=dict)
     thermal: float = 0.0
     t_ref: float = 20.0
-
-
-def random_poses(model: Manipulator, count: int, rng: np.random.Generator,
-                 limits_rad: ArrayLike | None = None) -> F64:
-    """Uniform random joint values within ``limits_rad`` (shape (n, 2); default +-2.5 rad),
-    shape (count, n)."""
-    lim = (np.tile([-2.5, 2.5], (model.n, 1)) if limits_rad is None
-           else np.asarray(limits_rad, dtype=float))
-    if lim.shape != (model.n, 2):
-        raise InputError(f"limits_rad: expected shape ({model.n}, 2), got {lim.shape}")
-    return rng.uniform(lim[:, 0], lim[:, 1], (count, model.n))
 
 
 def _gravity_torque(model: Manipulator, q: F64, masses: Mapping[str, float],
@@ -164,7 +153,7 @@ def synthesize(model: Manipulator, q: ArrayLike, injection: Injection, *,
         fk = forward_kinematics(model.with_arrays(axes=axes, bodies=bodies), qa)
         pts = fk.position[:, None, :] + np.einsum("pij,mj->pmi", fk.rotation, t)
     if frame == "instrument":
-        rb = rotation_matrix(base_rotvec)
+        rb = matrix_from_rotvec(base_rotvec)
         pts = pts @ rb.T + np.asarray(base_translation, dtype=float)
     pts = pts + rng.normal(scale=noise_sigma, size=pts.shape)
     M = t.shape[0]

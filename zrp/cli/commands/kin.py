@@ -1,0 +1,154 @@
+"""``zrp fk``, ``zrp ik`` and ``zrp models``: kinematics from the command line."""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from zrp.cli.main import emit
+from zrp.errors import InputError, ZRPWarning
+from zrp.kinematics.forward import forward_kinematics
+from zrp.kinematics.ik import CORRECTIONS, track_trajectory
+from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
+from zrp.model.files import builtin_models, load_model
+from zrp.model.manipulator import Manipulator
+from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM
+from zrp.rotations.rodrigues import er_angle
+
+
+def _joint_values(model: Manipulator, values: list[float], rad: bool, name: str) -> np.ndarray:
+    if len(values) != model.n:
+        raise InputError(f"{name}: expected {model.n} values for {model.name!r} "
+                         f"({', '.join(model.joint_names)}), got {len(values)}")
+    q = np.array(values, dtype=float)
+    if not rad:
+        q = np.where(model.prismatic, q, np.radians(q))
+    return q
+
+
+def _add_model(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--model", default="puma", metavar="FILE",
+                   help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
+                        "; default puma)")
+    p.add_argument("--rad", action="store_true",
+                   help="joint angles are given in rad (default: deg); prismatic values are "
+                        "always in the model's length unit")
+    p.add_argument("--json", action="store_true", help="print JSON")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("fk", help="forward kinematics of one joint vector",
+                       description="End-effector point, u_a, u_t, hand rotation and its "
+                       "Euler-Rodrigues parameters, and the current joint axes and points.")
+    _add_model(p)
+    p.add_argument("--q", nargs="+", type=float, required=True, metavar="Q",
+                   help="joint values q1..qn")
+    p.set_defaults(func=_fk)
+
+    p = sub.add_parser("ik", help="inverse kinematics along a circle or line",
+                       description="Integrate eq (7) along a trajectory (ABM4 predictor-"
+                       "corrector, RK4 start, Newton drift correction). Default: the paper's "
+                       "125 mm circle on the Table 1 PUMA (see README).")
+    _add_model(p)
+    p.add_argument("--q0", nargs="+", type=float, metavar="Q",
+                   help=f"start configuration (default for the PUMA: {list(PUMA_Q0_DEG)} deg)")
+    p.add_argument("--trajectory", choices=("circle", "line"), default="circle")
+    p.add_argument("--radius", type=float, default=PUMA_RADIUS_MM,
+                   help="circle radius in length units (default 125)")
+    p.add_argument("--normal", nargs=3, type=float, default=[1.0, 0.0, 0.0],
+                   help="circle plane normal (default 1 0 0)")
+    p.add_argument("--toward", nargs=3, type=float, default=[0.0, 0.0, 1.0],
+                   help="direction from the start point to the circle centre (default 0 0 1)")
+    p.add_argument("--displacement", nargs=3, type=float, default=[0.0, 100.0, 0.0],
+                   help="line: end minus start point (default 0 100 0)")
+    p.add_argument("--duration", type=float, default=PUMA_DURATION_S, help="s (default 4)")
+    p.add_argument("--time-law", choices=TIME_LAWS, default="quintic")
+    p.add_argument("--steps", type=int, default=1000, help="integration steps (default 1000)")
+    p.add_argument("--task", choices=("pose", "position"), default=None)
+    p.add_argument("--correction", choices=CORRECTIONS, default="newton")
+    p.add_argument("--out", default=None, metavar="CSV",
+                   help="joint trajectory CSV (default renders/<model>_<trajectory>_joints.csv)")
+    p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
+    p.set_defaults(func=_ik)
+
+    p = sub.add_parser("models", help="list the built-in model files")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=_models)
+
+
+def _fk(args: argparse.Namespace) -> int:
+    model = load_model(args.model)
+    q = _joint_values(model, args.q, args.rad, "--q")
+    fk = forward_kinematics(model, q)
+    payload = {
+        "model": model.name, "length_unit": model.length_unit, "q_rad_or_length": q,
+        "position": fk.position, "axial": fk.axial, "transverse": fk.transverse,
+        "rotation": fk.rotation, "euler_rodrigues": fk.er, "rotation_angle_rad": er_angle(fk.er),
+        "joint_axes": fk.axes, "joint_points": fk.points,
+    }
+    u = model.length_unit
+    text = "\n".join([
+        f"{model.name}",
+        f"p   = {np.array2string(fk.position, precision=6)} {u}",
+        f"u_a = {np.array2string(fk.axial, precision=6)}",
+        f"u_t = {np.array2string(fk.transverse, precision=6)}",
+        f"E   = {np.array2string(fk.er, precision=9)} (e0, e1, e2, e3)",
+    ])
+    emit(args, payload, text)
+    return 0
+
+
+def _ik(args: argparse.Namespace) -> int:
+    model = load_model(args.model)
+    if args.q0 is None:
+        if model.n != 6:
+            raise InputError(f"--q0: required for {model.name!r} (the default start "
+                             f"configuration is the PUMA's)")
+        q0 = _joint_values(model, list(PUMA_Q0_DEG), False, "--q0")
+    else:
+        q0 = _joint_values(model, args.q0, args.rad, "--q0")
+    start = forward_kinematics(model, q0).position
+    if args.trajectory == "circle":
+        traj = Circle.from_start(start, args.radius, args.normal, args.toward,
+                                 duration=args.duration, time_law=args.time_law)
+    else:
+        traj = Line(start, start + np.asarray(args.displacement), duration=args.duration,
+                    time_law=args.time_law)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", ZRPWarning)
+        res = track_trajectory(model, traj, q0, args.steps, task=args.task,
+                               correction=args.correction)
+    stem = Path(args.model).stem
+    out = Path(args.out) if args.out else Path("renders") / f"{stem}_{args.trajectory}_joints.csv"
+    res.save_csv(out, overwrite=args.force or args.out is None)
+    s = res.summary()
+    s["output"] = str(out)
+    s["warnings"] = [str(w.message) for w in caught]
+    u = model.length_unit
+    text = "\n".join([
+        f"{model.name}: {args.trajectory}, {s['steps']} steps over {s['duration_s']:g} s "
+        f"({s['method']}, task={s['task']})",
+        f"  max position error     {s['max_position_error']:.3e} {u}",
+        f"  max orientation error  {s['max_orientation_error_rad']:.3e} rad",
+        f"  integrator drift/step  {s['max_drift_position']:.3e} {u}, "
+        f"{s['max_drift_orientation_rad']:.3e} rad (removed by the correction)",
+        f"  min manipulability     {s['min_manipulability']:.4f} at t = "
+        f"{s['min_manipulability_t_s']:.3f} s ({s['damped_steps']} damped samples)",
+        f"  solve time             {s['elapsed_s'] * 1e3:.2f} ms"
+        + (" (first call: includes compiling the kernels)"
+           if s["elapsed_includes_compilation"] else ""),
+        *[f"  warning: {w}" for w in s["warnings"]],
+        f"  joint trajectory -> {out}",
+    ])
+    emit(args, s, text)
+    return 0
+
+
+def _models(args: argparse.Namespace) -> int:
+    models = {name: str(path) for name, path in sorted(builtin_models().items())}
+    text = "\n".join(f"{k:10s} {load_model(v).name}  ({v})" for k, v in models.items())
+    emit(args, models, text)
+    return 0

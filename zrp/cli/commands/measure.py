@@ -1,0 +1,110 @@
+"""``zrp measure``: measure the MuJoCo "real" robot like a laser-tracker calibration."""
+
+from __future__ import annotations
+
+import argparse
+
+from zrp.cli.main import emit
+from zrp.errors import InputError
+from zrp.model.files import builtin_models, load_model
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "measure", help="simulate a laser-tracker measurement of a MuJoCo 'real' robot",
+        description="Build the MuJoCo 'real' robot of a model with hidden effects (--effect), "
+        "command poses (random reachable ones or the PUMA circle), let the servos settle, read "
+        "the tool reflectors, add tracker noise, express them in an instrument frame and write "
+        "the measurement CSV of `zrp diagnose` plus a separate truth file "
+        "(docs/blind-benchmark.md).")
+    p.add_argument("--model", default="puma", metavar="M.toml",
+                   help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
+                        "; default puma)")
+    p.add_argument("--out", required=True, metavar="D.csv", help="measurement CSV to write")
+    p.add_argument("--truth", metavar="T.json",
+                   help="truth file to write (default: next to --out, D.truth.json)")
+    p.add_argument("--effect", action="append", default=[], metavar="NAME[:J]=VALUE[UNIT]",
+                   help="a hidden effect, repeatable: joint_offset:2=0.5mrad, "
+                        "encoder_scale:3=300ppm, cyclic_error:2[:h2]=0.3mrad, "
+                        "link_length:4=0.1,0.2,-0.1mm, axis_misalignment:3=0.5,0.2mrad, "
+                        "joint_compliance:2=20urad/Nm, backlash:1=0.8mrad, "
+                        "thermal_expansion=12ppm/K")
+    p.add_argument("--payload", type=float, default=0.0, metavar="KG",
+                   help="payload at the tool point, kg (logged in the load column)")
+    p.add_argument("--poses", type=int, default=200, help="number of poses (default 200)")
+    p.add_argument("--trajectory", choices=("random", "circle"), default="random",
+                   help="random reachable poses (default) or poses along the PUMA circle")
+    p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
+                   help="final approach against gravity for the joints that carry a "
+                        "gravity torque, the others from a random side (default; written as "
+                        "dir columns), every joint from a random side, or straight moves in "
+                        "measurement order")
+    p.add_argument("--noise", type=float, default=0.02, metavar="SIGMA",
+                   help="tracker noise per coordinate, model length unit (default 0.02)")
+    p.add_argument("--temp-rise", type=float, default=10.0, metavar="K",
+                   help="warm-up of the robot during the session, K (default 10)")
+    p.add_argument("--seed", type=int, default=0, help="seed of poses, noise and instrument")
+    p.add_argument("--deg", action="store_true", help="write q in degrees (then diagnose "
+                                                      "with --deg)")
+    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    p.add_argument("--progress", action="store_true", help="show a progress bar")
+    p.add_argument("--json", action="store_true", help="print a JSON summary")
+    p.set_defaults(func=_run)
+
+
+def _run(args: argparse.Namespace) -> int:
+    import time
+    from pathlib import Path
+
+    import numpy as np
+
+    from sim.measurement import (
+        Procedure,
+        measure,
+        parse_effects,
+        random_instrument,
+        trajectory_poses,
+        write_measurements,
+        write_truth,
+    )
+    from sim.real_robot import RealRobot
+    from zrp.kinematics import reachable_poses
+
+    if args.poses < 8:
+        raise InputError(f"--poses: expected at least 8 poses, got {args.poses}")
+    if not args.noise > 0:
+        raise InputError(f"--noise: expected a positive sigma (model length unit), got "
+                         f"{args.noise}")
+    if args.seed < 0:
+        raise InputError(f"--seed: expected an integer >= 0, got {args.seed}")
+    out = Path(args.out)
+    truth = Path(args.truth) if args.truth else out.with_name(out.stem + ".truth.json")
+    if truth.resolve() == out.resolve():
+        raise InputError("--truth: must differ from --out")
+    for path, opt in ((out, "--out"), (truth, "--truth")):
+        if path.exists() and not args.force:
+            raise InputError(f"{opt} {path}: exists; pass --force to overwrite")
+    model = load_model(args.model)
+    effects = parse_effects(args.effect, model, args.payload)
+    rng = np.random.default_rng(args.seed)
+    q = (reachable_poses(model, args.poses, rng) if args.trajectory == "random"
+         else trajectory_poses(model, args.poses, "circle"))
+    inst = random_instrument(model, rng, args.noise)
+    t0 = time.perf_counter()
+    robot = RealRobot(model, effects)
+    run = measure(robot, q, inst, rng, Procedure(approach=args.approach,
+                                                 temp_rise=args.temp_rise),
+                  progress=args.progress)
+    wall = time.perf_counter() - t0
+    write_measurements(run, out, deg=args.deg, force=args.force)
+    write_truth(run, truth, force=args.force)
+    payload = {"measurements": str(out), "truth": str(truth), "poses": len(q),
+               "points": run.measurements.n_rows, "effects": list(effects.active),
+               "payload_kg": effects.payload, "noise_sigma": args.noise,
+               "approach": args.approach, "trajectory": args.trajectory, "wall_s": wall}
+    text = (f"measured {len(q)} poses ({run.measurements.n_rows} points) of the real "
+            f"{model.name} with hidden effects: {', '.join(effects.active) or 'none'}; "
+            f"noise {args.noise:g} {model.length_unit} per coordinate; {wall:.1f} s\n"
+            f"wrote {out}\nwrote {truth} (the truth: keep it away from the diagnosis)")
+    emit(args, payload, text)
+    return 0

@@ -1,0 +1,92 @@
+"""``zrp mjcf``: write the MuJoCo model (MJCF) of a ZRP model, or import an arm from MJCF/URDF."""
+
+from __future__ import annotations
+
+import argparse
+import re
+from pathlib import Path
+
+from zrp.cli.main import emit
+from zrp.errors import InputError
+from zrp.model.files import builtin_models, load_model, save_model
+
+
+def _perturbations(items: list[str] | None) -> dict[str, float]:
+    out: dict[str, float] = {}
+    for item in items or []:
+        m = re.fullmatch(r"\s*([A-Za-z]+\d+)\s*=\s*([-+0-9.eE]+)\s*", item)
+        if not m:
+            raise InputError(f"--perturb: {item!r} is not NAME=XI, e.g. JE2=0.1 (xi in percent)")
+        out[m.group(1).upper()] = float(m.group(2))
+    return out
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "mjcf", help="write a model as MuJoCo MJCF, or import an arm from MJCF/URDF",
+        description="Write the MJCF of a ZRP model (nominal or perturbed; qpos = 0 is the zero "
+        "reference position; lengths converted to m), or with --from import the serial arm of "
+        "an MJCF/URDF file at qpos = 0 into a model TOML file.")
+    p.add_argument("--model", default="puma", metavar="FILE",
+                   help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
+                        "; default puma)")
+    p.add_argument("--perturb", nargs="+", metavar="NAME=XI", default=None,
+                   help="perturb before writing, e.g. JE2=0.1 LE3=-0.05 (xi in percent, eqs "
+                        "8-12, paper sign(0) convention)")
+    p.add_argument("--inertia", choices=("none", "rods", "puma560"), default="none",
+                   help="mass properties: none (kinematic), rods, or puma560 (literature "
+                        "values, 6R PUMA-type only)")
+    p.add_argument("--actuators", action="store_true",
+                   help="add PD servos (position + rate actuators) per joint")
+    p.add_argument("--kp", type=float, default=2000.0, help="servo gain, N m/rad")
+    p.add_argument("--kv", type=float, default=100.0, help="rate gain, N m s/rad")
+    p.add_argument("--from", dest="source", metavar="XML", default=None,
+                   help="import: MJCF or URDF file to read (writes a model TOML)")
+    p.add_argument("--site", default=None, help="import: end-effector site name")
+    p.add_argument("--body", default=None, help="import: end body name (if no site)")
+    p.add_argument("--unit", default="mm", help="import: length unit of the TOML (default mm)")
+    p.add_argument("--out", default=None, metavar="FILE",
+                   help="output (default renders/<model>.xml, or renders/<name>.toml with "
+                        "--from)")
+    p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=_run)
+
+
+def _slug(text: str) -> str:
+    return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_").lower() or "model"
+
+
+def _run(args: argparse.Namespace) -> int:
+    import mjcf
+
+    if args.source:
+        model = mjcf.from_mjcf(args.source, site=args.site, body=args.body,
+                               length_unit=args.unit)
+        out = Path(args.out or f"renders/{_slug(Path(args.source).stem)}.toml")
+        save_model(model, out, overwrite=args.force)
+        emit(args, {"written": str(out), "joints": model.n, "types": model.joint_types,
+                    "length_unit": model.length_unit},
+             f"imported {model!r} from {args.source} -> {out}")
+        return 0
+    model = load_model(args.model)
+    pert = _perturbations(args.perturb)
+    label = "nominal"
+    if pert:
+        from zrp.manufacturing.perturb import Perturbation
+
+        p = Perturbation(pert)
+        model = p.apply(model)
+        label = ", ".join(f"{k}={v:+g}%" for k, v in pert.items()) + f" ({p.convention})"
+    options = mjcf.MJCFOptions(inertia=args.inertia, actuators=args.actuators, kp=args.kp,
+                               kv=args.kv)
+    arm = mjcf.build(model, options)
+    suffix = "" if not pert else "_" + "_".join(f"{k}{v:g}" for k, v in pert.items())
+    out = Path(args.out or f"renders/{_slug(Path(args.model).stem)}{suffix}.xml")
+    mjcf.save_mjcf(arm, out, overwrite=args.force)
+    emit(args, {"written": str(out), "model": model.name, "perturbation": label,
+                "bodies": int(arm.model.nbody), "joints": int(arm.model.njnt),
+                "actuators": int(arm.model.nu), "inertia": args.inertia},
+         f"wrote {out}: {model.name} ({label}), {arm.model.njnt} joints, "
+         f"{arm.model.nu} actuators, inertia={args.inertia}")
+    return 0

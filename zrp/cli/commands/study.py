@@ -1,0 +1,141 @@
+"""``zrp study``: custom one-at-a-time perturbation sweeps (eqs 8-17) along a trajectory.
+
+Also holds the trajectory options shared by ``zrp study``, ``zrp tolerance`` and ``zrp paper``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+from zrp.cli.main import emit
+from zrp.errors import InputError, ZRPWarning
+from zrp.kinematics.trajectory import TIME_LAWS
+from zrp.manufacturing.perturb import PAPER_SIGN_ZERO
+from zrp.manufacturing.study import (
+    PAPER_PARAMETERS,
+    PAPER_XI,
+    JointPath,
+    circle_joint_path,
+    load_joint_csv,
+    one_at_a_time,
+)
+from zrp.model.files import builtin_models, load_model
+from zrp.model.manipulator import Manipulator
+
+
+def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
+    """--model, trajectory options and --json."""
+    p.add_argument("--model", default="puma", metavar="FILE",
+                   help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
+                        "; default puma)")
+    g = p.add_argument_group("trajectory (nominal inverse kinematics of a circle, or a file)")
+    g.add_argument("--joints", metavar="CSV", default=None,
+                   help="joint trajectory CSV: header, then t (s) and q1..qn (rad / length unit)"
+                        " per row, e.g. written by `zrp ik`; replaces the circle")
+    g.add_argument("--q0", nargs="+", type=float, metavar="DEG", default=None,
+                   help="start configuration in deg (prismatic joints in the length unit); "
+                        "default (0 0 0 0 90 0) for 6-joint arms")
+    g.add_argument("--radius", type=float, default=125.0,
+                   help="circle radius, length unit (default 125)")
+    g.add_argument("--normal", nargs=3, type=float, default=None, metavar=("X", "Y", "Z"),
+                   help="circle plane normal (default: the tool's axial direction at q0)")
+    g.add_argument("--toward", nargs=3, type=float, default=None, metavar=("X", "Y", "Z"),
+                   help="from the start point towards the centre (default: base +z)")
+    g.add_argument("--duration", type=float, default=4.0, help="s (default 4)")
+    g.add_argument("--time-law", choices=TIME_LAWS, default="quintic")
+    g.add_argument("--steps", type=int, default=steps,
+                   help=f"integration steps, samples = steps + 1 (default {steps})")
+    p.add_argument("--json", action="store_true", help="print JSON")
+
+
+def path_from_args(args: argparse.Namespace, model: Manipulator) -> JointPath:
+    """The nominal joint trajectory the options describe."""
+    if args.joints:
+        return load_joint_csv(args.joints, model)
+    q0 = None
+    if args.q0 is not None:
+        if len(args.q0) != model.n:
+            raise InputError(f"--q0: expected {model.n} values for {model.name!r}, got "
+                             f"{len(args.q0)}")
+        q0 = np.where(model.prismatic, args.q0, np.radians(args.q0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("default", ZRPWarning)
+        return circle_joint_path(model, q0=q0, radius=args.radius, duration=args.duration,
+                                 steps=args.steps, normal=args.normal, toward=args.toward,
+                                 time_law=args.time_law)
+
+
+def add_sign_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--sign0-links", type=int, choices=(-1, 0, 1),
+                   default=PAPER_SIGN_ZERO["links"],
+                   help="sign(0) in eq (11) for link vectors (default 0, as the published LE "
+                        "values imply)")
+    p.add_argument("--sign0-axes", type=int, choices=(-1, 0, 1), default=PAPER_SIGN_ZERO["axes"],
+                   help="sign(0) in eq (10) for joint axes (default +1; 0 makes every "
+                        "single-component axis error vanish)")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "study", help="one-at-a-time perturbation sweep (paper eqs 8-17)",
+        description="Perturb each parameter alone (LE<k>: link vector b_k,0; JE<k>: joint axis "
+        "u_k,0) by each xi (percent, -1 < xi < 1), replay the nominal IK joints on the "
+        "perturbed arm and report max delta_p (eq 17), max delta_R (eq 15) and the error angle.")
+    add_path_options(p)
+    p.add_argument("--params", nargs="+", default=list(PAPER_PARAMETERS), metavar="NAME",
+                   help="parameters (default: the paper's LE2 LE3 LE4 LE7 JE1..JE6)")
+    p.add_argument("--xi", nargs="+", type=float, default=list(PAPER_XI), metavar="PCT",
+                   help="levels in percent (default: 0, +-0.02, +-0.05, +-0.07, +-0.1)")
+    add_sign_options(p)
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="also write study_delta_p / study_delta_r / study_angle CSV and Markdown"
+                        " tables into DIR")
+    p.add_argument("--force", action="store_true", help="overwrite existing files in --out")
+    p.set_defaults(func=_study)
+
+
+def _study(args: argparse.Namespace) -> int:
+    model = load_model(args.model)
+    path = path_from_args(args, model)
+    st = one_at_a_time(model, path, args.params, args.xi, sign_zero_links=args.sign0_links,
+                       sign_zero_axes=args.sign0_axes)
+    files = []
+    if args.out:
+        out = Path(args.out)
+        for q in ("delta_p", "delta_r", "angle_rad"):
+            for ext in ("csv", "md"):
+                files.append(str(st.write_table(out / f"study_{q}.{ext}", q,
+                                                overwrite=args.force)))
+    payload = st.summary()
+    payload["linearity_delta_p"] = {
+        k: {f: (None if isinstance(x, float) and not np.isfinite(x) else x)
+            for f, x in vars(v).items()} for k, v in st.linearity().items()}
+    payload["files"] = files
+    u = st.unit
+    lines = [f"{model.name}: {path.label} ({st.t.size} samples)",
+             f"convention: {st.convention}",
+             "IK error of the nominal path: " + (f"{path.ik_position_error:.3g} {u}"
+                                                 if path.ik_position_error is not None
+                                                 else "unknown (not in the joint file)"),
+             "",
+             f"{'param':6s} {'xi %':>7s} {'max dp ' + u:>12s} {'max dR eq15':>12s} "
+             f"{'max angle rad':>14s}"]
+    for i, nm in enumerate(st.parameters):
+        for j, xi in enumerate(st.xi_percent):
+            lines.append(f"{nm:6s} {xi:7.3g} {st.max_delta_p[i, j]:12.4e} "
+                         f"{st.max_delta_r[i, j]:12.4e} {st.max_angle_rad[i, j]:14.4e}")
+    lines.append("")
+    lin_all = st.linearity()
+    if lin_all:
+        lines.append("linearity of max delta_p vs |xi| (slope per %, R^2):")
+        for nm, lin in lin_all.items():
+            lines.append(f"  {nm:6s} slope {lin.slope:.5g} {u}/%  R^2 {lin.r2:.8f}")
+    else:
+        lines.append("linearity: needs at least two distinct |xi| levels")
+    lines += [f"wrote {f}" for f in files]
+    emit(args, payload, "\n".join(lines))
+    return 0

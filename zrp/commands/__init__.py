@@ -1,1 +1,0 @@
-"""Subcommands of ``zrp``: each module defines ``register(subparsers)`` (see zrp.cli)."""

@@ -1,0 +1,47 @@
+"""Kinematics by the zero-reference-position method: forward kinematics and the eq (7)
+Jacobian (:mod:`.forward`, compiled in :mod:`._kernels`), trajectories (:mod:`.trajectory`),
+predictor-corrector inverse kinematics along them (:mod:`.ik`, compiled in :mod:`._ik_kernels`)
+and random joint values (:mod:`.sampling`).
+"""
+
+from zrp.kinematics.forward import FKResult as FKResult
+from zrp.kinematics.forward import check_q as check_q
+from zrp.kinematics.forward import end_effector_pose as end_effector_pose
+from zrp.kinematics.forward import forward_kinematics as forward_kinematics
+from zrp.kinematics.forward import jacobian as jacobian
+from zrp.kinematics.ik import CORRECTIONS as CORRECTIONS
+from zrp.kinematics.ik import TASKS as TASKS
+from zrp.kinematics.ik import IKResult as IKResult
+from zrp.kinematics.ik import track_trajectory as track_trajectory
+from zrp.kinematics.sampling import reachable_poses as reachable_poses
+from zrp.kinematics.sampling import uniform_joint_values as uniform_joint_values
+from zrp.kinematics.trajectory import TIME_LAWS as TIME_LAWS
+from zrp.kinematics.trajectory import Circle as Circle
+from zrp.kinematics.trajectory import FunctionTrajectory as FunctionTrajectory
+from zrp.kinematics.trajectory import Line as Line
+from zrp.kinematics.trajectory import OrientationLaw as OrientationLaw
+from zrp.kinematics.trajectory import TimeLaw as TimeLaw
+from zrp.kinematics.trajectory import Trajectory as Trajectory
+from zrp.kinematics.trajectory import TrajectorySample as TrajectorySample
+
+__all__ = [
+    "CORRECTIONS",
+    "TASKS",
+    "TIME_LAWS",
+    "Circle",
+    "FKResult",
+    "FunctionTrajectory",
+    "IKResult",
+    "Line",
+    "OrientationLaw",
+    "TimeLaw",
+    "Trajectory",
+    "TrajectorySample",
+    "check_q",
+    "end_effector_pose",
+    "forward_kinematics",
+    "jacobian",
+    "reachable_poses",
+    "track_trajectory",
+    "uniform_joint_values",
+]

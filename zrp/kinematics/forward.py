@@ -1,0 +1,158 @@
+"""Forward kinematics and the Jacobian of the ZRP method, batched over leading axes.
+
+* :func:`forward_kinematics` returns everything eqs (1)-(6) define (current joint axes and
+  points, body vectors, p, u_a, u_t, the hand rotation and its Euler-Rodrigues parameters),
+  vectorised with NumPy.
+* :func:`end_effector_pose` and :func:`jacobian` are the fast paths (compiled kernels) used by
+  the inverse kinematics, the error analysis and the benchmarks.
+
+Conventions: R_k is the composition of the rotations of joints 1..k (R_0 = I), so
+b_k = R_{k-1} b_{k,0}, u_k = R_{k-1} u_{k,0} and p = sum_k b_k (+ q_k u_k for prismatic k).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from zrp.errors import InputError
+from zrp.kinematics import _kernels as K
+from zrp.model.manipulator import Manipulator, hand_frame
+from zrp.rotations.rodrigues import (
+    er_from_axis_angle,
+    er_identity,
+    er_multiply,
+    er_rotate,
+    er_to_matrix,
+)
+
+__all__ = ["FKResult", "check_q", "end_effector_pose", "forward_kinematics", "jacobian"]
+
+F64 = NDArray[np.float64]
+
+
+def check_q(model: Manipulator, q: ArrayLike, name: str = "q") -> F64:
+    """Coerce joint values to a float array of shape (..., n), or raise naming the joint.
+
+    Revolute values are in rad, prismatic ones in the model's length unit.
+    """
+    try:
+        arr = np.asarray(q, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: expected numbers, got {type(q).__name__}") from exc
+    if arr.ndim == 0 or arr.shape[-1] != model.n:
+        raise InputError(
+            f"{name}: expected shape (..., {model.n}) for the {model.n} joints of "
+            f"{model.name!r}, got shape {arr.shape}"
+        )
+    if arr.dtype == np.float64 and arr.flags.c_contiguous and K.all_finite(arr):
+        return arr
+    bad = ~np.isfinite(arr)
+    if bad.any():
+        idx = np.argwhere(bad)[0]
+        where = f" at index {tuple(int(i) for i in idx[:-1])}" if arr.ndim > 1 else ""
+        raise InputError(f"{name}: joint {idx[-1] + 1} ({model.joint_names[idx[-1]]}) is "
+                         f"{arr[tuple(idx)]}{where}; expected finite values")
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class FKResult:
+    """Everything forward kinematics gives for joint values of shape (..., n).
+
+    Attributes:
+        axes: current joint axes u_k, shape (..., n, 3).
+        points: current point on each joint axis, p_k = b_1 + ... + b_k, shape (..., n, 3).
+        bodies: current body vectors b_k, k = 1..n+1, shape (..., n + 1, 3).
+        position: end-effector point p, shape (..., 3).
+        axial: u_a, shape (..., 3).
+        transverse: u_t, shape (..., 3).
+        er: Euler-Rodrigues parameters of the hand rotation R_n, shape (..., 4).
+    """
+
+    axes: F64
+    points: F64
+    bodies: F64
+    position: F64
+    axial: F64
+    transverse: F64
+    er: F64
+
+    @property
+    def rotation(self) -> F64:
+        """Hand rotation R_n relative to the zero reference position, shape (..., 3, 3)."""
+        return er_to_matrix(self.er)
+
+    @property
+    def hand_frame(self) -> F64:
+        """Columns (u_t x u_a, u_t, u_a) in the base frame, shape (..., 3, 3)."""
+        return hand_frame(self.axial, self.transverse)
+
+
+def forward_kinematics(model: Manipulator, q: ArrayLike) -> FKResult:
+    """Eqs (1)-(6) vectorised: joint values shape (..., n) -> :class:`FKResult`."""
+    q = check_q(model, q)
+    batch = q.shape[:-1]
+    n = model.n
+    e = er_identity(batch)
+    axes = np.empty((*batch, n, 3))
+    points = np.empty((*batch, n, 3))
+    bodies = np.empty((*batch, n + 1, 3))
+    pos = np.zeros((*batch, 3))
+    for k in range(n):
+        bodies[..., k, :] = er_rotate(e, model.bodies[k])  # eq (2)
+        axes[..., k, :] = er_rotate(e, model.axes[k])  # eq (1)
+        pos = pos + bodies[..., k, :]
+        points[..., k, :] = pos
+        if model.prismatic[k]:
+            pos = pos + q[..., k, None] * axes[..., k, :]
+        else:
+            e = er_multiply(e, er_from_axis_angle(model.axes[k], q[..., k]))  # eqs (4)-(6)
+    bodies[..., n, :] = er_rotate(e, model.bodies[n])
+    pos = pos + bodies[..., n, :]
+    ee = model.end_effector
+    return FKResult(axes, points, bodies, pos, er_rotate(e, ee.axial),
+                    er_rotate(e, ee.transverse), e)
+
+
+def _flat(model: Manipulator, q: ArrayLike) -> tuple[F64, tuple[int, ...]]:
+    q = check_q(model, q)
+    return np.ascontiguousarray(q.reshape(-1, model.n)), q.shape[:-1]
+
+
+def _karrays(model: Manipulator) -> tuple:
+    cache = model.__dict__.get("_kernel_arrays")
+    if cache is None:
+        cache = K.kernel_arrays(model.axes, model.bodies, model.prismatic)
+        model.__dict__["_kernel_arrays"] = cache
+    return cache
+
+
+def end_effector_pose(model: Manipulator, q: ArrayLike) -> tuple[F64, F64]:
+    """Fast forward kinematics of the end effector only.
+
+    Args:
+        q: joint values, shape (..., n).
+
+    Returns:
+        position p, shape (..., 3), and Euler-Rodrigues parameters of R_n, shape (..., 4).
+    """
+    qf, batch = _flat(model, q)
+    out = np.empty((qf.shape[0], 7))
+    K.fk_pose_batch(qf, *_karrays(model), out)
+    out = out.reshape(*batch, 7)
+    return out[..., :3], out[..., 3:]
+
+
+def jacobian(model: Manipulator, q: ArrayLike) -> F64:
+    """Eq (7): J with J qdot = [omega_h; V_p], shape (..., 6, n).
+
+    Revolute column k: [u_k; u_k x (p - p_k)]; prismatic column k: [0; u_k]. Rows 0-2 are in
+    rad per joint unit, rows 3-5 in length unit per joint unit.
+    """
+    qf, batch = _flat(model, q)
+    jac = np.empty((qf.shape[0], 6, model.n))
+    K.jac_batch(qf, *_karrays(model), np.empty((0, 7)), jac)
+    return jac.reshape(*batch, 6, model.n)

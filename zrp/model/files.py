@@ -1,0 +1,185 @@
+"""Read and write manipulator models as TOML files (layout documented in README.md).
+
+```toml
+name = "PUMA-type manipulator (paper, Table 1)"
+length_unit = "mm"
+[[joint]]            # one table per joint, base to tip
+type = "revolute"    # or "prismatic"
+axis = [0, 0, 1]     # u_{k,0}
+body = [0, 0, 0]     # b_{k,0}
+[end_effector]
+body = [0, 0, -127]       # b_{n+1,0}
+axial = [0, 0, -1]        # u_{a,0}
+transverse = [0, -1, 0]   # u_{t,0}
+```
+"""
+
+from __future__ import annotations
+
+import re
+import sys
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from zrp.errors import ModelError, ModelFileError, OutputExistsError
+from zrp.model.manipulator import EndEffector, Joint, Manipulator
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+__all__ = ["builtin_models", "dumps_model", "load_model", "loads_model", "save_model"]
+
+_TOP_KEYS = {"name", "length_unit", "joint", "end_effector"}
+_JOINT_KEYS = {"type", "axis", "body", "name"}
+_EE_KEYS = {"body", "axial", "transverse"}
+
+
+def _line_of(text: str, pattern: str, occurrence: int = 0) -> int | None:
+    """1-based line number of the ``occurrence``-th line matching ``pattern`` (a regex)."""
+    rx = re.compile(pattern)
+    hits = [i for i, line in enumerate(text.splitlines(), start=1) if rx.match(line.strip())]
+    return hits[occurrence] if occurrence < len(hits) else None
+
+
+def _key_line(text: str, table_line: int | None, key: str) -> int | None:
+    """Line of ``key = ...`` inside the table that starts at ``table_line``."""
+    if table_line is None:
+        return None
+    lines = text.splitlines()
+    for i in range(table_line, len(lines)):
+        s = lines[i].strip()
+        if s.startswith("[") and i + 1 != table_line:
+            return None
+        if re.match(rf"{re.escape(key)}\s*=", s):
+            return i + 1
+    return None
+
+
+def loads_model(text: str, source: str = "<string>") -> Manipulator:
+    """Parse a model from TOML text. Errors name ``source`` and the line at fault."""
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelFileError(f"{source}: not valid TOML: {exc}") from exc
+    return _from_dict(data, text, source)
+
+
+def load_model(path: str | Path) -> Manipulator:
+    """Read a model file. ``path`` may also name a built-in model (see :func:`builtin_models`)."""
+    p = Path(path)
+    if not p.exists():
+        builtins = builtin_models()
+        if str(path) in builtins:
+            p = builtins[str(path)]
+        else:
+            raise ModelFileError(
+                f"{path}: no such model file; built-in models are {sorted(builtins)}"
+            )
+    try:
+        text = p.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ModelFileError(f"{p}: cannot read model file: {exc}") from exc
+    return loads_model(text, str(p))
+
+
+def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
+    def fail(msg: str, line: int | None) -> ModelFileError:
+        where = f"{source}, line {line}" if line else source
+        return ModelFileError(f"{where}: {msg}")
+
+    unknown = set(data) - _TOP_KEYS
+    if unknown:
+        key = sorted(unknown)[0]
+        raise fail(f"unknown key {key!r}; expected one of {sorted(_TOP_KEYS)}",
+                   _line_of(text, rf"{re.escape(key)}\s*="))
+    joints_raw = data.get("joint")
+    if not isinstance(joints_raw, list) or not joints_raw:
+        raise fail("no [[joint]] tables; a model needs at least one joint", None)
+    if "end_effector" not in data or not isinstance(data["end_effector"], dict):
+        raise fail("missing [end_effector] table (keys body, axial, transverse)", None)
+    unit = data.get("length_unit", "mm")
+    if not isinstance(unit, str) or not unit:
+        raise fail(f"length_unit: expected a string such as \"mm\", got {unit!r}",
+                   _line_of(text, r"length_unit\s*="))
+
+    def check_table(label: str, table: dict[str, Any], allowed: set[str],
+                    required: tuple[str, ...], tline: int | None) -> None:
+        bad = set(table) - allowed
+        if bad:
+            key = sorted(bad)[0]
+            raise fail(f"{label}: unknown key {key!r}; expected one of {sorted(allowed)}",
+                       _key_line(text, tline, key) or tline)
+        for key in required:
+            if key not in table:
+                raise fail(f"{label}: missing {key!r}", tline)
+
+    def line_of_error(exc: ModelError, fields: tuple[str, ...], tline: int | None) -> int | None:
+        """The line of the field a validation message names (its text before the colon)."""
+        head = str(exc).split(":")[0]
+        field = next((f for f in fields if f in head), None)
+        return (_key_line(text, tline, field) if field else None) or tline
+
+    joint_fields = ("type", "axis", "body")
+    joints = []
+    for k, jd in enumerate(joints_raw, start=1):
+        tline = _line_of(text, r"\[\[\s*joint\s*\]\]", k - 1)
+        check_table(f"joint {k}", jd, _JOINT_KEYS, joint_fields, tline)
+        try:
+            joints.append(Joint(type=jd["type"], axis=jd["axis"], body=jd["body"],
+                                name=str(jd.get("name", "")), index=k))
+        except ModelError as exc:
+            raise fail(str(exc), line_of_error(exc, joint_fields, tline)) from exc
+
+    ed = data["end_effector"]
+    eline = _line_of(text, r"\[\s*end_effector\s*\]")
+    ee_fields = ("axial", "transverse", "body")
+    check_table("end_effector", ed, _EE_KEYS, ee_fields, eline)
+    try:
+        ee = EndEffector(body=ed["body"], axial=ed["axial"], transverse=ed["transverse"])
+    except ModelError as exc:
+        raise fail(str(exc), line_of_error(exc, ee_fields, eline)) from exc
+    return Manipulator(tuple(joints), ee, name=str(data.get("name", Path(source).stem)),
+                       length_unit=unit)
+
+
+def _fmt_vec(v: np.ndarray) -> str:
+    return "[" + ", ".join(repr(float(x)) if x != int(x) else str(int(x)) for x in v) + "]"
+
+
+def dumps_model(model: Manipulator) -> str:
+    """The model as TOML text in the documented layout (floats written with full precision)."""
+    out = [f"name = {_toml_str(model.name)}", f"length_unit = {_toml_str(model.length_unit)}", ""]
+    for j in model.joints:
+        out.append("[[joint]]")
+        if j.name:
+            out.append(f"name = {_toml_str(j.name)}")
+        out += [f'type = "{j.type}"', f"axis = {_fmt_vec(j.axis)}", f"body = {_fmt_vec(j.body)}",
+                ""]
+    ee = model.end_effector
+    out += ["[end_effector]", f"body = {_fmt_vec(ee.body)}", f"axial = {_fmt_vec(ee.axial)}",
+            f"transverse = {_fmt_vec(ee.transverse)}", ""]
+    return "\n".join(out)
+
+
+def _toml_str(s: str) -> str:
+    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
+
+
+def save_model(model: Manipulator, path: str | Path, *, overwrite: bool = False) -> Path:
+    """Write ``model`` to ``path``; refuses to replace an existing file unless ``overwrite``."""
+    p = Path(path)
+    if p.exists() and not overwrite:
+        raise OutputExistsError(f"{p}: exists; pass overwrite=True (--force) to replace it")
+    p.write_text(dumps_model(model), encoding="utf-8")
+    return p
+
+
+def builtin_models() -> dict[str, Path]:
+    """Model files shipped with the package, by short name (e.g. ``"puma"``)."""
+    root = resources.files("zrp.model.builtin")
+    return {Path(str(f)).stem: Path(str(f)) for f in root.iterdir() if str(f).endswith(".toml")}
