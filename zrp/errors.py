@@ -12,6 +12,7 @@ __all__ = [
     "InputError",
     "ModelError",
     "ModelFileError",
+    "OutputBusyError",
     "OutputExistsError",
     "SingularityWarning",
     "TrackingWarning",
@@ -38,7 +39,44 @@ class InputError(ZRPError, ValueError):
 
 
 class OutputExistsError(ZRPError, FileExistsError):
-    """Refusing to overwrite an existing file without ``overwrite=True``."""
+    """Refusing to replace existing files without ``overwrite=True``.
+
+    Args:
+        paths: the files that exist (or one message, for compatibility).
+        option: how the caller says "replace them"; the command line shows ``--force``.
+    """
+
+    def __init__(self, paths: object, option: str = "overwrite=True") -> None:
+        if isinstance(paths, str):
+            self.paths: tuple[str, ...] = ()
+            super().__init__(paths)
+            return
+        self.paths = tuple(str(p) for p in paths)  # type: ignore[attr-defined]
+        self.option = option
+        super().__init__(self.message(option))
+
+    def message(self, option: str = "overwrite=True") -> str:
+        """The message, naming ``option`` as the way to replace the files."""
+        if not self.paths:
+            return str(self.args[0]) if self.args else "output exists"
+        shown = ", ".join(self.paths[:5]) + (f" and {len(self.paths) - 5} more"
+                                             if len(self.paths) > 5 else "")
+        verb = "exists" if len(self.paths) == 1 else "exist"
+        return f"{shown}: {verb}; pass {option} to replace"
+
+    def __str__(self) -> str:
+        return self.message(getattr(self, "option", "overwrite=True"))
+
+
+class OutputBusyError(ZRPError, RuntimeError):
+    """Another run is writing into the same output folder (it holds the folder's lock)."""
+
+    def __init__(self, folder: object, pid: int, host: str) -> None:
+        self.folder, self.pid, self.host = str(folder), pid, host
+        who = f"process {pid}" + (f" on {host}" if host else "") if pid > 0 else "another run"
+        super().__init__(f"{folder}: {who} is writing into this folder; wait for it to finish "
+                         "or choose another output folder (a lock left by a crashed run is "
+                         "taken over automatically)")
 
 
 class IKError(ZRPError, RuntimeError):
