@@ -5,11 +5,12 @@
 * :func:`manipulator_from_mujoco` / :func:`from_mjcf` read a serial arm from MJCF or URDF.
 """
 
-from mjcf.builder import BuiltArm, MJCFOptions, build, build_spec, mjcf_xml, save_mjcf
+from mjcf.builder import BuiltArm, MJCFOptions, build, build_spec
 from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
 from mjcf.gravity import gravity_torques
 from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
 from mjcf.inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
+from mjcf.writer import mjcf_xml, save_mjcf
 from zrp.units import LENGTH_UNITS, metres_per_unit
 
 __all__ = [

@@ -13,133 +13,42 @@ Layout (every body frame is aligned with the base frame at q = 0):
   and a pedestal under the base.
 
 So MuJoCo's forward kinematics of this model is the ZRP product of exponentials exactly.
+The XML text and file: :mod:`mjcf.writer`.
 """
 
 from __future__ import annotations
 
-import math
 import re
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from mjcf.inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
-from zrp.errors import InputError, OutputExistsError
+from mjcf.errors import MJCFCompileError
+from mjcf.inertia import BodyInertia, puma560_inertias, rod_inertias
+from mjcf.options import (
+    BASE_RGBA,
+    FLOOR_RGBA,
+    NAME_OK,
+    PRISMATIC_RGBA,
+    REVOLUTE_RGBA,
+    RGBA,
+    MJCFOptions,
+)
+from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 from zrp.units import metres_per_unit
 
 __all__ = [
     "BuiltArm",
-    "MJCFOptions",
     "build",
     "build_spec",
-    "mjcf_xml",
-    "save_mjcf",
+    "hand_quat",
+    "joint_name",
 ]
 
 F64 = NDArray[np.float64]
-RGBA = tuple[float, float, float, float]
-
-LINK_RGBA: RGBA = (0.55, 0.62, 0.72, 1.0)
-REVOLUTE_RGBA: RGBA = (0.95, 0.55, 0.15, 1.0)
-PRISMATIC_RGBA: RGBA = (0.30, 0.75, 0.35, 1.0)
-BASE_RGBA: RGBA = (0.35, 0.35, 0.38, 1.0)
-FLOOR_RGBA: RGBA = (0.88, 0.88, 0.86, 1.0)
-_NAME_OK = re.compile(r"^[A-Za-z_][A-Za-z0-9_.:-]*$")
-
-
-def _check_rgba(value: ArrayLike, name: str) -> RGBA:
-    arr = np.asarray(value, dtype=float)
-    if arr.shape != (4,) or not np.all(np.isfinite(arr)) or arr.min() < 0 or arr.max() > 1:
-        raise InputError(f"{name}: expected 4 numbers in [0, 1] (r, g, b, a), got {value!r}")
-    return (float(arr[0]), float(arr[1]), float(arr[2]), float(arr[3]))
-
-
-def _check_positive(value: float, name: str, unit: str, allow_zero: bool = False) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name}: expected a number ({unit}), got {value!r}") from exc
-    ok = v >= 0 if allow_zero else v > 0
-    if not (math.isfinite(v) and ok):
-        bound = ">= 0" if allow_zero else "> 0"
-        raise InputError(f"{name}: expected a finite number {bound} ({unit}), got {value!r}")
-    return v
-
-
-@dataclass(frozen=True)
-class MJCFOptions:
-    """How to build the MJCF model.
-
-    Attributes:
-        inertia: "none" (1 g placeholder bodies: kinematics only), "rods" (uniform rods and
-            motor masses, any arm) or "puma560" (literature values, 6R PUMA-type arms only).
-        actuators: add a PD servo per joint: a position actuator ``servo{k}`` (gain ``kp``) and,
-            if ``kv > 0``, a velocity actuator ``servo{k}_rate`` (gain ``kv``). ctrl holds the
-            n position set points, then the n rate set points (0 = plain damping).
-        kp: position gain, N m/rad (N/m for prismatic joints).
-        kv: velocity gain, N m s/rad (N s/m).
-        gravity_compensation: compensate gravity on every body (MuJoCo ``gravcomp``).
-        gravity: gravity vector, m/s^2, shape (3,).
-        timestep: simulation step, s.
-        visuals: add link capsules, joint cylinders and the end-effector triad.
-        floor: add a floor and a pedestal under the base.
-        alpha: opacity multiplier of every visual (e.g. 0.3 for a ghost arm).
-        link_rgba: colour of the link capsules.
-        tint: if given, one colour for every visual of the arm (e.g. a pale "ghost" arm).
-        link_radius: capsule radius, m; None picks 2.2 % of the arm's reach.
-        prefix: prefix of every element name (to put several arms in one scene).
-        offscreen_size: (width, height) of MuJoCo's offscreen framebuffer, pixels.
-    """
-
-    inertia: str = "none"
-    actuators: bool = False
-    kp: float = 2000.0
-    kv: float = 100.0
-    gravity_compensation: bool = False
-    gravity: tuple[float, float, float] = (0.0, 0.0, -9.81)
-    timestep: float = 1e-3
-    visuals: bool = True
-    floor: bool = True
-    alpha: float = 1.0
-    link_rgba: RGBA = LINK_RGBA
-    tint: RGBA | None = None
-    link_radius: float | None = None
-    prefix: str = ""
-    offscreen_size: tuple[int, int] = (1280, 960)
-
-    def __post_init__(self) -> None:
-        if self.inertia not in INERTIA_MODELS:
-            raise InputError(f"inertia: unknown model {self.inertia!r}; expected one of "
-                             f"{INERTIA_MODELS}")
-        _check_positive(self.kp, "kp", "N m/rad")
-        _check_positive(self.kv, "kv", "N m s/rad", allow_zero=True)
-        _check_positive(self.timestep, "timestep", "s")
-        g = np.asarray(self.gravity, dtype=float)
-        if g.shape != (3,) or not np.all(np.isfinite(g)):
-            raise InputError(f"gravity: expected 3 finite numbers (m/s^2), got {self.gravity!r}")
-        object.__setattr__(self, "gravity", tuple(float(x) for x in g))
-        a = _check_positive(self.alpha, "alpha", "opacity in (0, 1]")
-        if a > 1:
-            raise InputError(f"alpha: expected an opacity in (0, 1], got {self.alpha!r}")
-        object.__setattr__(self, "link_rgba", _check_rgba(self.link_rgba, "link_rgba"))
-        if self.tint is not None:
-            object.__setattr__(self, "tint", _check_rgba(self.tint, "tint"))
-        if self.link_radius is not None:
-            _check_positive(self.link_radius, "link_radius", "m")
-        if self.prefix and not _NAME_OK.match(self.prefix):
-            raise InputError(f"prefix: {self.prefix!r} is not a valid MJCF name prefix; use "
-                             f"letters, digits and _ . : -")
-        size = tuple(int(x) for x in self.offscreen_size)
-        if len(size) != 2 or min(size) < 1:
-            raise InputError(f"offscreen_size: expected (width, height) in pixels, got "
-                             f"{self.offscreen_size!r}")
-        object.__setattr__(self, "offscreen_size", size)
-
 
 @dataclass(frozen=True, eq=False)
 class BuiltArm:
@@ -186,7 +95,8 @@ class BuiltArm:
         return np.asarray(qpos, dtype=float) / self._qscale
 
 
-def _hand_quat(model: Manipulator) -> F64:
+def hand_quat(model: Manipulator) -> F64:
+    """Quaternion (w, x, y, z) of the hand frame, the end-effector site's orientation."""
     quat = np.zeros(4)
     mujoco.mju_mat2Quat(quat, np.ascontiguousarray(model.end_effector.frame).ravel())
     return quat
@@ -215,18 +125,14 @@ def _inertias(model: Manipulator, options: MJCFOptions, scale: float) -> list[Bo
     return [BodyInertia(mass=1e-3, com=np.zeros(3), inertia=tiny) for _ in range(model.n)]
 
 
-def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco.MjSpec:
-    """The :class:`mujoco.MjSpec` of ``model`` (see the module docstring for the layout)."""
-    if not isinstance(model, Manipulator):
-        raise InputError(f"model: expected a zrp.Manipulator, got {type(model).__name__}")
-    options = options or MJCFOptions()
-    scale = metres_per_unit(model.length_unit, "model.length_unit")
-    pre = options.prefix
-    bodies_m = np.asarray(model.bodies) * scale
-    axes = np.asarray(model.axes)
-    reach_m = float(np.sum(np.linalg.norm(bodies_m, axis=1))) or 1.0
-    radius = options.link_radius or 0.022 * reach_m
+def _colour(rgba: RGBA | list[float], options: MJCFOptions) -> list[float]:
+    """``rgba`` (or the tint) with the options' opacity applied."""
+    base = options.tint if options.tint is not None else rgba
+    return [base[0], base[1], base[2], base[3] * options.alpha]
 
+
+def _new_spec(model: Manipulator, options: MJCFOptions, reach_m: float) -> mujoco.MjSpec:
+    """An empty spec with the compiler, physics and visual settings."""
     spec = mujoco.MjSpec()
     spec.modelname = re.sub(r"[^A-Za-z0-9_.-]+", "_", model.name).strip("_") or "arm"
     spec.compiler.degree = False
@@ -241,43 +147,66 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
     spec.visual.headlight.diffuse = [0.55, 0.55, 0.55]
     spec.stat.extent = 1.2 * reach_m
     spec.stat.center = [0.0, 0.0, 0.0]
+    return spec
 
-    alpha = options.alpha
-    tint = options.tint
 
-    def colour(rgba: RGBA | list[float]) -> list[float]:
-        base = tint if tint is not None else rgba
-        return [base[0], base[1], base[2], base[3] * alpha]
-
-    world = spec.worldbody
-    if options.visuals and options.floor:
+def _add_surroundings(world: mujoco.MjsBody, options: MJCFOptions, reach_m: float,
+                      radius: float) -> None:
+    """Light, floor and pedestal (with ``floor``), and the base cylinder (with ``visuals``)."""
+    if not options.visuals:
+        return
+    pre = options.prefix
+    if options.floor:
         floor_z = -reach_m
         light = world.add_light(name=f"{pre}light", pos=[0.0, -reach_m, 3 * reach_m],
                                 dir=[0.0, 0.3, -1.0])
         light.type = mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
         light.castshadow = False
-        _visual_geom(world, mujoco.mjtGeom.mjGEOM_PLANE, colour(FLOOR_RGBA),
+        _visual_geom(world, mujoco.mjtGeom.mjGEOM_PLANE, _colour(FLOOR_RGBA, options),
                      size=[2 * reach_m, 2 * reach_m, 0.05], pos=[0, 0, floor_z],
                      name=f"{pre}floor", group=2)
-        _visual_geom(world, mujoco.mjtGeom.mjGEOM_CYLINDER, colour(BASE_RGBA),
+        _visual_geom(world, mujoco.mjtGeom.mjGEOM_CYLINDER, _colour(BASE_RGBA, options),
                      size=[2.5 * radius, 0], fromto=[0, 0, floor_z, 0, 0, -2 * radius],
                      name=f"{pre}pedestal", group=2)
-    if options.visuals:
-        _visual_geom(world, mujoco.mjtGeom.mjGEOM_CYLINDER, colour(BASE_RGBA),
-                     size=[2.5 * radius, 0], fromto=[0, 0, -2 * radius, 0, 0, 0],
-                     name=f"{pre}base", group=1)
+    _visual_geom(world, mujoco.mjtGeom.mjGEOM_CYLINDER, _colour(BASE_RGBA, options),
+                 size=[2.5 * radius, 0], fromto=[0, 0, -2 * radius, 0, 0, 0],
+                 name=f"{pre}base", group=1)
 
+
+def _add_joint_visual(body: mujoco.MjsBody, model: Manipulator, k: int, u: F64,
+                      options: MJCFOptions, radius: float) -> None:
+    """A box (prismatic) or a cylinder along the axis (revolute) marking joint k."""
+    name = f"{options.prefix}u{k + 1}"
+    if model.prismatic[k]:
+        _visual_geom(body, mujoco.mjtGeom.mjGEOM_BOX, _colour(PRISMATIC_RGBA, options),
+                     size=[1.1 * radius] * 3, name=name)
+    else:
+        h = 1.6 * radius
+        _visual_geom(body, mujoco.mjtGeom.mjGEOM_CYLINDER, _colour(REVOLUTE_RGBA, options),
+                     size=[1.35 * radius, 0], fromto=[*(-h * u), *(h * u)], name=name)
+
+
+def _add_links(world: mujoco.MjsBody, model: Manipulator, options: MJCFOptions,
+               scale: float, radius: float) -> tuple[list[str], mujoco.MjsBody]:
+    """Bodies link1..linkn with their joints, mass properties and visuals.
+
+    Returns:
+        the joint names and the last body.
+    """
+    pre = options.prefix
+    bodies_m = np.asarray(model.bodies) * scale
+    axes = np.asarray(model.axes)
     inertias = _inertias(model, options, scale)
+    link_rgba = _colour(options.link_rgba, options)
     joint_names: list[str] = []
     parent = world
-    link_rgba = colour(options.link_rgba)
     for k in range(model.n):
         b = bodies_m[k]
         if options.visuals and np.linalg.norm(b) > 1e-9:
             _visual_geom(parent, mujoco.mjtGeom.mjGEOM_CAPSULE, link_rgba, size=[radius, 0, 0],
                          fromto=[0, 0, 0, *b], name=f"{pre}b{k + 1}")
         body = parent.add_body(name=f"{pre}link{k + 1}", pos=list(b))
-        joint = body.add_joint(name=f"{pre}{_joint_name(model, k)}", axis=list(axes[k]))
+        joint = body.add_joint(name=f"{pre}{joint_name(model, k)}", axis=list(axes[k]))
         joint.type = (mujoco.mjtJoint.mjJNT_SLIDE if model.prismatic[k]
                       else mujoco.mjtJoint.mjJNT_HINGE)
         joint.armature = inertias[k].armature
@@ -289,53 +218,71 @@ def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco
         if options.gravity_compensation:
             body.gravcomp = 1.0
         if options.visuals:
-            u = axes[k]
-            if model.prismatic[k]:
-                _visual_geom(body, mujoco.mjtGeom.mjGEOM_BOX, colour(PRISMATIC_RGBA),
-                             size=[1.1 * radius] * 3, name=f"{pre}u{k + 1}")
-            else:
-                h = 1.6 * radius
-                _visual_geom(body, mujoco.mjtGeom.mjGEOM_CYLINDER,
-                             colour(REVOLUTE_RGBA), size=[1.35 * radius, 0],
-                             fromto=[*(-h * u), *(h * u)], name=f"{pre}u{k + 1}")
+            _add_joint_visual(body, model, k, axes[k], options, radius)
         joint_names.append(joint.name)
         parent = body
+    return joint_names, parent
 
-    if options.actuators:
-        # PD servo per joint as two actuators: position (kp), then rate (kv) set points, so
-        # ctrl = [n positions, n rates]. With rate set points 0 this is MuJoCo's position
-        # actuator with damping kv; feeding the reference rates removes the kv * qdot lag.
+
+def _add_servos(spec: mujoco.MjSpec, joint_names: list[str], options: MJCFOptions) -> None:
+    """PD servo per joint as two actuators: position (kp), then rate (kv) set points, so
+    ctrl = [n positions, n rates]. With rate set points 0 this is MuJoCo's position actuator
+    with damping kv; feeding the reference rates removes the kv * qdot lag."""
+    pre = options.prefix
+    for k, jname in enumerate(joint_names):
+        act = spec.add_actuator(name=f"{pre}servo{k + 1}", target=jname,
+                                trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.set_to_position(kp=options.kp, kv=0.0)
+    if options.kv > 0:
         for k, jname in enumerate(joint_names):
-            act = spec.add_actuator(name=f"{pre}servo{k + 1}", target=jname,
+            vel = spec.add_actuator(name=f"{pre}servo{k + 1}_rate", target=jname,
                                     trntype=mujoco.mjtTrn.mjTRN_JOINT)
-            act.set_to_position(kp=options.kp, kv=0.0)
-        if options.kv > 0:
-            for k, jname in enumerate(joint_names):
-                vel = spec.add_actuator(name=f"{pre}servo{k + 1}_rate", target=jname,
-                                        trntype=mujoco.mjtTrn.mjTRN_JOINT)
-                vel.set_to_velocity(kv=options.kv)
+            vel.set_to_velocity(kv=options.kv)
 
-    tip = bodies_m[model.n]
+
+def _add_hand(last: mujoco.MjsBody, model: Manipulator, options: MJCFOptions, tip: F64,
+              radius: float) -> None:
+    """The last body vector, the end-effector site and its RGB triad."""
+    pre = options.prefix
     if options.visuals and np.linalg.norm(tip) > 1e-9:
-        _visual_geom(parent, mujoco.mjtGeom.mjGEOM_CAPSULE, link_rgba,
+        _visual_geom(last, mujoco.mjtGeom.mjGEOM_CAPSULE, _colour(options.link_rgba, options),
                      size=[0.6 * radius, 0, 0], fromto=[0, 0, 0, *tip],
                      name=f"{pre}b{model.n + 1}")
-    parent.add_site(name=f"{pre}end_effector", pos=list(tip), quat=list(_hand_quat(model)),
-                    size=[0.5 * radius, 0, 0], rgba=[1.0, 1.0, 1.0, 0.0])
+    last.add_site(name=f"{pre}end_effector", pos=list(tip), quat=list(hand_quat(model)),
+                  size=[0.5 * radius, 0, 0], rgba=[1.0, 1.0, 1.0, 0.0])
     if options.visuals:
         frame = model.end_effector.frame
         colours = ([0.9, 0.15, 0.15], [0.15, 0.8, 0.15], [0.15, 0.3, 0.95])
         for col, name in enumerate("xyz"):
             d = frame[:, col] * 3.0 * radius
-            _visual_geom(parent, mujoco.mjtGeom.mjGEOM_CAPSULE, colour([*colours[col], 1.0]),
-                         size=[0.25 * radius, 0, 0], fromto=[*tip, *(tip + d)],
-                         name=f"{pre}hand_{name}", group=1)
+            _visual_geom(last, mujoco.mjtGeom.mjGEOM_CAPSULE,
+                         _colour([*colours[col], 1.0], options), size=[0.25 * radius, 0, 0],
+                         fromto=[*tip, *(tip + d)], name=f"{pre}hand_{name}", group=1)
+
+
+def build_spec(model: Manipulator, options: MJCFOptions | None = None) -> mujoco.MjSpec:
+    """The :class:`mujoco.MjSpec` of ``model`` (see the module docstring for the layout)."""
+    if not isinstance(model, Manipulator):
+        raise InputError(f"model: expected a zrp.Manipulator, got {type(model).__name__}")
+    options = options or MJCFOptions()
+    scale = metres_per_unit(model.length_unit, "model.length_unit")
+    bodies_m = np.asarray(model.bodies) * scale
+    reach_m = float(np.sum(np.linalg.norm(bodies_m, axis=1))) or 1.0
+    radius = options.link_radius or 0.022 * reach_m
+    spec = _new_spec(model, options, reach_m)
+    _add_surroundings(spec.worldbody, options, reach_m, radius)
+    joint_names, last = _add_links(spec.worldbody, model, options, scale, radius)
+    if options.actuators:
+        _add_servos(spec, joint_names, options)
+    _add_hand(last, model, options, bodies_m[model.n], radius)
     return spec
 
 
-def _joint_name(model: Manipulator, k: int) -> str:
+def joint_name(model: Manipulator, k: int) -> str:
+    """MJCF name of joint k (0-based): the model's name if it is a valid MJCF name, else
+    ``q<k+1>`` (without the options' prefix)."""
     name = model.joint_names[k]
-    return name if _NAME_OK.match(name) else f"q{k + 1}"
+    return name if NAME_OK.match(name) else f"q{k + 1}"
 
 
 def build(model: Manipulator, options: MJCFOptions | None = None) -> BuiltArm:
@@ -345,8 +292,6 @@ def build(model: Manipulator, options: MJCFOptions | None = None) -> BuiltArm:
         InputError: bad options (the message names the option).
         mjcf.MJCFCompileError: MuJoCo refused the model (its message is included).
     """
-    from mjcf.errors import MJCFCompileError
-
     options = options or MJCFOptions()
     spec = build_spec(model, options)
     try:
@@ -355,7 +300,7 @@ def build(model: Manipulator, options: MJCFOptions | None = None) -> BuiltArm:
         raise MJCFCompileError(f"MuJoCo could not compile the model of {model.name!r}: "
                                f"{exc}") from exc
     pre = options.prefix
-    jids = [mujoco.mj_name2id(compiled, mujoco.mjtObj.mjOBJ_JOINT, f"{pre}{_joint_name(model, k)}")
+    jids = [mujoco.mj_name2id(compiled, mujoco.mjtObj.mjOBJ_JOINT, f"{pre}{joint_name(model, k)}")
             for k in range(model.n)]
     bids = [mujoco.mj_name2id(compiled, mujoco.mjtObj.mjOBJ_BODY, f"{pre}link{k + 1}")
             for k in range(model.n)]
@@ -371,61 +316,3 @@ def build(model: Manipulator, options: MJCFOptions | None = None) -> BuiltArm:
         site_id=int(site),
         body_ids=np.array(bids, dtype=np.int64),
     )
-
-
-def _fmt(values: ArrayLike) -> str:
-    return " ".join(repr(float(v)) for v in np.asarray(values, dtype=float).ravel())
-
-
-def mjcf_xml(arm: BuiltArm | Manipulator, options: MJCFOptions | None = None) -> str:
-    """MJCF text of a built arm (or of a model, built with ``options``).
-
-    MuJoCo's writer keeps 6 significant digits; the kinematic attributes (body positions,
-    joint axes, the end-effector site) are rewritten here at full double precision so that the
-    file reproduces the model exactly.
-    """
-    if isinstance(arm, Manipulator):
-        arm = build(arm, options)
-    elif not isinstance(arm, BuiltArm):
-        raise InputError(f"arm: expected a mjcf.BuiltArm or a zrp.Manipulator, got "
-                         f"{type(arm).__name__}")
-    text = arm.spec.to_xml()
-    root = ET.fromstring(text)
-    model = arm.manipulator
-    pre = arm.options.prefix
-    bodies_m = np.asarray(model.bodies) * arm.scale
-    by_name = {el.get("name"): el for el in root.iter() if el.get("name")}
-    for k in range(model.n):
-        body = by_name[f"{pre}link{k + 1}"]
-        body.set("pos", _fmt(bodies_m[k]))
-        joint = by_name[f"{pre}{_joint_name(model, k)}"]
-        joint.set("axis", _fmt(model.axes[k]))
-    site = by_name[f"{pre}end_effector"]
-    site.set("pos", _fmt(bodies_m[model.n]))
-    site.set("quat", _fmt(_hand_quat(model)))
-    ET.indent(root, space="  ")
-    comment = (f"<!-- {model.name}: built by zrp-accuracy mjcf from a zero-reference-position "
-               f"model ({model.length_unit} -> m x {arm.scale:g}); qpos = 0 is the zero "
-               f"reference. -->\n")
-    return comment + ET.tostring(root, encoding="unicode") + "\n"
-
-
-def save_mjcf(arm: BuiltArm | Manipulator, path: str | Path, *, overwrite: bool = False,
-              options: MJCFOptions | None = None) -> Path:
-    """Write :func:`mjcf_xml` to ``path``; refuses to replace a file unless ``overwrite``."""
-    path = Path(path)
-    if path.exists() and not overwrite:
-        raise OutputExistsError(f"output {str(path)!r} exists; pass overwrite=True (--force) to "
-                                f"replace it")
-    if path.is_dir():
-        raise InputError(f"output {str(path)!r} is a directory; expected a .xml file path")
-    text = mjcf_xml(arm, options)
-    try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        path.write_text(text, encoding="utf-8")
-    except OSError as exc:
-        from mjcf.errors import MJCFOutputError
-
-        raise MJCFOutputError(f"output {str(path)!r}: cannot write ({exc.strerror or exc})") \
-            from exc
-    return path

@@ -1,7 +1,13 @@
 """Simulation layer: MuJoCo playback and consistency checks against ZRP (:mod:`.playback`),
-servo dynamics (:mod:`.dynamics`), offscreen rendering and video (:mod:`.gl`, :mod:`.render`,
-:mod:`.video`), the physics "real" robot (:mod:`.real_robot`), its measuring procedure
-(:mod:`.measurement`) and the blind benchmark of the gap diagnosis (:mod:`.benchmark`).
+servo dynamics (:mod:`.dynamics`), offscreen rendering (:mod:`.gl`, :mod:`.render`), comparison
+frames and videos (:mod:`.frames`, :mod:`.video`), the physics "real" robot (its hidden
+effects :mod:`.effects` and their text specs :mod:`.effect_specs`, its MuJoCo model
+:mod:`.robot_model`, the robot and its controller :mod:`.real_robot`), its measuring procedure
+(:mod:`.measurement`) and the blind benchmark of the gap diagnosis (the package
+:mod:`.benchmark`, imported by name: ``from sim.benchmark import run_benchmark``).
+
+What a video shows is the caller's choice: the paper's scenes are assembled in the core
+(:mod:`zrp.paper.scenes`) and passed to :func:`render_video` as segments.
 
 MuJoCo fixes its GL backend when it is first imported; :mod:`sim.gl` imports
 ``mujoco.egl``/``mujoco.osmesa`` directly, so :class:`OffscreenRenderer` works whatever was
@@ -24,6 +30,23 @@ _EXPORTS = {
         "default_dynamic_options",
         "dynamic_playback",
     ),
+    "effect_specs": (
+        "parse_effects",
+    ),
+    "effects": (
+        "EFFECT_NAMES",
+        "HiddenEffects",
+        "default_tool_points",
+        "motor_map",
+        "true_geometry",
+    ),
+    "frames": (
+        "VideoOptions",
+        "VideoSegment",
+        "comparison_frames",
+        "nice_factor",
+        "video_frames",
+    ),
     "gl": (
         "BACKENDS",
         "GLBackendError",
@@ -38,7 +61,6 @@ _EXPORTS = {
         "MeasurementRun",
         "Procedure",
         "measure",
-        "parse_effects",
         "random_instrument",
         "trajectory_poses",
         "write_measurements",
@@ -51,29 +73,22 @@ _EXPORTS = {
         "kinematic_playback",
     ),
     "real_robot": (
-        "EFFECT_NAMES",
-        "HiddenEffects",
         "Reading",
         "RealRobot",
-        "RealRobotOptions",
         "Session",
-        "default_tool_points",
-        "motor_map",
-        "true_geometry",
     ),
     "render": (
         "OffscreenRenderer",
     ),
+    "robot_model": (
+        "RealRobotOptions",
+    ),
     "video": (
-        "PAPER_LEVELS",
-        "VideoOptions",
         "VideoResult",
         "VideoWriteError",
-        "comparison_frames",
-        "nice_factor",
         "render_comparison_video",
-        "render_paper_video",
-        "render_teaching_sweep",
+        "render_video",
+        "video_path",
     ),
 }
 _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}

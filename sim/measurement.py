@@ -24,20 +24,24 @@ blind benchmark never shows to the diagnosis.
 from __future__ import annotations
 
 import csv
-import json
 import math
-import re
+import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
+from tqdm.auto import tqdm
 
-from sim.real_robot import EFFECT_NAMES, HiddenEffects, RealRobot
+from sim.effects import HiddenEffects
+from sim.real_robot import RealRobot
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap.data import Measurements
+from zrp.kinematics.ik import track_trajectory
 from zrp.model.manipulator import Manipulator
+from zrp.output import atomic_path, check_writable, write_json
+from zrp.paper.scenario import puma_circle
 from zrp.rotations import matrix_from_rotvec
 
 __all__ = [
@@ -47,7 +51,6 @@ __all__ = [
     "MeasurementRun",
     "Procedure",
     "measure",
-    "parse_effects",
     "random_instrument",
     "trajectory_poses",
     "write_measurements",
@@ -99,86 +102,6 @@ class Instrument:
     def rotation(self) -> F64:
         """Instrument-from-base rotation, shape (3, 3)."""
         return matrix_from_rotvec(self.rotvec)
-
-
-_ANGLE = {"rad": 1.0, "mrad": 1e-3, "urad": 1e-6, "deg": math.pi / 180.0}
-_SCALE = {"": 1.0, "ppm": 1e-6}
-_COMPLIANCE = {"rad/Nm": 1.0, "mrad/Nm": 1e-3, "urad/Nm": 1e-6}
-_THERMAL = {"/K": 1.0, "1/K": 1.0, "ppm/K": 1e-6}
-_SPEC = re.compile(r"^\s*([a-z_]+)(?::(\d+))?(?::h(\d+))?\s*=\s*([-+0-9.eE,\s]+?)\s*"
-                   r"((?:[A-Za-df-z/][A-Za-z/0-9]*)?)\s*$")
-
-
-def parse_effects(specs: list[str] | tuple[str, ...], model: Manipulator,
-                  payload: float = 0.0) -> HiddenEffects:
-    """Hidden effects from command-line specs ``NAME[:JOINT][:hH]=VALUE[UNIT]``.
-
-    Units (default first): ``joint_offset``, ``backlash``, ``cyclic_error`` (amplitude of
-    sin(h q), h from ``:hH``, default 1) in rad, mrad, urad or deg; ``encoder_scale``
-    dimensionless or ppm; ``link_length:K=DX,DY,DZ`` in the model's length unit (or mm, m,
-    um...); ``axis_misalignment:K=A,B`` (tilts towards t1, t2) in rad, mrad, urad, deg;
-    ``joint_compliance`` in rad/Nm, mrad/Nm, urad/Nm; ``thermal_expansion`` (no joint) in /K
-    or ppm/K. Example: ``backlash:1=0.8mrad``, ``thermal_expansion=12ppm/K``.
-    """
-    from zrp.units import metres_per_unit
-
-    kw: dict[str, Any] = {}
-    for spec in specs:
-        m = _SPEC.match(spec)
-        if not m:
-            raise InputError(f"--effect {spec!r}: expected NAME[:JOINT]=VALUE[UNIT], e.g. "
-                             "backlash:1=0.8mrad or thermal_expansion=12ppm/K")
-        name, joint, harm, value, unit = m.groups()
-        if name not in EFFECT_NAMES:
-            raise InputError(f"--effect {spec!r}: unknown effect {name!r}; expected one of "
-                             f"{', '.join(EFFECT_NAMES)}")
-        try:
-            vals = [float(v) for v in value.replace(" ", "").split(",") if v]
-        except ValueError:
-            raise InputError(f"--effect {spec!r}: {value!r} is not a number list") from None
-        if name == "thermal_expansion":
-            if joint is not None:
-                raise InputError(f"--effect {spec!r}: thermal_expansion takes no joint")
-            table, count = _THERMAL, 1
-            unit = unit or "/K"
-        else:
-            if joint is None:
-                raise InputError(f"--effect {spec!r}: {name} needs a joint, e.g. {name}:2=...")
-            if name == "link_length":
-                table, count = None, 3
-            elif name == "axis_misalignment":
-                table, count = _ANGLE, 2
-            elif name == "encoder_scale":
-                table, count = _SCALE, 1
-            elif name == "joint_compliance":
-                table, count = _COMPLIANCE, 1
-                unit = unit or "rad/Nm"
-            else:
-                table, count = _ANGLE, 1
-            unit = unit or ("rad" if table is _ANGLE else "")
-        if harm is not None and name != "cyclic_error":
-            raise InputError(f"--effect {spec!r}: :hH (harmonic) is for cyclic_error only")
-        if len(vals) != count:
-            raise InputError(f"--effect {spec!r}: {name} takes {count} value(s), got {len(vals)}")
-        if table is None:
-            factor = (metres_per_unit(unit, f"--effect {spec!r} unit")
-                      / metres_per_unit(model.length_unit)) if unit else 1.0
-        elif unit in table:
-            factor = table[unit]
-        else:
-            raise InputError(f"--effect {spec!r}: unit {unit!r}; expected one of "
-                             f"{', '.join(u or '(none)' for u in table)}")
-        v = [x * factor for x in vals]
-        if name == "thermal_expansion":
-            kw[name] = v[0]
-            continue
-        k = int(joint)
-        entry: Any = (tuple(v) if count > 1 else
-                      (int(harm or 1), v[0], 0.0) if name == "cyclic_error" else v[0])
-        kw.setdefault(name, {})[k] = entry
-    eff = HiddenEffects(payload=payload, **kw)
-    eff.check(model)
-    return eff
 
 
 def random_instrument(model: Manipulator, rng: np.random.Generator,
@@ -255,9 +178,6 @@ def trajectory_poses(model: Manipulator, count: int, trajectory: str = "circle")
         raise InputError(f"trajectory: {trajectory!r}; expected 'circle'")
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 8:
         raise InputError(f"count: expected at least 8 poses along the trajectory, got {count!r}")
-    from zrp.kinematics.ik import track_trajectory
-    from zrp.paper.scenario import puma_circle
-
     if model.n != 6:
         raise InputError(f"trajectory 'circle' is the PUMA's; the model {model.name!r} has "
                          f"{model.n} joints")
@@ -303,8 +223,6 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
         procedure: approach, speeds, timing, temperature.
         progress: tqdm bar over the poses.
     """
-    from tqdm.auto import tqdm
-
     proc = procedure or Procedure()
     if not isinstance(robot, RealRobot):
         raise InputError(f"robot: expected a sim.real_robot.RealRobot, got "
@@ -414,19 +332,25 @@ def _nominal_static_torque(robot: RealRobot, q: F64) -> F64:
     return nominal.static_torque(q)
 
 
-def _check_out(path: Path, force: bool, what: str) -> None:
-    if path.exists() and not force:
-        raise OutputExistsError(f"{what} {str(path)!r} exists; pass --force (force=True) to "
-                                "replace it")
-    if path.is_dir():
-        raise InputError(f"{what} {str(path)!r} is a directory; expected a file path")
+#: How a refusal to replace a file names the way out. The API argument comes first; the
+#: command line (which rewrites it to ``--force`` itself) is named too, as tests pin it.
+REPLACE = "overwrite=True (--force on the command line)"
 
 
-def write_measurements(run: MeasurementRun, path: str | Path, *, deg: bool = False,
-                       force: bool = False) -> Path:
-    """Write the measurement CSV (the diagnosis's format; q in deg with ``deg``), atomically."""
-    path = Path(path)
-    _check_out(path, force, "measurement file")
+def _check_new(path: str | os.PathLike[str], overwrite: bool) -> Path:
+    """``path`` as a Path, refused if it exists (unless ``overwrite``) or cannot be a file."""
+    try:
+        (p,) = check_writable([path], overwrite)
+    except OutputExistsError as exc:
+        raise OutputExistsError(exc.paths or [path], REPLACE) from None
+    return p
+
+
+def write_measurements(run: MeasurementRun, path: str | os.PathLike[str], *, deg: bool = False,
+                       overwrite: bool = False) -> Path:
+    """Write the measurement CSV (the diagnosis's format; q in deg with ``deg``) atomically;
+    an existing file is replaced only with ``overwrite=True``."""
+    path = _check_new(path, overwrite)
     meas = run.measurements
     n = meas.n_joints
     q = np.degrees(meas.q) if deg else meas.q
@@ -434,9 +358,8 @@ def write_measurements(run: MeasurementRun, path: str | Path, *, deg: bool = Fal
             "load"]
     if run.direction is not None:
         cols += [f"dir{k}" for k in range(1, n + 1)]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".part")
-    with open(tmp, "w", newline="", encoding="utf-8") as fh:
+    with atomic_path(path, overwrite=overwrite) as tmp, \
+            open(tmp, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
         for i in range(meas.n_rows):
@@ -446,16 +369,12 @@ def write_measurements(run: MeasurementRun, path: str | Path, *, deg: bool = Fal
             if run.direction is not None:
                 row += [str(int(v)) for v in meas.direction[i]]  # type: ignore[index]
             w.writerow(row)
-    tmp.replace(path)
     return path
 
 
-def write_truth(run: MeasurementRun, path: str | Path, *, force: bool = False) -> Path:
-    """Write the truth file (JSON: hidden effects, true joint angles, noise, instrument)."""
-    path = Path(path)
-    _check_out(path, force, "truth file")
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(path.name + ".part")
-    tmp.write_text(json.dumps(run.truth, indent=1), encoding="utf-8")
-    tmp.replace(path)
-    return path
+def write_truth(run: MeasurementRun, path: str | os.PathLike[str], *,
+                overwrite: bool = False) -> Path:
+    """Write the truth file (strict JSON: hidden effects, true joint angles, noise, instrument)
+    atomically; an existing file is replaced only with ``overwrite=True``."""
+    path = _check_new(path, overwrite)
+    return write_json(path, run.truth, overwrite=overwrite, indent=1)

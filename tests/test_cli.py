@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 
-from zrp.cli.main import main
+from zrp.cli.app import main
 
 
 def test_help_lists_subcommands(capsys):

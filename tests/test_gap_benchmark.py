@@ -23,8 +23,8 @@ from sim.benchmark import (
     summary_rows,
     write_outputs,
 )
-from sim.real_robot import HiddenEffects
-from zrp.cli.main import main
+from sim.effects import HiddenEffects
+from zrp.cli.app import main
 from zrp.errors import InputError
 
 SMALL = {"poses": 40, "none_fraction": 0.0, "pair_fraction": 0.0}
@@ -58,7 +58,7 @@ def test_truth_never_reaches_the_diagnosis(puma, tmp_path, monkeypatch):
             calls[-1] = (*calls[-1], list(_OPENED))
             _OPENED = None
 
-    monkeypatch.setattr(gb, "diagnose_blind", spy)
+    monkeypatch.setattr(gb.runner, "diagnose_blind", spy)
     cfg = BenchmarkConfig(scenarios=2, seed=5, **SMALL)
     res = run_benchmark(puma, cfg, tmp_path, progress=False)
     assert len(calls) == 2 and len(res.scores) == 2
@@ -128,7 +128,7 @@ def test_scenarios_do_not_depend_on_how_many_are_drawn(puma):
 
 def _fake_truth(puma, effects, q, sigma=0.02):
     """A truth dict as the measuring procedure writes it, with exact joint values."""
-    from sim.real_robot import default_tool_points, motor_map
+    from sim.effects import default_tool_points, motor_map
 
     qm = motor_map(effects, q)
     return {"effects": effects.to_dict(), "instrument": {"noise_sigma": sigma},

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.cli.main import main
+from zrp.cli.app import main
 from zrp.gap import Injection, diagnose, load_measurements, synthesize
 from zrp.kinematics import uniform_joint_values
 

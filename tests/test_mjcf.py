@@ -254,8 +254,9 @@ def test_bad_models_and_options():
         mjcf.MJCFOptions(gravity=(0, 0, float("nan")))
     with pytest.raises(InputError, match=r"model: expected a zrp\.Manipulator"):
         mjcf.build("puma")  # type: ignore[arg-type]
-    furlong = zrp.Manipulator.from_arrays(m.axes, m.bodies, axial=m.end_effector.axial,
-                                          transverse=m.end_effector.transverse,
-                                          length_unit="furlong")
     with pytest.raises(InputError, match=r"length_unit.*furlong.*expected one of"):
+        # an unknown unit is refused where the model is made, before mjcf.build sees it
+        furlong = zrp.Manipulator.from_arrays(m.axes, m.bodies, axial=m.end_effector.axial,
+                                              transverse=m.end_effector.transverse,
+                                              length_unit="furlong")
         mjcf.build(furlong)

@@ -6,7 +6,7 @@ import mujoco
 import numpy as np
 
 import zrp
-from zrp.cli.main import main
+from zrp.cli.app import main
 
 
 def test_writes_perturbed_model_and_refuses_overwrite(tmp_path, capsys):

@@ -8,9 +8,9 @@ import warnings
 import numpy as np
 import pytest
 
-from zrp.cli.main import main
+from zrp.cli.app import main
 from zrp.errors import OutputExistsError
-from zrp.paper.example import (
+from zrp.paper import (
     PUBLISHED_ROWS,
     PUBLISHED_TABLE2,
     PUBLISHED_TABLE3,
@@ -76,7 +76,7 @@ def test_implied_joint_angles_reach_half_turns():
 
 def test_other_model_runs_without_published_values(tmp_path):
     from zrp import load_model
-    from zrp.manufacturing.study import circle_joint_path
+    from zrp.paper.scenario import circle_joint_path
 
     model = load_model("stanford")
     q0 = np.radians([10.0, 60.0, 0.0, 20.0, 40.0, 10.0])

@@ -9,23 +9,19 @@ import numpy as np
 import pytest
 
 import zrp
+from sim.effect_specs import parse_effects
+from sim.effects import HiddenEffects, motor_map, true_geometry
 from sim.measurement import (
     Instrument,
     Procedure,
     measure,
-    parse_effects,
     random_instrument,
     trajectory_poses,
     write_measurements,
     write_truth,
 )
-from sim.real_robot import (
-    HiddenEffects,
-    RealRobot,
-    RealRobotOptions,
-    motor_map,
-    true_geometry,
-)
+from sim.real_robot import RealRobot
+from sim.robot_model import RealRobotOptions
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap import load_measurements
 from zrp.kinematics import reachable_poses
@@ -215,7 +211,7 @@ def test_csv_has_what_a_user_has_and_the_truth_is_separate(puma, tmp_path):
         write_measurements(run, csv_path)
     with pytest.raises(OutputExistsError, match="--force"):
         write_truth(run, truth_path)
-    write_measurements(run, csv_path, deg=True, force=True)
+    write_measurements(run, csv_path, deg=True, overwrite=True)
     np.testing.assert_allclose(load_measurements(csv_path, puma, deg=True).q_pose, q)
 
 

@@ -9,6 +9,7 @@ from test_mjcf import perturbed_puma
 
 import mjcf
 import sim
+import sim.frames
 import sim.gl
 import zrp
 from zrp.errors import InputError, OutputExistsError
@@ -208,13 +209,11 @@ def test_lazy_import_and_configure_backend(monkeypatch):
 
 
 def test_failed_render_leaves_no_partial_file(backend, circle, tmp_path, monkeypatch):
-    import sim.video
-
     def broken(*args, **kwargs):
         yield np.zeros((240, 320, 3), np.uint8)
         raise RuntimeError("renderer exploded")
 
-    monkeypatch.setattr(sim.video, "_segment_frames", broken)
+    monkeypatch.setattr(sim.frames, "_segment_frames", broken)
     t, q = circle
     out = tmp_path / "v.mp4"
     with pytest.raises(RuntimeError, match="exploded"):
@@ -226,7 +225,7 @@ def test_failed_render_leaves_no_partial_file(backend, circle, tmp_path, monkeyp
 def test_exaggerated_model_scales_the_errors():
     nominal = zrp.load_model("puma")
     perturbed = perturbed_puma()
-    big = sim.video.exaggerated_model(nominal, perturbed, 10.0)
+    big = sim.frames.exaggerated_model(nominal, perturbed, 10.0)
     np.testing.assert_allclose(big.bodies - nominal.bodies,
                                10.0 * (perturbed.bodies - nominal.bodies), atol=1e-9)
     q = np.array([0.3, -0.5, 0.4, 0.2, 0.9, -0.3])
@@ -235,7 +234,7 @@ def test_exaggerated_model_scales_the_errors():
     p10 = zrp.forward_kinematics(big, q).position
     # first order: the tool point moves ~10 times as far (errors here are ~1e-3)
     assert np.linalg.norm(p10 - p0) == pytest.approx(10 * np.linalg.norm(p1 - p0), rel=0.05)
-    same = sim.video.exaggerated_model(nominal, perturbed, 1.0)
+    same = sim.frames.exaggerated_model(nominal, perturbed, 1.0)
     np.testing.assert_allclose(same.axes, perturbed.axes, atol=1e-15)
 
 

@@ -7,7 +7,7 @@ import json
 import pytest
 
 import sim
-from zrp.cli.main import main
+from zrp.cli.app import main
 
 
 @pytest.fixture(scope="module")

@@ -16,11 +16,11 @@ from zrp.manufacturing.study import (
     PAPER_PARAMETERS,
     PAPER_XI,
     JointPath,
-    circle_joint_path,
     fit_linearity,
     load_joint_csv,
     one_at_a_time,
 )
+from zrp.paper.scenario import circle_joint_path
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 

@@ -7,16 +7,18 @@ import pytest
 
 from zrp import load_model
 from zrp.errors import InputError
-from zrp.manufacturing.deviation import pose_deviation
-from zrp.manufacturing.sensitivity import apply_parameters, parameter_jacobian, worst_case_bound
-from zrp.manufacturing.tolerance import (
+from zrp.manufacturing import (
     Tolerances,
     allocate_tolerances,
+    apply_parameters,
     draw_parameters,
     monte_carlo,
+    parameter_jacobian,
     percentile_ci,
     tolerance_report,
+    worst_case_bound,
 )
+from zrp.manufacturing.deviation import pose_deviation
 
 
 def _path(n: int, steps: int = 120, seed: int = 0) -> np.ndarray:

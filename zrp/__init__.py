@@ -8,6 +8,7 @@ from zrp.errors import (
     OutputExistsError,
     SingularityWarning,
     TrackingWarning,
+    UnitError,
     UnreachableError,
     ZRPError,
     ZRPWarning,
@@ -24,8 +25,10 @@ from zrp.kinematics.trajectory import (
     Trajectory,
     TrajectorySample,
 )
+from zrp.manufacturing.allocation import Allocation, allocate_tolerances
 from zrp.manufacturing.deviation import Deviation, pose_deviation, trajectory_deviation
 from zrp.manufacturing.perturb import PAPER_SIGN_ZERO, Perturbation
+from zrp.manufacturing.population import MonteCarloResult, monte_carlo
 from zrp.manufacturing.sensitivity import (
     apply_parameters,
     parameter_jacobian,
@@ -33,25 +36,14 @@ from zrp.manufacturing.sensitivity import (
     parameter_space,
     pose_error,
 )
-from zrp.manufacturing.study import (
-    JointPath,
-    StudyResult,
-    circle_joint_path,
-    load_joint_csv,
-    one_at_a_time,
-)
-from zrp.manufacturing.tolerance import (
-    Allocation,
-    MonteCarloResult,
-    Tolerances,
-    allocate_tolerances,
-    monte_carlo,
-)
+from zrp.manufacturing.study import JointPath, StudyResult, load_joint_csv, one_at_a_time
+from zrp.manufacturing.tolerance import Tolerances
 from zrp.model.dh import DHRow, from_dh, from_mdh
 from zrp.model.files import builtin_models, dumps_model, load_model, loads_model, save_model
 from zrp.model.manipulator import EndEffector, Joint, Manipulator, hand_frame
-from zrp.paper.example import run_paper_example, write_paper_outputs
-from zrp.paper.scenario import puma_circle, puma_circle_ik
+from zrp.paper.example import run_paper_example
+from zrp.paper.report import write_paper_outputs
+from zrp.paper.scenario import circle_joint_path, puma_circle, puma_circle_ik
 
 __version__ = "0.1.0"
 
@@ -85,6 +77,7 @@ __all__ = [
     "TrackingWarning",
     "Trajectory",
     "TrajectorySample",
+    "UnitError",
     "UnreachableError",
     "ZRPError",
     "ZRPWarning",

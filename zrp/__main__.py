@@ -1,5 +1,5 @@
 import sys
 
-from zrp.cli.main import main
+from zrp.cli.app import main
 
 sys.exit(main())

@@ -16,6 +16,7 @@ __all__ = [
     "OutputExistsError",
     "SingularityWarning",
     "TrackingWarning",
+    "UnitError",
     "UnreachableError",
     "ZRPError",
     "ZRPWarning",
@@ -77,6 +78,10 @@ class OutputBusyError(ZRPError, RuntimeError):
         super().__init__(f"{folder}: {who} is writing into this folder; wait for it to finish "
                          "or choose another output folder (a lock left by a crashed run is "
                          "taken over automatically)")
+
+
+class UnitError(ModelError, InputError):
+    """An unknown unit (the message names the field and lists the known units)."""
 
 
 class IKError(ZRPError, RuntimeError):

@@ -6,7 +6,7 @@ Every layer converts through :func:`metres_per_unit`; an unknown unit is an erro
 
 from __future__ import annotations
 
-from zrp.errors import InputError
+from zrp.errors import UnitError
 
 __all__ = ["G_STANDARD", "LENGTH_UNITS", "canonical_length_unit", "metres_per_unit"]
 
@@ -36,11 +36,11 @@ def canonical_length_unit(unit: str, field: str = "length_unit") -> str:
         InputError: naming ``field`` and listing the known units.
     """
     if not isinstance(unit, str):
-        raise InputError(f"{field}: expected a unit name such as 'mm', got {unit!r}")
+        raise UnitError(f"{field}: expected a unit name such as 'mm', got {unit!r}")
     key = unit.strip().lower()
     key = _ALIASES.get(key, key)
     if key not in LENGTH_UNITS:
-        raise InputError(f"{field}: unknown length unit {unit!r}; expected one of "
+        raise UnitError(f"{field}: unknown length unit {unit!r}; expected one of "
                          f"{sorted(LENGTH_UNITS)}")
     return key
 

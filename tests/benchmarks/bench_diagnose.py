@@ -6,7 +6,7 @@ survey and "where" analysis. The baseline measured in the same run is the regist
 alone (the least any diagnosis must do), so the printed ratio says what the search costs on
 top of it, independent of the machine's load.
 
-Run: python benchmarks/bench_diagnose.py
+Run: python tests/benchmarks/bench_diagnose.py
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import numpy as np
 import zrp
 from zrp.gap import Injection, diagnose, synthesize
 from zrp.gap.effects import Context, registration_parameters
-from zrp.gap.fit import fit, initial_registration
+from zrp.gap.leastsq import fit, initial_registration
 from zrp.kinematics import uniform_joint_values
 
 GOAL_S = 10.0

@@ -5,7 +5,7 @@ scoring) within 10 minutes on this machine, with a progress bar. Baselines measu
 same run: the same poses "measured" kinematically (forward kinematics of the true geometry, no
 dynamics) and real time (how long the simulated sessions would take on the robot).
 
-    python3 benchmarks/bench_gap_benchmark.py [--scenarios 50] [--poses 200] [--seed 0]
+    python3 tests/benchmarks/bench_gap_benchmark.py [--scenarios 50] [--poses 200] [--seed 0]
 
 Writes the tables to renders/gap_benchmark_bench/ (generated output, replaced).
 """
@@ -33,7 +33,7 @@ TARGET_S = 600.0
 
 def kinematic_baseline(model: zrp.Manipulator, cfg: BenchmarkConfig) -> float:
     """Seconds to compute the same sessions' tool points by forward kinematics only."""
-    from sim.real_robot import default_tool_points, true_geometry
+    from sim.effects import default_tool_points, true_geometry
     from zrp.kinematics import reachable_poses
 
     tool = default_tool_points(model)
@@ -61,7 +61,7 @@ def main() -> None:
     t0 = time.perf_counter()
     res = run_benchmark(model, cfg, out / "work", progress=True, jobs=args.jobs)
     wall = time.perf_counter() - t0
-    write_outputs(res, out, force=True)
+    write_outputs(res, out, overwrite=True)
     print(render_text(res))
     # real time of the sessions: the t column of each CSV's last pose (motion, settling and
     # 5 s per tracker reading)

@@ -12,7 +12,7 @@ Measured in one run on the same model (the Table 1 PUMA built by ``mjcf.build``)
 
 Targets (issue 4): full frames >= 30 fps on the 2-core CPU; the 10 s video in <= 20 s.
 
-Run: ``python benchmarks/bench_render.py [--frames 150] [--backend egl|osmesa]``
+Run: ``python3 tests/benchmarks/bench_render.py [--frames 150] [--backend egl|osmesa]``
 """
 
 from __future__ import annotations

@@ -8,32 +8,42 @@ In-process use::
     diag = diagnose(model, meas, seed=0)
     diag.top_effect, diag.final.rms, diag.to_dict()
     write_outputs(diag, "DIR")  # diagnosis.json, report.md, residuals.csv, plots
+
+The engine (every module but :mod:`zrp.gap.report`) never imports the report; the report's
+wording of the verdict is installed into :class:`Diagnosis` here.
 """
 
+from zrp.gap.csvfile import load_measurements as load_measurements
 from zrp.gap.data import DataWarning as DataWarning
 from zrp.gap.data import Measurements as Measurements
-from zrp.gap.data import load_measurements as load_measurements
 from zrp.gap.effects import EFFECTS as EFFECTS
 from zrp.gap.effects import REGISTRATION as REGISTRATION
 from zrp.gap.effects import Context as Context
 from zrp.gap.effects import ParamSpec as ParamSpec
 from zrp.gap.effects import effect_parameters as effect_parameters
-from zrp.gap.fit import Aliased as Aliased
-from zrp.gap.fit import FitResult as FitResult
-from zrp.gap.fit import FitWarning as FitWarning
-from zrp.gap.pipeline import Candidate as Candidate
-from zrp.gap.pipeline import Diagnosis as Diagnosis
-from zrp.gap.pipeline import GapWarning as GapWarning
-from zrp.gap.pipeline import Metrics as Metrics
-from zrp.gap.pipeline import NoiseFloor as NoiseFloor
-from zrp.gap.pipeline import ParameterEstimate as ParameterEstimate
-from zrp.gap.pipeline import Step as Step
+from zrp.gap.leastsq import Aliased as Aliased
+from zrp.gap.leastsq import FitResult as FitResult
+from zrp.gap.leastsq import FitWarning as FitWarning
+from zrp.gap.metrics import Metrics as Metrics
+from zrp.gap.metrics import NoiseFloor as NoiseFloor
+from zrp.gap.noise import noise_floor as noise_floor
+from zrp.gap.options import DiagnosisOptions as DiagnosisOptions
 from zrp.gap.pipeline import diagnose as diagnose
-from zrp.gap.pipeline import noise_floor as noise_floor
-from zrp.gap.pipeline import split_poses as split_poses
 from zrp.gap.report import write_outputs as write_outputs
+from zrp.gap.report.verdict import verdict_text as _verdict_text
+from zrp.gap.results import Candidate as Candidate
+from zrp.gap.results import Diagnosis as Diagnosis
+from zrp.gap.results import GapWarning as GapWarning
+from zrp.gap.results import ParameterEstimate as ParameterEstimate
+from zrp.gap.results import Step as Step
+from zrp.gap.results import Where as Where
+from zrp.gap.results import install_verdict_renderer as _install_verdict_renderer
+from zrp.gap.split import split_poses as split_poses
 from zrp.gap.synthetic import Injection as Injection
 from zrp.gap.synthetic import synthesize as synthesize
+from zrp.gap.where import WhereAnalysis as WhereAnalysis
+
+_install_verdict_renderer(_verdict_text)
 
 __all__ = [
     "EFFECTS",
@@ -43,6 +53,7 @@ __all__ = [
     "Context",
     "DataWarning",
     "Diagnosis",
+    "DiagnosisOptions",
     "FitResult",
     "FitWarning",
     "GapWarning",
@@ -53,6 +64,8 @@ __all__ = [
     "ParamSpec",
     "ParameterEstimate",
     "Step",
+    "Where",
+    "WhereAnalysis",
     "diagnose",
     "effect_parameters",
     "load_measurements",

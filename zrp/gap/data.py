@@ -1,29 +1,16 @@
-"""Measurement data of the sim-to-real gap diagnosis: strict CSV loading and validation.
+"""Measurement data of the sim-to-real gap diagnosis: validated, immutable arrays.
 
-One row per measured point, rows in measurement order. Columns (header names, any order):
-
-* ``pose`` (required): an id; all rows of a pose share the same joint values.
-* ``point`` (optional): which target on the tool (e.g. one of several reflectors); default "p".
-* ``q1`` .. ``qn`` (required): joint values, rad (deg with ``deg=True``) for revolute joints,
-  the model's length unit for prismatic ones.
-* ``x``, ``y``, ``z`` (required): measured position in the model's length unit, in the
-  instrument's frame (or the robot's base frame with ``frame="base"``).
-* ``qw``, ``qx``, ``qy``, ``qz`` (optional, all four): measured orientation (loaded and checked;
-  the diagnosis uses positions only and says so with a warning).
-* ``t`` (s), ``temp`` (deg C), ``load`` (kg) (optional).
-* ``dir1`` .. ``dirn`` (optional, all n): the direction from which each joint approached the
-  pose (-1, 0 or +1); when absent it is taken from the measurement order (see
-  :meth:`Measurements.approach_direction`).
-
-Nothing is dropped silently: an unknown column, a missing value, a non-number or a NaN is an
-error naming the file, line and column.
+:class:`Measurements` holds one row per measured point, rows in measurement order (the CSV
+format and its strict reader are in :mod:`zrp.gap.csvfile`; :meth:`Measurements.to_csv` writes
+it). Nothing is dropped silently: a wrong shape, a NaN, a repeated (pose, point) or rows of one
+pose with different joint values are errors naming the source and line.
 """
 
 from __future__ import annotations
 
 import csv
-import math
-import warnings
+import io
+import os
 from dataclasses import dataclass
 from functools import cached_property
 from pathlib import Path
@@ -32,13 +19,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError, ZRPWarning
-from zrp.model.manipulator import Manipulator
+from zrp.output import write_text
 
 __all__ = [
     "FRAMES",
     "DataWarning",
     "Measurements",
-    "load_measurements",
 ]
 
 F64 = NDArray[np.float64]
@@ -268,180 +254,23 @@ class Measurements:
                    None if direction is None else np.asarray(direction, dtype=float),
                    None, source)
 
-    def to_csv(self, path: str | Path, *, deg: bool = False, overwrite: bool = False) -> None:
-        """Write in the CSV format :func:`load_measurements` reads (q in deg with ``deg``)."""
-        from zrp.errors import OutputExistsError
+    def to_csv(self, path: str | os.PathLike[str], *, deg: bool = False,
+               overwrite: bool = False) -> Path:
+        """Write in the CSV format :func:`~zrp.gap.load_measurements` reads (q in deg with
+        ``deg``), atomically; an existing file is replaced only with ``overwrite``.
 
-        path = Path(path)
-        if path.exists() and not overwrite:
-            raise OutputExistsError(f"{path}: exists; pass overwrite=True (--force) to replace it")
+        Raises:
+            OutputExistsError: ``path`` exists and ``overwrite`` is False.
+        """
         n = self.n_joints
         q = np.degrees(self.q) if deg else self.q
         cols = ["pose", "point", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z"]
         extra = [c for c in OPTIONAL_SCALARS if getattr(self, c) is not None]
-        with open(path, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(cols + extra)
-            for i in range(self.n_rows):
-                w.writerow([self.pose[i], self.point[i], *(repr(float(v)) for v in q[i]),
-                            *(repr(float(v)) for v in self.xyz[i]),
-                            *(repr(float(getattr(self, c)[i])) for c in extra)])
-
-
-def _number(text: str, src: str, line: int, col: str) -> float:
-    s = text.strip()
-    if s == "":
-        raise InputError(f"{src} line {line}: column {col} is empty; expected a number")
-    try:
-        v = float(s)
-    except ValueError:
-        raise InputError(f"{src} line {line}: column {col} is {s!r}; expected a number") from None
-    if not math.isfinite(v):
-        raise InputError(f"{src} line {line}: column {col} is {s!r}; expected a finite number")
-    return v
-
-
-def load_measurements(path: str | Path, model: Manipulator, *, deg: bool = False,
-                      frame: str = "instrument") -> Measurements:
-    """Read a measurement CSV (format in the module docstring) strictly.
-
-    Args:
-        path: the CSV file.
-        model: the robot model (gives n, the joint types and the length unit).
-        deg: revolute joint values (and nothing else) are in degrees.
-        frame: "instrument" (positions in an unknown instrument frame) or "base".
-
-    Raises:
-        InputError: naming the file, line and column of the first problem.
-    """
-    path = Path(path)
-    src = str(path)
-    if frame not in FRAMES:
-        raise InputError(f"frame: {frame!r} is not a frame; expected one of {FRAMES}")
-    if not path.is_file():
-        raise InputError(f"{src}: no such file")
-    n = model.n
-    qcols = [f"q{k}" for k in range(1, n + 1)]
-    dcols = [f"dir{k}" for k in range(1, n + 1)]
-    required = ["pose", *qcols, "x", "y", "z"]
-    allowed = [*required, "point", *QUAT_COLUMNS, *OPTIONAL_SCALARS, *dcols]
-    with open(path, newline="", encoding="utf-8-sig") as fh:
-        text = fh.read()
-    if not text.strip():
-        raise InputError(f"{src}: the file is empty; expected a header line with the columns "
-                         f"{', '.join(required)} (optional: point, t, temp, load, qw..qz, dir1..)")
-    reader = csv.reader(text.splitlines())
-    header: list[str] | None = None
-    rows: list[tuple[int, list[str]]] = []
-    comments: list[int] = []
-    for lineno, rec in enumerate(reader, start=1):
-        if not rec or all(not c.strip() for c in rec):
-            continue
-        if rec[0].lstrip().startswith("#"):
-            if header is not None:
-                comments.append(lineno)
-            continue
-        if header is None:
-            header = [c.strip() for c in rec]
-            continue
-        rows.append((lineno, rec))
-    assert header is not None
-    if comments:
-        shown = ", ".join(map(str, comments[:10])) + (" ..." if len(comments) > 10 else "")
-        warnings.warn(f"{src}: {len(comments)} comment line(s) starting with # skipped (lines "
-                      f"{shown})", DataWarning, stacklevel=2)
-    dup = sorted({c for c in header if header.count(c) > 1})
-    if dup:
-        raise InputError(f"{src} line 1: column(s) {', '.join(dup)} appear more than once")
-    unknown = [c for c in header if c not in allowed]
-    if unknown:
-        extra_q = [c for c in unknown if c.startswith("q") and c[1:].isdigit()]
-        hint = (f" (the model {model.name!r} has {n} joints: q1..q{n})" if extra_q else "")
-        raise InputError(f"{src} line 1: unknown column(s) {', '.join(unknown)}{hint}; valid "
-                         f"columns are {', '.join(allowed)}")
-    missing = [c for c in required if c not in header]
-    if missing:
-        raise InputError(f"{src} line 1: missing column(s) {', '.join(missing)}; required: "
-                         f"{', '.join(required)} (q in rad, or deg with --deg; x, y, z in "
-                         f"{model.length_unit})")
-    quat_given = [c for c in QUAT_COLUMNS if c in header]
-    if quat_given and len(quat_given) != 4:
-        raise InputError(f"{src} line 1: orientation needs all of qw, qx, qy, qz; got only "
-                         f"{', '.join(quat_given)}")
-    dir_given = [c for c in dcols if c in header]
-    if dir_given and len(dir_given) != n:
-        raise InputError(f"{src} line 1: approach directions need all of {', '.join(dcols)}; "
-                         f"got only {', '.join(dir_given)}")
-    if not rows:
-        raise InputError(f"{src}: no data rows after the header; expected one row per "
-                         "measured point")
-    col = {c: i for i, c in enumerate(header)}
-    r = len(rows)
-    pose = np.empty(r, dtype=object)
-    point = np.array(["p"] * r, dtype=object)
-    q = np.empty((r, n))
-    xyz = np.empty((r, 3))
-    opt = {c: np.empty(r) for c in OPTIONAL_SCALARS if c in col}
-    quat = np.empty((r, 4)) if quat_given else None
-    dirs = np.empty((r, n)) if dir_given else None
-    lines = np.empty(r, dtype=np.int64)
-    for i, (lineno, rec) in enumerate(rows):
-        if len(rec) != len(header):
-            raise InputError(f"{src} line {lineno}: {len(rec)} fields, but the header has "
-                             f"{len(header)} ({', '.join(header)})")
-        lines[i] = lineno
-        pid = rec[col["pose"]].strip()
-        if not pid:
-            raise InputError(f"{src} line {lineno}: column pose is empty; expected an id")
-        pose[i] = pid
-        if "point" in col:
-            lab = rec[col["point"]].strip()
-            if not lab:
-                raise InputError(f"{src} line {lineno}: column point is empty; expected a label")
-            point[i] = lab
-        for k, c in enumerate(qcols):
-            q[i, k] = _number(rec[col[c]], src, lineno, c)
-        for k, c in enumerate("xyz"):
-            xyz[i, k] = _number(rec[col[c]], src, lineno, c)
-        for c, arr in opt.items():
-            arr[i] = _number(rec[col[c]], src, lineno, c)
-        if quat is not None:
-            for k, c in enumerate(QUAT_COLUMNS):
-                quat[i, k] = _number(rec[col[c]], src, lineno, c)
-            nq = float(np.linalg.norm(quat[i]))
-            if abs(nq - 1.0) > 1e-3:
-                raise InputError(f"{src} line {lineno}: orientation (qw, qx, qy, qz) has norm "
-                                 f"{nq:.6g}; expected a unit quaternion")
-        if dirs is not None:
-            for k, c in enumerate(dcols):
-                v = _number(rec[col[c]], src, lineno, c)
-                if v not in (-1.0, 0.0, 1.0):
-                    raise InputError(f"{src} line {lineno}: column {c} is {v:g}; expected -1, 0 "
-                                     "or +1")
-                dirs[i, k] = v
-    rev = ~np.asarray(model.prismatic)
-    if deg:
-        q[:, rev] = np.radians(q[:, rev])
-    else:
-        big = np.abs(q[:, rev]) > 2.0 * math.pi + 1e-6
-        if big.any():
-            i, k = (int(v) for v in np.argwhere(big)[0])
-            kk = int(np.flatnonzero(rev)[k])
-            raise InputError(
-                f"{src} line {lines[i]}: column q{kk + 1} is {q[i, kk]:g}, more than 2 pi rad: "
-                "the joint values look like degrees; pass --deg (deg=True)")
-    if "temp" in opt:
-        tv = opt["temp"]
-        if np.any((tv < -60.0) | (tv > 150.0)):
-            i = int(np.argmax((tv < -60.0) | (tv > 150.0)))
-            raise InputError(f"{src} line {lines[i]}: column temp is {tv[i]:g}; expected a "
-                             "temperature in deg C (-60 to 150)")
-    if "load" in opt and np.any(opt["load"] < 0.0):
-        i = int(np.argmax(opt["load"] < 0.0))
-        raise InputError(f"{src} line {lines[i]}: column load is {opt['load'][i]:g}; expected "
-                         "a payload mass in kg >= 0")
-    if quat is not None:
-        warnings.warn(f"{src}: measured orientations (qw..qz) are loaded but the diagnosis uses "
-                      "positions only", DataWarning, stacklevel=2)
-    return Measurements(pose, point, q, xyz, frame, opt.get("t"), opt.get("temp"),
-                        opt.get("load"), quat, dirs, lines, src)
+        buf = io.StringIO()
+        w = csv.writer(buf)
+        w.writerow(cols + extra)
+        for i in range(self.n_rows):
+            w.writerow([self.pose[i], self.point[i], *(repr(float(v)) for v in q[i]),
+                        *(repr(float(v)) for v in self.xyz[i]),
+                        *(repr(float(getattr(self, c)[i])) for c in extra)])
+        return write_text(path, buf.getvalue(), overwrite=overwrite)

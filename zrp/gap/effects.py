@@ -22,6 +22,7 @@ corrected model (see :mod:`zrp.gap.problem`, which also gives the analytic Jacob
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -274,6 +275,125 @@ def _dq(ctx: Context, name: str, unit: str, effect: str, k: int, col: F64,
     return ParamSpec(name, unit, effect, "dq", k + 1, 0, basis, group or f"q{k + 1}")
 
 
+def _junits(ctx: Context) -> list[str]:
+    """Unit of each joint's value: rad, or the length unit for prismatic joints."""
+    return [ctx.model.length_unit if p else "rad" for p in ctx.model.prismatic]
+
+
+#: what an effect builder returns: the specs, and None or why the effect cannot be tried.
+Built = tuple[list[ParamSpec], str | None]
+
+
+def _joint_offset(ctx: Context) -> Built:
+    junit = _junits(ctx)
+    return [_dq(ctx, f"q{k + 1}.offset", junit[k], "joint_offset", k, np.ones(len(ctx.q)))
+            for k in range(ctx.n)], None
+
+
+def _encoder_scale(ctx: Context) -> Built:
+    return [_dq(ctx, f"q{k + 1}.scale", "1", "encoder_scale", k, ctx.q[:, k])
+            for k in range(ctx.n)], None
+
+
+def _cyclic_error(ctx: Context) -> Built:
+    q = ctx.q
+    rev = [k for k in range(ctx.n) if not ctx.model.prismatic[k]]
+    if not rev:
+        return [], "no revolute joint"
+    return [_dq(ctx, f"q{k + 1}.{fn}{h}", "rad", "cyclic_error", k,
+                np.sin(h * q[:, k]) if fn == "sin" else np.cos(h * q[:, k]))
+            for k in rev for h in ctx.harmonics for fn in ("sin", "cos")], None
+
+
+def _backlash(ctx: Context) -> Built:
+    junit = _junits(ctx)
+    basis = ctx.backlash_basis()
+    specs = [_dq(ctx, f"q{k + 1}.backlash", junit[k], "backlash", k, basis[:, k])
+             for k in range(ctx.n) if np.any(basis[:, k] > 0) and np.any(basis[:, k] < 0)]
+    if not specs:
+        return [], ("no joint approaches its poses from both directions or sees gravity "
+                    "torques of both signs")
+    return specs, None
+
+
+def _compliance_mjcf(ctx: Context) -> Built:
+    """One compliance per joint (rad per N m) on the given gravity torques, and one per joint
+    for an unknown payload at the tool (it adds c_k m g h_ee: linear in c_k m)."""
+    effect = "joint_compliance"
+    junit = _junits(ctx)
+    load = ctx.meas.per_pose("load")
+    tau = np.array(ctx.gravity_torque, dtype=float)
+    h_ee = ctx.end_effector_arms()
+    to_m = metres_per_unit(ctx.model.length_unit, "model.length_unit")
+    if load is not None:
+        tau = tau + G_STANDARD * load[:, None] * h_ee * to_m
+    specs: list[ParamSpec] = []
+    for k in range(ctx.n):
+        if np.ptp(tau[:, k]) > 0 or np.any(tau[:, k] != 0):
+            specs.append(_dq(ctx, f"q{k + 1}.compliance", f"{junit[k]}/(N m)", effect, k,
+                             tau[:, k]))
+        if np.any(h_ee[:, k] != 0.0):
+            specs.append(_dq(ctx, f"q{k + 1}.compliance_payload", f"{junit[k]}/kg", effect, k,
+                             G_STANDARD * h_ee[:, k] * to_m))
+    return specs, None
+
+
+def _compliance_lumped(ctx: Context) -> Built:
+    """One weight per joint and lumped mass point (rad per length unit), and one per joint
+    for a varying ``load`` column."""
+    effect = "joint_compliance"
+    unit = ctx.model.length_unit
+    load = ctx.meas.per_pose("load")
+    labels, h = ctx.moment_arms()
+    h = np.where(np.abs(h) > 1e-9 * ctx.model.characteristic_length, h, 0.0)
+    specs: list[ParamSpec] = []
+    for k in range(ctx.n):
+        specs += [_dq(ctx, f"q{k + 1}.w_{lab}", f"rad/{unit}", effect, k, h[:, k, jj])
+                  for jj, lab in enumerate(labels) if np.any(h[:, k, jj] != 0.0)]
+        h_ee = ctx.end_effector_arms()
+        if load is not None and np.ptp(load) > 0 and np.any(h_ee[:, k] != 0.0):
+            specs.append(_dq(ctx, f"q{k + 1}.w_load", f"rad/({unit} kg)", effect, k,
+                             load * h_ee[:, k]))
+    return specs, (None if specs else "no joint carries a gravity torque")
+
+
+def _joint_compliance(ctx: Context) -> Built:
+    return _compliance_mjcf(ctx) if ctx.gravity_torque is not None else _compliance_lumped(ctx)
+
+
+def _link_length(ctx: Context) -> Built:
+    unit = ctx.model.length_unit
+    return [ParamSpec(f"b{k + 1}.{c}", unit, "link_length", "link", k + 1, i,
+                      group=f"b{k + 1}")
+            for k in range(ctx.n + 1) for i, c in enumerate("xyz")], None
+
+
+def _axis_misalignment(ctx: Context) -> Built:
+    return [ParamSpec(f"u{k + 1}.t{t + 1}", "rad", "axis_misalignment", "tilt", k + 1, t,
+                      group=f"q{k + 1}") for k in range(ctx.n) for t in range(2)], None
+
+
+def _thermal_expansion(ctx: Context) -> Built:
+    if ctx.dtemp is None:
+        return [], "no temp column"
+    if np.ptp(ctx.dtemp) < 0.1:
+        return [], f"temp varies by only {np.ptp(ctx.dtemp):.3g} deg C"
+    return [ParamSpec("kappa", "1/degC", "thermal_expansion", "thermal", 0, 0,
+                      group="kappa")], None
+
+
+_BUILDERS: dict[str, Callable[[Context], Built]] = {
+    "joint_offset": _joint_offset,
+    "encoder_scale": _encoder_scale,
+    "link_length": _link_length,
+    "axis_misalignment": _axis_misalignment,
+    "joint_compliance": _joint_compliance,
+    "backlash": _backlash,
+    "thermal_expansion": _thermal_expansion,
+    "cyclic_error": _cyclic_error,
+}
+
+
 def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str | None]:
     """The full (possibly redundant) parameter set of one effect.
 
@@ -283,71 +403,4 @@ def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str |
     """
     if effect not in EFFECTS:
         raise InputError(f"effect: {effect!r} is not an effect; valid: {', '.join(EFFECTS)}")
-    model, n, q = ctx.model, ctx.n, ctx.q
-    unit = model.length_unit
-    junit = [unit if p else "rad" for p in model.prismatic]
-    if effect == "joint_offset":
-        return [_dq(ctx, f"q{k + 1}.offset", junit[k], effect, k, np.ones(len(q)))
-                for k in range(n)], None
-    if effect == "encoder_scale":
-        return [_dq(ctx, f"q{k + 1}.scale", "1", effect, k, q[:, k]) for k in range(n)], None
-    if effect == "cyclic_error":
-        rev = [k for k in range(n) if not model.prismatic[k]]
-        if not rev:
-            return [], "no revolute joint"
-        return [_dq(ctx, f"q{k + 1}.{fn}{h}", "rad", effect, k,
-                    np.sin(h * q[:, k]) if fn == "sin" else np.cos(h * q[:, k]))
-                for k in rev for h in ctx.harmonics for fn in ("sin", "cos")], None
-    if effect == "backlash":
-        basis = ctx.backlash_basis()
-        specs = []
-        for k in range(n):
-            b = basis[:, k]
-            if np.any(b > 0) and np.any(b < 0):
-                specs.append(_dq(ctx, f"q{k + 1}.backlash", junit[k], effect, k, b))
-        if not specs:
-            return [], ("no joint approaches its poses from both directions or sees gravity "
-                        "torques of both signs")
-        return specs, None
-    if effect == "joint_compliance":
-        specs: list[ParamSpec] = []
-        load = ctx.meas.per_pose("load")
-        if ctx.gravity_torque is not None:
-            tau = np.array(ctx.gravity_torque, dtype=float)
-            h_ee = ctx.end_effector_arms()
-            to_m = metres_per_unit(unit, "model.length_unit")
-            if load is not None:
-                tau = tau + G_STANDARD * load[:, None] * h_ee * to_m
-            for k in range(n):
-                if np.ptp(tau[:, k]) > 0 or np.any(tau[:, k] != 0):
-                    specs.append(_dq(ctx, f"q{k + 1}.compliance", f"{junit[k]}/(N m)", effect,
-                                     k, tau[:, k]))
-                # an unknown payload at the tool adds c_k m g h_ee: linear in c_k m
-                if np.any(h_ee[:, k] != 0.0):
-                    specs.append(_dq(ctx, f"q{k + 1}.compliance_payload", f"{junit[k]}/kg",
-                                     effect, k, G_STANDARD * h_ee[:, k] * to_m))
-            return specs, None
-        labels, h = ctx.moment_arms()
-        h = np.where(np.abs(h) > 1e-9 * model.characteristic_length, h, 0.0)
-        for k in range(n):
-            for jj, lab in enumerate(labels):
-                if np.any(h[:, k, jj] != 0.0):
-                    specs.append(_dq(ctx, f"q{k + 1}.w_{lab}", f"rad/{unit}", effect, k,
-                                     h[:, k, jj]))
-            h_ee = ctx.end_effector_arms()
-            if load is not None and np.ptp(load) > 0 and np.any(h_ee[:, k] != 0.0):
-                specs.append(_dq(ctx, f"q{k + 1}.w_load", f"rad/({unit} kg)", effect, k,
-                                 load * h_ee[:, k]))
-        return specs, (None if specs else "no joint carries a gravity torque")
-    if effect == "link_length":
-        return [ParamSpec(f"b{k + 1}.{c}", unit, effect, "link", k + 1, i, group=f"b{k + 1}")
-                for k in range(n + 1) for i, c in enumerate("xyz")], None
-    if effect == "axis_misalignment":
-        return [ParamSpec(f"u{k + 1}.t{t + 1}", "rad", effect, "tilt", k + 1, t,
-                          group=f"q{k + 1}") for k in range(n) for t in range(2)], None
-    # thermal_expansion
-    if ctx.dtemp is None:
-        return [], "no temp column"
-    if np.ptp(ctx.dtemp) < 0.1:
-        return [], f"temp varies by only {np.ptp(ctx.dtemp):.3g} deg C"
-    return [ParamSpec("kappa", "1/degC", effect, "thermal", 0, 0, group="kappa")], None
+    return _BUILDERS[effect](ctx)

@@ -7,7 +7,7 @@ For pose i (joint values q_i, rad) and tool point j, the corrected model predict
 where p and R_n come from the zero-reference-position forward kinematics of the corrected
 geometry (body vectors b_{k,0} + db_k, scaled by 1 + kappa dT_i; axes tilted), R_b =
 exp([phi]) R_b0 and t_b the registration. The Jacobian columns (derivations in
-docs/diagnosis.md) are exact at any theta and are checked against finite differences in the
+zrp/gap/README.md) are exact at any theta and are checked against finite differences in the
 tests:
 
 * rot: -[R_b x]_x J_l(phi) (J_l: left Jacobian of SO(3));  trans: I;  tool t_j: R_b R_n;
@@ -20,6 +20,7 @@ tests:
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -39,6 +40,23 @@ def _axis_rotations(u: F64, q: F64) -> F64:
     s = np.sin(q)[:, None, None]
     c = np.cos(q)[:, None, None]
     return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+
+
+@dataclass(frozen=True)
+class _Chain:
+    """The corrected chain per pose (S poses): joint values q (S, n); axes u, v (n, 3);
+    body scale (S,); rotations before each body R_{k-1} (S, n + 1, 3, 3); joint points p_k
+    (S, n, 3); current axes (S, n, 3); sum of the rotated bodies (S, 3); end point (S, 3)."""
+
+    q: F64
+    u: F64
+    v: F64
+    scale: F64
+    rprev: F64
+    pts: F64
+    ucur: F64
+    bsum: F64
+    pos: F64
 
 
 class Problem:
@@ -127,11 +145,8 @@ class Problem:
         return self.q + self.B @ theta[self.idx["dq"]]
 
     # ---- evaluation -----------------------------------------------------------------------
-    def evaluate(self, theta: ArrayLike, jac: bool = True) -> tuple[F64, F64 | None]:
-        """Predicted positions (R, 3) and, with ``jac``, the Jacobian (R, 3, p)."""
-        theta = np.asarray(theta, dtype=float)
-        if theta.shape != (self.size,):
-            raise InputError(f"theta: expected shape ({self.size},), got {theta.shape}")
+    def _chain(self, theta: F64) -> _Chain:
+        """The corrected kinematic chain at ``theta`` on the problem's poses."""
         model = self.ctx.model
         n = model.n
         S = self.poses.size
@@ -160,47 +175,30 @@ class Problem:
                 pos = pos + q[:, k, None] * uc
             else:
                 r = r @ _axis_rotations(u[k], q[:, k])
-        rn = rprev[:, n]
+        return _Chain(q, u, v, scale, rprev, pts, ucur, bsum, pos)
+
+    def evaluate(self, theta: ArrayLike, jac: bool = True) -> tuple[F64, F64 | None]:
+        """Predicted positions (R, 3) and, with ``jac``, the Jacobian (R, 3, p)."""
+        theta = np.asarray(theta, dtype=float)
+        if theta.shape != (self.size,):
+            raise InputError(f"theta: expected shape ({self.size},), got {theta.shape}")
+        ch = self._chain(theta)
+        rn = ch.rprev[:, self.ctx.model.n]
         t = self.tool_offsets(theta)
         rp, rpt = self.row_pose, self.row_point
-        x = pos[rp] + np.einsum("rij,rj->ri", rn[rp], t[rpt])
+        x = ch.pos[rp] + np.einsum("rij,rj->ri", rn[rp], t[rpt])
         rb, tb = self.base(theta)
         pred = x @ rb.T + tb
         if not jac:
             return pred, None
-        R = rp.size
-        J = np.zeros((R, 3, self.size))
         # columns in the base frame first, rotated by R_b below
-        if self.idx["tool"].size:
-            for i in self.idx["tool"]:
-                c = self.specs[i].comp
-                m, cc = divmod(c, 3)
-                sel = rpt == m
-                J[sel, :, i] = rn[rp[sel], :, cc]
-        if self.idx["dq"].size:
-            rel = x[:, None, :] - pts[rp]  # (R, n, 3)
-            dxdq = np.where(model.prismatic[None, :, None], ucur[rp],
-                            np.cross(ucur[rp], rel))
-            J[:, :, self.idx["dq"]] = np.einsum("rkc,rkp->rcp", dxdq, self.B[rp])
-        for i in self.idx["link"]:
-            s = self.specs[i]
-            J[:, :, i] = scale[rp, None] * rprev[rp, s.joint - 1, :, s.comp]
-        if self.idx["tilt"].size:
-            tang = self.ctx.tangents
-            for i in self.idx["tilt"]:
-                s = self.specs[i]
-                k = s.joint - 1
-                uk = u[k]
-                du = (tang[k, s.comp] - uk * (uk @ tang[k, s.comp])) / np.linalg.norm(v[k])
-                if model.prismatic[k]:
-                    J[:, :, i] = (q[:, k, None] * (rprev[:, k] @ du))[rp]
-                else:
-                    loc = (np.sin(q[:, k])[:, None] * du
-                           + (1.0 - np.cos(q[:, k]))[:, None] * np.cross(uk, du))
-                    om = np.einsum("sij,sj->si", rprev[:, k], loc)
-                    J[:, :, i] = np.cross(om[rp], x - pts[rp, k])
+        J = np.zeros((rp.size, 3, self.size))
+        self._tool_columns(J, rn)
+        self._dq_columns(J, ch, x)
+        self._link_columns(J, ch)
+        self._tilt_columns(J, ch, x)
         if self.idx["thermal"].size:
-            J[:, :, self.idx["thermal"][0]] = self.dT[rp, None] * bsum[rp]
+            J[:, :, self.idx["thermal"][0]] = self.dT[rp, None] * ch.bsum[rp]
         J = np.einsum("ij,rjp->rip", rb, J)
         if self.instrument:
             y = x @ rb.T
@@ -208,6 +206,43 @@ class Problem:
             J[:, :, self.idx["rot"]] = -skew(y) @ jl
             J[:, :, self.idx["trans"]] = np.eye(3)
         return pred, J
+
+    def _tool_columns(self, J: F64, rn: F64) -> None:
+        rp, rpt = self.row_pose, self.row_point
+        for i in self.idx["tool"]:
+            m, cc = divmod(self.specs[i].comp, 3)
+            sel = rpt == m
+            J[sel, :, i] = rn[rp[sel], :, cc]
+
+    def _dq_columns(self, J: F64, ch: _Chain, x: F64) -> None:
+        if not self.idx["dq"].size:
+            return
+        rp = self.row_pose
+        rel = x[:, None, :] - ch.pts[rp]  # (R, n, 3)
+        dxdq = np.where(self.ctx.model.prismatic[None, :, None], ch.ucur[rp],
+                        np.cross(ch.ucur[rp], rel))
+        J[:, :, self.idx["dq"]] = np.einsum("rkc,rkp->rcp", dxdq, self.B[rp])
+
+    def _link_columns(self, J: F64, ch: _Chain) -> None:
+        rp = self.row_pose
+        for i in self.idx["link"]:
+            s = self.specs[i]
+            J[:, :, i] = ch.scale[rp, None] * ch.rprev[rp, s.joint - 1, :, s.comp]
+
+    def _tilt_columns(self, J: F64, ch: _Chain, x: F64) -> None:
+        rp, q, tang = self.row_pose, ch.q, self.ctx.tangents
+        for i in self.idx["tilt"]:
+            s = self.specs[i]
+            k = s.joint - 1
+            uk = ch.u[k]
+            du = (tang[k, s.comp] - uk * (uk @ tang[k, s.comp])) / np.linalg.norm(ch.v[k])
+            if self.ctx.model.prismatic[k]:
+                J[:, :, i] = (q[:, k, None] * (ch.rprev[:, k] @ du))[rp]
+            else:
+                loc = (np.sin(q[:, k])[:, None] * du
+                       + (1.0 - np.cos(q[:, k]))[:, None] * np.cross(uk, du))
+                om = np.einsum("sij,sj->si", ch.rprev[:, k], loc)
+                J[:, :, i] = np.cross(om[rp], x - ch.pts[rp, k])
 
     def residual(self, theta: ArrayLike) -> F64:
         """Predicted minus measured, shape (3R,) (x, y, z per row)."""

@@ -82,6 +82,67 @@ def _gravity_torque(model: Manipulator, q: F64, masses: Mapping[str, float],
     return tau
 
 
+def _approach(q: F64) -> F64:
+    """Direction from which each joint approached each pose (the measurement order)."""
+    d = np.zeros_like(q)
+    for i in range(1, q.shape[0]):
+        s = np.sign(q[i] - q[i - 1])
+        d[i] = np.where(s != 0, s, d[i - 1])
+    return d
+
+
+def _actual_joint_values(model: Manipulator, q: F64, inj: Injection) -> F64:
+    """The joint values the "real" robot reaches when ``q`` is commanded."""
+    qa = q.copy()
+    for k, v in inj.joint_offset.items():
+        qa[:, k - 1] += v
+    for k, v in inj.encoder_scale.items():
+        qa[:, k - 1] += v * q[:, k - 1]
+    g_dir = np.array([0.0, 0.0, -1.0])
+    if inj.backlash:
+        d = _approach(q)
+        tau_b = _gravity_torque(model, q, inj.masses, g_dir)
+        for k, v in inj.backlash.items():
+            f = inj.backlash_friction.get(k, np.inf)
+            t = tau_b[:, k - 1]
+            qa[:, k - 1] += v * np.where(np.abs(t) > f, np.sign(t), -d[:, k - 1])
+    for k, (h, a, b) in inj.cyclic_error.items():
+        qa[:, k - 1] += a * np.sin(h * q[:, k - 1]) + b * np.cos(h * q[:, k - 1])
+    if inj.compliance or inj.backlash_gravity:
+        tau = _gravity_torque(model, q, inj.masses, g_dir)
+        for k, c in inj.compliance.items():
+            qa[:, k - 1] += c * tau[:, k - 1]
+        for k, b in inj.backlash_gravity.items():
+            qa[:, k - 1] += b * np.sign(tau[:, k - 1])
+    return qa
+
+
+def _actual_model(model: Manipulator, inj: Injection) -> tuple[F64, F64]:
+    """Axes (n, 3) and bodies (n + 1, 3) of the "real" robot (tilts and link errors)."""
+    bodies = np.array(model.bodies, dtype=float)
+    for k, db in inj.link.items():
+        bodies[k - 1] += np.asarray(db, dtype=float)
+    tilts = np.zeros((model.n, 2))
+    for k, tv in inj.tilt.items():
+        tilts[k - 1] = tv
+    return tilt_axes(model.axes, axis_tangents(model.axes), tilts), bodies
+
+
+def _tool_points(model: Manipulator, qa: F64, inj: Injection, t: F64,
+                 temp: F64 | None) -> F64:
+    """Tool points of the "real" robot in its base frame, shape (P, M, 3)."""
+    axes, bodies = _actual_model(model, inj)
+    if inj.thermal and temp is not None:
+        pts = np.empty((qa.shape[0], t.shape[0], 3))
+        for i in range(qa.shape[0]):
+            s = 1.0 + inj.thermal * (temp[i] - inj.t_ref)
+            fk = forward_kinematics(model.with_arrays(axes=axes, bodies=bodies * s), qa[i])
+            pts[i] = fk.position + t @ fk.rotation.T
+        return pts
+    fk = forward_kinematics(model.with_arrays(axes=axes, bodies=bodies), qa)
+    return fk.position[:, None, :] + np.einsum("pij,mj->pmi", fk.rotation, t)
+
+
 def synthesize(model: Manipulator, q: ArrayLike, injection: Injection, *,
                rng: np.random.Generator, noise_sigma: float = 0.02,
                tool_offsets: ArrayLike = ((50.0, 0.0, 30.0), (-40.0, 60.0, 30.0),
@@ -107,51 +168,12 @@ def synthesize(model: Manipulator, q: ArrayLike, injection: Injection, *,
     P, n = q.shape
     if n != model.n:
         raise InputError(f"q: expected {model.n} columns, got {n}")
-    inj = injection
-    qa = q.copy()
-    for k, v in inj.joint_offset.items():
-        qa[:, k - 1] += v
-    for k, v in inj.encoder_scale.items():
-        qa[:, k - 1] += v * q[:, k - 1]
-    if inj.backlash:
-        d = np.zeros_like(q)
-        for i in range(1, P):
-            s = np.sign(q[i] - q[i - 1])
-            d[i] = np.where(s != 0, s, d[i - 1])
-        tau_b = _gravity_torque(model, q, inj.masses, np.array([0.0, 0.0, -1.0]))
-        for k, v in inj.backlash.items():
-            f = inj.backlash_friction.get(k, np.inf)
-            t = tau_b[:, k - 1]
-            qa[:, k - 1] += v * np.where(np.abs(t) > f, np.sign(t), -d[:, k - 1])
-    for k, (h, a, b) in inj.cyclic_error.items():
-        qa[:, k - 1] += a * np.sin(h * q[:, k - 1]) + b * np.cos(h * q[:, k - 1])
-    if inj.compliance or inj.backlash_gravity:
-        tau = _gravity_torque(model, q, inj.masses, np.array([0.0, 0.0, -1.0]))
-        for k, c in inj.compliance.items():
-            qa[:, k - 1] += c * tau[:, k - 1]
-        for k, b in inj.backlash_gravity.items():
-            qa[:, k - 1] += b * np.sign(tau[:, k - 1])
-    bodies = np.array(model.bodies, dtype=float)
-    for k, db in inj.link.items():
-        bodies[k - 1] += np.asarray(db, dtype=float)
-    tilts = np.zeros((n, 2))
-    for k, tv in inj.tilt.items():
-        tilts[k - 1] = tv
-    axes = tilt_axes(model.axes, axis_tangents(model.axes), tilts)
+    if injection.thermal and temp is None:
+        raise InputError("thermal injection needs temp (deg C per pose)")
+    qa = _actual_joint_values(model, q, injection)
     t = np.asarray(tool_offsets, dtype=float)
-    if inj.thermal:
-        if temp is None:
-            raise InputError("thermal injection needs temp (deg C per pose)")
     temp_arr = None if temp is None else np.asarray(temp, dtype=float)
-    pts = np.empty((P, t.shape[0], 3))
-    if inj.thermal and temp_arr is not None:
-        for i in range(P):
-            s = 1.0 + inj.thermal * (temp_arr[i] - inj.t_ref)
-            fk = forward_kinematics(model.with_arrays(axes=axes, bodies=bodies * s), qa[i])
-            pts[i] = fk.position + t @ fk.rotation.T
-    else:
-        fk = forward_kinematics(model.with_arrays(axes=axes, bodies=bodies), qa)
-        pts = fk.position[:, None, :] + np.einsum("pij,mj->pmi", fk.rotation, t)
+    pts = _tool_points(model, qa, injection, t, temp_arr)
     if frame == "instrument":
         rb = matrix_from_rotvec(base_rotvec)
         pts = pts @ rb.T + np.asarray(base_translation, dtype=float)

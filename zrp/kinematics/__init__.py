@@ -1,7 +1,7 @@
 """Kinematics by the zero-reference-position method: forward kinematics and the eq (7)
 Jacobian (:mod:`.forward`, compiled in :mod:`._kernels`), trajectories (:mod:`.trajectory`),
 predictor-corrector inverse kinematics along them (:mod:`.ik`, compiled in :mod:`._ik_kernels`)
-and random joint values (:mod:`.sampling`).
+and random joint values (:mod:`.sampling`). See README.md in this folder.
 """
 
 from zrp.kinematics.forward import FKResult as FKResult

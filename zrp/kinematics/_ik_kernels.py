@@ -45,38 +45,44 @@ def _pose_error(pose, pd, erd, err):
 
 
 @njit(cache=True)
-def _dls_solve(jac, rhs, m, inv_l, cscale, w0, lam_max, out, info):
-    """qdot = S Js^T (Js Js^T + lam^2 I)^-1 rhs with the dimensionless Js = T J S.
-
-    Task rows T: m = 6 -> [omega; v / L], m = 3 -> [v / L]; ``rhs`` is already scaled.
-    Joint columns S: 1 for revolute joints (rad), L for prismatic ones (length), so that every
-    entry of Js is dimensionless. info[0] <- manipulability sqrt(det(Js Js^T)),
-    info[1] <- lam^2 used.
-    """
+def _scaled_jacobian(jac, m, inv_l, cscale, js):
+    """js <- T J S: the task rows (m = 6: [omega; v / L], m = 3: [v / L]) of the Jacobian with
+    its joint columns scaled by ``cscale``."""
     n = jac.shape[1]
     off = 6 - m
-    js = np.empty((m, n))
     for i in range(m):
         sc = 1.0 if (i + off) < 3 else inv_l
         for j in range(n):
             js[i, j] = jac[i + off, j] * sc * cscale[j]
-    a = np.zeros((m, m))
+
+
+@njit(cache=True)
+def _gram_lower(js, a):
+    """Lower triangle of a <- js js^T."""
+    m, n = js.shape
     for i in range(m):
         for j in range(i + 1):
             acc = 0.0
             for k in range(n):
                 acc += js[i, k] * js[j, k]
             a[i, j] = acc
-    # Cholesky of A (no damping) for the manipulability.
-    c = np.zeros((m, m))
+
+
+@njit(cache=True)
+def _cholesky(a, lam2, c, check):
+    """c <- lower Cholesky factor of a + lam2 I (lower triangle of ``a`` used).
+
+    With ``check``, stops at the first pivot <= 1e-300 and returns 0; otherwise returns the
+    product of the diagonal, sqrt(det(a + lam2 I)).
+    """
+    m = a.shape[0]
     w = 1.0
     for j in range(m):
-        d = a[j, j]
+        d = a[j, j] + lam2
         for k in range(j):
             d -= c[j, k] * c[j, k]
-        if d <= 1e-300:
-            w = 0.0
-            break
+        if check and d <= 1e-300:
+            return 0.0
         c[j, j] = math.sqrt(d)
         w *= c[j, j]
         for i in range(j + 1, m):
@@ -84,23 +90,13 @@ def _dls_solve(jac, rhs, m, inv_l, cscale, w0, lam_max, out, info):
             for k in range(j):
                 acc -= c[i, k] * c[j, k]
             c[i, j] = acc / c[j, j]
-    lam2 = 0.0
-    if w < w0:
-        r = 1.0 - w / w0
-        lam2 = lam_max * lam_max * r * r
-    if lam2 > 0.0:
-        for j in range(m):
-            d = a[j, j] + lam2
-            for k in range(j):
-                d -= c[j, k] * c[j, k]
-            c[j, j] = math.sqrt(d)
-            for i in range(j + 1, m):
-                acc = a[i, j]
-                for k in range(j):
-                    acc -= c[i, k] * c[j, k]
-                c[i, j] = acc / c[j, j]
-    # Solve C C^T y = rhs.
-    y = np.empty(m)
+    return w
+
+
+@njit(cache=True)
+def _cho_solve(c, rhs, y):
+    """Solve C C^T y = rhs for the lower-triangular C."""
+    m = c.shape[0]
     for i in range(m):
         acc = rhs[i]
         for k in range(i):
@@ -111,6 +107,33 @@ def _dls_solve(jac, rhs, m, inv_l, cscale, w0, lam_max, out, info):
         for k in range(i + 1, m):
             acc -= c[k, i] * y[k]
         y[i] = acc / c[i, i]
+
+
+@njit(cache=True)
+def _dls_solve(jac, rhs, m, inv_l, cscale, w0, lam_max, out, info):
+    """qdot = S Js^T (Js Js^T + lam^2 I)^-1 rhs with the dimensionless Js = T J S.
+
+    Task rows T: m = 6 -> [omega; v / L], m = 3 -> [v / L]; ``rhs`` is already scaled.
+    Joint columns S: 1 for revolute joints (rad), L for prismatic ones (length), so that every
+    entry of Js is dimensionless. info[0] <- manipulability sqrt(det(Js Js^T)),
+    info[1] <- lam^2 used.
+    """
+    n = jac.shape[1]
+    js = np.empty((m, n))
+    _scaled_jacobian(jac, m, inv_l, cscale, js)
+    a = np.zeros((m, m))
+    _gram_lower(js, a)
+    # Cholesky of A (no damping) for the manipulability.
+    c = np.zeros((m, m))
+    w = _cholesky(a, 0.0, c, True)
+    lam2 = 0.0
+    if w < w0:
+        r = 1.0 - w / w0
+        lam2 = lam_max * lam_max * r * r
+    if lam2 > 0.0:
+        _cholesky(a, lam2, c, False)
+    y = np.empty(m)
+    _cho_solve(c, rhs, y)
     for j in range(n):
         acc = 0.0
         for i in range(m):

@@ -12,6 +12,7 @@ error shows its order of accuracy).
 from __future__ import annotations
 
 import csv
+import io
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -24,7 +25,6 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.errors import (
     IKError,
     InputError,
-    OutputExistsError,
     SingularityWarning,
     TrackingWarning,
     UnreachableError,
@@ -33,6 +33,7 @@ from zrp.kinematics import _ik_kernels as IKK
 from zrp.kinematics.forward import _karrays, check_q, end_effector_pose
 from zrp.kinematics.trajectory import Trajectory
 from zrp.model.manipulator import Manipulator
+from zrp.output import write_text
 
 __all__ = ["CORRECTIONS", "TASKS", "IKResult", "track_trajectory"]
 
@@ -111,26 +112,30 @@ class IKResult:
             "notes": list(self.notes),
         }
 
-    def save_csv(self, path: str | Path, *, overwrite: bool = False) -> Path:
-        """Write t, q, qdot and the per-step diagnostics, one row per sample."""
-        p = Path(path)
-        if p.exists() and not overwrite:
-            raise OutputExistsError(f"{p}: exists; pass overwrite=True (--force) to replace it")
-        p.parent.mkdir(parents=True, exist_ok=True)
+    def csv_text(self) -> str:
+        """t, q, qdot and the per-step diagnostics as CSV text, one row per sample."""
         names = list(self.joint_names)
         header = (["t_s", *names, *[f"{nm}_dot" for nm in names], "position_error",
                    "orientation_error_rad", "drift_position", "drift_orientation_rad",
                    "correction", "manipulability", "damping"])
-        with p.open("w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            cols = np.column_stack([self.t, self.q, self.qdot, self.position_error,
-                                    self.orientation_error, self.drift_position,
-                                    self.drift_orientation, self.correction,
-                                    self.manipulability, self.damping])
-            for row in cols:
-                w.writerow([repr(float(x)) for x in row])
-        return p
+        buf = io.StringIO(newline="")
+        w = csv.writer(buf)
+        w.writerow(header)
+        cols = np.column_stack([self.t, self.q, self.qdot, self.position_error,
+                                self.orientation_error, self.drift_position,
+                                self.drift_orientation, self.correction,
+                                self.manipulability, self.damping])
+        for row in cols:
+            w.writerow([repr(float(x)) for x in row])
+        return buf.getvalue()
+
+    def save_csv(self, path: str | Path, *, overwrite: bool = False) -> Path:
+        """Write :meth:`csv_text` to ``path`` (atomically, through :mod:`zrp.output`).
+
+        Raises:
+            OutputExistsError: ``path`` exists and ``overwrite`` is False.
+        """
+        return write_text(path, self.csv_text(), overwrite=overwrite)
 
 
 def _reachability(model: Manipulator, t: F64, p: F64) -> None:
@@ -146,6 +151,88 @@ def _reachability(model: Manipulator, t: F64, p: F64) -> None:
             f"the trajectory leaves the workspace at t = {t[i]:.6g} s: point "
             f"{np.round(p[i], 6).tolist()} is {dist[i]:.6g} {model.length_unit} from joint 1, "
             f"beyond the arm's reach of {reach:.6g} {model.length_unit}")
+
+
+def _check_options(model: Manipulator, trajectory: Trajectory, q0: ArrayLike, steps: int,
+                   task: str | None, correction: str, gain: float | None
+                   ) -> tuple[F64, int, str, float]:
+    """Validated (q0, steps, task, gain); warns (at the caller's caller) about risky options."""
+    if not isinstance(trajectory, Trajectory):
+        raise InputError(f"trajectory: expected a zrp Trajectory (Circle, Line, "
+                         f"FunctionTrajectory), got {type(trajectory).__name__}")
+    q0 = np.array(check_q(model, q0, "q0"), dtype=float)
+    if q0.shape != (model.n,):
+        raise InputError(f"q0: expected shape ({model.n},), got {q0.shape}")
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 4:
+        raise InputError(f"steps: expected an integer >= 4, got {steps!r}")
+    if task is None:
+        task = "pose" if model.n >= 6 else "position"
+    if task not in TASKS:
+        raise InputError(f"task: {task!r} is unknown; expected one of {TASKS}")
+    if correction not in CORRECTIONS:
+        raise InputError(f"correction: {correction!r} is unknown; expected one of {CORRECTIONS}")
+    if gain is None:
+        gain = 50.0 if correction == "feedback" else 0.0
+    if not np.isfinite(gain) or gain < 0:
+        raise InputError(f"gain: expected a finite number >= 0 (1/s), got {gain!r}")
+    if correction == "feedback" and gain * trajectory.duration / steps > 0.3:
+        warnings.warn(f"gain * h = {gain * trajectory.duration / steps:.3g} exceeds 0.3: the "
+                      f"feedback is outside the predictor-corrector's stability region; use "
+                      f"more steps or a smaller gain", TrackingWarning, stacklevel=3)
+    if task == "pose" and model.n < 6:
+        warnings.warn(f"task='pose' with {model.n} joints: the orientation cannot be tracked "
+                      "independently; damped least squares will share the error",
+                      TrackingWarning, stacklevel=3)
+    return q0, int(steps), task, float(gain)
+
+
+def _desired_orientation(model: Manipulator, q0: F64, sample: Any, mid: Any,
+                         n_steps: int) -> tuple[F64, F64, F64, F64]:
+    """(er, omega) at the samples and at the three RK4 midpoints; without an orientation law
+    the hand keeps its orientation at ``q0``."""
+    if sample.er is not None:
+        return sample.er, sample.omega, mid.er, mid.omega
+    _, er0 = end_effector_pose(model, q0)
+    return (np.tile(er0, (n_steps + 1, 1)), np.zeros((n_steps + 1, 3)), np.tile(er0, (3, 1)),
+            np.zeros((3, 3)))
+
+
+def _check_reached(model: Manipulator, t: F64, sample: Any, out: dict[str, F64],
+                   correction: str) -> None:
+    bad = out["err_p"] > 1e-3 * model.characteristic_length
+    if bad.any() and correction != "none":
+        i = int(np.argmax(bad))
+        raise UnreachableError(
+            f"cannot reach the desired pose at t = {t[i]:.6g} s: point "
+            f"{np.round(sample.position[i], 6).tolist()} stays {out['err_p'][i]:.4g} "
+            f"{model.length_unit} away (manipulability {out['manip'][i]:.3g}); the target is "
+            f"outside the workspace or at a singularity")
+
+
+def _notes(model: Manipulator, t: F64, sample: Any, out: dict[str, F64], use_newton: bool,
+           position_tol: float, orientation_tol_rad: float) -> list[tuple[str, type[Warning]]]:
+    """Diagnostics worth a warning: damped samples, and samples where Newton missed its
+    tolerance."""
+    notes: list[tuple[str, type[Warning]]] = []
+    length = model.characteristic_length
+    damped = np.flatnonzero(out["lam"] > 0)
+    if damped.size:
+        i = int(damped[np.argmin(out["manip"][damped])])
+        notes.append((f"near a singularity on {damped.size} of {t.size} samples (t = "
+                      f"{t[damped[0]]:.4g}..{t[damped[-1]]:.4g} s); lowest manipulability "
+                      f"{out['manip'][i]:.3g} at t = {t[i]:.4g} s, point "
+                      f"{np.round(sample.position[i], 4).tolist()}; damped least squares "
+                      "active", SingularityWarning))
+    if use_newton:
+        loose = (out["err_p"] > max(position_tol, 1e-12 * length) * 100) | (
+            out["err_o"] > max(orientation_tol_rad, 1e-14) * 100)
+        if loose.any():
+            i = int(np.argmax(out["err_p"] / length + out["err_o"]))
+            notes.append((f"tracking tolerance missed on {int(loose.sum())} samples; worst at "
+                          f"t = {t[i]:.4g} s: position error {out['err_p'][i]:.3g} "
+                          f"{model.length_unit}, orientation error {out['err_o'][i]:.3g} rad",
+                          TrackingWarning))
+    return notes
 
 
 def track_trajectory(
@@ -191,37 +278,12 @@ def track_trajectory(
             reached within 1e-3 of the characteristic length (time and point in the message).
         IKError: the integration diverged.
     """
-    if not isinstance(trajectory, Trajectory):
-        raise InputError(f"trajectory: expected a zrp Trajectory (Circle, Line, "
-                         f"FunctionTrajectory), got {type(trajectory).__name__}")
-    q0 = np.array(check_q(model, q0, "q0"), dtype=float)
-    if q0.shape != (model.n,):
-        raise InputError(f"q0: expected shape ({model.n},), got {q0.shape}")
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 4:
-        raise InputError(f"steps: expected an integer >= 4, got {steps!r}")
-    if task is None:
-        task = "pose" if model.n >= 6 else "position"
-    if task not in TASKS:
-        raise InputError(f"task: {task!r} is unknown; expected one of {TASKS}")
-    if correction not in CORRECTIONS:
-        raise InputError(f"correction: {correction!r} is unknown; expected one of {CORRECTIONS}")
-    if gain is None:
-        gain = 50.0 if correction == "feedback" else 0.0
-    if not np.isfinite(gain) or gain < 0:
-        raise InputError(f"gain: expected a finite number >= 0 (1/s), got {gain!r}")
-    if correction == "feedback" and gain * trajectory.duration / steps > 0.3:
-        warnings.warn(f"gain * h = {gain * trajectory.duration / steps:.3g} exceeds 0.3: the "
-                      f"feedback is outside the predictor-corrector's stability region; use "
-                      f"more steps or a smaller gain", TrackingWarning, stacklevel=2)
-    if task == "pose" and model.n < 6:
-        warnings.warn(f"task='pose' with {model.n} joints: the orientation cannot be tracked "
-                      "independently; damped least squares will share the error",
-                      TrackingWarning, stacklevel=2)
+    q0, n_steps, task, gain = _check_options(model, trajectory, q0, steps, task, correction,
+                                             gain)
     length = model.characteristic_length
     if position_tol is None:
         position_tol = 1e-14 * length
 
-    n_steps = int(steps)
     h = trajectory.duration / n_steps
     t = np.linspace(0.0, trajectory.duration, n_steps + 1)
     tm = t[:3] + 0.5 * h
@@ -229,14 +291,7 @@ def track_trajectory(
     mid = trajectory.evaluate(tm)
     _reachability(model, t, sample.position)
 
-    if sample.er is None:
-        _, er0 = end_effector_pose(model, q0)
-        erd = np.tile(er0, (n_steps + 1, 1))
-        wd = np.zeros((n_steps + 1, 3))
-        erm = np.tile(er0, (3, 1))
-        wm = np.zeros((3, 3))
-    else:
-        erd, wd, erm, wm = sample.er, sample.omega, mid.er, mid.omega
+    erd, wd, erm, wm = _desired_orientation(model, q0, sample, mid, n_steps)
     m = 6 if task == "pose" else 3
     out = {k: np.zeros(n_steps + 1) for k in
            ("manip", "lam", "drift_p", "drift_o", "err_p", "err_o", "corr")}
@@ -251,7 +306,7 @@ def track_trajectory(
         np.ascontiguousarray(erd), np.ascontiguousarray(wd),
         np.ascontiguousarray(mid.position), np.ascontiguousarray(mid.velocity),
         np.ascontiguousarray(erm), np.ascontiguousarray(wm), *_karrays(model), m,
-        1.0 / length, np.where(model.prismatic, length, 1.0), float(gain),
+        1.0 / length, np.where(model.prismatic, length, 1.0), gain,
         float(manipulability_threshold), float(max_damping),
         use_newton, float(position_tol), float(orientation_tol_rad), int(max_iter),
         q_out, qd_out, out["manip"], out["lam"], out["drift_p"], out["drift_o"], out["err_p"],
@@ -262,36 +317,11 @@ def track_trajectory(
                       f"{np.round(sample.position[k_fail], 6).tolist()}): joint values became "
                       f"non-finite; try more steps or a start configuration away from "
                       f"singularities")
-    notes: list[str] = []
-    bad = out["err_p"] > 1e-3 * length
-    if bad.any() and correction != "none":
-        i = int(np.argmax(bad))
-        raise UnreachableError(
-            f"cannot reach the desired pose at t = {t[i]:.6g} s: point "
-            f"{np.round(sample.position[i], 6).tolist()} stays {out['err_p'][i]:.4g} "
-            f"{model.length_unit} away (manipulability {out['manip'][i]:.3g}); the target is "
-            f"outside the workspace or at a singularity")
-    damped = np.flatnonzero(out["lam"] > 0)
-    if damped.size:
-        i = int(damped[np.argmin(out["manip"][damped])])
-        msg = (f"near a singularity on {damped.size} of {n_steps + 1} samples (t = "
-               f"{t[damped[0]]:.4g}..{t[damped[-1]]:.4g} s); lowest manipulability "
-               f"{out['manip'][i]:.3g} at t = {t[i]:.4g} s, point "
-               f"{np.round(sample.position[i], 4).tolist()}; damped least squares active")
-        notes.append(msg)
-        if warn:
-            warnings.warn(msg, SingularityWarning, stacklevel=2)
-    if use_newton:
-        loose = (out["err_p"] > max(position_tol, 1e-12 * length) * 100) | (
-            out["err_o"] > max(orientation_tol_rad, 1e-14) * 100)
-        if loose.any():
-            i = int(np.argmax(out["err_p"] / length + out["err_o"]))
-            msg = (f"tracking tolerance missed on {int(loose.sum())} samples; worst at t = "
-                   f"{t[i]:.4g} s: position error {out['err_p'][i]:.3g} {model.length_unit}, "
-                   f"orientation error {out['err_o'][i]:.3g} rad")
-            notes.append(msg)
-            if warn:
-                warnings.warn(msg, TrackingWarning, stacklevel=2)
+    _check_reached(model, t, sample, out, correction)
+    notes = _notes(model, t, sample, out, use_newton, position_tol, orientation_tol_rad)
+    if warn:
+        for msg, category in notes:
+            warnings.warn(msg, category, stacklevel=2)
     return IKResult(
         t=t, q=q_out, qdot=qd_out, desired_position=sample.position, desired_er=erd,
         position_error=out["err_p"], orientation_error=out["err_o"],
@@ -299,4 +329,4 @@ def track_trajectory(
         correction=out["corr"], iterations=iters, manipulability=out["manip"],
         damping=out["lam"], task=task, method=f"ABM4-PECE (RK4 start), correction={correction}",
         joint_names=model.joint_names, length_unit=model.length_unit, elapsed_s=elapsed,
-        notes=tuple(notes), includes_compilation=first_call)
+        notes=tuple(msg for msg, _ in notes), includes_compilation=first_call)

@@ -1,9 +1,17 @@
 """Manufacturing errors: perturbed link vectors and joint axes (eqs 8-12, :mod:`.perturb`),
-pose deviations along a trajectory (eqs 15-17, :mod:`.deviation`), the identification Jacobian
-and contributions (:mod:`.sensitivity`), one-at-a-time studies (:mod:`.study`), Monte Carlo
-tolerance analysis and allocation (:mod:`.tolerance`).
+pose deviations along a trajectory (eqs 15-17, :mod:`.deviation`), the parameter vector and its
+identification Jacobian (:mod:`.sensitivity`), one-at-a-time studies (:mod:`.study`), and the
+tolerance analysis: tolerances and random draws (:mod:`.tolerance`), the nonlinear Monte Carlo
+(:mod:`.population`), the first-order budget (:mod:`.budget`), allocation
+(:mod:`.allocation`) and its figure (:mod:`.plots`). See README.md in this folder.
 """
 
+from zrp.manufacturing.allocation import Allocation as Allocation
+from zrp.manufacturing.allocation import allocate_tolerances as allocate_tolerances
+from zrp.manufacturing.budget import Contribution as Contribution
+from zrp.manufacturing.budget import contributions as contributions
+from zrp.manufacturing.budget import tolerance_report as tolerance_report
+from zrp.manufacturing.budget import worst_case_bound as worst_case_bound
 from zrp.manufacturing.deviation import Deviation as Deviation
 from zrp.manufacturing.deviation import check_times as check_times
 from zrp.manufacturing.deviation import delta_r_eq15 as delta_r_eq15
@@ -19,37 +27,31 @@ from zrp.manufacturing.perturb import parse_parameter as parse_parameter
 from zrp.manufacturing.perturb import perturb_axis as perturb_axis
 from zrp.manufacturing.perturb import perturb_components as perturb_components
 from zrp.manufacturing.perturb import perturbation_names as perturbation_names
-from zrp.manufacturing.sensitivity import Contribution as Contribution
+from zrp.manufacturing.plots import histogram_png as histogram_png
+from zrp.manufacturing.population import MonteCarloResult as MonteCarloResult
+from zrp.manufacturing.population import first_order_max as first_order_max
+from zrp.manufacturing.population import monte_carlo as monte_carlo
 from zrp.manufacturing.sensitivity import ParameterSpace as ParameterSpace
 from zrp.manufacturing.sensitivity import apply_parameters as apply_parameters
 from zrp.manufacturing.sensitivity import axis_tangents as axis_tangents
-from zrp.manufacturing.sensitivity import contributions as contributions
 from zrp.manufacturing.sensitivity import parameter_jacobian as parameter_jacobian
 from zrp.manufacturing.sensitivity import parameter_names as parameter_names
 from zrp.manufacturing.sensitivity import parameter_space as parameter_space
 from zrp.manufacturing.sensitivity import perturbed_arrays as perturbed_arrays
 from zrp.manufacturing.sensitivity import pose_error as pose_error
 from zrp.manufacturing.sensitivity import tilt_axes as tilt_axes
-from zrp.manufacturing.sensitivity import worst_case_bound as worst_case_bound
 from zrp.manufacturing.study import PAPER_PARAMETERS as PAPER_PARAMETERS
 from zrp.manufacturing.study import PAPER_XI as PAPER_XI
 from zrp.manufacturing.study import JointPath as JointPath
 from zrp.manufacturing.study import Linearity as Linearity
 from zrp.manufacturing.study import StudyResult as StudyResult
-from zrp.manufacturing.study import circle_joint_path as circle_joint_path
 from zrp.manufacturing.study import fit_linearity as fit_linearity
 from zrp.manufacturing.study import load_joint_csv as load_joint_csv
 from zrp.manufacturing.study import one_at_a_time as one_at_a_time
 from zrp.manufacturing.tolerance import DISTRIBUTIONS as DISTRIBUTIONS
-from zrp.manufacturing.tolerance import Allocation as Allocation
-from zrp.manufacturing.tolerance import MonteCarloResult as MonteCarloResult
 from zrp.manufacturing.tolerance import Tolerances as Tolerances
-from zrp.manufacturing.tolerance import allocate_tolerances as allocate_tolerances
 from zrp.manufacturing.tolerance import draw_parameters as draw_parameters
-from zrp.manufacturing.tolerance import first_order_max as first_order_max
-from zrp.manufacturing.tolerance import monte_carlo as monte_carlo
 from zrp.manufacturing.tolerance import percentile_ci as percentile_ci
-from zrp.manufacturing.tolerance import tolerance_report as tolerance_report
 
 __all__ = [
     "DISTRIBUTIONS",
@@ -72,13 +74,13 @@ __all__ = [
     "axis_tangents",
     "check_times",
     "check_xi_percent",
-    "circle_joint_path",
     "contributions",
     "delta_r_eq15",
     "delta_r_literal",
     "draw_parameters",
     "first_order_max",
     "fit_linearity",
+    "histogram_png",
     "load_joint_csv",
     "monte_carlo",
     "one_at_a_time",

@@ -5,14 +5,15 @@ by each xi (percent) while the others stay at zero; the nominal inverse-kinemati
 are replayed on the perturbed arm and delta_p (eq 17), delta_R (eq 15) and the plain error
 angle are recorded at every sample.
 
-Joint trajectories (:class:`JointPath`) come from the nominal inverse kinematics of a circle
-(:func:`circle_joint_path`, the paper's 125 mm circle by default), from an
-:class:`~zrp.kinematics.ik.IKResult`, or from a CSV file written by ``zrp ik``.
+Joint trajectories (:class:`JointPath`) come from a nominal inverse-kinematics result
+(:meth:`JointPath.from_ik`, e.g. of a circle: :func:`zrp.paper.scenario.circle_joint_path`) or
+from a CSV file written by ``zrp ik`` (:func:`load_joint_csv`).
 """
 
 from __future__ import annotations
 
 import csv
+import io
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -22,10 +23,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from zrp.errors import InputError, ModelFileError, OutputExistsError, ZRPWarning
+from zrp.errors import InputError, ModelFileError, ZRPWarning
 from zrp.kinematics import _kernels as K
-from zrp.kinematics.forward import check_q, end_effector_pose, forward_kinematics
-from zrp.kinematics.ik import IKResult, track_trajectory
+from zrp.kinematics.forward import check_q, end_effector_pose
+from zrp.kinematics.ik import IKResult
 from zrp.manufacturing.perturb import (
     PAPER_SIGN_ZERO,
     Perturbation,
@@ -33,6 +34,7 @@ from zrp.manufacturing.perturb import (
     parse_parameter,
 )
 from zrp.model.manipulator import Manipulator
+from zrp.output import write_text
 from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply
 
 __all__ = [
@@ -41,7 +43,6 @@ __all__ = [
     "JointPath",
     "Linearity",
     "StudyResult",
-    "circle_joint_path",
     "fit_linearity",
     "load_joint_csv",
     "one_at_a_time",
@@ -93,45 +94,6 @@ class JointPath:
         """From a nominal inverse-kinematics result (keeps its tracking errors)."""
         return cls(ik.t, ik.q, label or ik.method, float(ik.position_error.max()),
                    float(ik.orientation_error.max()))
-
-
-def circle_joint_path(model: Manipulator, *, q0: ArrayLike | None = None,
-                      radius: float = 125.0, duration: float = 4.0, steps: int = 360,
-                      normal: ArrayLike | None = None, toward: ArrayLike | None = None,
-                      time_law: str = "quintic") -> JointPath:
-    """Nominal inverse kinematics of a circle through the end-effector point at ``q0``.
-
-    Defaults reproduce :func:`zrp.paper.scenario.puma_circle` for the PUMA: q0 = (0, 0, 0, 0, 90, 0)
-    deg, the circle's plane normal is the tool's axial direction u_a at q0, the centre lies
-    ``radius`` above the start (base +z projected into the plane; base +x if z is normal to it).
-
-    Args:
-        q0: start configuration, shape (n,) (rad / length unit); default the PUMA's for 6-joint
-            arms, required otherwise.
-        radius: length unit. duration: s. steps: integration steps (T = steps + 1 samples).
-    """
-    from zrp.kinematics.trajectory import Circle
-    from zrp.paper.scenario import PUMA_Q0_DEG
-
-    if q0 is None:
-        if model.n != 6:
-            raise InputError(f"q0: required for {model.name!r} ({model.n} joints); the default "
-                             f"start configuration is the 6-joint PUMA's")
-        q0 = np.radians(PUMA_Q0_DEG)
-    q0 = np.asarray(check_q(model, q0, "q0"), dtype=float)
-    if q0.shape != (model.n,):
-        raise InputError(f"q0: expected shape ({model.n},), got {q0.shape}")
-    fk = forward_kinematics(model, q0)
-    nrm = fk.axial if normal is None else np.asarray(normal, dtype=float)
-    if toward is None:
-        nn = nrm / max(float(np.linalg.norm(nrm)), 1e-300)
-        z = np.array([0.0, 0.0, 1.0])
-        toward = z if np.linalg.norm(z - (z @ nn) * nn) > 1e-6 else np.array([1.0, 0.0, 0.0])
-    circle = Circle.from_start(fk.position, radius, nrm, toward, duration=duration,
-                               time_law=time_law)
-    ik = track_trajectory(model, circle, q0, steps)
-    return JointPath.from_ik(ik, f"{radius:g} {model.length_unit} circle, {steps} steps, "
-                                 f"{duration:g} s, {ik.method}")
 
 
 def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
@@ -301,31 +263,41 @@ class StudyResult:
             rows.append([float(self.xi_percent[j]), *[float(data[c, j]) for c in cols]])
         return ["xi_percent", *params], rows
 
+    def table_text(self, fmt: str = "csv", quantity: str = "delta_p",
+                   parameters: Sequence[str] | None = None,
+                   xi_rows: Sequence[float] | None = None, *, caption: str = "") -> str:
+        """:meth:`table` as CSV (``fmt="csv"``) or Markdown (``fmt="md"``, with ``caption``)."""
+        if fmt not in ("csv", "md"):
+            raise InputError(f"fmt: expected 'csv' or 'md', got {fmt!r}")
+        header, rows = self.table(quantity, parameters, xi_rows)
+        if fmt == "csv":
+            buf = io.StringIO(newline="")
+            w = csv.writer(buf)
+            w.writerow(header)
+            for r in rows:
+                w.writerow([f"{r[0]:g}", *[f"{v:.6e}" for v in r[1:]]])
+            return buf.getvalue()
+        lines = [caption, ""] if caption else []
+        lines.append("| xi (%) | " + " | ".join(header[1:]) + " |")
+        lines.append("|---:|" + "---:|" * (len(header) - 1))
+        for r in rows:
+            lines.append(f"| {r[0]:g} | " + " | ".join(f"{v:.2E}" for v in r[1:]) + " |")
+        lines += ["", f"Sign convention: {self.convention}.", ""]
+        return "\n".join(lines)
+
     def write_table(self, path: str | Path, quantity: str = "delta_p",
                     parameters: Sequence[str] | None = None,
                     xi_rows: Sequence[float] | None = None, *, overwrite: bool = False,
                     caption: str = "") -> Path:
-        """Write :meth:`table` as CSV (``.csv``) or Markdown (``.md``)."""
-        p = Path(path)
-        if p.exists() and not overwrite:
-            raise OutputExistsError(f"{p}: exists; pass overwrite=True (--force) to replace it")
-        p.parent.mkdir(parents=True, exist_ok=True)
-        header, rows = self.table(quantity, parameters, xi_rows)
-        if p.suffix == ".csv":
-            with p.open("w", newline="") as fh:
-                w = csv.writer(fh)
-                w.writerow(header)
-                for r in rows:
-                    w.writerow([f"{r[0]:g}", *[f"{v:.6e}" for v in r[1:]]])
-        else:
-            lines = [caption, ""] if caption else []
-            lines.append("| xi (%) | " + " | ".join(header[1:]) + " |")
-            lines.append("|---:|" + "---:|" * (len(header) - 1))
-            for r in rows:
-                lines.append(f"| {r[0]:g} | " + " | ".join(f"{v:.2E}" for v in r[1:]) + " |")
-            lines += ["", f"Sign convention: {self.convention}.", ""]
-            p.write_text("\n".join(lines), encoding="utf-8")
-        return p
+        """Write :meth:`table` as CSV (``.csv``) or Markdown (any other suffix), atomically
+        (:mod:`zrp.output`).
+
+        Raises:
+            OutputExistsError: ``path`` exists and ``overwrite`` is False.
+        """
+        fmt = "csv" if Path(path).suffix == ".csv" else "md"
+        return write_text(path, self.table_text(fmt, quantity, parameters, xi_rows,
+                                                caption=caption), overwrite=overwrite)
 
     def summary(self) -> dict[str, Any]:
         return {

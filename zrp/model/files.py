@@ -24,8 +24,10 @@ from typing import Any
 
 import numpy as np
 
-from zrp.errors import ModelError, ModelFileError, OutputExistsError
+from zrp.errors import InputError, ModelError, ModelFileError
 from zrp.model.manipulator import EndEffector, Joint, Manipulator
+from zrp.output import write_text
+from zrp.units import canonical_length_unit
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -106,6 +108,10 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
     if not isinstance(unit, str) or not unit:
         raise fail(f"length_unit: expected a string such as \"mm\", got {unit!r}",
                    _line_of(text, r"length_unit\s*="))
+    try:
+        canonical_length_unit(unit)
+    except InputError as exc:
+        raise fail(str(exc), _line_of(text, r"length_unit\s*=")) from exc
 
     def check_table(label: str, table: dict[str, Any], allowed: set[str],
                     required: tuple[str, ...], tline: int | None) -> None:
@@ -171,12 +177,12 @@ def _toml_str(s: str) -> str:
 
 
 def save_model(model: Manipulator, path: str | Path, *, overwrite: bool = False) -> Path:
-    """Write ``model`` to ``path``; refuses to replace an existing file unless ``overwrite``."""
-    p = Path(path)
-    if p.exists() and not overwrite:
-        raise OutputExistsError(f"{p}: exists; pass overwrite=True (--force) to replace it")
-    p.write_text(dumps_model(model), encoding="utf-8")
-    return p
+    """Write ``model`` to ``path`` atomically (:mod:`zrp.output`).
+
+    Raises:
+        OutputExistsError: ``path`` exists and ``overwrite`` is False.
+    """
+    return write_text(path, dumps_model(model), overwrite=overwrite)
 
 
 def builtin_models() -> dict[str, Path]:

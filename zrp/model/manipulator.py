@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import ModelError, ZRPWarning
+from zrp.units import canonical_length_unit
 
 __all__ = [
     "JOINT_TYPES",
@@ -163,7 +164,10 @@ class Manipulator:
         joints: base to tip.
         end_effector: the tool point and its orientation vectors.
         name: free text.
-        length_unit: unit of every body vector and prismatic joint value, e.g. "mm".
+        length_unit: unit of every body vector and prismatic joint value, e.g. "mm"; one of
+            :data:`zrp.units.LENGTH_UNITS` or an alias ("millimetre", "inch"...), kept as
+            given. An unknown unit is a :class:`~zrp.errors.UnitError` (a ModelError and an
+            InputError).
     """
 
     joints: tuple[Joint, ...]
@@ -182,9 +186,9 @@ class Manipulator:
             raise ModelError(
                 f"end_effector: expected a zrp.EndEffector, got {type(self.end_effector).__name__}"
             )
-        if not isinstance(self.length_unit, str) or not self.length_unit:
-            raise ModelError(f"length_unit: expected a non-empty string such as 'mm', got "
-                             f"{self.length_unit!r}")
+        # kept as the user spelled it ("mm", "millimetre"...), only checked here; an unknown
+        # unit raises UnitError, both a ModelError and an InputError
+        canonical_length_unit(self.length_unit, "length_unit")
         # Re-index so that every joint knows its 1-based position (used in messages).
         joints = tuple(
             j if j.index == k else dataclasses.replace(j, index=k)

@@ -1,38 +1,90 @@
 """The paper's numerical example as a scenario: the Table 1 PUMA drawing a 125 mm circle
-(:mod:`.scenario`), its perturbation study, the comparison with the published Tables 2-3 and
-Figures 2-7 (:mod:`.example`).
+(:mod:`.scenario`), its perturbation study (:mod:`.example`), the published Tables 2-3 as data
+(:mod:`.published`), the comparison with them (:mod:`.comparison`), the paper's claims checked
+(:mod:`.claims`), and the outputs: tables, report and JSON (:mod:`.report`), Figures 2-7
+(:mod:`.figures`), and the scenes of its videos (:mod:`.scenes`). See README.md in this folder.
 """
 
-from zrp.paper.example import PUBLISHED_ROWS as PUBLISHED_ROWS
-from zrp.paper.example import PUBLISHED_TABLE2 as PUBLISHED_TABLE2
-from zrp.paper.example import PUBLISHED_TABLE2_ZERO as PUBLISHED_TABLE2_ZERO
-from zrp.paper.example import PUBLISHED_TABLE3 as PUBLISHED_TABLE3
-from zrp.paper.example import PUBLISHED_TABLE3_ZERO as PUBLISHED_TABLE3_ZERO
-from zrp.paper.example import Cell as Cell
+from zrp.paper.claims import check_claims as check_claims
+from zrp.paper.comparison import Cell as Cell
+from zrp.paper.comparison import compare_with_published as compare_with_published
+from zrp.paper.comparison import kind_columns as kind_columns
+from zrp.paper.comparison import table_value as table_value
 from zrp.paper.example import PaperExample as PaperExample
-from zrp.paper.example import compare_with_published as compare_with_published
-from zrp.paper.example import implied_joint_angles as implied_joint_angles
+from zrp.paper.example import default_parameters as default_parameters
 from zrp.paper.example import run_paper_example as run_paper_example
-from zrp.paper.example import write_paper_outputs as write_paper_outputs
+from zrp.paper.published import CELL_STATUSES as CELL_STATUSES
+from zrp.paper.published import JE_PARAMS as JE_PARAMS
+from zrp.paper.published import LE_PARAMS as LE_PARAMS
+from zrp.paper.published import LIKELY_TYPOS as LIKELY_TYPOS
+from zrp.paper.published import PUBLISHED_ROWS as PUBLISHED_ROWS
+from zrp.paper.published import PUBLISHED_TABLE2 as PUBLISHED_TABLE2
+from zrp.paper.published import PUBLISHED_TABLE2_ZERO as PUBLISHED_TABLE2_ZERO
+from zrp.paper.published import PUBLISHED_TABLE3 as PUBLISHED_TABLE3
+from zrp.paper.published import PUBLISHED_TABLE3_ZERO as PUBLISHED_TABLE3_ZERO
+from zrp.paper.published import half_ulp as half_ulp
+from zrp.paper.published import implied_joint_angles as implied_joint_angles
+from zrp.paper.report import comparison_csv as comparison_csv
+from zrp.paper.report import comparison_markdown as comparison_markdown
+from zrp.paper.report import output_names as output_names
+from zrp.paper.report import paper_summary as paper_summary
+from zrp.paper.report import write_paper_outputs as write_paper_outputs
+from zrp.paper.scenario import PUMA_DURATION_S as PUMA_DURATION_S
 from zrp.paper.scenario import PUMA_Q0_DEG as PUMA_Q0_DEG
+from zrp.paper.scenario import PUMA_RADIUS_MM as PUMA_RADIUS_MM
 from zrp.paper.scenario import CircleSetup as CircleSetup
+from zrp.paper.scenario import circle_joint_path as circle_joint_path
+from zrp.paper.scenario import is_paper_model as is_paper_model
+from zrp.paper.scenario import paper_start as paper_start
 from zrp.paper.scenario import puma_circle as puma_circle
 from zrp.paper.scenario import puma_circle_ik as puma_circle_ik
+from zrp.paper.scenes import PAPER_LEVELS as PAPER_LEVELS
+from zrp.paper.scenes import Scene as Scene
+from zrp.paper.scenes import SceneSegment as SceneSegment
+from zrp.paper.scenes import paper_video_file_name as paper_video_file_name
+from zrp.paper.scenes import paper_video_scene as paper_video_scene
+from zrp.paper.scenes import perturbed_puma as perturbed_puma
+from zrp.paper.scenes import teaching_sweep_scene as teaching_sweep_scene
 
 __all__ = [
+    "CELL_STATUSES",
+    "JE_PARAMS",
+    "LE_PARAMS",
+    "LIKELY_TYPOS",
+    "PAPER_LEVELS",
     "PUBLISHED_ROWS",
     "PUBLISHED_TABLE2",
     "PUBLISHED_TABLE2_ZERO",
     "PUBLISHED_TABLE3",
     "PUBLISHED_TABLE3_ZERO",
+    "PUMA_DURATION_S",
     "PUMA_Q0_DEG",
+    "PUMA_RADIUS_MM",
     "Cell",
     "CircleSetup",
     "PaperExample",
+    "Scene",
+    "SceneSegment",
+    "check_claims",
+    "circle_joint_path",
     "compare_with_published",
+    "comparison_csv",
+    "comparison_markdown",
+    "default_parameters",
+    "half_ulp",
     "implied_joint_angles",
+    "is_paper_model",
+    "kind_columns",
+    "output_names",
+    "paper_start",
+    "paper_summary",
+    "paper_video_file_name",
+    "paper_video_scene",
+    "perturbed_puma",
     "puma_circle",
     "puma_circle_ik",
     "run_paper_example",
+    "table_value",
+    "teaching_sweep_scene",
     "write_paper_outputs",
 ]

@@ -1,1 +1,1 @@
-"""Subcommands of ``zrp``: each module defines ``register(subparsers)`` (see zrp.cli.main)."""
+"""Subcommands of ``zrp``: each module defines ``register(subparsers)`` (see zrp.cli.app)."""

@@ -3,23 +3,27 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
 import sys
 from pathlib import Path
 
-from zrp.cli.main import emit
+from zrp.cli.app import emit
 from zrp.errors import InputError
+from zrp.gap import diagnose as run_diagnosis
+from zrp.gap import load_measurements
+from zrp.gap.effects import EFFECTS
+from zrp.gap.report import OUTPUT_FILES, write_outputs
 from zrp.model.files import load_model
+from zrp.output import OutputDir
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from zrp.gap.effects import EFFECTS
-
     p = sub.add_parser(
         "diagnose", help="sim-to-real gap diagnosis from measured tool positions",
         description="Register the measurements (base frame, tool offsets), then find which "
         "unmodelled effects explain the remaining gap and how far it shrinks on withheld poses. "
         "Writes DIR/diagnosis.json, DIR/report.md, DIR/residuals.csv and PNG plots "
-        "(docs/diagnosis.md).")
+        "(zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml",
                    help="model TOML file or built-in name")
     p.add_argument("--mjcf", metavar="M.xml",
@@ -47,30 +51,45 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="show a progress bar (default: when stderr is a terminal)")
     p.add_argument("--json", action="store_true", help="print diagnosis.json to stdout")
-    p.set_defaults(func=_run)
+    p.set_defaults(func=_run, api_names={
+        "withheld_fraction": "--withheld",
+        "noise_sigma": "--noise",
+        "folds": "--folds",
+        "alpha": "--alpha",
+        "max_steps": "--max-steps",
+        "seed": "--seed",
+        "effects": "--effects",
+        "gravity_torque": "--mjcf",
+    })
 
 
 def _run(args: argparse.Namespace) -> int:
+    # mjcf loads MuJoCo (+0.25 s measured): only when this command runs, not for every `zrp`.
     from mjcf.gravity import gravity_torques
-    from zrp.gap import diagnose, load_measurements
-    from zrp.gap.report import OUTPUT_FILES, jsonable, write_outputs
 
-    out = Path(args.out)
-    if not args.force:
-        existing = [f for f in OUTPUT_FILES if (out / f).exists()]
-        if existing:
-            raise InputError(f"--out {out}: {', '.join(existing)} already exist(s); pass "
-                             "--force to overwrite")
     if args.max_steps < 1:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")
+    # reading the inputs creates nothing: a bad input leaves no output folder behind
     model = load_model(args.model)
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)
     tau = None if args.mjcf is None else gravity_torques(args.mjcf, meas.q_pose, field="--mjcf")
-    diag = diagnose(model, meas, gravity_torque=tau, effects=args.effects, seed=args.seed,
-                    withheld_fraction=args.withheld, folds=args.folds, alpha=args.alpha,
-                    max_steps=args.max_steps, noise_sigma=args.noise,
-                    progress=sys.stderr.isatty() if args.progress is None else args.progress)
-    files = write_outputs(diag, out, force=args.force, plots=not args.no_plots)
+    out_dir = Path(args.out)
+    created = not out_dir.exists()
+    try:
+        # the folder is this run's from here on: existing outputs are refused before the
+        # computation, and a concurrent run into the same folder is refused, never mixed in
+        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES) as out:
+            diag = run_diagnosis(model, meas, gravity_torque=tau, effects=args.effects,
+                            seed=args.seed, withheld_fraction=args.withheld, folds=args.folds,
+                            alpha=args.alpha, max_steps=args.max_steps, noise_sigma=args.noise,
+                            progress=sys.stderr.isatty() if args.progress is None
+                            else args.progress)
+            files = write_outputs(diag, out, plots=not args.no_plots)
+    except BaseException:
+        if created:  # a failed run leaves no empty folder it made
+            with contextlib.suppress(OSError):
+                out_dir.rmdir()
+        raise
     text = diag.verdict + "\n" + "\n".join(f"wrote {f}" for f in files)
-    emit(args, jsonable(diag.to_dict()), text)
+    emit(args, diag.to_dict(), text)
     return 0

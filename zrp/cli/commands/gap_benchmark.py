@@ -3,10 +3,12 @@
 from __future__ import annotations
 
 import argparse
+from pathlib import Path
 
-from zrp.cli.main import emit
+from zrp.cli.app import emit
 from zrp.errors import InputError
 from zrp.model.files import builtin_models, load_model
+from zrp.output import OutputDir
 
 DEFAULT_OUT = "renders/gap_benchmark"
 
@@ -20,7 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "magnitude in the MuJoCo 'real' robot; measure it, run the diagnosis on the "
         "measurement CSV alone, then score it against the truth: effect named first, joints "
         "located, withheld RMS after correction vs the noise, shrink. Prints and writes a "
-        "confusion matrix and a summary table (docs/blind-benchmark.md).")
+        "confusion matrix and a summary table (sim/README.md).")
     p.add_argument("--scenarios", type=int, default=50, metavar="K",
                    help="number of scenarios (default 50)")
     p.add_argument("--seed", type=int, default=0, metavar="S", help="master seed (default 0)")
@@ -45,14 +47,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-mjcf", action="store_true",
                    help="do not give the diagnosis the nominal MJCF (lumped-mass compliance)")
     p.add_argument("--out", default=None, metavar="DIR",
-                   help=f"output directory (default {DEFAULT_OUT}, replaced freely: generated "
-                        "output; elsewhere existing files need --force)")
+                   help=f"output directory (default {DEFAULT_OUT}, generated output that is "
+                        "replaced; elsewhere existing files need --force). One run at a time "
+                        "per folder: a second run into it is refused")
     p.add_argument("--workdir", default=None, metavar="DIR",
                    help="where the measurement CSVs, truth files and diagnoses go (default "
                         "OUT/work)")
     p.add_argument("--jobs", type=int, default=1, metavar="N",
                    help="worker processes (default 1; results are the same for any N)")
-    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    p.add_argument("--force", action="store_true",
+                   help="replace existing output files in --out (checked before the run)")
     p.add_argument("--no-plots", action="store_true", help="skip confusion.png")
     p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     p.add_argument("--json", action="store_true", help="print results.json to stdout")
@@ -60,34 +64,32 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from pathlib import Path
-
+    # sim loads MuJoCo and the diagnosis (+0.2 s measured): only when this command runs.
     from sim.benchmark import (
-        OUTPUT_FILES,
         BenchmarkConfig,
+        output_names,
         render_text,
         run_benchmark,
         write_outputs,
     )
 
     out = Path(args.out or DEFAULT_OUT)
-    force = args.force or args.out is None
-    if not force:
-        existing = [f for f in OUTPUT_FILES if (out / f).exists()]
-        if existing:
-            raise InputError(f"--out {out}: {', '.join(existing)} already exist(s); pass "
-                             "--force to overwrite")
+    overwrite = args.force or args.out is None
+    work = Path(args.workdir) if args.workdir else out / "work"
+    if work.resolve() == out.resolve():
+        raise InputError("--workdir: must differ from --out (it is locked for the run)")
+    if args.jobs < 1:
+        raise InputError(f"--jobs: expected at least 1 worker, got {args.jobs}")
     cfg = BenchmarkConfig(scenarios=args.scenarios, seed=args.seed, poses=args.poses,
                           none_fraction=args.none, pair_fraction=args.pairs,
                           effects=tuple(args.effects), noise=tuple(args.noise),
                           poses_from=args.poses_from, approach=args.approach,
                           use_mjcf=not args.no_mjcf)
     model = load_model(args.model)
-    work = Path(args.workdir) if args.workdir else out / "work"
-    if args.jobs < 1:
-        raise InputError(f"--jobs: expected at least 1 worker, got {args.jobs}")
-    result = run_benchmark(model, cfg, work, progress=not args.no_progress, jobs=args.jobs)
-    files = write_outputs(result, out, force=True, plots=not args.no_plots)
+    # the folder is locked and its files checked before the (long) run
+    with OutputDir(out, overwrite=overwrite, names=output_names(not args.no_plots)) as folder:
+        result = run_benchmark(model, cfg, work, progress=not args.no_progress, jobs=args.jobs)
+        files = write_outputs(result, folder, plots=not args.no_plots)
     text = render_text(result) + "\n" + "\n".join(f"wrote {f}" for f in files)
     emit(args, result.to_dict(), text)
     return 0

@@ -8,14 +8,15 @@ from pathlib import Path
 
 import numpy as np
 
-from zrp.cli.main import emit
+from zrp.cli.app import emit
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.ik import CORRECTIONS, track_trajectory
 from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
 from zrp.model.files import builtin_models, load_model
 from zrp.model.manipulator import Manipulator
-from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM
+from zrp.output import check_writable
+from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM, is_paper_model
 from zrp.rotations.rodrigues import er_angle
 
 
@@ -54,7 +55,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "125 mm circle on the Table 1 PUMA (see README).")
     _add_model(p)
     p.add_argument("--q0", nargs="+", type=float, metavar="Q",
-                   help=f"start configuration (default for the PUMA: {list(PUMA_Q0_DEG)} deg)")
+                   help="start configuration (default "
+                        f"{' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg for the paper's PUMA, "
+                        "the built-in puma; required for every other model)")
     p.add_argument("--trajectory", choices=("circle", "line"), default="circle")
     p.add_argument("--radius", type=float, default=PUMA_RADIUS_MM,
                    help="circle radius in length units (default 125)")
@@ -70,9 +73,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--task", choices=("pose", "position"), default=None)
     p.add_argument("--correction", choices=CORRECTIONS, default="newton")
     p.add_argument("--out", default=None, metavar="CSV",
-                   help="joint trajectory CSV (default renders/<model>_<trajectory>_joints.csv)")
-    p.add_argument("--force", action="store_true", help="overwrite --out if it exists")
-    p.set_defaults(func=_ik)
+                   help="joint trajectory CSV (default renders/<model>_<trajectory>_joints.csv,"
+                        " generated output that is replaced on every run)")
+    p.add_argument("--force", action="store_true",
+                   help="replace the --out file if it exists (without it, an existing file is "
+                        "never replaced; checked before solving)")
+    p.set_defaults(func=_ik, api_names={"q0": "--q0", "steps": "--steps"})
 
     p = sub.add_parser("models", help="list the built-in model files")
     p.add_argument("--json", action="store_true", help="print JSON")
@@ -104,12 +110,18 @@ def _fk(args: argparse.Namespace) -> int:
 def _ik(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     if args.q0 is None:
-        if model.n != 6:
-            raise InputError(f"--q0: required for {model.name!r} (the default start "
-                             f"configuration is the PUMA's)")
+        if not is_paper_model(model):
+            raise InputError(
+                f"--q0: required for {model.name!r} ({model.n} joints): the default start "
+                f"configuration ({' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg) is the "
+                f"paper's, for its PUMA only; give --q0 with {model.n} values")
         q0 = _joint_values(model, list(PUMA_Q0_DEG), False, "--q0")
     else:
         q0 = _joint_values(model, args.q0, args.rad, "--q0")
+    stem = Path(args.model).stem
+    out = Path(args.out) if args.out else Path("renders") / f"{stem}_{args.trajectory}_joints.csv"
+    overwrite = args.force or args.out is None
+    check_writable([out], overwrite)
     start = forward_kinematics(model, q0).position
     if args.trajectory == "circle":
         traj = Circle.from_start(start, args.radius, args.normal, args.toward,
@@ -121,9 +133,7 @@ def _ik(args: argparse.Namespace) -> int:
         warnings.simplefilter("always", ZRPWarning)
         res = track_trajectory(model, traj, q0, args.steps, task=args.task,
                                correction=args.correction)
-    stem = Path(args.model).stem
-    out = Path(args.out) if args.out else Path("renders") / f"{stem}_{args.trajectory}_joints.csv"
-    res.save_csv(out, overwrite=args.force or args.out is None)
+    res.save_csv(out, overwrite=overwrite)
     s = res.summary()
     s["output"] = str(out)
     s["warnings"] = [str(w.message) for w in caught]

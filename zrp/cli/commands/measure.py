@@ -3,10 +3,16 @@
 from __future__ import annotations
 
 import argparse
+import time
+from pathlib import Path
 
-from zrp.cli.main import emit
+import numpy as np
+
+from zrp.cli.app import emit
 from zrp.errors import InputError
+from zrp.kinematics import reachable_poses
 from zrp.model.files import builtin_models, load_model
+from zrp.output import check_writable
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -16,7 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "command poses (random reachable ones or the PUMA circle), let the servos settle, read "
         "the tool reflectors, add tracker noise, express them in an instrument frame and write "
         "the measurement CSV of `zrp diagnose` plus a separate truth file "
-        "(docs/blind-benchmark.md).")
+        "(sim/README.md).")
     p.add_argument("--model", default="puma", metavar="M.toml",
                    help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
                         "; default puma)")
@@ -46,29 +52,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seed", type=int, default=0, help="seed of poses, noise and instrument")
     p.add_argument("--deg", action="store_true", help="write q in degrees (then diagnose "
                                                       "with --deg)")
-    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    p.add_argument("--force", action="store_true",
+                   help="replace --out and --truth if they exist (refused otherwise, before "
+                        "anything is simulated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
-    p.set_defaults(func=_run)
+    p.set_defaults(func=_run, api_names={"count": "--poses", "specs": "--effect"})
 
 
 def _run(args: argparse.Namespace) -> int:
-    import time
-    from pathlib import Path
-
-    import numpy as np
-
-    from sim.measurement import (
-        Procedure,
-        measure,
-        parse_effects,
-        random_instrument,
-        trajectory_poses,
-        write_measurements,
-        write_truth,
-    )
-    from sim.real_robot import RealRobot
-    from zrp.kinematics import reachable_poses
+    # sim loads MuJoCo (+0.1-0.2 s measured): only when this command runs, not for every `zrp`.
+    import sim
 
     if args.poses < 8:
         raise InputError(f"--poses: expected at least 8 poses, got {args.poses}")
@@ -81,23 +75,20 @@ def _run(args: argparse.Namespace) -> int:
     truth = Path(args.truth) if args.truth else out.with_name(out.stem + ".truth.json")
     if truth.resolve() == out.resolve():
         raise InputError("--truth: must differ from --out")
-    for path, opt in ((out, "--out"), (truth, "--truth")):
-        if path.exists() and not args.force:
-            raise InputError(f"{opt} {path}: exists; pass --force to overwrite")
+    check_writable([out, truth], args.force)  # before the simulation, which takes a while
     model = load_model(args.model)
-    effects = parse_effects(args.effect, model, args.payload)
+    effects = sim.parse_effects(args.effect, model, args.payload, field="--effect")
     rng = np.random.default_rng(args.seed)
     q = (reachable_poses(model, args.poses, rng) if args.trajectory == "random"
-         else trajectory_poses(model, args.poses, "circle"))
-    inst = random_instrument(model, rng, args.noise)
+         else sim.trajectory_poses(model, args.poses, "circle"))
+    inst = sim.random_instrument(model, rng, args.noise)
     t0 = time.perf_counter()
-    robot = RealRobot(model, effects)
-    run = measure(robot, q, inst, rng, Procedure(approach=args.approach,
-                                                 temp_rise=args.temp_rise),
-                  progress=args.progress)
+    robot = sim.RealRobot(model, effects)
+    procedure = sim.Procedure(approach=args.approach, temp_rise=args.temp_rise)
+    run = sim.measure(robot, q, inst, rng, procedure, progress=args.progress)
     wall = time.perf_counter() - t0
-    write_measurements(run, out, deg=args.deg, force=args.force)
-    write_truth(run, truth, force=args.force)
+    sim.write_measurements(run, out, deg=args.deg, overwrite=args.force)
+    sim.write_truth(run, truth, overwrite=args.force)
     payload = {"measurements": str(out), "truth": str(truth), "poses": len(q),
                "points": run.measurements.n_rows, "effects": list(effects.active),
                "payload_kg": effects.payload, "noise_sigma": args.noise,

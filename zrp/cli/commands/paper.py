@@ -1,7 +1,7 @@
 """``zrp paper``: the paper's whole numerical example into renders/ (tables, figures, report).
 
-Also renders the nominal-vs-perturbed video through ``sim.render_paper_video`` when the
-``sim`` package provides it (``--no-video`` skips it).
+Also renders the nominal-vs-perturbed video of the circle (the scene from
+:mod:`zrp.paper.scenes`, rendered by :func:`sim.render_video`; ``--no-video`` skips it).
 """
 
 from __future__ import annotations
@@ -11,10 +11,15 @@ import time
 from pathlib import Path
 from typing import Any
 
-from zrp.cli.commands.study import add_path_options, path_from_args
-from zrp.cli.main import emit
+from zrp.cli.app import emit
+from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
 from zrp.model.files import load_model
-from zrp.paper.example import run_paper_example, write_paper_outputs
+from zrp.model.manipulator import Manipulator
+from zrp.output import OutputDir
+from zrp.paper.example import PaperExample, run_paper_example
+from zrp.paper.report import output_names, write_paper_outputs
+from zrp.paper.scenario import is_paper_model
+from zrp.paper.scenes import paper_video_file_name, paper_video_scene
 
 DEFAULT_OUT = "renders"
 
@@ -27,41 +32,52 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(CSV, Markdown), Figures 2-7 (PNG), the comparison with the published values "
         "(comparison.md) and a JSON summary, written into renders/.")
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
-                   help="output directory (default renders/, generated output that is replaced;"
-                        " any other directory needs --force to replace existing files)")
-    p.add_argument("--force", action="store_true", help="replace existing output files")
+                   help="output directory (default renders/: generated output, replaced on "
+                        "every run; in any other directory existing files are never replaced "
+                        "without --force, checked before anything is computed)")
+    p.add_argument("--force", action="store_true",
+                   help="replace existing output files in --out")
     add_path_options(p)
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     p.add_argument("--no-video", action="store_true",
-                   help="skip the video (sim.render_paper_video)")
-    p.set_defaults(func=_paper)
+                   help="skip the video of the nominal and perturbed arm")
+    p.set_defaults(func=_paper, api_names={"q0": "--q0", "steps": "--steps"})
 
 
-def _video(args: argparse.Namespace, out: Path, overwrite: bool) -> dict[str, Any]:
-    """Call sim.render_paper_video(out_dir, steps=, overwrite=, progress=) if it exists."""
+def _video_name(args: argparse.Namespace, model: Manipulator) -> str | None:
+    """The video's file name (.mp4, or .gif without ffmpeg), or None when none is made."""
+    if args.no_video or not is_paper_model(model):
+        return None
+    # sim loads MuJoCo and its GL backend (about 0.3 s measured): only when a video is made
+    import sim
+
+    return sim.video_path(paper_video_file_name()).name
+
+
+def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
+           model: Manipulator) -> dict[str, Any]:
+    """Render the nominal-vs-perturbed video of the paper's circle into the locked folder."""
     if args.no_video:
         return {"status": "skipped (--no-video)"}
+    if name is None:
+        return {"status": "skipped (the video shows the paper's Table 1 PUMA only)"}
+    # sim loads MuJoCo and its GL backend (about 0.3 s measured): only when a video is made
+    import sim
+
+    scene = paper_video_scene(steps=args.steps)
     try:
-        import sim
-    except ImportError as exc:
-        return {"status": f"skipped (the sim package is not importable: {exc})"}
-    fn = getattr(sim, "render_paper_video", None)
-    if not callable(fn):
-        return {"status": "skipped (sim.render_paper_video is not available)"}
-    gl_errors = tuple(e for e in (getattr(sim, "GLUnavailableError", None),
-                                  getattr(sim, "GLBackendError", None)) if isinstance(e, type))
-    try:
-        res = fn(out, steps=args.steps, overwrite=overwrite, progress=not args.json)
-    except gl_errors as exc:  # no OpenGL backend on this machine: the rest is still valid
+        with folder.path(name) as tmp:
+            sim.render_video(scene.segments, tmp, title=scene.title, overwrite=True,
+                             progress=not args.json)
+    except (sim.GLUnavailableError, sim.GLBackendError) as exc:
+        # no OpenGL backend on this machine: the tables and figures are still valid
         return {"status": f"skipped (no offscreen OpenGL: {exc})"}
-    path = getattr(res, "path", res)
-    return {"status": "written", "path": str(path)}
+    return {"status": "written", "path": str(folder.root / name)}
 
 
-def _paper(args: argparse.Namespace) -> int:
-    out = Path(args.out)
-    overwrite = args.force or args.out == DEFAULT_OUT
-    model = load_model(args.model)
+def _compute(args: argparse.Namespace, model: Manipulator, out: OutputDir
+             ) -> tuple[PaperExample, list[Path], float]:
+    """IK, study, comparison and claims, written into the (checked and locked) folder."""
     t0 = time.perf_counter()
     path = path_from_args(args, model)
     t_path = time.perf_counter() - t0
@@ -70,10 +86,20 @@ def _paper(args: argparse.Namespace) -> int:
     ex.timings_s["total_compute"] = sum(v for k, v in ex.timings_s.items()
                                         if k != "total_compute")
     t0 = time.perf_counter()
-    files = write_paper_outputs(ex, out, overwrite=overwrite, figures=not args.no_figures)
-    t_write = time.perf_counter() - t0
-    video = (_video(args, out, overwrite) if ex.checks["published_values_apply"]
-             else {"status": "skipped (sim.render_paper_video shows the paper's PUMA only)"})
+    files = write_paper_outputs(ex, out, figures=not args.no_figures)
+    return ex, files, time.perf_counter() - t0
+
+
+def _paper(args: argparse.Namespace) -> int:
+    out = Path(args.out)
+    overwrite = args.force or out == Path(DEFAULT_OUT)
+    model = load_model(args.model)
+    check_path_options(args, model)
+    video_name = _video_name(args, model)
+    names = [*output_names(figures=not args.no_figures), *([video_name] if video_name else [])]
+    with OutputDir(out, overwrite=overwrite, names=names) as folder:
+        ex, files, t_write = _compute(args, model, folder)
+        video = _video(args, folder, video_name, model)
     counts: dict[str, int] = {}
     for c in ex.cells:
         counts[c.status] = counts.get(c.status, 0) + 1

@@ -3,8 +3,15 @@
 from __future__ import annotations
 
 import argparse
+from dataclasses import replace
+from pathlib import Path
+from typing import Any
 
-from zrp.cli.main import emit
+from zrp.cli.app import emit
+from zrp.output import OutputDir
+from zrp.paper.scenes import PAPER_LEVELS, Scene, paper_video_scene, teaching_sweep_scene
+
+DEFAULT_OUT = "renders"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,7 +30,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--levels", nargs="+", type=float, default=None, metavar="PCT",
                    help="levels of the sweep (default the paper's)")
     p.add_argument("--steps", type=int, default=360, help="inverse-kinematics steps (360)")
-    p.add_argument("--out-dir", default="renders", help="output folder (default renders/)")
+    p.add_argument("--out-dir", default=None, metavar="DIR",
+                   help=f"output folder (default {DEFAULT_OUT}/, generated output whose videos "
+                        "are replaced; in any other folder an existing video needs --force). "
+                        "One run at a time per folder: a second run into it is refused")
+    p.add_argument("--force", action="store_true",
+                   help="replace existing videos in --out-dir (checked before rendering)")
     p.add_argument("--width", type=int, default=640)
     p.add_argument("--height", type=int, default=480)
     p.add_argument("--fps", type=int, default=30)
@@ -41,47 +53,47 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run)
 
 
+def _result(r: Any) -> dict[str, Any]:
+    return {"path": str(r.path), "frames": r.frames, "wall_seconds": r.wall_seconds,
+            "magnify": r.magnify, "backend": r.backend,
+            "segments": [{"label": lab.replace("\n", "; "), "max_delta_p_mm": dp,
+                          "max_delta_R_eq15": dr, "max_theta_rad": th}
+                         for lab, dp, dr, th in zip(r.labels, r.max_delta_p, r.max_delta_r,
+                                                    r.max_theta, strict=True)]}
+
+
 def _run(args: argparse.Namespace) -> int:
+    # sim loads MuJoCo (+0.1 s measured) and must see --backend before it creates a GL
+    # context: imported when this command runs, not for every `zrp`.
     import sim
-    from zrp.manufacturing.perturb import Perturbation
-    from zrp.model.files import load_model
-    from zrp.paper.scenario import puma_circle_ik
 
     opts = sim.VideoOptions(width=args.width, height=args.height, fps=args.fps,
                             seconds=args.seconds, magnify=args.magnify, format=args.format,
                             backend=args.backend)
-    ik = puma_circle_ik(steps=args.steps)
-    nominal = load_model("puma")
-    perturbed = Perturbation.single(args.parameter, args.xi).apply(nominal)
-    checks = [sim.consistency_check(m, ik.q) for m in (nominal, perturbed)]
-    dyn = None if args.no_dynamics else sim.dynamic_playback(perturbed, ik.t, ik.q)
-    results = [sim.render_paper_video(args.out_dir, parameter=args.parameter, xi_percent=args.xi,
-                                      steps=args.steps, options=opts, progress=not args.quiet)]
+    videos: list[tuple[Scene, sim.VideoOptions]] = [
+        (paper_video_scene(args.parameter, args.xi, steps=args.steps), opts)]
     if args.sweep:
-        from dataclasses import replace
-
-        sweep_opts = replace(opts, seconds=None)
-        results.append(sim.render_teaching_sweep(
-            args.out_dir, parameter=args.parameter,
-            levels=tuple(args.levels) if args.levels else sim.PAPER_LEVELS,
-            seconds_per_level=args.seconds or 3.0, steps=args.steps, options=sweep_opts,
-            progress=not args.quiet))
-    payload = {
-        "videos": [{"path": str(r.path), "frames": r.frames, "wall_seconds": r.wall_seconds,
-                    "magnify": r.magnify, "backend": r.backend,
-                    "segments": [{"label": lab.replace("\n", "; "), "max_delta_p_mm": dp,
-                                  "max_delta_R_eq15": dr, "max_theta_rad": th}
-                                 for lab, dp, dr, th in zip(r.labels, r.max_delta_p,
-                                                            r.max_delta_r, r.max_theta,
-                                                            strict=True)]}
-                   for r in results],
+        levels = tuple(args.levels) if args.levels else PAPER_LEVELS
+        videos.append((teaching_sweep_scene(args.parameter, levels, steps=args.steps),
+                       replace(opts, seconds=args.seconds or 3.0)))
+    names = [sim.video_path(scene.file_name, o).name for scene, o in videos]
+    overwrite = args.force or args.out_dir is None
+    with OutputDir(Path(args.out_dir or DEFAULT_OUT), overwrite=overwrite, names=names) as out:
+        seg = videos[0][0].segments[0]
+        checks = [sim.consistency_check(m, seg.q) for m in (seg.nominal, seg.perturbed)]
+        dyn = None if args.no_dynamics else sim.dynamic_playback(seg.perturbed, seg.t, seg.q)
+        results = [sim.render_video(scene.segments, out.root / name, title=scene.title,
+                                    options=o, overwrite=overwrite, progress=not args.quiet)
+                   for (scene, o), name in zip(videos, names, strict=True)]
+    payload: dict[str, Any] = {
+        "videos": [_result(r) for r in results],
         "consistency": [{"model": c.model_name, "max_position_error_mm": c.max_position_error_mm,
                          "max_orientation_error_rad": c.max_orientation_error,
                          "passed": c.passed()} for c in checks],
     }
     if dyn is not None:
         payload["dynamic_playback"] = {
-            "model": perturbed.name, "inertia": dyn.options.inertia, "kp": dyn.options.kp,
+            "model": seg.perturbed.name, "inertia": dyn.options.inertia, "kp": dyn.options.kp,
             "kv": dyn.options.kv, "max_tracking_error_mm": dyn.max_tracking_error,
             "rms_tracking_error_mm": dyn.rms_tracking_error,
             "max_geometric_delta_p_mm": results[0].max_delta_p[0]}

@@ -7,11 +7,10 @@ from __future__ import annotations
 
 import argparse
 import warnings
-from pathlib import Path
 
 import numpy as np
 
-from zrp.cli.main import emit
+from zrp.cli.app import emit
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.trajectory import TIME_LAWS
 from zrp.manufacturing.perturb import PAPER_SIGN_ZERO
@@ -19,12 +18,18 @@ from zrp.manufacturing.study import (
     PAPER_PARAMETERS,
     PAPER_XI,
     JointPath,
-    circle_joint_path,
+    StudyResult,
     load_joint_csv,
     one_at_a_time,
 )
 from zrp.model.files import builtin_models, load_model
 from zrp.model.manipulator import Manipulator
+from zrp.output import OutputDir
+from zrp.paper.scenario import PUMA_Q0_DEG, circle_joint_path, is_paper_model
+
+#: The tables ``zrp study --out DIR`` writes.
+STUDY_TABLES = tuple(f"study_{q}.{ext}" for q in ("delta_p", "delta_r", "angle_rad")
+                     for ext in ("csv", "md"))
 
 
 def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
@@ -38,7 +43,8 @@ def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
                         " per row, e.g. written by `zrp ik`; replaces the circle")
     g.add_argument("--q0", nargs="+", type=float, metavar="DEG", default=None,
                    help="start configuration in deg (prismatic joints in the length unit); "
-                        "default (0 0 0 0 90 0) for 6-joint arms")
+                        f"default {' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} for the paper's "
+                        "PUMA (the built-in puma), required for every other model")
     g.add_argument("--radius", type=float, default=125.0,
                    help="circle radius, length unit (default 125)")
     g.add_argument("--normal", nargs=3, type=float, default=None, metavar=("X", "Y", "Z"),
@@ -52,16 +58,29 @@ def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
     p.add_argument("--json", action="store_true", help="print JSON")
 
 
+def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
+    """Check the trajectory options against ``model`` before any work: --q0 has one value per
+    joint, and is given for every model but the paper's PUMA (which has a default start)."""
+    if args.joints:
+        return
+    if args.q0 is None:
+        if not is_paper_model(model):
+            raise InputError(
+                f"--q0: required for {model.name!r} ({model.n} joints): the default start "
+                f"configuration ({' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg) is the paper's,"
+                f" for its PUMA only; give --q0 with {model.n} values in deg (prismatic joints "
+                f"in {model.length_unit}), or a joint trajectory with --joints CSV")
+    elif len(args.q0) != model.n:
+        raise InputError(f"--q0: expected {model.n} values for {model.name!r}, got "
+                         f"{len(args.q0)}")
+
+
 def path_from_args(args: argparse.Namespace, model: Manipulator) -> JointPath:
     """The nominal joint trajectory the options describe."""
+    check_path_options(args, model)
     if args.joints:
         return load_joint_csv(args.joints, model)
-    q0 = None
-    if args.q0 is not None:
-        if len(args.q0) != model.n:
-            raise InputError(f"--q0: expected {model.n} values for {model.name!r}, got "
-                             f"{len(args.q0)}")
-        q0 = np.where(model.prismatic, args.q0, np.radians(args.q0))
+    q0 = None if args.q0 is None else np.where(model.prismatic, args.q0, np.radians(args.q0))
     with warnings.catch_warnings():
         warnings.simplefilter("default", ZRPWarning)
         return circle_joint_path(model, q0=q0, radius=args.radius, duration=args.duration,
@@ -92,24 +111,41 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="levels in percent (default: 0, +-0.02, +-0.05, +-0.07, +-0.1)")
     add_sign_options(p)
     p.add_argument("--out", default=None, metavar="DIR",
-                   help="also write study_delta_p / study_delta_r / study_angle CSV and Markdown"
-                        " tables into DIR")
-    p.add_argument("--force", action="store_true", help="overwrite existing files in --out")
-    p.set_defaults(func=_study)
+                   help="also write study_delta_p / study_delta_r / study_angle_rad CSV and "
+                        "Markdown tables into DIR (checked before the study runs)")
+    p.add_argument("--force", action="store_true",
+                   help="replace tables that already exist in --out (without it, existing "
+                        "files are never replaced)")
+    p.set_defaults(func=_study, api_names={
+        "q0": "--q0",
+        "steps": "--steps",
+        "xi_percent": "--xi",
+        "parameters": "--params",
+    })
+
+
+def _run_study(args: argparse.Namespace, model: Manipulator,
+               out: OutputDir | None) -> tuple[JointPath, StudyResult]:
+    path = path_from_args(args, model)
+    st = one_at_a_time(model, path, args.params, args.xi, sign_zero_links=args.sign0_links,
+                       sign_zero_axes=args.sign0_axes)
+    if out is not None:
+        for name in STUDY_TABLES:
+            quantity, fmt = name[len("study_"):].split(".")
+            out.write_text(name, st.table_text(fmt, quantity))
+    return path, st
 
 
 def _study(args: argparse.Namespace) -> int:
     model = load_model(args.model)
-    path = path_from_args(args, model)
-    st = one_at_a_time(model, path, args.params, args.xi, sign_zero_links=args.sign0_links,
-                       sign_zero_axes=args.sign0_axes)
-    files = []
+    check_path_options(args, model)
+    files: list[str] = []
     if args.out:
-        out = Path(args.out)
-        for q in ("delta_p", "delta_r", "angle_rad"):
-            for ext in ("csv", "md"):
-                files.append(str(st.write_table(out / f"study_{q}.{ext}", q,
-                                                overwrite=args.force)))
+        with OutputDir(args.out, overwrite=args.force, names=STUDY_TABLES) as out:
+            path, st = _run_study(args, model, out)
+        files = [str(f) for f in out.written]
+    else:
+        path, st = _run_study(args, model, None)
     payload = st.summary()
     payload["linearity_delta_p"] = {
         k: {f: (None if isinstance(x, float) and not np.isfinite(x) else x)

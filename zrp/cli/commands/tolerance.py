@@ -3,23 +3,22 @@
 from __future__ import annotations
 
 import argparse
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from zrp.cli.commands.study import add_path_options, path_from_args
-from zrp.cli.main import emit
+from zrp.cli.app import emit
+from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
 from zrp.errors import InputError
-from zrp.manufacturing.tolerance import (
-    DISTRIBUTIONS,
-    Tolerances,
-    allocate_tolerances,
-    monte_carlo,
-    percentile_ci,
-    tolerance_report,
-)
+from zrp.manufacturing.allocation import allocate_tolerances
+from zrp.manufacturing.budget import tolerance_report
+from zrp.manufacturing.plots import histogram_png
+from zrp.manufacturing.population import monte_carlo
+from zrp.manufacturing.study import JointPath
+from zrp.manufacturing.tolerance import DISTRIBUTIONS, Tolerances, percentile_ci
 from zrp.model.files import load_model
+from zrp.model.manipulator import Manipulator
+from zrp.output import check_writable
 
 
 def _parse_tol(items: list[str] | None) -> dict[str, float]:
@@ -60,7 +59,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     m.add_argument("-n", "--robots", type=int, default=20000, help="robots N (default 20000)")
     m.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
     m.add_argument("--percentile", type=float, default=99.0, help="reported percentile (99)")
-    m.add_argument("--hist", default=None, metavar="PNG", help="write a histogram PNG")
+    m.add_argument("--hist", default=None, metavar="PNG",
+                   help="write a histogram PNG (checked before the Monte Carlo runs)")
     m.add_argument("--top", type=int, default=10, help="rows of the contribution table (10)")
     m.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     a = p.add_argument_group("allocation")
@@ -75,58 +75,79 @@ def register(sub: argparse._SubParsersAction) -> None:
     a.add_argument("--n-search", type=int, default=4000, help="robots per bisection step")
     a.add_argument("--fixed", action="append", metavar="NAME=VALUE",
                    help="tolerances kept fixed during allocation (repeatable)")
-    p.add_argument("--force", action="store_true", help="overwrite --hist if it exists")
-    p.set_defaults(func=_tolerance)
+    p.add_argument("--force", action="store_true",
+                   help="replace the --hist file if it exists (without it, an existing file is "
+                        "never replaced)")
+    p.set_defaults(func=_tolerance, api_names={
+        "q0": "--q0",
+        "steps": "--steps",
+        "n_robots": "--robots",
+        "percentile": "--percentile",
+    })
 
 
 def _tolerance(args: argparse.Namespace) -> int:
     model = load_model(args.model)
-    path = path_from_args(args, model)
+    check_path_options(args, model)
     if not 0.0 < args.percentile < 100.0:
         raise InputError(f"--percentile: expected 0 < P < 100 (e.g. 99), got {args.percentile}")
+    if args.hist:
+        check_writable([args.hist], args.force)
+    path = path_from_args(args, model)
     rng = np.random.default_rng(args.seed)
-    u = model.length_unit
-    if args.hist and Path(args.hist).exists() and not args.force:
-        raise InputError(f"--hist {args.hist}: exists; pass --force to replace it")
     if args.allocate:
-        al = allocate_tolerances(model, path.q, rng=rng, max_delta_p=args.max_dp,
-                                 max_angle_rad=args.max_angle, percentile=args.percentile,
-                                 distribution=args.distribution, angle_scale_mm=args.angle_scale,
-                                 fixed=_parse_tol(args.fixed), n_search=args.n_search,
-                                 n_verify=args.robots, progress=not args.no_progress)
-        s = al.summary()
-        s["trajectory"] = path.label
-        s["distribution"] = args.distribution
-        pct = args.percentile
-        lines = [
-            f"{model.name}: {path.label} ({path.t.size} samples), {args.distribution} "
-            f"({'half-width' if args.distribution == 'uniform' else '3 sigma'})",
-            f"requirement: max delta_p <= {args.max_dp:g} {u}"
-            + (f", max angle <= {args.max_angle:g} rad" if args.max_angle else "")
-            + f" at the {pct:g}th percentile",
-            f"looseness = harmonic mean of length-equivalent tolerances (angles x "
-            f"{args.angle_scale:g} mm): {al.looseness_mm:.4g} mm "
-            f"(equal-tolerance baseline {al.baseline_looseness_mm:.4g} mm, x"
-            f"{s['looser_than_baseline_factor']:.3g})",
-            f"verified by Monte Carlo ({al.verification.n_robots} fresh robots): P{pct:g} "
-            f"delta_p = {s[f'verified_p{pct:g}_delta_p']:.4g} {u} (95 % CI "
-            f"{al.ci_delta_p[0]:.4g}..{al.ci_delta_p[1]:.4g}) -> "
-            f"{'OK' if al.verified else 'NOT MET'}",
-            f"first-order worst case (all parameters at the corner of their box): "
-            f"{al.worst_case_p:.4g} {u}, {al.worst_case_angle_rad:.3g} rad",
-            "",
-            "allocated tolerances:",
-        ]
-        for nm, val, unit in zip(al.tolerances.names, al.tolerances.values,
-                                 al.tolerances.units, strict=True):
-            lines.append(f"  {nm:10s} {val:.4g} {unit}")
-        lines += ["", al.contribution.markdown(u, top=args.top)]
-        if args.hist:
-            s["histogram"] = str(al.verification.histogram_png(args.hist, overwrite=args.force))
-            lines.append(f"wrote {s['histogram']}")
-        emit(args, s, "\n".join(lines))
-        return 0
+        return _allocate(args, model, path, rng)
+    return _analyse(args, model, path, rng)
 
+
+def _allocate(args: argparse.Namespace, model: Manipulator, path: JointPath,
+              rng: np.random.Generator) -> int:
+    """--allocate: the loosest tolerances meeting the requirement, verified."""
+    u = model.length_unit
+    al = allocate_tolerances(model, path.q, rng=rng, max_delta_p=args.max_dp,
+                             max_angle_rad=args.max_angle, percentile=args.percentile,
+                             distribution=args.distribution, angle_scale_mm=args.angle_scale,
+                             fixed=_parse_tol(args.fixed), n_search=args.n_search,
+                             n_verify=args.robots, progress=not args.no_progress)
+    s = al.summary()
+    s["trajectory"] = path.label
+    s["distribution"] = args.distribution
+    pct = args.percentile
+    lines = [
+        f"{model.name}: {path.label} ({path.t.size} samples), {args.distribution} "
+        f"({'half-width' if args.distribution == 'uniform' else '3 sigma'})",
+        f"requirement: max delta_p <= {args.max_dp:g} {u}"
+        + (f", max angle <= {args.max_angle:g} rad" if args.max_angle else "")
+        + f" at the {pct:g}th percentile",
+        f"looseness = harmonic mean of length-equivalent tolerances (angles x "
+        f"{args.angle_scale:g} mm): {al.looseness_mm:.4g} mm "
+        f"(equal-tolerance baseline {al.baseline_looseness_mm:.4g} mm, x"
+        f"{s['looser_than_baseline_factor']:.3g})",
+        f"verified by Monte Carlo ({al.verification.n_robots} fresh robots): P{pct:g} "
+        f"delta_p = {s[f'verified_p{pct:g}_delta_p']:.4g} {u} (95 % CI "
+        f"{al.ci_delta_p[0]:.4g}..{al.ci_delta_p[1]:.4g}) -> "
+        f"{'OK' if al.verified else 'NOT MET'}",
+        f"first-order worst case (all parameters at the corner of their box): "
+        f"{al.worst_case_p:.4g} {u}, {al.worst_case_angle_rad:.3g} rad",
+        "",
+        "allocated tolerances:",
+    ]
+    for nm, val, unit in zip(al.tolerances.names, al.tolerances.values,
+                             al.tolerances.units, strict=True):
+        lines.append(f"  {nm:10s} {val:.4g} {unit}")
+    lines += ["", al.contribution.markdown(u, top=args.top)]
+    if args.hist:
+        s["histogram"] = str(histogram_png(al.verification, args.hist,
+                                           overwrite=args.force))
+        lines.append(f"wrote {s['histogram']}")
+    emit(args, s, "\n".join(lines))
+    return 0
+
+
+def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
+             rng: np.random.Generator) -> int:
+    """Monte Carlo of the given tolerances, with the first-order budget beside it."""
+    u = model.length_unit
     offsets = args.offsets is not None
     tol = Tolerances.build(model, length=args.length, angle_rad=args.angle,
                            offset=args.offsets or 0.0, per_parameter=_parse_tol(args.tol),
@@ -175,7 +196,7 @@ def _tolerance(args: argparse.Namespace) -> int:
         rep["contribution"].markdown(u, top=args.top),
     ]
     if args.hist:
-        payload["histogram"] = str(mc.histogram_png(args.hist, overwrite=args.force))
+        payload["histogram"] = str(histogram_png(mc, args.hist, overwrite=args.force))
         lines.append(f"wrote {payload['histogram']}")
     emit(args, payload, "\n".join(lines))
     return 0

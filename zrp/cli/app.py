@@ -1,6 +1,6 @@
 """The ``zrp`` command line. Subcommands live in :mod:`zrp.cli.commands`, one module each.
 
-Every module in ``zrp/commands/`` defines ``register(subparsers)``, which adds its parser and
+Every module in ``zrp/cli/commands/`` defines ``register(subparsers)``, which adds its parser and
 sets ``func`` (called with the parsed namespace, returning an exit code). Errors derived from
 :class:`zrp.ZRPError` are printed as one clear line (exit code 2) instead of a traceback.
 """
@@ -9,18 +9,18 @@ from __future__ import annotations
 
 import argparse
 import importlib
-import json
 import pkgutil
+import re
 import sys
 from collections.abc import Sequence
 from typing import Any
 
-import numpy as np
-
 from zrp import __version__
-from zrp.errors import ZRPError
+from zrp.cli import commands
+from zrp.errors import OutputExistsError, ZRPError
+from zrp.jsonio import dumps
 
-__all__ = ["build_parser", "emit", "main"]
+__all__ = ["API_TO_CLI", "build_parser", "cli_message", "emit", "main"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -31,32 +31,45 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"zrp {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
-    from zrp.cli import commands
-
     for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
         mod = importlib.import_module(f"{commands.__name__}.{info.name}")
         mod.register(sub)
     return parser
 
 
-def _jsonable(obj: Any) -> Any:
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, (np.floating, np.integer, np.bool_)):
-        return obj.item()
-    if isinstance(obj, dict):
-        return {str(k): _jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    return obj
-
-
 def emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
     """Print ``payload`` as JSON when ``--json`` was given, else the human-readable ``text``."""
     if getattr(args, "json", False):
-        print(json.dumps(_jsonable(payload), indent=2))
+        print(dumps(payload), end="")
     else:
         print(text)
+
+
+#: How library messages name API arguments, and the command-line option each stands for.
+#: Library code names what the Python caller passes; the command line shows its own flags.
+API_TO_CLI = {
+    "overwrite=True": "--force",
+    "deg=True": "--deg",
+}
+#: Argument names used as the field of a message ("q0: expected ..."), per command's
+#: ``api_names`` default, are shown as that command's option.
+_BOTH = re.compile(r"[\w.=]+ \((--[\w-]+) on the command line\)")
+
+
+def cli_message(exc: BaseException, api_names: dict[str, str] | None = None) -> str:
+    """The message of ``exc`` for the command line: API arguments become options.
+
+    A library message may name both ("pass deg=True (--deg on the command line)"): the
+    command line shows only its option. ``api_names`` maps argument names used as a
+    message's field (``q0: ...``, ``noise_sigma=...``) to the command's options.
+    """
+    text = exc.message("--force") if isinstance(exc, OutputExistsError) else str(exc)
+    text = _BOTH.sub(r"\1", text)
+    for api, flag in API_TO_CLI.items():
+        text = text.replace(api, flag)
+    for api, flag in (api_names or {}).items():
+        text = re.sub(rf"(?<![\w.-]){re.escape(api)}(?=\s*[:=])", flag, text)
+    return text
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -68,7 +81,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return int(args.func(args) or 0)
     except ZRPError as exc:
-        print(f"zrp {args.command}: error: {exc}", file=sys.stderr)
+        msg = cli_message(exc, getattr(args, "api_names", None))
+        print(f"zrp {args.command}: error: {msg}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:  # pragma: no cover
         print("interrupted", file=sys.stderr)

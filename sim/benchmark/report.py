@@ -1,0 +1,183 @@
+"""Blind benchmark, part 6: the report - Markdown text, CSV tables, JSON and the confusion
+plot - written through :class:`zrp.output.OutputDir` (checked up front, atomic, one run at a
+time per folder).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from sim.benchmark.results import BenchmarkResult, confusion_matrix, summary_rows
+from sim.measurement import REPLACE
+from zrp.errors import OutputExistsError
+from zrp.output import OutputDir
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
+
+__all__ = ["OUTPUT_FILES", "output_names", "render_text", "write_outputs"]
+
+OUTPUT_FILES = ("summary.md", "confusion.csv", "scenarios.csv", "results.json", "confusion.png")
+
+
+def output_names(plots: bool = True) -> tuple[str, ...]:
+    """The files :func:`write_outputs` writes (without the PNG unless ``plots``)."""
+    return tuple(f for f in OUTPUT_FILES if plots or not f.endswith(".png"))
+
+
+def _md_table(header: list[str], rows: list[list[Any]]) -> str:
+    def fmt(v: Any) -> str:
+        if isinstance(v, float):
+            return "-" if not math.isfinite(v) else f"{v:.3g}"
+        return str(v)
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    lines += ["| " + " | ".join(fmt(v) for v in r) + " |" for r in rows]
+    return "\n".join(lines)
+
+
+def render_text(result: BenchmarkResult) -> str:
+    """Markdown: summary table, confusion matrix, pairs, failures and timings."""
+    cfg = result.config
+    sc = result.scores
+    out = [f"# Blind gap benchmark: {result.model_name}", "",
+           f"{len(sc)} scenarios (seed {cfg.seed}), {cfg.poses} poses each "
+           f"({cfg.poses_from} poses, {cfg.approach} approach), tracker noise "
+           f"{cfg.noise[0]:g}-{cfg.noise[1]:g} per coordinate, MJCF inertias "
+           f"{'given' if cfg.use_mjcf else 'not given'} to the diagnosis. Visible: signature "
+           f"after registration >= {cfg.excitation_threshold:g} x noise RMS. Target: withheld "
+           f"RMS after correction <= {cfg.ratio_target:g} x noise RMS.", "", "## Summary", ""]
+    rows = summary_rows(result)
+    out.append(_md_table(["group", "visible", "n", "right effect first",
+                          "right or reported tie", "+ joints located",
+                          f"RMS <= {cfg.ratio_target:g}x noise", "all three", "median ratio",
+                          "median shrink", "both found"],
+                         [[r["group"], r["visible"], r["n"], r["top"], r["top_or_tie"],
+                           r["top_and_joints"],
+                           r["ratio_ok"], r["all_three"], r["median_ratio"],
+                           r["median_shrink"], r.get("both_found", "")] for r in rows]))
+    conf = confusion_matrix(result)
+    cols = sorted({c for r in conf.values() for c in r})
+    out += ["", "## Confusion matrix (single effect and none; row: hidden, column: named first)",
+            "", _md_table(["hidden \\ named", *cols],
+                          [[r, *[conf[r].get(c, 0) or "" for c in cols]] for r in sorted(conf)])]
+    pairs = [s for s in sc if s.kind == "pair"]
+    if pairs:
+        out += ["", "## Pairs", "", _md_table(
+            ["#", "hidden (SNR)", "named", "both found", "ratio"],
+            [[s.index, ", ".join(f"{e} {list(s.hidden_joints[e])} ({s.snr.get(e, 0):.2g})"
+                                 for e in s.hidden),
+              ", ".join(s.found), s.all_found, s.ratio] for s in pairs])]
+    bad = [s for s in sc if not s.success]
+    if bad:
+        out += ["", "## Scenarios not fully right", "", _md_table(
+            ["#", "kind", "hidden [joints] (SNR)", "named [joints]", "ratio", "note"],
+            [[s.index, s.kind,
+              ", ".join(f"{e} {list(s.hidden_joints[e])} ({s.snr.get(e, 0):.2g})"
+                        for e in s.hidden) or "none",
+              ", ".join(f"{e} {list(j)}" for e, j in zip(s.found, s.found_joints,
+                                                          strict=False)) or "none",
+              s.ratio, s.note]
+             for s in bad])]
+    out += ["", f"Wall time {result.wall_s:.1f} s: simulation {result.sim_s:.1f} s, diagnosis "
+            f"{result.diag_s:.1f} s ({result.wall_s / max(len(sc), 1):.2f} s per scenario)."]
+    return "\n".join(out) + "\n"
+
+
+_SCENARIO_COLUMNS = ["index", "kind", "hidden", "hidden_joints", "snr", "payload", "found",
+                     "found_joints", "top_correct", "tied", "joints_correct", "all_found",
+                     "noise_rms", "nominal_rms", "final_rms", "ratio", "shrink", "unexplained",
+                     "success", "note", "sim_s", "diag_s"]
+
+
+def _confusion_rows(conf: dict[str, dict[str, int]]) -> list[list[Any]]:
+    cols = sorted({c for r in conf.values() for c in r})
+    return [["hidden", *cols]] + [[r, *[conf[r].get(c, 0) for c in cols]] for r in sorted(conf)]
+
+
+def _scenario_rows(result: BenchmarkResult) -> list[list[Any]]:
+    rows: list[list[Any]] = [_SCENARIO_COLUMNS]
+    for s in result.scores:
+        rows.append([s.index, s.kind, ";".join(s.hidden) or "none",
+                     ";".join(f"{e}:{'/'.join(map(str, j))}"
+                              for e, j in s.hidden_joints.items()),
+                     ";".join(f"{e}:{v:.3g}" for e, v in s.snr.items()), s.payload,
+                     ";".join(s.found),
+                     ";".join("/".join(map(str, j)) for j in s.found_joints),
+                     s.top_correct, ";".join(s.tied), s.joints_correct, s.all_found,
+                     f"{s.noise_rms:.5g}",
+                     f"{s.nominal_rms:.5g}", f"{s.final_rms:.5g}", f"{s.ratio:.4g}",
+                     f"{s.shrink:.4g}", s.unexplained, s.success, s.note,
+                     f"{s.sim_s:.2f}", f"{s.diag_s:.2f}"])
+    return rows
+
+
+def _write_csv(out: OutputDir, name: str, rows: list[list[Any]]) -> None:
+    with out.path(name) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
+        csv.writer(fh).writerows(rows)
+
+
+def _write_all(result: BenchmarkResult, out: OutputDir, plots: bool) -> list[Path]:
+    start = len(out.written)
+    out.write_text("summary.md", render_text(result))
+    conf = confusion_matrix(result)
+    _write_csv(out, "confusion.csv", _confusion_rows(conf))
+    _write_csv(out, "scenarios.csv", _scenario_rows(result))
+    out.write_json("results.json", result.to_dict(), indent=1)
+    if plots:
+        out.savefig("confusion.png", _confusion_figure(conf), dpi=110)
+    return list(out.written[start:])
+
+
+def write_outputs(result: BenchmarkResult, out: str | os.PathLike[str] | OutputDir, *,
+                  overwrite: bool = False, plots: bool = True) -> list[Path]:
+    """Write summary.md, confusion.csv, scenarios.csv, results.json (and confusion.png).
+
+    Args:
+        result: the run.
+        out: the output folder; or an :class:`zrp.output.OutputDir` the caller has entered
+            (then its own ``overwrite`` applies), to hold one lock over a longer run.
+        overwrite: replace existing files; without it nothing is written if one exists.
+        plots: also write confusion.png.
+
+    Returns:
+        the files written, in order.
+    """
+    if isinstance(out, OutputDir):
+        return _write_all(result, out, plots)
+    try:
+        with OutputDir(out, overwrite=overwrite, names=output_names(plots)) as folder:
+            return _write_all(result, folder, plots)
+    except OutputExistsError as exc:
+        if not exc.paths:
+            raise
+        raise OutputExistsError(exc.paths, REPLACE) from None
+
+
+def _confusion_figure(conf: dict[str, dict[str, int]]) -> Figure:
+    # Matplotlib (~0.4 s to import) only when a plot is wanted (``plots=False`` skips it).
+    from matplotlib.figure import Figure
+
+    rows = sorted(conf)
+    cols = sorted({c for r in conf.values() for c in r})
+    a = np.array([[conf[r].get(c, 0) for c in cols] for r in rows], dtype=float)
+    fig = Figure(figsize=(1.2 + 0.9 * len(cols), 1.0 + 0.45 * len(rows)))
+    ax = fig.subplots()
+    ax.imshow(a, cmap="Blues")
+    ax.set_xticks(range(len(cols)), cols, rotation=40, ha="right")
+    ax.set_yticks(range(len(rows)), rows)
+    for i in range(len(rows)):
+        for j in range(len(cols)):
+            if a[i, j]:
+                ax.text(j, i, int(a[i, j]), ha="center", va="center",
+                        color="white" if a[i, j] > a.max() / 2 else "black")
+    ax.set_xlabel("named first by the diagnosis")
+    ax.set_ylabel("hidden in the real robot")
+    ax.set_title("Blind gap benchmark: confusion matrix")
+    fig.tight_layout()
+    return fig

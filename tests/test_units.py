@@ -1,0 +1,80 @@
+"""One units module for every layer: the same robot described in mm, dm, ft or in gets the
+same gravity torques in N m everywhere, and an unknown unit is an error everywhere."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import zrp
+from zrp.units import G_STANDARD, LENGTH_UNITS, canonical_length_unit, metres_per_unit
+
+UNITS = ("dm", "ft", "in", "m", "cm")
+
+
+def in_unit(model: zrp.Manipulator, unit: str) -> zrp.Manipulator:
+    """The same physical robot as ``model`` (in mm), described in ``unit``."""
+    f = 1e-3 / metres_per_unit(unit)
+    joints = tuple(dataclasses.replace(j, body=np.asarray(j.body) * f) for j in model.joints)
+    ee = dataclasses.replace(model.end_effector, body=np.asarray(model.end_effector.body) * f)
+    return dataclasses.replace(model, joints=joints, end_effector=ee, length_unit=unit)
+
+
+@pytest.fixture(scope="module")
+def puma():
+    return zrp.load_model("puma")
+
+
+@pytest.fixture(scope="module")
+def q():
+    return zrp.uniform_joint_values(zrp.load_model("puma"), 12, np.random.default_rng(3))
+
+
+def test_units_table():
+    assert metres_per_unit("mm") == 1e-3
+    assert metres_per_unit("ft") == pytest.approx(0.3048)
+    assert metres_per_unit("in") == pytest.approx(0.0254)
+    assert metres_per_unit("dm") == pytest.approx(0.1)
+    assert canonical_length_unit("Millimetres") == "mm"
+    assert G_STANDARD == 9.80665
+    assert set(UNITS) <= set(LENGTH_UNITS)
+
+
+@pytest.mark.parametrize("unit", ["furlong", "", "MM2", 3])
+def test_unknown_unit_is_an_error_everywhere(puma, unit):
+    with pytest.raises(zrp.InputError, match="length_unit"):
+        metres_per_unit(unit)
+    with pytest.raises(zrp.ZRPError, match="length_unit"):
+        dataclasses.replace(puma, length_unit=unit)
+
+
+@pytest.mark.parametrize("unit", UNITS)
+def test_model_in_another_unit_has_the_same_kinematics(puma, q, unit):
+    other = in_unit(puma, unit)
+    p_mm = zrp.end_effector_pose(puma, q)[0]
+    p_u = zrp.end_effector_pose(other, q)[0]
+    np.testing.assert_allclose(p_u * metres_per_unit(unit), p_mm * 1e-3, atol=1e-12)
+
+
+@pytest.mark.parametrize("unit", UNITS)
+def test_mjcf_gravity_torques_do_not_depend_on_the_unit(puma, q, unit, tmp_path):
+    mjcf = pytest.importorskip("mjcf")
+    opts = mjcf.MJCFOptions(inertia="rods", visuals=False, floor=False)
+    paths = []
+    for m, name in ((puma, "mm.xml"), (in_unit(puma, unit), f"{unit}.xml")):
+        paths.append(mjcf.save_mjcf(mjcf.build(m, opts), tmp_path / name))
+    tau_mm = mjcf.gravity_torques(paths[0], q)
+    tau_u = mjcf.gravity_torques(paths[1], q)
+    assert np.abs(tau_mm).max() > 1.0  # N m: a real load
+    np.testing.assert_allclose(tau_u, tau_mm, rtol=1e-9, atol=1e-9)
+
+
+@pytest.mark.parametrize("unit", UNITS)
+def test_real_robot_static_torque_does_not_depend_on_the_unit(puma, q, unit):
+    sim = pytest.importorskip("sim")
+    t_mm = sim.RealRobot(puma).static_torque(q)
+    t_u = sim.RealRobot(in_unit(puma, unit)).static_torque(q)
+    assert np.abs(t_mm).max() > 1.0
+    np.testing.assert_allclose(t_u, t_mm, rtol=1e-7, atol=1e-7)

@@ -1,0 +1,223 @@
+"""report.md: the diagnosis for a reader (verdict, shrink table, parameters, ranking, aliasing,
+where the gap lies, warnings, method)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from zrp.gap.results import Candidate, Diagnosis, ParameterEstimate
+from zrp.gap.where import Region, WhereAnalysis
+
+__all__ = ["report_markdown"]
+
+
+def _val(v: float, unit: str) -> str:
+    if unit == "rad":
+        return f"{v * 1e3:.4g} mrad ({math.degrees(v):.4g} deg)"
+    return f"{v:.4g} {unit}"
+
+
+def _ci(p: ParameterEstimate, unit: str) -> str:
+    lo, hi = p.ci95
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return "undetermined"
+    if unit == "rad":
+        return f"[{lo * 1e3:.4g}, {hi * 1e3:.4g}] mrad"
+    return f"[{lo:.4g}, {hi:.4g}] {unit}"
+
+
+def _joints(joints: Sequence[int]) -> str:
+    return ", ".join(map(str, joints)) or "-"
+
+
+def _parameter_table(params: Sequence[ParameterEstimate]) -> list[str]:
+    return (["| parameter | value | 95 % interval |", "|---|---|---|"]
+            + [f"| {p.name} | {_val(p.value, p.unit)} | {_ci(p, p.unit)} |" for p in params])
+
+
+def _candidate_table(cands: Sequence[Candidate], u: str) -> list[str]:
+    out = [f"| effect | joints | params | CV RMS ({u}) | dBIC | p | added? | note |",
+           "|---|---|---|---|---|---|---|---|"]
+    for c in cands:
+        cv = "" if math.isnan(c.cv_rms) else f"{c.cv_rms:.4g}"
+        db = "" if math.isnan(c.bic_delta) else f"{c.bic_delta:.1f}"
+        out.append(f"| {c.effect} | {_joints(c.joints)} | {c.n_params} | {cv} | {db} | "
+                   f"{c.p_value:.2g} | {'yes' if c.significant else 'no'} | {c.note} |")
+    out.append("")
+    return out
+
+
+def _regions(regions: Sequence[Region], u: str) -> list[str]:
+    return [f"- radius {r.radius[0]:.0f}-{r.radius[1]:.0f} {u}, {r.height}: RMS {r.rms:.4g} "
+            f"{u} ({r.n_points} points)" for r in regions]
+
+
+def _header(diag: Diagnosis) -> list[str]:
+    s = diag.settings
+    return [f"# Sim-to-real gap diagnosis: {diag.model_name}\n",
+            f"Data: {diag.context.meas.source}: {s['n_poses']} poses, {s['n_points']} measured "
+            f"points ({', '.join(s['point_labels'])}), frame `{s['frame']}`. Fitting set "
+            f"{len(diag.fitting_poses)} poses, withheld set {len(diag.withheld_poses)} poses "
+            f"(never used for fitting or selection), {s['folds']} cross-validation folds.\n",
+            "## Verdict\n",
+            diag.verdict + "\n"]
+
+
+def _shrink(diag: Diagnosis) -> list[str]:
+    u, nf, nom = diag.length_unit, diag.noise_floor, diag.nominal
+    L = ["## How far the gap shrinks (withheld poses)\n",
+         f"| step | effect | joints | RMS ({u}) | p95 ({u}) | max ({u}) | CV RMS ({u}) "
+         "| F-test p | dBIC |",
+         "|---|---|---|---|---|---|---|---|---|",
+         f"| 0 | registration (base_frame, tool_offset) | - | {nom.rms:.4g} | {nom.p95:.4g} | "
+         f"{nom.max:.4g} | | | |"]
+    for i, st in enumerate(diag.steps, 1):
+        w = st.withheld
+        L.append(f"| {i} | {st.effect} | {_joints(st.joints)} | {w.rms:.4g} | {w.p95:.4g} | "
+                 f"{w.max:.4g} | {st.cv_rms:.4g} | {st.p_value:.2g} | {st.bic_delta:.1f} |")
+    if nf.rms is not None:
+        L.append(f"| | noise floor ({nf.method}) | | {nf.rms:.4g} | {nf.p95:.4g} | | | | |")
+    L.append("")
+    L.append(f"Final withheld RMS / nominal: {diag.shrink:.3f}. ")
+    if nf.sigma is not None:
+        L.append(f"Noise floor: sigma = {nf.sigma:.4g} {u} per coordinate from {nf.method} "
+                 f"({nf.n_samples} samples); RMS of pure noise sqrt(3) sigma = {nf.rms:.4g} {u}."
+                 + (" Distances between rigidly linked points measure the instrument's noise "
+                    "only; the robot's repeatability adds to it, so the attainable floor is "
+                    "somewhat higher." if nf.method == "rigid_links" else ""))
+    L += ["\n![shrink](shrink.png)\n", "![residuals](residuals_before_after.png)\n",
+          "![residual vs joint](residual_vs_joint.png)\n"]
+    return L
+
+
+def _parameters(diag: Diagnosis) -> list[str]:
+    L = ["## Identified parameters (final model, 95 % intervals)\n",
+         "Estimated jointly in the final model (the per-step values in diagnosis.json were "
+         "each estimated before the later effects were added).\n"]
+    by_eff: dict[str, list[ParameterEstimate]] = {}
+    for p in diag.final_parameters:
+        by_eff.setdefault(p.effect, []).append(p)
+    for eff, params in by_eff.items():
+        L.append(f"### {eff} (joints {_joints(diag.final_joints.get(eff, ()))})\n")
+        L += _parameter_table(params)
+        L.append("")
+    for i, st in enumerate(diag.steps, 1):
+        if not math.isnan(st.geometric_overlap):
+            L.append(f"Step {i} ({st.effect}): geometric overlap "
+                     f"{100 * st.geometric_overlap:.0f} %: that share of the step's correction "
+                     "could also be produced by joint offsets, encoder scales, link and axis "
+                     "errors over these poses"
+                     + (" (so it is only weakly distinguishable from geometry; e.g. a first "
+                        "harmonic overlaps an offset and a scale when a joint turns less than a "
+                        "full turn)." if st.geometric_overlap > 0.5 else "."))
+            L.append("")
+    if diag.where.backward_pruned:
+        L.append("Dropped in the backward pass (no longer significant in the final model): "
+                 + ", ".join(diag.where.backward_pruned) + ".\n")
+    L.append("Registration:\n")
+    L += _parameter_table(diag.registration)
+    L.append("")
+    return L
+
+
+def _ranking(diag: Diagnosis) -> list[str]:
+    u = diag.length_unit
+    L = ["## Which effect: ranking of the candidates\n",
+         "Ranked by cross-validated RMS within the fitting set; an effect is added when its F "
+         "test is significant (p < alpha), its BIC falls and its CV RMS improves by at least "
+         "1 %.\n"]
+    if diag.steps:
+        L.append("At step 1:\n")
+        L += _candidate_table(diag.steps[0].candidates, u)
+    last = diag.where.last_candidates
+    if last:
+        L.append(f"After step {len(diag.steps)} (none added):\n" if diag.steps
+                 else "On top of the registration (none added):\n")
+        L += _candidate_table(last, u)
+    return L
+
+
+def _aliasing(diag: Diagnosis) -> list[str]:
+    L = ["## Parameters the data cannot tell apart\n"]
+    if diag.aliased:
+        L.append("Reported, never absorbed silently: a dropped parameter is not estimated; "
+                 "its effect is carried by its partners.\n")
+        for a in diag.aliased:
+            L.append(f"- {a.name} ({a.effect}) vs {', '.join(a.partners) or 'registration'}: "
+                     f"{'not identifiable (dropped)' if a.dropped else 'weakly identifiable'}"
+                     f" (independent share {a.fraction:.2g})")
+        L.append("")
+    rows = [(eff, v) for eff, v in diag.where.identifiability.items() if v.not_identifiable]
+    if rows:
+        L.append("Not identifiable on top of the registration, per effect (robot structure or "
+                 "these poses; 'limited by data' means richer poses would identify it):\n")
+        for eff, v in rows:
+            items = ", ".join(f"{a.name} ~ {'/'.join(a.partners) or 'no effect'}"
+                              for a in v.not_identifiable)
+            L.append(f"- {eff}: {items}")
+            if v.limited_by_data:
+                L.append(f"  - limited by data: {', '.join(v.limited_by_data)}")
+        L.append("")
+    return L
+
+
+def _where(w: WhereAnalysis, u: str) -> list[str]:
+    extra = [f"measurement order {w.order_r2:.2f}"]
+    if w.time_r2 is not None:
+        extra.append(f"time {w.time_r2:.2f}")
+    if w.temperature_r2 is not None:
+        extra.append(f"temperature {w.temperature_r2:.2f}")
+    L = ["## Where the gap lies (fitting poses, after registration)\n",
+         "RMS per point: " + ", ".join(f"{k} {v:.4g} {u}" for k, v in w.per_point.items())
+         + ".\n",
+         "Share of the residual explained by a smooth function of each joint angle (R^2): "
+         + ", ".join(f"q{j.joint} {j.r2:.2f}" for j in w.joints) + ".\n",
+         "R^2 against " + ", ".join(extra) + ".\n",
+         f"Projection on the geometric parameters of each joint (share of the residual, "
+         f"all together {w.geometric_share:.2f}): "
+         + ", ".join(f"joint {p.joint} {p.share:.2f}" for p in w.projection) + ".\n",
+         "Singular directions of the identification Jacobian carrying most residual:\n"]
+    for c in w.components:
+        L.append(f"- share {c.share:.3f}, singular value {c.singular_value:.3g}: "
+                 + ", ".join(f"{n} ({v:+.2f})" for n, v in c.parameters))
+    L.append("\nWorkspace regions (horizontal radius x height):\n")
+    return L + _regions(w.regions, u)
+
+
+def _remains(wf: WhereAnalysis, u: str) -> list[str]:
+    L = ["\n## What remains after the final model (fitting poses)\n",
+         "Share explained by a smooth function of each joint angle (R^2): "
+         + ", ".join(f"q{j.joint} {j.r2:.2f}" for j in wf.joints)
+         + f"; measurement order {wf.order_r2:.2f}.\n"]
+    if wf.common_share is not None:
+        L.append(f"Common to all points of a pose (a shift of the whole tool): "
+                 f"{100 * wf.common_share:.0f} % of the remaining energy.\n")
+    L.append("Workspace regions:\n")
+    L += _regions(wf.regions, u)
+    L.append(f"\nGeometric parameters could still explain {100 * wf.geometric_share:.0f} % of "
+             "it.")
+    return L
+
+
+METHOD = ("See zrp/gap/README.md. Registration (base_frame, tool_offset) first; each "
+          "candidate effect is a parametrised model correction fitted by least squares with "
+          "analytic Jacobians; joints whose parameters fail a Wald test are pruned; "
+          "candidates are ranked by cross-validated RMS and added greedily while an F test, "
+          "BIC and the CV RMS agree that they help. Intervals are 95 % normal-theory "
+          "intervals from the fit's covariance (they assume the model is right; with an "
+          "unexplained gap they are optimistic).")
+
+
+def report_markdown(diag: Diagnosis) -> str:
+    """The text of report.md."""
+    u = diag.length_unit
+    L = (_header(diag) + _shrink(diag) + _parameters(diag) + _ranking(diag) + _aliasing(diag)
+         + _where(diag.where.nominal, u))
+    if diag.where.after_final_model is not None:
+        L += _remains(diag.where.after_final_model, u)
+    if diag.warnings:
+        L.append("\n## Warnings\n")
+        L.extend(f"- {m}" for m in diag.warnings)
+    L += ["\n## Method\n", METHOD]
+    return "\n".join(L) + "\n"

@@ -1,0 +1,74 @@
+"""Write a :class:`~zrp.gap.Diagnosis` to a folder: diagnosis.json, residuals.csv, the PNG
+plots and report.md, through the one output policy (:mod:`zrp.output`)."""
+
+from __future__ import annotations
+
+import csv
+import io
+import os
+from pathlib import Path
+
+import numpy as np
+
+from zrp.gap.report.markdown import report_markdown
+from zrp.gap.report.plots import DPI, PLOT_FILES, figures, withheld_rows
+from zrp.gap.results import Diagnosis
+from zrp.output import OutputDir
+
+__all__ = ["OUTPUT_FILES", "residuals_csv", "write_outputs"]
+
+#: every file :func:`write_outputs` writes (all are checked, even without plots, so that no
+#: plot of an earlier run is left beside the new results).
+OUTPUT_FILES = ("diagnosis.json", "report.md", "residuals.csv", *PLOT_FILES)
+
+
+def residuals_csv(diag: Diagnosis) -> str:
+    """The withheld residuals before and after the corrections, one row per measured point
+    with its source line."""
+    meas = diag.context.meas
+    rb = diag.withheld_residual_before.reshape(-1, 3)
+    ra = diag.withheld_residual_after.reshape(-1, 3)
+    buf = io.StringIO()
+    w = csv.writer(buf)
+    w.writerow(["line", "pose", "point", "before_x", "before_y", "before_z", "before_norm",
+                "after_x", "after_y", "after_z", "after_norm"])
+    for i, r in enumerate(withheld_rows(diag)):
+        w.writerow([int(meas.lines[r]), meas.pose[r], meas.point[r],
+                    *(f"{v:.6g}" for v in rb[i]), f"{np.linalg.norm(rb[i]):.6g}",
+                    *(f"{v:.6g}" for v in ra[i]), f"{np.linalg.norm(ra[i]):.6g}"])
+    return buf.getvalue()
+
+
+def _write(diag: Diagnosis, out: OutputDir, plots: bool) -> list[Path]:
+    first = len(out.written)
+    out.write_json("diagnosis.json", diag.to_dict())
+    out.write_text("residuals.csv", residuals_csv(diag))
+    if plots:
+        for name, fig in figures(diag):
+            out.savefig(name, fig, dpi=DPI)
+    out.write_text("report.md", report_markdown(diag))
+    return out.written[first:]
+
+
+def write_outputs(diag: Diagnosis, out_dir: str | os.PathLike[str] | OutputDir, *,
+                  overwrite: bool = False, plots: bool = True) -> list[Path]:
+    """Write diagnosis.json, residuals.csv, (with ``plots``) the PNGs and report.md.
+
+    Args:
+        out_dir: the folder, or an :class:`~zrp.output.OutputDir` the caller has entered
+            (then its own ``overwrite`` policy applies, and it should have checked
+            :data:`OUTPUT_FILES` on entry).
+        overwrite: replace files that exist (for a folder path).
+
+    Returns:
+        the paths written, in order.
+
+    Raises:
+        OutputExistsError: one of :data:`OUTPUT_FILES` exists and ``overwrite`` is False
+            (nothing is written then).
+        OutputBusyError: another run is writing into the folder.
+    """
+    if isinstance(out_dir, OutputDir):
+        return _write(diag, out_dir, plots)
+    with OutputDir(out_dir, overwrite=overwrite, names=OUTPUT_FILES) as out:
+        return _write(diag, out, plots)

@@ -1,0 +1,413 @@
+"""What a diagnosis returns: typed, frozen results with their JSON form (``to_dict``).
+
+The JSON schema is documented in zrp/gap/README.md; :data:`SCHEMA_VERSION` names it. The
+plain-words verdict (:attr:`Diagnosis.verdict`) is prose, so it belongs to the report
+(:mod:`zrp.gap.report.verdict`); the engine only holds the slot the report fills
+(:func:`install_verdict_renderer`, wired in ``zrp/gap/__init__.py``) and never imports it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.errors import InputError, ZRPWarning
+from zrp.gap.effects import EFFECTS, Context
+from zrp.gap.leastsq import Aliased, FitResult
+from zrp.gap.metrics import Metrics, NoiseFloor
+from zrp.gap.where import WhereAnalysis
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "UNEXPLAINED_RATIO",
+    "BacklashSwitch",
+    "Candidate",
+    "Diagnosis",
+    "EffectIdentifiability",
+    "GapWarning",
+    "ParameterEstimate",
+    "Step",
+    "Where",
+    "alias_dict",
+    "install_verdict_renderer",
+    "parameter_estimates",
+]
+
+F64 = NDArray[np.float64]
+SCHEMA_VERSION = 1
+#: final withheld RMS above this multiple of the noise-floor RMS counts as unexplained.
+UNEXPLAINED_RATIO = 1.5
+#: two-sided 95 % quantile of the standard normal distribution.
+Z95 = 1.959963984540054
+
+
+class GapWarning(ZRPWarning):
+    """The diagnosis ran but something limits what it can say (aliasing, poor data...)."""
+
+
+@dataclass(frozen=True)
+class ParameterEstimate:
+    """An identified parameter with its 95 % confidence interval (normal approximation)."""
+
+    name: str
+    effect: str
+    joint: int
+    unit: str
+    value: float
+    stderr: float
+    ci95: tuple[float, float]
+
+    def __post_init__(self) -> None:
+        if not math.isfinite(self.value):
+            raise InputError(f"ParameterEstimate {self.name}: value {self.value} is not finite")
+        if not (self.stderr >= 0):
+            raise InputError(f"ParameterEstimate {self.name}: stderr {self.stderr} < 0")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"name": self.name, "effect": self.effect, "joint": self.joint,
+                "unit": self.unit, "value": self.value, "stderr": self.stderr,
+                "ci95": list(self.ci95)}
+
+
+def parameter_estimates(result: FitResult, first: int, last: int | None = None
+                        ) -> tuple[ParameterEstimate, ...]:
+    """The parameters ``first`` .. ``last`` (default: all after ``first``) of a fit, with
+    their 95 % intervals."""
+    se = result.stderr
+    out = []
+    for i in range(first, len(result.specs) if last is None else last):
+        s = result.specs[i]
+        v = float(result.theta[i])
+        h = Z95 * float(se[i])
+        out.append(ParameterEstimate(s.name, s.effect, s.joint, s.unit, v, float(se[i]),
+                                     (v - h, v + h)))
+    return tuple(out)
+
+
+def _nan_to_none(x: float) -> float | None:
+    return None if math.isnan(x) else x
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One effect tried at one step of the greedy search.
+
+    Attributes:
+        effect: the effect.
+        joints: joints (or body vectors for ``link_length``) whose parameters were significant.
+        n_params: parameters kept after the significance pruning.
+        cv_rms: cross-validated 3-D RMS on the fitting set (length unit); NaN if not fitted.
+        bic_delta: BIC change against the current model (negative is better).
+        p_value: F test of the improvement against the current model.
+        significant: it passed all the tests for being added.
+        note: why it was not tried or not significant.
+    """
+
+    effect: str
+    joints: tuple[int, ...]
+    n_params: int
+    cv_rms: float
+    bic_delta: float
+    p_value: float
+    significant: bool
+    note: str = ""
+
+    def __post_init__(self) -> None:
+        if self.effect not in EFFECTS:
+            raise InputError(f"Candidate.effect: {self.effect!r} not in {EFFECTS}")
+        if not 0.0 <= self.p_value <= 1.0:
+            raise InputError(f"Candidate {self.effect}: p_value {self.p_value} not in [0, 1]")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"effect": self.effect, "joints": list(self.joints), "n_params": self.n_params,
+                "cv_rms": _nan_to_none(self.cv_rms), "bic_delta": _nan_to_none(self.bic_delta),
+                "p_value": self.p_value, "significant": self.significant, "note": self.note}
+
+
+def alias_dict(a: Aliased) -> dict[str, Any]:
+    """The JSON form of an :class:`~zrp.gap.leastsq.Aliased` report."""
+    return {"name": a.name, "effect": a.effect, "partners": list(a.partners),
+            "fraction": a.fraction, "dropped": a.dropped}
+
+
+@dataclass(frozen=True)
+class Step:
+    """One effect added to the model, with what it achieved on the withheld poses."""
+
+    effect: str
+    joints: tuple[int, ...]
+    parameters: tuple[ParameterEstimate, ...]
+    withheld: Metrics
+    fitting: Metrics
+    cv_rms: float
+    p_value: float
+    bic_delta: float
+    candidates: tuple[Candidate, ...]
+    aliased: tuple[Aliased, ...]
+    geometric_overlap: float = math.nan
+    ties: tuple[str, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.effect not in EFFECTS:
+            raise InputError(f"Step.effect: {self.effect!r} not in {EFFECTS}")
+        bad = [t for t in self.ties if t not in EFFECTS]
+        if bad:
+            raise InputError(f"Step.ties: {bad} not in {EFFECTS}")
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"effect": self.effect, "joints": list(self.joints), "ties": list(self.ties),
+                "geometric_overlap": _nan_to_none(self.geometric_overlap),
+                "parameters": [p.to_dict() for p in self.parameters],
+                "rms": self.withheld.rms, "p95": self.withheld.p95, "max": self.withheld.max,
+                "withheld": self.withheld.to_dict(), "fitting": self.fitting.to_dict(),
+                "cv_rms": self.cv_rms, "p_value": self.p_value, "bic_delta": self.bic_delta,
+                "candidates": [c.to_dict() for c in self.candidates],
+                "aliased": [alias_dict(a) for a in self.aliased]}
+
+
+@dataclass(frozen=True)
+class EffectIdentifiability:
+    """Which parameters of one effect these data cannot identify on top of the registration.
+
+    Attributes:
+        not_identifiable: parameters dropped (aliased with others).
+        weak: parameters kept but only weakly identifiable.
+        limited_by_data: names of the dropped ones that a rich pose set would identify.
+    """
+
+    not_identifiable: tuple[Aliased, ...]
+    weak: tuple[Aliased, ...]
+    limited_by_data: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"not_identifiable": [alias_dict(a) for a in self.not_identifiable],
+                "weak": [alias_dict(a) for a in self.weak],
+                "limited_by_data": list(self.limited_by_data)}
+
+
+@dataclass(frozen=True)
+class BacklashSwitch:
+    """Where a joint with play rests (the ``backlash`` effect as added to the model).
+
+    Attributes:
+        switch: per joint, the gravity torque above which it rests on the loaded flank (None:
+            always against its approach direction).
+        band: per joint, the range of plausible switching torques (None where modelled by the
+            approach direction only).
+        payload_kg: the unknown payload at the tool profiled with MJCF torques, kg.
+    """
+
+    switch: tuple[float | None, ...]
+    band: tuple[list[float] | None, ...]
+    payload_kg: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"backlash_switch": list(self.switch), "backlash_switch_band": list(self.band),
+                "backlash_payload_kg": self.payload_kg}
+
+
+@dataclass(frozen=True, eq=False)
+class Where(Mapping[str, Any]):
+    """Where the gap lies: the "where" section of a :class:`Diagnosis`.
+
+    Attributes:
+        nominal: the analysis of the residual after registration (fitting poses).
+        identifiability: per effect, what these data cannot identify.
+        backlash: the flank model of ``backlash`` when that effect was added.
+        last_candidates: the candidates of the step at which the search stopped (none was
+            added), or None.
+        backward_pruned: significance groups dropped in the backward pass.
+        after_final_model: the analysis of the residual of the final model (when an effect
+            was added).
+
+    Read-only mapping access (``where["projection"]``, ``where.get("backlash_switch")``) gives
+    the JSON form (:meth:`to_dict`), for code written against the dictionary this replaces.
+    """
+
+    nominal: WhereAnalysis
+    identifiability: Mapping[str, EffectIdentifiability] = field(default_factory=dict)
+    backlash: BacklashSwitch | None = None
+    last_candidates: tuple[Candidate, ...] | None = None
+    backward_pruned: tuple[str, ...] = ()
+    after_final_model: WhereAnalysis | None = None
+
+    def to_dict(self) -> dict[str, Any]:
+        out = self.nominal.to_dict()
+        out["identifiability"] = {e: v.to_dict() for e, v in self.identifiability.items()}
+        if self.backlash is not None:
+            out.update(self.backlash.to_dict())
+        if self.last_candidates is not None:
+            out["last_candidates"] = [c.to_dict() for c in self.last_candidates]
+        if self.backward_pruned:
+            out["backward_pruned"] = list(self.backward_pruned)
+        if self.after_final_model is not None:
+            out["after_final_model"] = self.after_final_model.to_dict()
+        return out
+
+    def __getitem__(self, key: str) -> Any:
+        return self.to_dict()[key]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.to_dict())
+
+    def __len__(self) -> int:
+        return len(self.to_dict())
+
+
+#: Renders :attr:`Diagnosis.verdict`; installed by the report (see zrp/gap/__init__.py).
+_verdict_renderer: Callable[[Diagnosis], str] | None = None
+
+
+def install_verdict_renderer(render: Callable[[Diagnosis], str]) -> None:
+    """Set the function that words :attr:`Diagnosis.verdict` (the report's
+    :func:`zrp.gap.report.verdict.verdict_text`; the engine does not import the report)."""
+    global _verdict_renderer
+    _verdict_renderer = render
+
+
+@dataclass(frozen=True, eq=False)
+class Diagnosis:
+    """The result of :func:`~zrp.gap.diagnose` (see zrp/gap/README.md for the JSON form).
+
+    Attributes:
+        model_name, length_unit: of the nominal model.
+        nominal: withheld errors after registration only.
+        nominal_fitting: fitting-set errors after registration only.
+        registration: the registration parameters (base frame, tool offsets).
+        steps: effects added, in order.
+        final: withheld errors of the final model.
+        noise_floor: the noise estimate.
+        unexplained: True when the final withheld RMS exceeds UNEXPLAINED_RATIO x the noise
+            floor RMS; None when there is no noise estimate.
+        split: pose ids of the fitting and withheld sets and the CV folds.
+        where: the "where" analysis (:class:`Where`).
+        aliased: parameters that the data cannot tell apart (reported, never absorbed).
+        warnings: messages of the warnings raised during the run.
+        nominal_fit, final_fit: the fits (for plots and in-process use).
+        withheld_residual_before, withheld_residual_after: shape (3 Rw,).
+        context: the data context.
+        withheld_poses, fitting_poses: pose indices, shapes (Pw,), (Pf,).
+        settings: the options of the run.
+    """
+
+    model_name: str
+    length_unit: str
+    nominal: Metrics
+    nominal_fitting: Metrics
+    registration: tuple[ParameterEstimate, ...]
+    steps: tuple[Step, ...]
+    final: Metrics
+    noise_floor: NoiseFloor
+    unexplained: bool | None
+    split: dict[str, Any]
+    where: Where
+    aliased: tuple[Aliased, ...]
+    warnings: tuple[str, ...]
+    nominal_fit: FitResult
+    final_fit: FitResult
+    withheld_residual_before: F64
+    withheld_residual_after: F64
+    context: Context
+    fitting_poses: NDArray[np.int64]
+    withheld_poses: NDArray[np.int64]
+    settings: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if not all(isinstance(st, Step) for st in self.steps):
+            raise InputError("Diagnosis.steps: expected Step objects")
+        if self.unexplained is not None and not isinstance(self.unexplained, bool):
+            raise InputError(f"Diagnosis.unexplained: expected True, False or None, got "
+                             f"{self.unexplained!r}")
+        if np.intersect1d(self.fitting_poses, self.withheld_poses).size:
+            raise InputError("Diagnosis: fitting and withheld poses overlap")
+
+    @property
+    def effects(self) -> tuple[str, ...]:
+        """Effects found, in order ("none" alone when nothing helped)."""
+        return tuple(s.effect for s in self.steps) or ("none",)
+
+    @property
+    def top_effect(self) -> str:
+        """The first effect found, or "none"."""
+        return self.effects[0]
+
+    @property
+    def shrink(self) -> float:
+        """Final over nominal withheld RMS (1: no improvement)."""
+        return self.final.rms / self.nominal.rms if self.nominal.rms > 0 else 1.0
+
+    @property
+    def ratio_to_noise_floor(self) -> float | None:
+        """Final withheld RMS over the noise-floor RMS (None without a usable floor)."""
+        nf = self.noise_floor.rms
+        return None if nf is None or nf == 0 else self.final.rms / nf
+
+    @property
+    def where_final(self) -> WhereAnalysis:
+        """The analysis of what the final model leaves (the nominal one when nothing was
+        added)."""
+        final = self.where.after_final_model
+        return self.where.nominal if final is None else final
+
+    @property
+    def verdict(self) -> str:
+        """One paragraph in plain words (worded by the report)."""
+        if _verdict_renderer is None:
+            raise RuntimeError("no verdict renderer installed; import zrp.gap (its __init__ "
+                               "installs zrp.gap.report.verdict.verdict_text)")
+        return _verdict_renderer(self)
+
+    @property
+    def final_parameters(self) -> tuple[ParameterEstimate, ...]:
+        """All effect parameters of the final model, estimated jointly (after the backward
+        pass), with 95 % intervals. The per-step values are each estimated without the effects
+        added later, so these are the ones to use."""
+        return parameter_estimates(self.final_fit, len(self.registration))
+
+    @property
+    def final_joints(self) -> dict[str, tuple[int, ...]]:
+        """Effect -> joints (body-vector indices for link_length) in the final model."""
+        out: dict[str, set[int]] = {}
+        for s in self.final_fit.specs[len(self.registration):]:
+            out.setdefault(s.effect, set())
+            if s.joint > 0:
+                out[s.effect].add(s.joint)
+        return {e: tuple(sorted(j)) for e, j in out.items()}
+
+    def parameter(self, name: str) -> ParameterEstimate:
+        """The final estimate of one parameter (registration or effect)."""
+        for p in self.final_parameters + self.registration:
+            if p.name == name:
+                return p
+        raise InputError(f"no identified parameter {name!r}; identified: "
+                         f"{', '.join(p.name for p in self.final_parameters)}")
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON document (schema in zrp/gap/README.md)."""
+        return {
+            "schema_version": SCHEMA_VERSION,
+            "model": self.model_name,
+            "length_unit": self.length_unit,
+            "settings": self.settings,
+            "nominal": {**self.nominal.to_dict(), "fitting": self.nominal_fitting.to_dict()},
+            "registration": [p.to_dict() for p in self.registration],
+            "steps": [s.to_dict() for s in self.steps],
+            "effects": list(self.effects),
+            "final": {**self.final.to_dict(), "shrink": self.shrink,
+                      "effects": [{"effect": e, "joints": list(j)}
+                                  for e, j in self.final_joints.items()],
+                      "parameters": [p.to_dict() for p in self.final_parameters],
+                      "ratio_to_noise_floor": self.ratio_to_noise_floor},
+            "noise_floor": self.noise_floor.to_dict(),
+            "unexplained": self.unexplained,
+            "verdict": self.verdict,
+            "split": self.split,
+            "where": self.where.to_dict(),
+            "aliased": [alias_dict(a) for a in self.aliased],
+            "warnings": list(self.warnings),
+        }

@@ -1,0 +1,119 @@
+"""The paper's video scenes: which arms, which joint path, which labels (NumPy only).
+
+A scene is the content of a comparison video, assembled here in the core and drawn by the
+simulation layer (``sim.render_video``, which takes the segments as they are):
+
+* :func:`paper_video_scene`: the Table 1 PUMA drawing the 125 mm circle (the nominal inverse
+  kinematics, :func:`zrp.paper.scenario.puma_circle_ik`), nominal ghost vs one parameter
+  perturbed by xi percent (:class:`zrp.manufacturing.perturb.Perturbation`);
+* :func:`teaching_sweep_scene`: the same circle once per perturbation level of the paper, in
+  turn, so that the deviation visibly grows with xi.
+
+Typical use (the command line's ``zrp render`` and ``zrp paper`` do this)::
+
+    scene = paper_video_scene("JE2", 0.1, steps=360)
+    sim.render_video(scene.segments, out_dir / scene.file_name, title=scene.title)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.errors import InputError
+from zrp.manufacturing.perturb import Perturbation
+from zrp.manufacturing.study import PAPER_XI
+from zrp.model.files import load_model
+from zrp.model.manipulator import Manipulator
+from zrp.paper.scenario import puma_circle_ik
+
+__all__ = [
+    "PAPER_LEVELS",
+    "Scene",
+    "SceneSegment",
+    "paper_video_file_name",
+    "paper_video_scene",
+    "perturbed_puma",
+    "teaching_sweep_scene",
+]
+
+F64 = NDArray[np.float64]
+
+#: The paper's perturbation levels, percent (the non-negative half of the study's xi).
+PAPER_LEVELS: tuple[float, ...] = tuple(x for x in PAPER_XI if x >= 0.0)
+
+
+class SceneSegment(NamedTuple):
+    """One part of a scene: the ``nominal`` and the ``perturbed`` arm along the joint path
+    ``q(t)`` (t in s, shape (N,); q rad, shape (N, n)), titled ``label``. The field order is
+    that of ``sim.VideoSegment``, so a segment is passed to the renderer as it is."""
+
+    nominal: Manipulator
+    perturbed: Manipulator
+    t: F64
+    q: F64
+    label: str
+
+
+@dataclass(frozen=True, eq=False)
+class Scene:
+    """A video's content.
+
+    Attributes:
+        segments: drawn one after the other, at one magnification.
+        title: first line of the text on every frame.
+        file_name: the video's file name (``.mp4``) in the output folder.
+    """
+
+    segments: tuple[SceneSegment, ...]
+    title: str
+    file_name: str
+
+
+def perturbed_puma(parameter: str, xi_percent: float) -> tuple[Manipulator, Manipulator, str]:
+    """The Table 1 PUMA, its copy with ``parameter`` (LE<k> or JE<k>) perturbed by
+    ``xi_percent``, and the label (perturbation and sign(0) convention)."""
+    nominal = load_model("puma")
+    pert = Perturbation.single(parameter, xi_percent)
+    label = f"{parameter} xi = {xi_percent:+g} %\n{pert.convention}"
+    return nominal, pert.apply(nominal), label
+
+
+def paper_video_scene(parameter: str = "JE2", xi_percent: float = 0.1, *,
+                      steps: int = 360) -> Scene:
+    """The paper's 125 mm PUMA circle: nominal ghost vs one perturbed parameter.
+
+    File ``puma_circle_<parameter>_<xi>pct.mp4``; ``steps``: inverse-kinematics steps.
+    """
+    ik = puma_circle_ik(steps=steps)
+    nominal, perturbed, label = perturbed_puma(parameter, xi_percent)
+    seg = SceneSegment(nominal, perturbed, np.asarray(ik.t), np.asarray(ik.q), label)
+    return Scene((seg,), "PUMA, 125 mm circle", paper_video_file_name(parameter, xi_percent))
+
+
+def paper_video_file_name(parameter: str = "JE2", xi_percent: float = 0.1) -> str:
+    """``puma_circle_<parameter>_<xi>pct.mp4``, the file :func:`paper_video_scene` names."""
+    return f"puma_circle_{parameter}_{xi_percent:g}pct.mp4"
+
+
+def teaching_sweep_scene(parameter: str = "JE2", levels: Sequence[float] = PAPER_LEVELS, *,
+                         steps: int = 360) -> Scene:
+    """Teaching demo: the PUMA circle at each perturbation level (percent) in turn.
+
+    File ``puma_sweep_<parameter>.mp4``; drawn at one magnification, the deviation visibly
+    grows with xi.
+    """
+    if len(levels) == 0:
+        raise InputError("levels: expected at least one perturbation level (percent)")
+    ik = puma_circle_ik(steps=steps)
+    t, q = np.asarray(ik.t), np.asarray(ik.q)
+    segs = []
+    for xi in levels:
+        nominal, perturbed, label = perturbed_puma(parameter, float(xi))
+        segs.append(SceneSegment(nominal, perturbed, t, q, label))
+    return Scene(tuple(segs), f"PUMA circle: {parameter} swept over the paper's levels",
+                 f"puma_sweep_{parameter}.mp4")
