@@ -78,3 +78,32 @@ def test_real_robot_static_torque_does_not_depend_on_the_unit(puma, q, unit):
     t_u = sim.RealRobot(in_unit(puma, unit)).static_torque(q)
     assert np.abs(t_mm).max() > 1.0
     np.testing.assert_allclose(t_u, t_mm, rtol=1e-7, atol=1e-7)
+
+
+@pytest.mark.parametrize("unit", UNITS)
+def test_gap_payload_and_gravity_torques_do_not_depend_on_the_unit(puma, q, unit):
+    """The diagnosis's gravity torques with a payload (N m) and its payload-compliance columns
+    (N m per kg): the same numbers for the model in mm and in ``unit``. (Before one units module,
+    the gap's own table lacked dm and ft and fell back to mm silently: 100x and 305x off.)"""
+    from zrp.gap import Context, Measurements, effect_parameters
+
+    tau = np.random.default_rng(1).normal(size=q.shape) * 20.0  # N m, from an MJCF say
+    load = np.linspace(0.0, 3.0, len(q))  # kg logged per pose
+
+    def torques(model):
+        xyz = np.zeros((len(q), 3))
+        meas = Measurements.from_arrays(np.arange(len(q)), q, xyz, load=load)
+        ctx = Context(model, meas, gravity_torque=tau, payload_kg=2.5)
+        specs, _ = effect_parameters(ctx, "joint_compliance")
+        cols = {s.name: s.basis[:, s.joint - 1] for s in specs}
+        return ctx.gravity_side_torque(), cols
+
+    side_mm, cols_mm = torques(puma)
+    side_u, cols_u = torques(in_unit(puma, unit))
+    assert np.abs(side_mm - tau).max() > 1.0  # the payload adds a real torque
+    np.testing.assert_allclose(side_u, side_mm, rtol=1e-9, atol=1e-9)
+    assert cols_u.keys() == cols_mm.keys()
+    assert any(k.endswith("compliance_payload") for k in cols_mm)
+    for name in cols_mm:
+        np.testing.assert_allclose(cols_u[name], cols_mm[name], rtol=1e-9, atol=1e-9,
+                                   err_msg=name)
