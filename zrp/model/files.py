@@ -37,7 +37,7 @@ else:  # pragma: no cover
 __all__ = ["builtin_models", "dumps_model", "load_model", "loads_model", "save_model"]
 
 _TOP_KEYS = {"name", "length_unit", "joint", "end_effector"}
-_JOINT_KEYS = {"type", "axis", "body", "name"}
+_JOINT_KEYS = {"type", "axis", "body", "name", "limits", "velocity_limit"}
 _EE_KEYS = {"body", "axial", "transverse"}
 
 
@@ -130,14 +130,15 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
         field = next((f for f in fields if f in head), None)
         return (_key_line(text, tline, field) if field else None) or tline
 
-    joint_fields = ("type", "axis", "body")
+    joint_fields = ("type", "axis", "body", "velocity_limit", "limits")
     joints = []
     for k, jd in enumerate(joints_raw, start=1):
         tline = _line_of(text, r"\[\[\s*joint\s*\]\]", k - 1)
-        check_table(f"joint {k}", jd, _JOINT_KEYS, joint_fields, tline)
+        check_table(f"joint {k}", jd, _JOINT_KEYS, joint_fields[:3], tline)
         try:
             joints.append(Joint(type=jd["type"], axis=jd["axis"], body=jd["body"],
-                                name=str(jd.get("name", "")), index=k))
+                                name=str(jd.get("name", "")), index=k,
+                                limits=jd.get("limits"), velocity_limit=jd.get("velocity_limit")))
         except ModelError as exc:
             raise fail(str(exc), line_of_error(exc, joint_fields, tline)) from exc
 
@@ -164,8 +165,12 @@ def dumps_model(model: Manipulator) -> str:
         out.append("[[joint]]")
         if j.name:
             out.append(f"name = {_toml_str(j.name)}")
-        out += [f'type = "{j.type}"', f"axis = {_fmt_vec(j.axis)}", f"body = {_fmt_vec(j.body)}",
-                ""]
+        out += [f'type = "{j.type}"', f"axis = {_fmt_vec(j.axis)}", f"body = {_fmt_vec(j.body)}"]
+        if j.limits is not None:  # optional; rad or the length unit (prismatic)
+            out.append(f"limits = [{j.limits[0]!r}, {j.limits[1]!r}]")  # inf is valid TOML
+        if j.velocity_limit is not None:
+            out.append(f"velocity_limit = {j.velocity_limit!r}")
+        out.append("")
     ee = model.end_effector
     out += ["[end_effector]", f"body = {_fmt_vec(ee.body)}", f"axial = {_fmt_vec(ee.axial)}",
             f"transverse = {_fmt_vec(ee.transverse)}", ""]

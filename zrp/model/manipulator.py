@@ -32,6 +32,7 @@ __all__ = [
     "EndEffector",
     "Joint",
     "Manipulator",
+    "check_limits",
     "check_unit_vector",
     "check_vector3",
     "hand_frame",
@@ -82,6 +83,19 @@ def check_unit_vector(value: ArrayLike, where: str) -> NDArray[np.float64]:
     return arr / norm
 
 
+def check_limits(value: object, where: str) -> tuple[float, float] | None:
+    """``None`` or a pair (lo, hi) of numbers with lo <= hi (either may be -inf/+inf)."""
+    if value is None:
+        return None
+    try:
+        lo, hi = (float(x) for x in value)  # type: ignore[attr-defined]
+    except (TypeError, ValueError) as exc:
+        raise ModelError(f"{where}: expected [lo, hi] (two numbers), got {value!r}") from exc
+    if np.isnan(lo) or np.isnan(hi) or not lo <= hi:
+        raise ModelError(f"{where}: expected lo <= hi, got [{lo!r}, {hi!r}]")
+    return (lo, hi)
+
+
 def _frozen(arr: NDArray[np.float64]) -> NDArray[np.float64]:
     arr = np.array(arr, dtype=float)
     arr.setflags(write=False)
@@ -93,6 +107,9 @@ class Joint:
     """One joint: its type, axis u_{k,0} and body vector b_{k,0} (length unit of the model).
 
     ``index`` (1-based) and ``name`` only serve error messages and output labels.
+    ``limits`` = (lo, hi) bounds q_k (rad, or the length unit for a prismatic joint; None:
+    unlimited, e.g. a URDF continuous joint); ``velocity_limit`` bounds |qdot_k| (rad/s or
+    length unit/s; None: not given).
     """
 
     type: JointType
@@ -100,6 +117,8 @@ class Joint:
     body: NDArray[np.float64]
     name: str = ""
     index: int = field(default=0, compare=False)
+    limits: tuple[float, float] | None = None
+    velocity_limit: float | None = None
 
     def __post_init__(self) -> None:
         label = f"joint {self.index}" if self.index else "joint"
@@ -111,6 +130,14 @@ class Joint:
             )
         object.__setattr__(self, "axis", _frozen(check_unit_vector(self.axis, f"{label} axis")))
         object.__setattr__(self, "body", _frozen(check_vector3(self.body, f"{label} body")))
+        object.__setattr__(self, "limits", check_limits(self.limits, f"{label} limits"))
+        if self.velocity_limit is not None:
+            v = self.velocity_limit
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.floating, np.integer)) \
+                    or not np.isfinite(v) or v <= 0:
+                raise ModelError(f"{label} velocity_limit: expected a finite number > 0, got "
+                                 f"{v!r}")
+            object.__setattr__(self, "velocity_limit", float(v))
 
     @property
     def is_prismatic(self) -> bool:
@@ -209,6 +236,8 @@ class Manipulator:
         name: str = "manipulator",
         length_unit: str = "mm",
         joint_names: Sequence[str] | None = None,
+        limits: Sequence[tuple[float, float] | None] | None = None,
+        velocity_limits: Sequence[float | None] | None = None,
     ) -> Manipulator:
         """Build from stacked arrays.
 
@@ -217,6 +246,8 @@ class Manipulator:
             bodies: b_{k,0} for k = 1..n+1, shape (n + 1, 3); the last row is the end effector's.
             axial, transverse: u_{a,0} and u_{t,0}, shape (3,).
             types: one type for all joints, or one per joint.
+            limits: per joint (lo, hi) or None, rad or length unit; velocity_limits: per joint
+                or None.
         """
         axes = np.asarray(axes, dtype=float)
         bodies = np.asarray(bodies, dtype=float)
@@ -231,8 +262,14 @@ class Manipulator:
         if len(types) != n:
             raise ModelError(f"types: expected {n} joint types, got {len(types)}")
         names = list(joint_names) if joint_names is not None else [""] * n
+        lims = list(limits) if limits is not None else [None] * n
+        vels = list(velocity_limits) if velocity_limits is not None else [None] * n
+        for label, seq in (("joint_names", names), ("limits", lims), ("velocity_limits", vels)):
+            if len(seq) != n:
+                raise ModelError(f"{label}: expected {n} entries (one per joint), got {len(seq)}")
         joints = tuple(
-            Joint(type=t, axis=axes[k], body=bodies[k], name=names[k], index=k + 1)  # type: ignore[arg-type]
+            Joint(type=t, axis=axes[k], body=bodies[k], name=names[k], index=k + 1,  # type: ignore[arg-type]
+                  limits=lims[k], velocity_limit=vels[k])
             for k, t in enumerate(types)
         )
         return cls(joints, EndEffector(bodies[n], axial, transverse), name, length_unit)
@@ -296,7 +333,23 @@ class Manipulator:
             name=self.name if name is None else name,
             length_unit=self.length_unit,
             joint_names=[j.name for j in self.joints],
+            limits=[j.limits for j in self.joints],
+            velocity_limits=[j.velocity_limit for j in self.joints],
         )
+
+    @cached_property
+    def lower(self) -> NDArray[np.float64]:
+        """Lower joint limits, shape (n,) (-inf where a joint has none)."""
+        return _frozen(np.array([j.limits[0] if j.limits else -np.inf for j in self.joints]))
+
+    @cached_property
+    def upper(self) -> NDArray[np.float64]:
+        """Upper joint limits, shape (n,) (+inf where a joint has none)."""
+        return _frozen(np.array([j.limits[1] if j.limits else np.inf for j in self.joints]))
+
+    @property
+    def has_limits(self) -> bool:
+        return any(j.limits is not None for j in self.joints)
 
     def __repr__(self) -> str:
         kinds = "".join("P" if p else "R" for p in self.prismatic)
