@@ -1,0 +1,293 @@
+"""Read the kinematic tree of a URDF file (standard library ``xml.etree``) into a ZRP model.
+
+Only what kinematics needs is read: links (by name), joints (type, parent, child, ``origin``
+xyz/rpy, ``axis``, ``limit``, ``mimic``). Meshes, ``package://`` URIs, inertias and collision
+geometry are never opened or checked, so a URDF imports as shipped.
+
+The chain runs from ``base_link`` (default: the tree's root) to ``end_link`` (any link, also one
+behind fixed joints such as ``tool0``). At q = 0 every joint frame sits at its ``origin``; its
+world axis R_joint @ axis is u_{k,0} and its origin the point on joint k, so b_{1,0} is the
+first joint's origin in the base link's frame, b_{k,0} the difference of consecutive joint
+origins and b_{n+1,0} the vector to the end link's origin, whose frame's z and y columns give
+u_{a,0} and u_{t,0} (the ``zrp.hand_frame`` convention). URDF lengths are metres; the model is
+converted to ``length_unit``. ``revolute`` and ``continuous`` joints become revolute joints
+(continuous ones without limits), ``prismatic`` ones prismatic, ``fixed`` ones fold into the
+body vectors. ``floating`` and ``planar`` joints and mimic joints on the chain are refused with
+an error that names them (for a mobile manipulator, start at the arm's base link).
+"""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.errors import ModelFileError
+from zrp.model.manipulator import Manipulator
+from zrp.units import metres_per_unit
+
+__all__ = ["URDFImport", "URDFJoint", "URDFTree", "from_urdf", "import_urdf", "read_urdf"]
+
+F64 = NDArray[np.float64]
+_MOVING = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
+_KNOWN = {*_MOVING, "fixed", "floating", "planar"}
+
+
+@dataclass(frozen=True)
+class URDFJoint:
+    """One ``<joint>``: lengths in m, angles in rad; ``limits`` None when absent/continuous."""
+
+    name: str
+    type: str
+    parent: str
+    child: str
+    origin: F64 = field(repr=False)  # 4x4 homogeneous transform parent -> joint frame
+    axis: F64 = field(repr=False)
+    limits: tuple[float, float] | None = None
+    velocity_limit: float | None = None
+    mimic: str | None = None
+
+
+@dataclass(frozen=True)
+class URDFTree:
+    """The kinematic tree: link names, joints by child link, and the root link."""
+
+    name: str
+    source: str
+    links: tuple[str, ...]
+    joints: dict[str, URDFJoint]  # keyed by child link
+    root: str
+
+    def children(self, link: str) -> list[str]:
+        return [c for c, j in self.joints.items() if j.parent == link]
+
+    def leaves(self, start: str) -> list[str]:
+        """Links without children in the subtree under ``start`` (depth first)."""
+        out, stack = [], [start]
+        while stack:
+            link = stack.pop()
+            kids = self.children(link)
+            if not kids:
+                out.append(link)
+            stack.extend(reversed(kids))
+        return out
+
+    def path(self, base: str, end: str) -> list[URDFJoint]:
+        """Joints from ``base`` down to ``end``, base first."""
+        chain: list[URDFJoint] = []
+        link = end
+        while link != base:
+            j = self.joints.get(link)
+            if j is None:
+                raise ModelFileError(f"{self.source}: end_link {end!r} is not below base_link "
+                                     f"{base!r} in the kinematic tree")
+            chain.append(j)
+            link = j.parent
+        return chain[::-1]
+
+
+@dataclass(frozen=True, eq=False)
+class URDFImport:
+    """A URDF import: the model, the links it runs between and notes on what was left out."""
+
+    model: Manipulator
+    base_link: str
+    end_link: str
+    joints: tuple[str, ...]
+    notes: tuple[str, ...] = ()
+
+
+def _floats(text: str | None, n: int, default: list[float], where: str) -> F64:
+    if text is None:
+        return np.array(default, dtype=float)
+    try:
+        v = np.array([float(x) for x in text.split()], dtype=float)
+    except ValueError as exc:
+        raise ModelFileError(f"{where}: expected {n} numbers, got {text!r}") from exc
+    if v.shape != (n,) or not np.all(np.isfinite(v)):
+        raise ModelFileError(f"{where}: expected {n} finite numbers, got {text!r}")
+    return v
+
+
+def rpy_matrix(rpy: F64) -> F64:
+    """URDF fixed-axis roll-pitch-yaw: R = Rz(yaw) Ry(pitch) Rx(roll), shape (3, 3)."""
+    r, p, y = rpy
+    cr, sr, cp, sp, cy, sy = np.cos(r), np.sin(r), np.cos(p), np.sin(p), np.cos(y), np.sin(y)
+    return np.array([[cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr],
+                     [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr],
+                     [-sp, cp * sr, cp * cr]])
+
+
+def _limits(el: ET.Element, jtype: str, where: str) -> tuple[tuple[float, float] | None,
+                                                             float | None]:
+    lim = el.find("limit")
+    if lim is None:
+        return None, None
+    vel = lim.get("velocity")
+    v = float(vel) if vel is not None and float(vel) > 0 else None
+    if jtype == "continuous":
+        return None, v
+    lo, hi = float(lim.get("lower", "0")), float(lim.get("upper", "0"))
+    if lo > hi:
+        raise ModelFileError(f"{where} limit: lower {lo} > upper {hi}")
+    return (lo, hi), v
+
+
+def _joint(el: ET.Element, source: str) -> URDFJoint:
+    name = el.get("name", "")
+    where = f"{source}: joint {name!r}"
+    jtype = el.get("type", "")
+    if jtype not in _KNOWN:
+        raise ModelFileError(f"{where}: type {jtype!r} is unknown; expected one of "
+                             f"{sorted(_KNOWN)}")
+    parent, child = el.find("parent"), el.find("child")
+    if parent is None or child is None or not parent.get("link") or not child.get("link"):
+        raise ModelFileError(f"{where}: needs <parent link=...> and <child link=...>")
+    org = el.find("origin")
+    xyz = _floats(org.get("xyz") if org is not None else None, 3, [0, 0, 0], f"{where} origin xyz")
+    rpy = _floats(org.get("rpy") if org is not None else None, 3, [0, 0, 0], f"{where} origin rpy")
+    t = np.eye(4)
+    t[:3, :3], t[:3, 3] = rpy_matrix(rpy), xyz
+    ax_el = el.find("axis")
+    axis = _floats(ax_el.get("xyz") if ax_el is not None else None, 3, [1, 0, 0],
+                   f"{where} axis")
+    if jtype in _MOVING:
+        norm = float(np.linalg.norm(axis))
+        if norm < 1e-12:
+            raise ModelFileError(f"{where} axis: is a zero vector; expected e.g. '0 0 1'")
+        axis = axis / norm
+    lims, vel = _limits(el, jtype, where) if jtype in _MOVING else (None, None)
+    mimic = el.find("mimic")
+    return URDFJoint(name, jtype, parent.get("link", ""), child.get("link", ""), t, axis, lims,
+                     vel, mimic.get("joint") if mimic is not None else None)
+
+
+def read_urdf(source: str | Path) -> URDFTree:
+    """Parse a URDF file path (or URDF XML text) into its kinematic tree.
+
+    Raises:
+        ModelFileError: unreadable file, invalid XML (with its line), a joint without parent or
+            child, an unknown joint type, several roots or a link with two parents.
+    """
+    text_given = isinstance(source, str) and source.lstrip().startswith("<")
+    label = "<urdf string>" if text_given else str(source)
+    try:
+        root_el = (ET.fromstring(source) if text_given  # noqa: S314 (a local robot file)
+                   else ET.parse(source).getroot())  # noqa: S314
+    except ET.ParseError as exc:
+        raise ModelFileError(f"{label}, line {exc.position[0]}: not valid XML: {exc}") from exc
+    except OSError as exc:
+        raise ModelFileError(f"{label}: cannot read the URDF file: {exc}") from exc
+    if root_el.tag != "robot":
+        raise ModelFileError(f"{label}: the root element is <{root_el.tag}>; expected <robot>")
+    links = tuple(el.get("name", "") for el in root_el.findall("link"))
+    if not links:
+        raise ModelFileError(f"{label}: the <robot> has no <link> elements: nothing to import")
+    joints: dict[str, URDFJoint] = {}
+    for el in root_el.findall("joint"):
+        j = _joint(el, label)
+        if j.child in joints:
+            raise ModelFileError(f"{label}: link {j.child!r} has two parent joints "
+                                 f"({joints[j.child].name!r}, {j.name!r})")
+        joints[j.child] = j
+    roots = [lk for lk in links if lk not in joints]
+    if len(roots) != 1:
+        raise ModelFileError(f"{label}: expected one root link, found {roots}")
+    return URDFTree(root_el.get("name", "") or Path(label).stem, label, links, joints,
+                    roots[0])
+
+
+def _default_end(tree: URDFTree, base: str) -> str:
+    """The last moving link when every leaf under ``base`` shares one chain of moving joints."""
+    chains = {}
+    for leaf in tree.leaves(base):
+        moving = tuple(j.name for j in tree.path(base, leaf) if j.type != "fixed")
+        chains.setdefault(moving, leaf)
+    chains.pop((), None)
+    longest = max(chains, key=len, default=())
+    if not longest:
+        raise ModelFileError(f"{tree.source}: no moving joint below base_link {base!r}")
+    if any(c[:len(longest)] != longest[:len(c)] for c in chains):
+        raise ModelFileError(
+            f"{tree.source}: the kinematic tree below {base!r} branches; name the end effector "
+            f"with end_link=, e.g. one of the branch ends {sorted(chains.values())}")
+    last = next(j for j in tree.joints.values() if j.name == longest[-1])
+    return last.child
+
+
+def _check_chain(tree: URDFTree, chain: list[URDFJoint], base: str) -> None:
+    for j in chain:
+        if j.type in ("floating", "planar"):
+            raise ModelFileError(
+                f"{tree.source}: joint {j.name!r} between {base!r} and the end effector is "
+                f"{j.type}; a ZRP arm has revolute and prismatic joints only: start at "
+                f"base_link={j.child!r} (the arm of a mobile manipulator)")
+        if j.mimic is not None:
+            raise ModelFileError(
+                f"{tree.source}: joint {j.name!r} mimics joint {j.mimic!r}; coupled joints are "
+                f"not modelled: choose an end_link before it")
+
+
+def import_urdf(source: str | Path, *, end_link: str | None = None,
+                base_link: str | None = None, length_unit: str = "mm",
+                name: str | None = None) -> URDFImport:
+    """Import the serial chain base_link -> end_link of a URDF (see the module docstring).
+
+    Args:
+        source: URDF file path or XML text.
+        end_link: the end-effector link (default: the last moving link when the tree has one
+            chain of moving joints; otherwise an error lists the branch ends).
+        base_link: the link whose frame is the base frame (default: the root link).
+        length_unit: unit of the model (URDF is in metres).
+        name: model name (default: the robot's name).
+
+    Raises:
+        ModelFileError: an unknown link, a branching tree without ``end_link``, a floating or
+            planar joint or a mimic joint on the chain, no moving joint.
+    """
+    tree = read_urdf(source)
+    base = tree.root if base_link is None else base_link
+    for arg, link in (("base_link", base), ("end_link", end_link)):
+        if link is not None and link not in tree.links:
+            raise ModelFileError(f"{tree.source}: {arg}: no link named {link!r}; the links are "
+                                 f"{list(tree.links)}")
+    end = _default_end(tree, base) if end_link is None else end_link
+    chain = tree.path(base, end)
+    _check_chain(tree, chain, base)
+    scale = 1.0 / metres_per_unit(length_unit)
+    t = np.eye(4)
+    axes, points, types, names, lims, vels = [], [], [], [], [], []
+    for j in chain:
+        t = t @ j.origin
+        if j.type == "fixed":
+            continue
+        axes.append(t[:3, :3] @ j.axis)
+        points.append(t[:3, 3] * scale)
+        types.append(_MOVING[j.type])
+        names.append(j.name)
+        s = scale if j.type == "prismatic" else 1.0
+        lims.append(None if j.limits is None else (j.limits[0] * s, j.limits[1] * s))
+        vels.append(None if j.velocity_limit is None else j.velocity_limit * s)
+    if not axes:
+        raise ModelFileError(f"{tree.source}: no revolute, continuous or prismatic joint between "
+                             f"{base!r} and {end!r}")
+    pts = np.array(points)
+    bodies = np.vstack([pts[:1], np.diff(pts, axis=0), (t[:3, 3] * scale - pts[-1])[None]])
+    model = Manipulator.from_arrays(
+        np.array(axes), bodies, axial=t[:3, 2], transverse=t[:3, 1], types=types,
+        name=name or tree.name, length_unit=length_unit, joint_names=names, limits=lims,
+        velocity_limits=vels)
+    on_chain = {j.name for j in chain}
+    others = sorted(j.name for j in tree.joints.values() if j.name not in on_chain
+                    and j.type != "fixed")
+    notes = [f"{len(others)} moving joints off the chain {base!r} -> {end!r} ignored: {others}"
+             ] if others else []
+    return URDFImport(model, base, end, tuple(names), tuple(notes))
+
+
+def from_urdf(source: str | Path, **kwargs: object) -> Manipulator:
+    """The model of :func:`import_urdf` (same arguments)."""
+    return import_urdf(source, **kwargs).model  # type: ignore[arg-type]
