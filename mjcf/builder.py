@@ -210,6 +210,9 @@ def _add_links(world: mujoco.MjsBody, model: Manipulator, options: MJCFOptions,
         joint.type = (mujoco.mjtJoint.mjJNT_SLIDE if model.prismatic[k]
                       else mujoco.mjtJoint.mjJNT_HINGE)
         joint.armature = inertias[k].armature
+        lim = model.joints[k].limits
+        if lim is not None and np.all(np.isfinite(lim)):  # MJCF ranges are finite (rad or m)
+            joint.range = [v * (scale if model.prismatic[k] else 1.0) for v in lim]
         inert = inertias[k]
         body.explicitinertial = True
         body.mass = inert.mass

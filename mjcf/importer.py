@@ -1,4 +1,5 @@
-"""Read a serial arm from an MJCF file (or a URDF, which MuJoCo loads) into a ZRP model.
+"""Read a serial arm from an MJCF file into a ZRP model (a ``.urdf`` path is read by
+:mod:`zrp.model.urdf`, without MuJoCo: kinematics need no meshes or inertias).
 
 The zero reference position is MuJoCo's qpos = 0 (not the model's ``qpos0``/``ref``): at
 qpos = 0 MuJoCo's kinematics gives, for each hinge/slide joint on the chain from the world to
@@ -20,6 +21,7 @@ import numpy as np
 from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
+from zrp.model.urdf import from_urdf
 from zrp.units import metres_per_unit
 
 __all__ = ["from_mjcf", "load_mujoco_model", "manipulator_from_mujoco"]
@@ -112,6 +114,11 @@ def manipulator_from_mujoco(
         MJCFImportError: ball/free joints on the chain, a branching tree without site/body, an
             unknown site/body name, or a file MuJoCo cannot load.
     """
+    if isinstance(source, (str, os.PathLike)) and str(source).lower().endswith(".urdf"):
+        # kinematics of a URDF come from its tree (zrp.model.urdf): no meshes or inertias
+        if site is not None:
+            raise InputError("site: a URDF has no sites; name the end-effector link with body=")
+        return from_urdf(source, end_link=body, length_unit=length_unit, name=name)
     m = load_mujoco_model(source)
     scale = metres_per_unit(length_unit)
     bid, sid = _end_body(m, site, body)
@@ -148,9 +155,13 @@ def manipulator_from_mujoco(
              for j in joints]
     names = [_name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in joints]
     model_name = name or bytes(m.names).split(b"\0", 1)[0].decode() or "imported arm"
+    limits = [None if not m.jnt_limited[j] else
+              tuple(m.jnt_range[j] / (scale if int(m.jnt_type[j]) == _SLIDE else 1.0))
+              for j in joints]
     return Manipulator.from_arrays(axes, bodies, axial=frame[:, 2], transverse=frame[:, 1],
                                    types=types, name=model_name, length_unit=length_unit,
-                                   joint_names=[n if not n.startswith("#") else "" for n in names])
+                                   joint_names=[n if not n.startswith("#") else "" for n in names],
+                                   limits=limits)
 
 
 def from_mjcf(path: str | os.PathLike[str], **kwargs: object) -> Manipulator:

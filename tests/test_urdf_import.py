@@ -20,7 +20,8 @@ from zrp.model.urdf import import_urdf, read_urdf
 def _erd_root() -> str:
     pin = pytest.importorskip("pinocchio", reason="optional: pip install pin")
     base = os.path.dirname(pin.__file__)
-    for up in ("../../../../share/example-robot-data/robots", "../../../share/example-robot-data/robots"):
+    for up in ("../../../../share/example-robot-data/robots",
+               "../../../share/example-robot-data/robots"):
         root = os.path.normpath(os.path.join(base, up))
         if os.path.isdir(root):
             return root
@@ -111,7 +112,7 @@ def test_panda_as_shipped_fixed_tool_frame_limits():
     assert np.array_equal(back.lower, m.lower) and np.array_equal(back.upper, m.upper)
     assert [j.velocity_limit for j in back.joints] == [j.velocity_limit for j in m.joints]
     # the default end effector of a branching hand: an error listing the branch ends
-    with pytest.raises(ModelFileError, match="branches.*panda_leftfinger"):
+    with pytest.raises(ModelFileError, match=r"branches.*panda_leftfinger"):
         import_urdf(f)
 
 
@@ -134,7 +135,7 @@ _TREE = """<robot name="t">
 
 
 def test_hand_made_tree_base_link_tool_mimic_and_floating():
-    with pytest.raises(ModelFileError, match="'free'.*floating.*base_link='cart'"):
+    with pytest.raises(ModelFileError, match=r"'free'.*floating.*base_link='cart'"):
         import_urdf(_TREE, end_link="tool")
     imp = import_urdf(_TREE, base_link="cart", end_link="tool")
     m = imp.model

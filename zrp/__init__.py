@@ -3,9 +3,11 @@
 from zrp.errors import (
     IKError,
     InputError,
+    JointLimitError,
     ModelError,
     ModelFileError,
     OutputExistsError,
+    SingularityError,
     SingularityWarning,
     TrackingWarning,
     UnitError,
@@ -16,6 +18,8 @@ from zrp.errors import (
 from zrp.gap import Diagnosis, Measurements, diagnose, load_measurements, write_outputs
 from zrp.kinematics.forward import FKResult, end_effector_pose, forward_kinematics, jacobian
 from zrp.kinematics.ik import IKResult, track_trajectory
+from zrp.kinematics.posture import PoseSolution, solve_pose
+from zrp.kinematics.redundant import track_posture
 from zrp.kinematics.sampling import reachable_poses, uniform_joint_values
 from zrp.kinematics.trajectory import (
     Circle,
@@ -41,6 +45,8 @@ from zrp.manufacturing.tolerance import Tolerances
 from zrp.model.dh import DHRow, from_dh, from_mdh
 from zrp.model.files import builtin_models, dumps_model, load_model, loads_model, save_model
 from zrp.model.manipulator import EndEffector, Joint, Manipulator, hand_frame
+from zrp.model.urdf import URDFImport, from_urdf, import_urdf
+from zrp.model.urdf_writer import save_urdf, urdf_xml
 from zrp.paper.example import run_paper_example
 from zrp.paper.report import write_paper_outputs
 from zrp.paper.scenario import circle_joint_path, puma_circle, puma_circle_ik
@@ -61,6 +67,7 @@ __all__ = [
     "IKResult",
     "InputError",
     "Joint",
+    "JointLimitError",
     "JointPath",
     "Line",
     "Manipulator",
@@ -70,6 +77,8 @@ __all__ = [
     "MonteCarloResult",
     "OutputExistsError",
     "Perturbation",
+    "PoseSolution",
+    "SingularityError",
     "SingularityWarning",
     "StudyResult",
     "TimeLaw",
@@ -77,6 +86,7 @@ __all__ = [
     "TrackingWarning",
     "Trajectory",
     "TrajectorySample",
+    "URDFImport",
     "UnitError",
     "UnreachableError",
     "ZRPError",
@@ -91,7 +101,9 @@ __all__ = [
     "forward_kinematics",
     "from_dh",
     "from_mdh",
+    "from_urdf",
     "hand_frame",
+    "import_urdf",
     "jacobian",
     "load_joint_csv",
     "load_measurements",
@@ -109,9 +121,13 @@ __all__ = [
     "reachable_poses",
     "run_paper_example",
     "save_model",
+    "save_urdf",
+    "solve_pose",
+    "track_posture",
     "track_trajectory",
     "trajectory_deviation",
     "uniform_joint_values",
+    "urdf_xml",
     "write_outputs",
     "write_paper_outputs",
 ]

@@ -10,10 +10,12 @@ from __future__ import annotations
 __all__ = [
     "IKError",
     "InputError",
+    "JointLimitError",
     "ModelError",
     "ModelFileError",
     "OutputBusyError",
     "OutputExistsError",
+    "SingularityError",
     "SingularityWarning",
     "TrackingWarning",
     "UnitError",
@@ -90,6 +92,14 @@ class IKError(ZRPError, RuntimeError):
 
 class UnreachableError(IKError):
     """A trajectory point lies outside the reachable workspace."""
+
+
+class SingularityError(IKError):
+    """The target is within reach but the arm is at a kinematic singularity there."""
+
+
+class JointLimitError(IKError):
+    """The motion needs a joint beyond its limits (the message names the joint and time)."""
 
 
 class ZRPWarning(UserWarning):

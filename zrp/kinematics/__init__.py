@@ -13,6 +13,12 @@ from zrp.kinematics.ik import CORRECTIONS as CORRECTIONS
 from zrp.kinematics.ik import TASKS as TASKS
 from zrp.kinematics.ik import IKResult as IKResult
 from zrp.kinematics.ik import track_trajectory as track_trajectory
+from zrp.kinematics.posture import PoseSolution as PoseSolution
+from zrp.kinematics.posture import Posture as Posture
+from zrp.kinematics.posture import check_limits_along as check_limits_along
+from zrp.kinematics.posture import solve_pose as solve_pose
+from zrp.kinematics.redundant import LIMIT_MODES as LIMIT_MODES
+from zrp.kinematics.redundant import track_posture as track_posture
 from zrp.kinematics.sampling import reachable_poses as reachable_poses
 from zrp.kinematics.sampling import uniform_joint_values as uniform_joint_values
 from zrp.kinematics.trajectory import TIME_LAWS as TIME_LAWS
@@ -26,6 +32,7 @@ from zrp.kinematics.trajectory import TrajectorySample as TrajectorySample
 
 __all__ = [
     "CORRECTIONS",
+    "LIMIT_MODES",
     "TASKS",
     "TIME_LAWS",
     "Circle",
@@ -34,14 +41,19 @@ __all__ = [
     "IKResult",
     "Line",
     "OrientationLaw",
+    "PoseSolution",
+    "Posture",
     "TimeLaw",
     "Trajectory",
     "TrajectorySample",
+    "check_limits_along",
     "check_q",
     "end_effector_pose",
     "forward_kinematics",
     "jacobian",
     "reachable_poses",
+    "solve_pose",
+    "track_posture",
     "track_trajectory",
     "uniform_joint_values",
 ]

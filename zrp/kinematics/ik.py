@@ -25,12 +25,15 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.errors import (
     IKError,
     InputError,
+    JointLimitError,
+    SingularityError,
     SingularityWarning,
     TrackingWarning,
     UnreachableError,
 )
 from zrp.kinematics import _ik_kernels as IKK
 from zrp.kinematics.forward import _karrays, check_q, end_effector_pose
+from zrp.kinematics.posture import check_limits_along
 from zrp.kinematics.trajectory import Trajectory
 from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
@@ -198,15 +201,23 @@ def _desired_orientation(model: Manipulator, q0: F64, sample: Any, mid: Any,
 
 
 def _check_reached(model: Manipulator, t: F64, sample: Any, out: dict[str, F64],
-                   correction: str) -> None:
+                   correction: str, manipulability_threshold: float) -> None:
     bad = out["err_p"] > 1e-3 * model.characteristic_length
     if bad.any() and correction != "none":
         i = int(np.argmax(bad))
+        pt = np.round(sample.position[i], 6).tolist()
+        dist = float(np.linalg.norm(sample.position[i] - model.bodies[0]))
+        reach = float(np.sum(np.linalg.norm(model.bodies[1:], axis=1)))
+        if out["manip"][i] < manipulability_threshold and dist <= reach:
+            raise SingularityError(
+                f"cannot follow the path at t = {t[i]:.6g} s: point {pt} is within reach "
+                f"({dist:.6g} of {reach:.6g} {model.length_unit}) but the arm is at a "
+                f"singularity (manipulability {out['manip'][i]:.3g}); it stays "
+                f"{out['err_p'][i]:.4g} {model.length_unit} away")
         raise UnreachableError(
-            f"cannot reach the desired pose at t = {t[i]:.6g} s: point "
-            f"{np.round(sample.position[i], 6).tolist()} stays {out['err_p'][i]:.4g} "
-            f"{model.length_unit} away (manipulability {out['manip'][i]:.3g}); the target is "
-            f"outside the workspace or at a singularity")
+            f"cannot reach the desired pose at t = {t[i]:.6g} s: point {pt} stays "
+            f"{out['err_p'][i]:.4g} {model.length_unit} away (manipulability "
+            f"{out['manip'][i]:.3g}); the target is outside the workspace")
 
 
 def _notes(model: Manipulator, t: F64, sample: Any, out: dict[str, F64], use_newton: bool,
@@ -235,6 +246,21 @@ def _notes(model: Manipulator, t: F64, sample: Any, out: dict[str, F64], use_new
     return notes
 
 
+def _limit_notes(model: Manipulator, t: F64, q: F64, mode: str
+                 ) -> list[tuple[str, type[Warning]]]:
+    if mode not in ("error", "warn", "ignore"):
+        raise InputError(f"limits: {mode!r} is unknown; expected 'error', 'warn' or 'ignore'")
+    if mode == "ignore":
+        return []
+    try:
+        check_limits_along(model, t, q)
+    except JointLimitError as exc:
+        if mode == "error":
+            raise
+        return [(str(exc), TrackingWarning)]
+    return []
+
+
 def track_trajectory(
     model: Manipulator,
     trajectory: Trajectory,
@@ -250,6 +276,7 @@ def track_trajectory(
     manipulability_threshold: float = 1e-3,
     max_damping: float = 0.05,
     warn: bool = True,
+    limits: Literal["error", "warn", "ignore"] = "error",
 ) -> IKResult:
     """Solve the inverse kinematics along ``trajectory`` from the start configuration ``q0``.
 
@@ -272,11 +299,17 @@ def track_trajectory(
         manipulability_threshold: below this manipulability the least squares are damped.
         max_damping: damping factor lambda reached at zero manipulability.
         warn: emit :class:`SingularityWarning` / :class:`TrackingWarning`.
+        limits: when the solved joints leave the model's joint limits: "error" (default,
+            :class:`JointLimitError` naming the joint and time), "warn" (a TrackingWarning) or
+            "ignore". The rates themselves ignore the limits; :func:`zrp.track_posture` keeps
+            redundant arms inside them.
 
     Raises:
         UnreachableError: a trajectory point lies beyond the arm's reach, or the pose cannot be
             reached within 1e-3 of the characteristic length (time and point in the message).
         IKError: the integration diverged.
+        SingularityError: a point within reach that the arm cannot follow at a singularity.
+        JointLimitError: with ``limits="error"``, the path needs a joint beyond its limits.
     """
     q0, n_steps, task, gain = _check_options(model, trajectory, q0, steps, task, correction,
                                              gain)
@@ -317,8 +350,9 @@ def track_trajectory(
                       f"{np.round(sample.position[k_fail], 6).tolist()}): joint values became "
                       f"non-finite; try more steps or a start configuration away from "
                       f"singularities")
-    _check_reached(model, t, sample, out, correction)
+    _check_reached(model, t, sample, out, correction, manipulability_threshold)
     notes = _notes(model, t, sample, out, use_newton, position_tol, orientation_tol_rad)
+    notes += _limit_notes(model, t, q_out, limits)
     if warn:
         for msg, category in notes:
             warnings.warn(msg, category, stacklevel=2)

@@ -19,6 +19,13 @@ from zrp.model.manipulator import Manipulator as Manipulator
 from zrp.model.manipulator import check_unit_vector as check_unit_vector
 from zrp.model.manipulator import check_vector3 as check_vector3
 from zrp.model.manipulator import hand_frame as hand_frame
+from zrp.model.urdf import URDFImport as URDFImport
+from zrp.model.urdf import URDFTree as URDFTree
+from zrp.model.urdf import from_urdf as from_urdf
+from zrp.model.urdf import import_urdf as import_urdf
+from zrp.model.urdf import read_urdf as read_urdf
+from zrp.model.urdf_writer import save_urdf as save_urdf
+from zrp.model.urdf_writer import urdf_xml as urdf_xml
 
 __all__ = [
     "JOINT_TYPES",
@@ -26,6 +33,8 @@ __all__ = [
     "EndEffector",
     "Joint",
     "Manipulator",
+    "URDFImport",
+    "URDFTree",
     "builtin_models",
     "check_unit_vector",
     "check_vector3",
@@ -33,9 +42,14 @@ __all__ = [
     "dumps_model",
     "from_dh",
     "from_mdh",
+    "from_urdf",
     "hand_frame",
+    "import_urdf",
     "load_model",
     "loads_model",
     "mdh_forward",
+    "read_urdf",
     "save_model",
+    "save_urdf",
+    "urdf_xml",
 ]

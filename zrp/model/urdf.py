@@ -175,8 +175,8 @@ def read_urdf(source: str | Path) -> URDFTree:
     text_given = isinstance(source, str) and source.lstrip().startswith("<")
     label = "<urdf string>" if text_given else str(source)
     try:
-        root_el = (ET.fromstring(source) if text_given  # noqa: S314 (a local robot file)
-                   else ET.parse(source).getroot())  # noqa: S314
+        root_el = (ET.fromstring(source) if text_given
+                   else ET.parse(source).getroot())
     except ET.ParseError as exc:
         raise ModelFileError(f"{label}, line {exc.position[0]}: not valid XML: {exc}") from exc
     except OSError as exc:
@@ -201,7 +201,8 @@ def read_urdf(source: str | Path) -> URDFTree:
 
 
 def _default_end(tree: URDFTree, base: str) -> str:
-    """The last moving link when every leaf under ``base`` shares one chain of moving joints."""
+    """When every leaf under ``base`` lies on one chain of moving joints: the leaf at its end
+    if it is the only one, else the last moving link (e.g. a UR's ``ee_link`` and ``tool0``)."""
     chains = {}
     for leaf in tree.leaves(base):
         moving = tuple(j.name for j in tree.path(base, leaf) if j.type != "fixed")
@@ -214,6 +215,10 @@ def _default_end(tree: URDFTree, base: str) -> str:
         raise ModelFileError(
             f"{tree.source}: the kinematic tree below {base!r} branches; name the end effector "
             f"with end_link=, e.g. one of the branch ends {sorted(chains.values())}")
+    tips = [leaf for leaf in tree.leaves(base)
+            if tuple(j.name for j in tree.path(base, leaf) if j.type != "fixed") == longest]
+    if len(tips) == 1:  # one tool link (behind fixed joints or not)
+        return tips[0]
     last = next(j for j in tree.joints.values() if j.name == longest[-1])
     return last.child
 
@@ -238,8 +243,9 @@ def import_urdf(source: str | Path, *, end_link: str | None = None,
 
     Args:
         source: URDF file path or XML text.
-        end_link: the end-effector link (default: the last moving link when the tree has one
-            chain of moving joints; otherwise an error lists the branch ends).
+        end_link: the end-effector link (default, when the tree has one chain of moving joints:
+            its only end link, or the last moving link if several fixed links hang there;
+            otherwise an error lists the branch ends).
         base_link: the link whose frame is the base frame (default: the root link).
         length_unit: unit of the model (URDF is in metres).
         name: model name (default: the robot's name).
