@@ -16,14 +16,14 @@ vector the tool y axis.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
-from zrp.model.manipulator import Manipulator
+from zrp.model.manipulator import Manipulator, check_limits
 
 __all__ = ["DHRow", "dh_forward", "from_dh", "from_mdh", "mdh_forward"]
 
@@ -35,7 +35,11 @@ class DHRow:
     """One row of a DH table. Lengths in the model's unit, angles in rad.
 
     ``offset`` is theta's value at the zero reference for a revolute joint, d's for a
-    prismatic one; the other of (theta, d) is the constant ``theta``/``d`` field.
+    prismatic one; the other of (theta, d) is the constant ``theta``/``d`` field. ``flip``
+    reverses the joint (Robotics Toolbox's ``flip``): theta = offset - q (or d = offset - q),
+    so the ZRP axis is -z. ``limits`` (Robotics Toolbox's ``qlim``) bounds q, rad or length
+    unit. Rows are best given by name (``DHRow(a=..., alpha=..., d=...)`` or a dict with those
+    keys); a plain sequence is read in the order (a, alpha, d, theta, type, offset).
     """
 
     a: float
@@ -44,6 +48,8 @@ class DHRow:
     theta: float = 0.0
     type: str = "revolute"
     offset: float = 0.0
+    flip: bool = False
+    limits: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if self.type not in ("revolute", "prismatic"):
@@ -52,13 +58,24 @@ class DHRow:
             v = getattr(self, name)
             if not np.isfinite(float(v)):
                 raise InputError(f"DH row {name}: expected a finite number, got {v!r}")
+        if self.limits is not None:
+            object.__setattr__(self, "limits", check_limits(self.limits, "DH row limits"))
 
 
 def _rows(rows: Sequence[DHRow | Sequence[float]]) -> list[DHRow]:
     out = []
+    known = [f.name for f in fields(DHRow)]
     for i, r in enumerate(rows, start=1):
         if isinstance(r, DHRow):
             out.append(r)
+        elif isinstance(r, Mapping):
+            bad = sorted(set(r) - set(known))
+            if bad:
+                raise InputError(f"DH row {i}: unknown field {bad[0]!r}; expected {known}")
+            try:
+                out.append(DHRow(**r))
+            except TypeError as exc:
+                raise InputError(f"DH row {i}: {exc}; expected fields {known}") from exc
         else:
             try:
                 out.append(DHRow(*r))  # type: ignore[arg-type]
@@ -93,42 +110,58 @@ def _tx(a: float) -> F64:
 
 
 def _joint_values(row: DHRow, qk: float) -> tuple[float, float]:
+    if row.flip:
+        qk = -qk
     if row.type == "revolute":
         return row.offset + qk, row.d
     return row.theta, row.offset + qk
 
 
+def _mat(t: ArrayLike | None, name: str) -> F64:
+    """A 4x4 homogeneous transform (identity for None)."""
+    if t is None:
+        return np.eye(4)
+    m = np.array(t, dtype=float)
+    if m.shape != (4, 4) or not np.all(np.isfinite(m)) or not np.allclose(m[3], [0, 0, 0, 1]):
+        raise InputError(f"{name}: expected a 4x4 homogeneous transform, got shape {m.shape}")
+    if not np.allclose(m[:3, :3] @ m[:3, :3].T, np.eye(3), atol=1e-9):
+        raise InputError(f"{name}: the rotation block is not orthonormal")
+    return m
+
+
 def dh_forward(rows: Sequence[DHRow | Sequence[float]], q: ArrayLike,
-               tool: ArrayLike | None = None) -> F64:
-    """Direct standard-DH chain: the tool's homogeneous transform, shape (4, 4)."""
+               tool: ArrayLike | None = None, base: ArrayLike | None = None) -> F64:
+    """Direct standard-DH chain base @ A_1 ... A_n @ tool: the tool's transform, (4, 4)."""
     rs = _rows(rows)
     q = np.asarray(q, dtype=float)
-    t = np.eye(4)
+    t = _mat(base, "base")
     for row, qk in zip(rs, q, strict=True):
         th, d = _joint_values(row, float(qk))
         t = t @ _rz(th) @ _tz(d) @ _tx(row.a) @ _rx(row.alpha)
-    return t @ (np.eye(4) if tool is None else np.asarray(tool, dtype=float))
+    return t @ _mat(tool, "tool")
 
 
 def mdh_forward(rows: Sequence[DHRow | Sequence[float]], q: ArrayLike,
-                tool: ArrayLike | None = None) -> F64:
+                tool: ArrayLike | None = None, base: ArrayLike | None = None) -> F64:
     """Direct modified-DH (Craig) chain: the tool's homogeneous transform, shape (4, 4).
 
     Row k holds (a_{k-1}, alpha_{k-1}, d_k, theta_k)."""
     rs = _rows(rows)
     q = np.asarray(q, dtype=float)
-    t = np.eye(4)
+    t = _mat(base, "base")
     for row, qk in zip(rs, q, strict=True):
         th, d = _joint_values(row, float(qk))
         t = t @ _rx(row.alpha) @ _tx(row.a) @ _rz(th) @ _tz(d)
-    return t @ (np.eye(4) if tool is None else np.asarray(tool, dtype=float))
+    return t @ _mat(tool, "tool")
 
 
-def _to_model(frames_joint: list[F64], tool_t: F64, types: list[str], name: str,
+def _to_model(frames_joint: list[F64], tool_t: F64, rs: list[DHRow], name: str,
               length_unit: str) -> Manipulator:
-    n = len(types)
+    n = len(rs)
+    types = [r.type for r in rs]
     pts = [f[:3, 3] for f in frames_joint]
-    axes = np.array([f[:3, 2] for f in frames_joint])
+    axes = np.array([f[:3, 2] * (-1.0 if r.flip else 1.0) for f, r in zip(frames_joint, rs,
+                                                                         strict=True)])
     bodies = np.zeros((n + 1, 3))
     prev = np.zeros(3)
     for k in range(n):
@@ -136,36 +169,42 @@ def _to_model(frames_joint: list[F64], tool_t: F64, types: list[str], name: str,
         prev = pts[k]
     bodies[n] = tool_t[:3, 3] - prev
     return Manipulator.from_arrays(axes, bodies, axial=tool_t[:3, 2], transverse=tool_t[:3, 1],
-                                   types=types, name=name, length_unit=length_unit)
+                                   types=types, name=name, length_unit=length_unit,
+                                   limits=[r.limits for r in rs])
 
 
 def from_dh(rows: Sequence[DHRow | Sequence[float]], *, tool: ArrayLike | None = None,
-            name: str = "from DH", length_unit: str = "mm") -> Manipulator:
+            base: ArrayLike | None = None, name: str = "from DH",
+            length_unit: str = "mm") -> Manipulator:
     """Standard DH table (rows base to tip) -> :class:`Manipulator`.
 
-    Joint k's axis is z_{k-1} through the origin of frame k-1, evaluated at the zero reference.
+    Joint k's axis is z_{k-1} (negated for a flipped joint) through the origin of frame k-1,
+    evaluated at the zero reference. ``base`` (world <- frame 0) and ``tool`` (frame n <- tool)
+    are 4x4 transforms (lengths in ``length_unit``); the model is expressed in the world frame.
     """
     rs = _rows(rows)
-    t = np.eye(4)
+    t = _mat(base, "base")
     frames = []
     for row in rs:
         frames.append(t.copy())
         th, d = _joint_values(row, 0.0)
         t = t @ _rz(th) @ _tz(d) @ _tx(row.a) @ _rx(row.alpha)
-    tool_t = t @ (np.eye(4) if tool is None else np.asarray(tool, dtype=float))
-    return _to_model(frames, tool_t, [r.type for r in rs], name, length_unit)
+    tool_t = t @ _mat(tool, "tool")
+    return _to_model(frames, tool_t, rs, name, length_unit)
 
 
 def from_mdh(rows: Sequence[DHRow | Sequence[float]], *, tool: ArrayLike | None = None,
-             name: str = "from modified DH", length_unit: str = "mm") -> Manipulator:
-    """Modified (Craig) DH table -> :class:`Manipulator`. Joint k's axis is z_k."""
+             base: ArrayLike | None = None, name: str = "from modified DH",
+             length_unit: str = "mm") -> Manipulator:
+    """Modified (Craig) DH table -> :class:`Manipulator`. Joint k's axis is z_k (negated for a
+    flipped joint); ``base`` and ``tool`` as in :func:`from_dh`."""
     rs = _rows(rows)
-    t = np.eye(4)
+    t = _mat(base, "base")
     frames = []
     for row in rs:
         t = t @ _rx(row.alpha) @ _tx(row.a)
         frames.append(t.copy())
         th, d = _joint_values(row, 0.0)
         t = t @ _rz(th) @ _tz(d)
-    tool_t = t @ (np.eye(4) if tool is None else np.asarray(tool, dtype=float))
-    return _to_model(frames, tool_t, [r.type for r in rs], name, length_unit)
+    tool_t = t @ _mat(tool, "tool")
+    return _to_model(frames, tool_t, rs, name, length_unit)
