@@ -50,6 +50,7 @@ class DHRow:
     offset: float = 0.0
     flip: bool = False
     limits: tuple[float, float] | None = None
+    name: str = ""
 
     def __post_init__(self) -> None:
         if self.type not in ("revolute", "prismatic"):
@@ -170,7 +171,8 @@ def _to_model(frames_joint: list[F64], tool_t: F64, rs: list[DHRow], name: str,
     bodies[n] = tool_t[:3, 3] - prev
     return Manipulator.from_arrays(axes, bodies, axial=tool_t[:3, 2], transverse=tool_t[:3, 1],
                                    types=types, name=name, length_unit=length_unit,
-                                   limits=[r.limits for r in rs])
+                                   limits=[r.limits for r in rs],
+                                   joint_names=[r.name for r in rs])
 
 
 def from_dh(rows: Sequence[DHRow | Sequence[float]], *, tool: ArrayLike | None = None,

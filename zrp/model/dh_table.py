@@ -26,6 +26,7 @@ TOML layout (lengths in ``length_unit``, angles in rad)::
     offset = 0.0       # theta (or d) at q = 0
     flip = false       # optional
     limits = [-3.1, 3.1]   # optional
+    name = "joint1"    # optional
 """
 
 from __future__ import annotations
@@ -117,9 +118,9 @@ def _row(model: Manipulator, k: int, a: float, alpha: float, d: float, theta: fl
     j = model.joints[k]
     if j.is_prismatic:
         return DHRow(a=a, alpha=alpha, d=0.0, theta=theta, type="prismatic", offset=d,
-                     limits=j.limits)
+                     limits=j.limits, name=j.name)
     return DHRow(a=a, alpha=alpha, d=d, theta=0.0, type="revolute", offset=theta,
-                 limits=j.limits)
+                 limits=j.limits, name=j.name)
 
 
 def _x_start(z: F64) -> F64:
@@ -217,7 +218,10 @@ def dumps_dh(table: DHTable) -> str:
            f'length_unit = "{table.length_unit}"', f"base = {mat(table.base)}",
            f"tool = {mat(table.tool)}", ""]
     for r in table.rows:
-        out += ["[[row]]", f"a = {_fmt(r.a)}", f"alpha = {_fmt(r.alpha)}", f"d = {_fmt(r.d)}",
+        out.append("[[row]]")
+        if r.name:
+            out.append('name = "' + r.name.replace("\\", "\\\\").replace('"', '\\"') + '"')
+        out += [f"a = {_fmt(r.a)}", f"alpha = {_fmt(r.alpha)}", f"d = {_fmt(r.d)}",
                 f"theta = {_fmt(r.theta)}", f'type = "{r.type}"', f"offset = {_fmt(r.offset)}"]
         if r.flip:
             out.append("flip = true")

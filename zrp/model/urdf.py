@@ -214,7 +214,7 @@ def _default_end(tree: URDFTree, base: str) -> str:
     if any(c[:len(longest)] != longest[:len(c)] for c in chains):
         raise ModelFileError(
             f"{tree.source}: the kinematic tree below {base!r} branches; name the end effector "
-            f"with end_link=, e.g. one of the branch ends {sorted(chains.values())}")
+            f"(end_link=NAME), e.g. one of the branch ends {sorted(chains.values())}")
     tips = [leaf for leaf in tree.leaves(base)
             if tuple(j.name for j in tree.path(base, leaf) if j.type != "fixed") == longest]
     if len(tips) == 1:  # one tool link (behind fixed joints or not)
