@@ -32,8 +32,8 @@ def _fmt(values: ArrayLike) -> str:
 def mjcf_xml(arm: BuiltArm | Manipulator, options: MJCFOptions | None = None) -> str:
     """MJCF text of a built arm (or of a model, built with ``options``).
 
-    MuJoCo's writer keeps 6 significant digits; the kinematic attributes (body positions,
-    joint axes, the end-effector site) are rewritten here at full double precision so that the
+    MuJoCo's writer keeps 6 significant digits; the kinematic attributes (body positions, joint
+    axes and ranges, the end-effector site) are rewritten here at full double precision so that the
     file reproduces the model exactly.
     """
     if isinstance(arm, Manipulator):
@@ -52,6 +52,9 @@ def mjcf_xml(arm: BuiltArm | Manipulator, options: MJCFOptions | None = None) ->
         body.set("pos", _fmt(bodies_m[k]))
         joint = by_name[f"{pre}{joint_name(model, k)}"]
         joint.set("axis", _fmt(model.axes[k]))
+        if joint.get("range") is not None:  # joint limits, full precision as well
+            s = arm.scale if model.prismatic[k] else 1.0
+            joint.set("range", _fmt(np.asarray(model.joints[k].limits) * s))
     site = by_name[f"{pre}end_effector"]
     site.set("pos", _fmt(bodies_m[model.n]))
     site.set("quat", _fmt(hand_quat(model)))
