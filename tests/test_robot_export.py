@@ -152,3 +152,16 @@ def test_cli_import_errors_name_the_option(tmp_path, capsys):
     src.write_text(URDF)
     assert main(["import", str(src), "--end", "nope", "--out", str(tmp_path / "x.toml")]) == 2
     assert "--end: no link named 'nope'" in capsys.readouterr().err
+
+
+def test_cli_ik_target_and_posture(tmp_path, capsys):
+    assert main(["ik", "--target", "500", "200", "-300", "--json"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    p = zrp.forward_kinematics(zrp.load_model("puma"), s["q"]).position
+    np.testing.assert_allclose(p, [500, 200, -300], atol=1e-9)
+    assert main(["ik", "--target", "5000", "0", "0"]) == 2
+    assert "--target: [5000.0, 0.0, 0.0]" in capsys.readouterr().err
+    out = tmp_path / "c.csv"
+    assert main(["ik", "--posture", "--out", str(out), "--json", "--steps", "200"]) == 0
+    s = json.loads(capsys.readouterr().out)
+    assert s["max_joint_change_end_start"] < 1e-6 and s["max_position_error"] < 1e-9

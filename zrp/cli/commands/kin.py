@@ -12,6 +12,8 @@ from zrp.cli.app import emit
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.ik import CORRECTIONS, track_trajectory
+from zrp.kinematics.posture import solve_pose
+from zrp.kinematics.redundant import track_posture
 from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
 from zrp.model.files import builtin_models, load_model
 from zrp.model.manipulator import Manipulator
@@ -72,13 +74,28 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--steps", type=int, default=1000, help="integration steps (default 1000)")
     p.add_argument("--task", choices=("pose", "position"), default=None)
     p.add_argument("--correction", choices=CORRECTIONS, default="newton")
+    p.add_argument("--posture", action="store_true",
+                   help="resolve redundancy toward the start configuration in the null space "
+                        "and keep inside the joint limits (track_posture); a closed path then "
+                        "returns to its start")
+    p.add_argument("--limits", choices=("error", "warn", "ignore"), default="error",
+                   help="when the path needs a joint beyond its limits (default error, naming "
+                        "the joint and time)")
+    p.add_argument("--target", nargs=3, type=float, default=None, metavar=("X", "Y", "Z"),
+                   help="single-pose IK: reach this point (length unit) from --q0 instead of "
+                        "following a trajectory; with --target-er also the hand rotation")
+    p.add_argument("--target-er", nargs=4, type=float, default=None,
+                   metavar=("E0", "E1", "E2", "E3"),
+                   help="hand rotation for --target (Euler-Rodrigues, relative to the zero "
+                        "reference, as zrp fk prints it)")
     p.add_argument("--out", default=None, metavar="CSV",
                    help="joint trajectory CSV (default renders/<model>_<trajectory>_joints.csv,"
                         " generated output that is replaced on every run)")
     p.add_argument("--force", action="store_true",
                    help="replace the --out file if it exists (without it, an existing file is "
                         "never replaced; checked before solving)")
-    p.set_defaults(func=_ik, api_names={"q0": "--q0", "steps": "--steps"})
+    p.set_defaults(func=_ik, api_names={"q0": "--q0", "steps": "--steps",
+                                        "position": "--target", "limits": "--limits"})
 
     p = sub.add_parser("models", help="list the built-in model files")
     p.add_argument("--json", action="store_true", help="print JSON")
@@ -118,6 +135,8 @@ def _ik(args: argparse.Namespace) -> int:
         q0 = _joint_values(model, list(PUMA_Q0_DEG), False, "--q0")
     else:
         q0 = _joint_values(model, args.q0, args.rad, "--q0")
+    if args.target is not None:
+        return _ik_target(args, model, q0)
     stem = Path(args.model).stem
     out = Path(args.out) if args.out else Path("renders") / f"{stem}_{args.trajectory}_joints.csv"
     overwrite = args.force or args.out is None
@@ -131,11 +150,16 @@ def _ik(args: argparse.Namespace) -> int:
                     time_law=args.time_law)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ZRPWarning)
-        res = track_trajectory(model, traj, q0, args.steps, task=args.task,
-                               correction=args.correction)
+        if args.posture:
+            res = track_posture(model, traj, q0, args.steps, task=args.task,
+                                limits=args.limits)
+        else:
+            res = track_trajectory(model, traj, q0, args.steps, task=args.task,
+                                   correction=args.correction, limits=args.limits)
     res.save_csv(out, overwrite=overwrite)
     s = res.summary()
     s["output"] = str(out)
+    s["max_joint_change_end_start"] = float(np.max(np.abs(res.q[-1] - res.q[0])))
     s["warnings"] = [str(w.message) for w in caught]
     u = model.length_unit
     text = "\n".join([
@@ -147,12 +171,32 @@ def _ik(args: argparse.Namespace) -> int:
         f"{s['max_drift_orientation_rad']:.3e} rad (removed by the correction)",
         f"  min manipulability     {s['min_manipulability']:.4f} at t = "
         f"{s['min_manipulability_t_s']:.3f} s ({s['damped_steps']} damped samples)",
+        f"  |q(end) - q(start)|    {s['max_joint_change_end_start']:.3e} (largest joint)",
         f"  solve time             {s['elapsed_s'] * 1e3:.2f} ms"
         + (" (first call: includes compiling the kernels)"
            if s["elapsed_includes_compilation"] else ""),
         *[f"  warning: {w}" for w in s["warnings"]],
         f"  joint trajectory -> {out}",
     ])
+    emit(args, s, text)
+    return 0
+
+
+def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> int:
+    sol = solve_pose(model, np.array(args.target), args.target_er, q0=q0)
+    s = sol.summary()
+    s["joint_names"] = list(model.joint_names)
+    shown = np.where(model.prismatic, sol.q, sol.q if args.rad else np.degrees(sol.q))
+    unit = "rad" if args.rad else "deg"
+    s["q_shown"], s["q_shown_unit"] = shown.tolist(), unit
+    text = "\n".join([
+        f"{model.name}: target {args.target} {model.length_unit} reached "
+        f"({s['iterations']} iterations)",
+        *[f"  {nm:<16s} {v: .9g}" for nm, v in zip(model.joint_names, shown, strict=True)],
+        f"  ({unit}; prismatic joints in {model.length_unit})",
+        f"  position error {s['position_error']:.3e} {model.length_unit}, orientation error "
+        f"{s['orientation_error_rad']:.3e} rad, smallest singular value "
+        f"{s['min_singular_value']:.3g}"])
     emit(args, s, text)
     return 0
 
