@@ -79,10 +79,12 @@ def _rows(rows: Sequence[DHRow | Sequence[float]]) -> list[DHRow]:
                 raise InputError(f"DH row {i}: {exc}; expected fields {known}") from exc
         else:
             try:
+                if len(r) > 6:  # flip, limits, name: by name only
+                    raise TypeError("too many positional fields")
                 out.append(DHRow(*r))  # type: ignore[arg-type]
             except TypeError as exc:
-                raise InputError(f"DH row {i}: expected (a, alpha, d, theta[, type, offset]), "
-                                 f"got {r!r}") from exc
+                raise InputError(f"DH row {i}: expected (a, alpha, d, theta[, type, offset]) "
+                                 f"(other fields by name), got {r!r}") from exc
     if not out:
         raise InputError("DH table: expected at least one row")
     return out
