@@ -92,6 +92,23 @@ def _end_body(m: mujoco.MjModel, site: str | None, body: str | None) -> tuple[in
     return bid, (sites[0] if len(sites) == 1 else -1)
 
 
+def _refuse_coupled(m: mujoco.MjModel, joints: list[int]) -> None:
+    """Joint equality constraints (couplings) on the chain are not modelled: refuse by name."""
+    on_chain = set(joints)
+    for e in range(m.neq):
+        if int(m.eq_type[e]) != int(mujoco.mjtEq.mjEQ_JOINT):
+            continue
+        pair = [int(m.eq_obj1id[e]), int(m.eq_obj2id[e])]
+        hit = [j for j in pair if j in on_chain]
+        if hit:
+            names = [_name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in pair if j >= 0]
+            raise MJCFImportError(
+                f"joint {_name(m, mujoco.mjtObj.mjOBJ_JOINT, max(hit, key=joints.index))!r} is "
+                f"coupled by a joint "
+                f"equality ({' ~ '.join(repr(n) for n in names)}); coupled joints are not "
+                f"modelled: choose an end body or site before it")
+
+
 def manipulator_from_mujoco(
     source: str | os.PathLike[str] | mujoco.MjModel,
     *,
@@ -138,6 +155,7 @@ def manipulator_from_mujoco(
                     f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, b)!r} is a {kind} joint; only hinge and "
                     f"slide joints form a ZRP serial arm")
             joints.append(j)
+    _refuse_coupled(m, joints)
     if not joints:
         raise MJCFImportError(f"no hinge or slide joint between the world and body "
                               f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, bid)!r}")

@@ -165,3 +165,12 @@ def test_cli_ik_target_and_posture(tmp_path, capsys):
     assert main(["ik", "--posture", "--out", str(out), "--json", "--steps", "200"]) == 0
     s = json.loads(capsys.readouterr().out)
     assert s["max_joint_change_end_start"] < 1e-6 and s["max_position_error"] < 1e-9
+
+
+def test_mjcf_coupled_joints_refused_by_name():
+    xml = """<mujoco><worldbody><body name="a"><joint name="j1" axis="0 0 1"/><geom size=".1"/>
+      <body name="b" pos="0 1 0"><joint name="j2" axis="1 0 0"/><geom size=".1"/>
+      <site name="tip" pos="0 1 0"/></body></body></worldbody>
+      <equality><joint joint1="j2" joint2="j1"/></equality></mujoco>"""
+    with pytest.raises(mjcf.MJCFImportError, match=r"joint 'j2' is coupled.*'j2' ~ 'j1'"):
+        mjcf.manipulator_from_mujoco(xml, site="tip")
