@@ -57,6 +57,23 @@ def _name(m: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:
     return mujoco.mj_id2name(m, obj, i) or f"#{i}"
 
 
+def _branch_ends(m: mujoco.MjModel) -> list[int]:
+    """Leaf bodies whose chains of joints are not all one chain (unequal branches included)."""
+    chains: dict[tuple[int, ...], int] = {}
+    parents = set(int(p) for p in m.body_parentid[1:])
+    for leaf in (b for b in range(1, m.nbody) if b not in parents):
+        path, b = [], leaf
+        while b > 0:
+            path += range(m.body_jntadr[b] + m.body_jntnum[b] - 1, m.body_jntadr[b] - 1, -1)
+            b = int(m.body_parentid[b])
+        if path:
+            chains.setdefault(tuple(path[::-1]), leaf)
+    longest = max(chains, key=len, default=())
+    if all(c == longest[:len(c)] for c in chains):
+        return []
+    return list(chains.values())
+
+
 def _end_body(m: mujoco.MjModel, site: str | None, body: str | None) -> tuple[int, int]:
     """(body id, site id or -1) of the end effector."""
     if site is not None and body is not None:
@@ -83,8 +100,9 @@ def _end_body(m: mujoco.MjModel, site: str | None, body: str | None) -> tuple[in
     tips = [b for b in range(1, m.nbody) if njoint_path[b] == deepest
             and not any(m.body_parentid[c] == b and njoint_path[c] == deepest
                         for c in range(1, m.nbody))]
-    if len(tips) > 1:
-        names = [_name(m, mujoco.mjtObj.mjOBJ_BODY, b) for b in tips]
+    ends = _branch_ends(m)
+    if len(tips) > 1 or len(ends) > 1:
+        names = sorted({_name(m, mujoco.mjtObj.mjOBJ_BODY, b) for b in [*tips, *ends]})
         raise MJCFImportError(f"the kinematic tree branches (end bodies {names}); name the end "
                               f"effector with site= or body=")
     bid = tips[0]

@@ -174,3 +174,14 @@ def test_mjcf_coupled_joints_refused_by_name():
       <equality><joint joint1="j2" joint2="j1"/></equality></mujoco>"""
     with pytest.raises(mjcf.MJCFImportError, match=r"joint 'j2' is coupled.*'j2' ~ 'j1'"):
         mjcf.manipulator_from_mujoco(xml, site="tip")
+
+
+def test_mjcf_unequal_branches_need_an_end_effector():
+    xml = """<mujoco><worldbody><body name="a"><joint axis="0 0 1"/><geom size=".1"/>
+      <body name="long" pos="0 1 0"><joint axis="1 0 0"/><geom size=".1"/>
+        <body name="longer" pos="0 1 0"><joint axis="1 0 0"/><geom size=".1"/></body></body>
+      <body name="short" pos="0 -1 0"><joint axis="1 0 0"/><geom size=".1"/></body>
+      </body></worldbody></mujoco>"""
+    with pytest.raises(mjcf.MJCFImportError, match=r"branches \(end bodies \['longer', 'short'\]"):
+        mjcf.manipulator_from_mujoco(xml)
+    assert mjcf.manipulator_from_mujoco(xml, body="short").n == 2
