@@ -47,6 +47,12 @@ _EXPORTS = {
         "nice_factor",
         "video_frames",
     ),
+    "framing": (
+        "frame_on_path",
+        "framing_report",
+        "path_normal",
+        "projected_fractions",
+    ),
     "gl": (
         "BACKENDS",
         "GLBackendError",
