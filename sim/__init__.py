@@ -53,6 +53,11 @@ _EXPORTS = {
         "path_normal",
         "projected_fractions",
     ),
+    "viewer": (
+        "DisplayUnavailableError",
+        "display_status",
+        "view_path",
+    ),
     "gl": (
         "BACKENDS",
         "GLBackendError",

@@ -41,6 +41,7 @@ from zrp.paper.scenario import puma_circle_ik as puma_circle_ik
 from zrp.paper.scenes import PAPER_LEVELS as PAPER_LEVELS
 from zrp.paper.scenes import Scene as Scene
 from zrp.paper.scenes import SceneSegment as SceneSegment
+from zrp.paper.scenes import paper_magnification as paper_magnification
 from zrp.paper.scenes import paper_video_file_name as paper_video_file_name
 from zrp.paper.scenes import paper_video_scene as paper_video_scene
 from zrp.paper.scenes import perturbed_puma as perturbed_puma
@@ -76,6 +77,7 @@ __all__ = [
     "is_paper_model",
     "kind_columns",
     "output_names",
+    "paper_magnification",
     "paper_start",
     "paper_summary",
     "paper_video_file_name",

@@ -68,6 +68,7 @@ def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
     try:
         with folder.path(name) as tmp:
             sim.render_video(scene.segments, tmp, title=scene.title, overwrite=True,
+                             options=sim.VideoOptions(magnify=scene.magnify),
                              progress=not args.json)
     except (sim.GLUnavailableError, sim.GLBackendError) as exc:
         # no OpenGL backend on this machine: the tables and figures are still valid
