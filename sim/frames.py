@@ -95,8 +95,9 @@ class VideoOptions:
         backend: "egl", "osmesa" or None (MUJOCO_GL, else the first that works).
         trace_segments: line segments per drawn path.
         ghost_alpha: opacity of the nominal arm.
-        fill: fraction of the frame height the arm and the path take together (the camera
-            looks along the path plane's normal, :func:`sim.framing.frame_on_path`).
+        fill: fraction of the free part of the frame (between the text panels) the arm and
+            the path take together (the camera looks along the path plane's normal,
+            :func:`sim.framing.frame_on_path`).
         plot: draw the live delta_p plot.
         exaggerate_arm: draw the perturbed arm with its parameter errors multiplied by the
             magnification too (see :func:`exaggerated_model`), so it visibly leaves the ghost
@@ -113,7 +114,7 @@ class VideoOptions:
     backend: str | None = None
     trace_segments: int = 120
     ghost_alpha: float = 0.35
-    fill: float = 0.62
+    fill: float = 0.92
     plot: bool = True
     exaggerate_arm: bool = True
 
@@ -212,7 +213,11 @@ def _camera(r: OffscreenRenderer, segs: Sequence[_Segment], opts: VideoOptions) 
     (:func:`sim.framing.frame_on_path`); hide the floor and the pedestal (geom group 2)."""
     path = np.vstack([s.p_des for s in segs])
     arm = np.vstack([_arm_points(s) for s in segs])
-    frame_on_path(r, path, arm, fill=opts.fill)
+    # the scene between the text blocks (their sizes in pixels at font scale 100): the
+    # title top left (3 lines), the legend on the right (~250 px), the numbers bottom left
+    w, h = opts.width, opts.height
+    frame_on_path(r, path, arm, box=(0.02, max(0.5, 1 - 255 / w), min(0.3, 125 / h),
+                                     max(0.7, 1 - 80 / h)), margin=opts.fill)
     r.option.geomgroup[2] = 0
     r.option.frame = mujoco.mjtFrame.mjFRAME_NONE
 
@@ -260,7 +265,7 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
             r.add_arrow(seg.p_des[f], magnified[f], ARROW_RGBA, arrow_r)
             r.add_sphere(magnified[f], 2.5 * arrow_r, ARROW_RGBA)
         r.render()
-        r.text(f"{title}\n{seg.label}\ndeviations drawn x{magnify:g}",
+        r.text(f"{title}\n{seg.label}",
                corner=mujoco.mjtGridPos.mjGRID_TOPLEFT)
         r.text(f"t\ndelta_p\ndelta_R (eq 15)\ntheta\n(< {NOISE_FLOOR:g} shown as 0)",
                f"{seg.t[f]:.2f} s\n{shown_value(seg.delta_p[f], '.4g')} {unit}\n"

@@ -45,17 +45,23 @@ def _basis(forward: F64) -> tuple[F64, F64]:
 
 
 def frame_on_path(r: OffscreenRenderer, path: ArrayLike, arm_points: ArrayLike,
-                  fill: float = 0.62) -> None:
+                  box: tuple[float, float, float, float] = (0.2, 0.8, 0.2, 0.8),
+                  margin: float = 0.92) -> None:
     """Camera normal to the path's plane, framing the arm and the path.
 
     Args:
         r: the renderer whose free camera is set.
         path: desired path, m, shape (M, 3).
         arm_points: points of the arm over the whole video (body origins), m, shape (K, 3).
-        fill: fraction of the frame height (and at most of its width) the union of both takes.
+        box: the part of the frame the union of both is fitted into, (left, right, bottom,
+            top) as fractions of the frame (x from the left, y from the bottom): the rest is
+            left to the text panels.
+        margin: fraction of the box the union takes (the rest is a border).
     """
-    if not 0 < fill < 1:
-        raise InputError(f"fill: expected a fraction in (0, 1), got {fill!r}")
+    x0, x1, y0, y1 = (float(v) for v in box)
+    if not (0 <= x0 < x1 <= 1 and 0 <= y0 < y1 <= 1 and 0 < margin <= 1):
+        raise InputError(f"box, margin: expected 0 <= left < right <= 1, 0 <= bottom < top <= "
+                         f"1 and 0 < margin <= 1, got {box!r}, {margin!r}")
     p = np.asarray(path, dtype=float)
     pts = np.vstack([p, np.asarray(arm_points, dtype=float).reshape(-1, 3)])
     forward = -path_normal(p)
@@ -63,10 +69,15 @@ def frame_on_path(r: OffscreenRenderer, path: ArrayLike, arm_points: ArrayLike,
     x, y = pts @ right, pts @ up
     centre = (0.5 * (x.max() + x.min()) * right + 0.5 * (y.max() + y.min()) * up
               + float(np.mean(p @ forward)) * forward)
-    fovy = math.radians(float(r.model.vis.global_.fovy))
+    tan_half = math.tan(math.radians(float(r.model.vis.global_.fovy)) / 2.0)
     aspect = r.width / r.height
-    half = 0.5 * max(y.max() - y.min(), (x.max() - x.min()) / aspect) / fill
-    distance = half / math.tan(fovy / 2.0)
+    # visible height H at the target: the union's height takes margin (y1 - y0) H, its
+    # width at most margin (x1 - x0) aspect H
+    height = max((y.max() - y.min()) / (y1 - y0),
+                 (x.max() - x.min()) / ((x1 - x0) * aspect)) / margin
+    distance = 0.5 * height / tan_half
+    centre = (centre + (0.5 - 0.5 * (x0 + x1)) * height * aspect * right
+              + (0.5 - 0.5 * (y0 + y1)) * height * up)
     az = math.degrees(math.atan2(forward[1], forward[0]))
     el = math.degrees(math.asin(float(np.clip(forward[2], -1.0, 1.0))))
     r.look_at(centre, distance, az, float(np.clip(el, -89.0, 89.0)))

@@ -60,6 +60,7 @@ CATALOGUE: tuple[tuple[str, str], ...] = (
                            "ghost, deviations magnified by a stated factor."),
     ("puma_sweep_*.*", "Video: the same circle once per perturbation level, at one "
                        "magnification, earlier traces kept: the deviation grows with xi."),
+    ("*index.html", "The index page of that folder's outputs."),
     ("gap_benchmark/*", "Output of the blind benchmark of the gap diagnosis (`zrp "
                         "gap-benchmark`)."),
 )
@@ -79,6 +80,19 @@ def _descriptions(folder: Path) -> dict[str, str]:
     return {str(k): str(v) for k, v in data.items()}
 
 
+def _sentence(rel: str) -> str:
+    """The catalogue's sentence for ``rel``: by its path, else by its name (noting the
+    recovered circle for files under ``recovered/``)."""
+    name = rel.rsplit("/", 1)[-1]
+    for key in (rel, name):
+        found = next((s for pat, s in CATALOGUE if fnmatch(key, pat)), None)
+        if found is not None:
+            if key == name != rel and rel.startswith("recovered/"):
+                found += " On the circle recovered from the published Tables 2-3."
+            return found
+    return _FALLBACK
+
+
 def index_entries(root: str | os.PathLike[str]) -> list[tuple[str, str]]:
     """(relative path, sentence) for every output file under ``root``, sorted by path
     (the index itself, lock files, hidden files and ``descriptions.json`` excluded)."""
@@ -89,8 +103,7 @@ def index_entries(root: str | os.PathLike[str]) -> list[tuple[str, str]]:
         if (not f.is_file() or rel == INDEX_NAME or f.name in (LOCK_NAME, DESCRIPTIONS)
                 or any(part.startswith(".") for part in f.relative_to(root).parts)):
             continue
-        sentence = _descriptions(f.parent).get(f.name) or next(
-            (s for pat, s in CATALOGUE if fnmatch(rel, pat)), _FALLBACK)
+        sentence = _descriptions(f.parent).get(f.name) or _sentence(rel)
         out.append((rel, sentence))
     return out
 

@@ -31,6 +31,7 @@ from zrp.manufacturing.perturb import Perturbation
 from zrp.manufacturing.study import PAPER_XI
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
+from zrp.paper.placement import RECOVERED, placement_path
 from zrp.paper.scenario import puma_circle_ik
 
 __all__ = [
@@ -106,16 +107,30 @@ def paper_magnification(parameter: str, q: F64) -> float:
     return next((m * 10.0**e for m in (5.0, 2.0, 1.0) if m * 10.0**e <= x), 10.0**e)
 
 
+def _circle(circle: str, steps: int) -> tuple[F64, F64]:
+    """(t, q) of the named circle: "default" (:func:`puma_circle_ik`) or "recovered"
+    (:data:`zrp.paper.placement.RECOVERED`)."""
+    if circle == "recovered":
+        path = placement_path(RECOVERED, steps)
+        return np.asarray(path.t), np.asarray(path.q)
+    if circle != "default":
+        raise InputError(f"circle: expected 'default' or 'recovered', got {circle!r}")
+    ik = puma_circle_ik(steps=steps)
+    return np.asarray(ik.t), np.asarray(ik.q)
+
+
 def paper_video_scene(parameter: str = "JE2", xi_percent: float = 0.1, *,
-                      steps: int = 360) -> Scene:
+                      steps: int = 360, circle: str = "default") -> Scene:
     """The paper's 125 mm PUMA circle: nominal ghost vs one perturbed parameter.
 
-    File ``puma_circle_<parameter>_<xi>pct.mp4``; ``steps``: inverse-kinematics steps.
+    File ``puma_circle_<parameter>_<xi>pct.mp4``; ``steps``: inverse-kinematics steps;
+    ``circle``: "default" or "recovered".
     """
-    ik = puma_circle_ik(steps=steps)
+    t, q = _circle(circle, steps)
     nominal, perturbed, label = perturbed_puma(parameter, xi_percent)
-    seg = SceneSegment(nominal, perturbed, np.asarray(ik.t), np.asarray(ik.q), label)
-    return Scene((seg,), "PUMA, 125 mm circle", paper_video_file_name(parameter, xi_percent),
+    seg = SceneSegment(nominal, perturbed, t, q, label)
+    title = "PUMA, 125 mm circle" + (" (recovered)" if circle == "recovered" else "")
+    return Scene((seg,), title, paper_video_file_name(parameter, xi_percent),
                  paper_magnification(parameter, seg.q))
 
 
