@@ -45,6 +45,7 @@ from sim.overlays import (
     GHOST_RGBA,
     LEGEND,
     NOISE_FLOOR,
+    PANEL_PX,
     delta_p_figure,
     shown_value,
 )
@@ -197,7 +198,8 @@ def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: Arra
 
 
 def _arm_points(seg: _Segment) -> F64:
-    """Body origins of the drawn arm over the segment (m), shape (frames x bodies, 3)."""
+    """Body origins of the drawn arm at up to 24 frames of the segment (m), shape
+    (frames, bodies, 3)."""
     arm = seg.drawn or seg.actual
     d = mujoco.MjData(arm.model)
     pts = []
@@ -205,19 +207,20 @@ def _arm_points(seg: _Segment) -> F64:
         d.qpos[arm.qpos_adr] = arm.qpos(seg.q[f])
         mujoco.mj_kinematics(arm.model, d)
         pts.append(d.xpos[1:].copy())
-    return np.concatenate(pts)
+    return np.stack(pts)
 
 
 def _camera(r: OffscreenRenderer, segs: Sequence[_Segment], opts: VideoOptions) -> None:
     """Look along the normal of the first path's plane and frame every arm and path
     (:func:`sim.framing.frame_on_path`); hide the floor and the pedestal (geom group 2)."""
     path = np.vstack([s.p_des for s in segs])
-    arm = np.vstack([_arm_points(s) for s in segs])
-    # the scene between the text blocks (their sizes in pixels at font scale 100): the
-    # title top left (3 lines), the legend on the right (~250 px), the numbers bottom left
+    arm = np.concatenate([_arm_points(s) for s in segs])
+    # the scene left of the right-hand column of text and plot (PANEL_PX wide at font scale
+    # 100) and below the two title lines
     w, h = opts.width, opts.height
-    frame_on_path(r, path, arm, box=(0.02, max(0.5, 1 - 255 / w), min(0.3, 125 / h),
-                                     max(0.7, 1 - 80 / h)), margin=opts.fill)
+    frame_on_path(r, path, arm.reshape(-1, 3),
+                  box=(0.01, max(0.5, 1 - (PANEL_PX + 10) / w), 0.01, max(0.7, 1 - 55 / h)),
+                  margin=opts.fill)
     r.option.geomgroup[2] = 0
     r.option.frame = mujoco.mjtFrame.mjFRAME_NONE
 
@@ -246,6 +249,8 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
     plot_idx = np.linspace(0, n_frames - 1, min(n_frames, max_pts)).astype(int) if opts.plot \
         else np.zeros(0, int)
     pw, ph = int(opts.width * 0.36), int(opts.height * 0.27)
+    col = max(pw, PANEL_PX)   # the right-hand column: legend, numbers, plot
+    numbers = (opts.width - col - 4, ph + 8, col, max(1, opts.height - ph - 8))
     legend = LEGEND.format(m=magnify, arm=f", errors x{magnify:g}" if seg.drawn else "")
     for f in range(n_frames):
         d_a.qpos[drawn.qpos_adr] = drawn.qpos(seg.q[f])
@@ -270,8 +275,8 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
         r.text(f"t\ndelta_p\ndelta_R (eq 15)\ntheta\n(< {NOISE_FLOOR:g} shown as 0)",
                f"{seg.t[f]:.2f} s\n{shown_value(seg.delta_p[f], '.4g')} {unit}\n"
                f"{shown_value(seg.delta_r[f], '.3e')}\n{shown_value(seg.theta[f], '.3e')} rad\n",
-               corner=mujoco.mjtGridPos.mjGRID_BOTTOMLEFT)
-        r.text(legend, corner=mujoco.mjtGridPos.mjGRID_RIGHT)
+               corner=mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport=numbers)
+        r.text(legend, corner=mujoco.mjtGridPos.mjGRID_TOPRIGHT)
         if opts.plot:
             shown = plot_idx[plot_idx <= f]
             fig.linepnt[0] = len(shown)

@@ -107,12 +107,16 @@ def projected_fractions(scene: mujoco.MjvScene, points: ArrayLike, aspect: float
 def framing_report(scene: mujoco.MjvScene, path: ArrayLike, arm_points: ArrayLike,
                    width: int, height: int) -> dict[str, float]:
     """Framing figures of the drawn frame: ``circle_aspect`` (projected width / height of the
-    path, in pixels; 1 for a circle seen face on), ``arm_height_fraction`` (vertical extent of
-    the arm's points / frame height) and ``path_height_fraction``."""
+    path, in pixels; 1 for a circle seen face on), ``arm_height_fraction`` (the smallest, over
+    the frames of ``arm_points`` (m, shape (F, bodies, 3)), vertical extent of the arm's body
+    origins / frame height) and ``path_height_fraction``."""
     fp = projected_fractions(scene, path, width / height)
-    fa = projected_fractions(scene, arm_points, width / height)
+    arm = np.asarray(arm_points, dtype=float)
+    arm = arm.reshape(1, -1, 3) if arm.ndim == 2 else arm
+    heights = [float(np.ptp(np.clip(projected_fractions(scene, a, width / height)[:, 1],
+                                    0.0, 1.0))) for a in arm]
     w = (fp[:, 0].max() - fp[:, 0].min()) * width
     h = (fp[:, 1].max() - fp[:, 1].min()) * height
     return {"circle_aspect": float(w / h) if h > 0 else float("inf"),
-            "arm_height_fraction": float(np.ptp(np.clip(fa[:, 1], 0.0, 1.0))),
+            "arm_height_fraction": min(heights),
             "path_height_fraction": float(h / height)}

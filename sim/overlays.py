@@ -7,7 +7,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
-__all__ = ["LEGEND", "NOISE_FLOOR", "delta_p_figure", "shown_value"]
+__all__ = ["LEGEND", "NOISE_FLOOR", "PANEL_PX", "delta_p_figure", "shown_value"]
 
 F64 = NDArray[np.float64]
 
@@ -17,6 +17,8 @@ EARLIER_RGBA = (0.65, 0.25, 0.6, 0.8)
 ARROW_RGBA = (1.0, 0.85, 0.1, 1.0)
 GHOST_RGBA = (0.95, 0.95, 0.95, 1.0)
 ARM_RGBA = (0.9, 0.55, 0.2, 1.0)
+#: Width of the right-hand column (legend, numbers, plot), pixels at font scale 100.
+PANEL_PX = 250
 #: Deviations below these print as 0 on the frames (mm-scale lengths are ~1e-13 at rounding).
 NOISE_FLOOR = 1e-9
 LEGEND = ("green: desired path (nominal)\nmagenta: actual path x{m:g}\nyellow arrow: "

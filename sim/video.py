@@ -198,7 +198,7 @@ def render_video(
                     write(frame)
                     bar.update(1)
             framing = framing_report(r.scene, np.vstack([s.p_des for s in segs]),
-                                     np.vstack([_arm_points(s) for s in segs]),
+                                     np.concatenate([_arm_points(s) for s in segs]),
                                      opts.width, opts.height)
     except InputError as exc:  # from atomic_path: the file could not be written or moved
         cause = exc.__cause__

@@ -52,7 +52,7 @@ def _bbox(mask: np.ndarray) -> tuple[int, int, int, int]:
 def test_video_frame_is_framed_on_the_circle(backend, tmp_path, which):
     scene = (paper_video_scene("JE2", 0.1, steps=120) if which == "paper"
              else teaching_sweep_scene("JE2", (0.05, 0.1), steps=120))
-    opts = sim.VideoOptions(width=480, height=360, fps=12, seconds=1.5, format="mp4",
+    opts = sim.VideoOptions(width=640, height=480, fps=20, seconds=2.0, format="mp4",
                             magnify=scene.magnify, backend=backend)
     res = sim.render_video(scene.segments, tmp_path / scene.file_name, title=scene.title,
                            options=opts, progress=False)

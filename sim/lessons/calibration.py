@@ -6,8 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from sim.effect_specs import parse_effects
-from sim.lessons.gallery import Lesson
-from sim.lessons.plots import figure
+from sim.lessons.gallery import Lesson, figure
 from sim.measurement import Procedure, measure, random_instrument
 from sim.real_robot import RealRobot
 from zrp.gap.pipeline import diagnose

@@ -8,8 +8,7 @@ from dataclasses import replace
 import numpy as np
 
 from sim.frames import VideoOptions
-from sim.lessons.gallery import Lesson
-from sim.lessons.plots import figure
+from sim.lessons.gallery import Lesson, figure
 from sim.video import render_video
 from zrp.manufacturing.perturb import Perturbation
 from zrp.manufacturing.study import one_at_a_time

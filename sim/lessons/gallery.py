@@ -1,15 +1,18 @@
-"""The lesson registry and the runner (see the package docstring)."""
+"""The lesson registry, the runner and the lessons' figure helper (see the package
+docstring)."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from zrp.errors import InputError
 from zrp.output import OutputDir
 
-__all__ = ["LESSONS", "Lesson", "lesson_file_names", "run_lessons"]
+__all__ = ["LESSONS", "Lesson", "figure", "lesson_file_names", "run_lessons"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,3 +78,22 @@ def run_lessons(out: OutputDir, names: Sequence[str] | None = None, *,
     ``small``: reduced size (what the test suite runs: fewer frames, robots and poses)."""
     reg = _registry()
     return [reg[n][2](out, small) for n in _check(names)]
+
+
+@contextmanager
+def figure(out: OutputDir, name: str, rows: int = 1) -> Iterator[tuple[Any, Any]]:
+    """A figure with ``rows`` stacked axes sharing x, saved as ``name`` into ``out``."""
+    import matplotlib  # plotting only when a lesson draws
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(rows, 1, figsize=(8, 2.6 + 2.2 * rows), sharex=rows > 1)
+    try:
+        yield fig, axes
+        for ax in (axes if rows > 1 else [axes]):
+            ax.grid(alpha=0.3)
+        fig.tight_layout()
+        out.savefig(name, fig, dpi=100)
+    finally:
+        plt.close(fig)

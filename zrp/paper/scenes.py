@@ -86,7 +86,8 @@ def perturbed_puma(parameter: str, xi_percent: float) -> tuple[Manipulator, Mani
     ``xi_percent``, and the label (perturbation and sign(0) convention)."""
     nominal = load_model("puma")
     pert = Perturbation.single(parameter, xi_percent)
-    label = f"{parameter} xi = {xi_percent:+g} %\n{pert.convention}"
+    label = (f"{parameter} xi = {xi_percent:+g} %; sign(0): links {pert.sign_zero_links:d}, "
+             f"axes {pert.sign_zero_axes:+d}")
     return nominal, pert.apply(nominal), label
 
 
@@ -154,5 +155,5 @@ def teaching_sweep_scene(parameter: str = "JE2", levels: Sequence[float] = PAPER
     for xi in levels:
         nominal, perturbed, label = perturbed_puma(parameter, float(xi))
         segs.append(SceneSegment(nominal, perturbed, t, q, label))
-    return Scene(tuple(segs), f"PUMA circle: {parameter} swept over the paper's levels",
+    return Scene(tuple(segs), f"PUMA circle: {parameter} at the paper's levels",
                  f"puma_sweep_{parameter}.mp4", paper_magnification(parameter, q))
