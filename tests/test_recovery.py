@@ -127,3 +127,16 @@ def test_cli_recovered_circle(tmp_path):
     bad = _zrp("paper", "--circle", "recovered", "--q0", "0", "0", "0", "0", "90", "0",
                "--out", str(tmp_path / "x"), cwd=tmp_path)
     assert bad.returncode == 2 and "--circle" in bad.stderr and "--q0" in bad.stderr
+
+
+def test_cli_recover_runs_a_tiny_search(tmp_path):
+    import json
+
+    p = _zrp("recover", "--popsize", "1", "--maxiter", "1", "--starts", "1", "--laws", "turning",
+             "--json", cwd=tmp_path)
+    assert p.returncode == 0, p.stderr
+    out = json.loads(p.stdout)
+    assert len(out["cells"]) == 48 and out["placement"]["orientation"] == "turning"
+    assert out["rms_log"] > 0.01            # a tiny search does not find the circle
+    bad = _zrp("recover", "--popsize", "0", cwd=tmp_path)
+    assert bad.returncode == 2 and "--popsize" in bad.stderr
