@@ -14,7 +14,7 @@ __all__ = ["CONCEPT", "FILES", "stack_lesson"]
 
 CONCEPT = ("Every robot built within the same tolerances is a different robot: drawing each "
            "link component within +-0.01 mm and each axis tilt within +-0.05 mrad gives a "
-           "distribution of the maximum deviation, far below the worst case that adds them all.")
+           "distribution of the maximum deviation (a median and a P99), not one number.")
 FILES = ("lesson3_tolerance_stack.png",)
 LENGTH_TOL_MM = 0.01
 ANGLE_TOL_RAD = 5e-5
