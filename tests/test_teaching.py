@@ -178,3 +178,40 @@ def test_view_without_a_display_says_so():
     assert p.returncode == 2
     assert "no display" in p.stderr and "zrp render" in p.stderr
     assert "Traceback" not in p.stderr
+
+
+def test_figures_keep_every_series_visible(tmp_path, monkeypatch):
+    """Each figure as drawn: the legend lies outside the axes (it covers no data), every
+    series of ours has its own (colour, dash, marker), series that coincide are named, and the
+    eq (15) figures carry the plain error angle on a twin axis."""
+    import zrp
+
+    seen: dict[str, object] = {}
+    original = OutputDir.savefig
+
+    def record(self, name, fig, **kw):
+        fig.canvas.draw()
+        seen[name] = fig
+        return original(self, name, fig, **kw)
+
+    monkeypatch.setattr(OutputDir, "savefig", record)
+    ex = zrp.run_paper_example(steps=60)
+    with monkeypatch.context() as m:
+        m.setattr("matplotlib.pyplot.close", lambda fig=None: None)
+        zrp.write_paper_outputs(ex, tmp_path / "p")
+    assert "fig3_je_max_rotation.png" in seen and "fig6_je_rotation_time_recovered.png" in seen
+    for name, fig in seen.items():
+        ax = fig.axes[0]
+        box = ax.get_window_extent()
+        leg = ax.get_legend().get_window_extent()
+        assert leg.x0 >= box.x1 - 1, name                      # legend right of the axes
+        ours = [ln for ln in ax.get_lines() if "published" not in ln.get_label()]
+        styles = {(ln.get_color(), str(ln.get_linestyle()), ln.get_marker()) for ln in ours}
+        assert len(styles) == len(ours), name
+        labels = [ln.get_label() for ln in ours]
+        if name.startswith(("fig3", "fig6")):
+            assert any("mrad" in a.get_ylabel() for a in ax.child_axes), name
+        if name == "fig3_je_max_rotation.png":     # JE4 within 0.5 % of JE1 on our circle
+            assert any("(= JE1 within 1 %)" in lab for lab in labels), labels
+        if name.startswith(("fig4", "fig7")):
+            assert any("(= LE3 within 1 %)" in lab for lab in labels), labels

@@ -80,7 +80,10 @@ def circles_markdown(ex: PaperExample) -> list[str]:
              "reproduces them: the hand turns once about the circle's normal while the tool "
              "goes round (with the hand held still the best RMS is 3.3 % and 8 cells stay "
              "outside 5 %). This run used the "
-             f"**{ex.circle}** circle; tables and Figures 2-7 are on it.", "",
+             f"**{ex.circle}** circle; tables and Figures 2-7 are on it"
+             + ("; Figures 5-7 on the recovered circle are beside them "
+                "(`fig5_je_position_time_recovered.png`, `fig6_..._recovered.png`, "
+                "`fig7_..._recovered.png`)." if ex.circle == "default" else "."), "",
              *_placement_rows(), ""]
     for name in ("default", "recovered"):
         rms, worst, within, digits = _stats(cells[name])
