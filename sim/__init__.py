@@ -47,6 +47,17 @@ _EXPORTS = {
         "nice_factor",
         "video_frames",
     ),
+    "framing": (
+        "frame_on_path",
+        "framing_report",
+        "path_normal",
+        "projected_fractions",
+    ),
+    "viewer": (
+        "DisplayUnavailableError",
+        "display_status",
+        "view_path",
+    ),
     "gl": (
         "BACKENDS",
         "GLBackendError",

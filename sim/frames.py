@@ -1,9 +1,16 @@
 """Frames of a nominal and a perturbed arm following the same joint trajectory.
 
-Each frame shows the perturbed ("actual") arm, the nominal arm as a translucent ghost, the
-desired path (nominal direct kinematics, blue), the actual path (red) and the current deviation
-vector (yellow arrow) both magnified about the desired path by a stated factor, a text block
-with the perturbation, delta_p, delta_R (eq 15) and theta, and a live plot of delta_p(t).
+Each frame shows the perturbed ("actual") arm (orange links), the nominal arm as a translucent
+white ghost, the desired path (nominal direct kinematics, green), the actual path (magenta) and
+the current deviation vector (yellow arrow with a ball at its tip), both magnified about the
+desired path by one stated factor for the whole video, a colour legend, a text block with the
+perturbation, delta_p, delta_R (eq 15) and theta (values below :data:`NOISE_FLOOR` print as 0,
+and the floor is stated), and a live plot of delta_p(t). In a video of several segments (a
+sweep over levels) the actual paths of the earlier segments stay drawn, dimmed.
+
+The camera looks along the normal of the desired path's plane (:mod:`sim.framing`), so a
+circle appears round, and frames the arm and the path together; the floor and the pedestal
+are hidden (seen edge on they only hid the text).
 
 The input is a sequence of segments (:class:`VideoSegment`: two models, a joint path q(t) and a
 label); what the models are and where the joint path comes from is the caller's business (the
@@ -25,7 +32,23 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from mjcf import BuiltArm, MJCFOptions, build
+from sim.framing import frame_on_path
 from sim.gl import _check_name
+from sim.magnify import exaggerated_model as exaggerated_model
+from sim.magnify import nice_factor as nice_factor
+from sim.overlays import (
+    ACTUAL_RGBA,
+    ARM_RGBA,
+    ARROW_RGBA,
+    DESIRED_RGBA,
+    EARLIER_RGBA,
+    GHOST_RGBA,
+    LEGEND,
+    NOISE_FLOOR,
+    PANEL_PX,
+    delta_p_figure,
+    shown_value,
+)
 from sim.playback import kinematic_playback
 from sim.render import OffscreenRenderer
 from zrp.errors import InputError, ZRPError
@@ -46,12 +69,6 @@ __all__ = [
 F64 = NDArray[np.float64]
 U8 = NDArray[np.uint8]
 FORMATS = ("auto", "mp4", "gif")
-
-DESIRED_RGBA = (0.25, 0.55, 1.0, 1.0)
-ACTUAL_RGBA = (1.0, 0.25, 0.2, 1.0)
-ARROW_RGBA = (1.0, 0.85, 0.1, 1.0)
-GHOST_RGBA = (0.6, 0.9, 1.0, 1.0)
-
 
 class VideoSegment(NamedTuple):
     """One part of a video: ``nominal`` (ghost) and ``perturbed`` arm along the joint path
@@ -79,7 +96,9 @@ class VideoOptions:
         backend: "egl", "osmesa" or None (MUJOCO_GL, else the first that works).
         trace_segments: line segments per drawn path.
         ghost_alpha: opacity of the nominal arm.
-        azimuth, elevation: camera angles, deg.
+        fill: fraction of the free part of the frame (between the text panels) the arm and
+            the path take together (the camera looks along the path plane's normal,
+            :func:`sim.framing.frame_on_path`).
         plot: draw the live delta_p plot.
         exaggerate_arm: draw the perturbed arm with its parameter errors multiplied by the
             magnification too (see :func:`exaggerated_model`), so it visibly leaves the ghost
@@ -95,9 +114,8 @@ class VideoOptions:
     format: str = "auto"
     backend: str | None = None
     trace_segments: int = 120
-    ghost_alpha: float = 0.4
-    azimuth: float = 150.0
-    elevation: float = -15.0
+    ghost_alpha: float = 0.35
+    fill: float = 0.92
     plot: bool = True
     exaggerate_arm: bool = True
 
@@ -118,45 +136,11 @@ class VideoOptions:
         if not 0 < self.ghost_alpha <= 1:
             raise InputError(f"ghost_alpha: expected an opacity in (0, 1], got "
                              f"{self.ghost_alpha!r}")
+        if not 0 < self.fill < 1:
+            raise InputError(f"fill: expected a fraction of the frame height in (0, 1), got "
+                             f"{self.fill!r}")
         if self.backend is not None:
             _check_name(self.backend, "backend")
-
-
-
-def exaggerated_model(nominal: Manipulator, perturbed: Manipulator, factor: float
-                      ) -> Manipulator:
-    """The perturbed model with its parameter errors multiplied by ``factor`` (for drawing).
-
-    b_k = b_k,nom + F (b_k,pert - b_k,nom); axes u_k = normalise(u_k,nom + F (u_k,pert -
-    u_k,nom)); the hand vectors likewise, u_t re-orthogonalised to u_a. To first order in the
-    errors the tool point moves F times as far from the nominal one as the perturbed arm's.
-    """
-    f = float(factor)
-
-    def mix(a: ArrayLike, b: ArrayLike) -> F64:
-        return np.asarray(a, dtype=float) + f * (np.asarray(b, dtype=float) - np.asarray(a))
-
-    axes = mix(nominal.axes, perturbed.axes)
-    axes /= np.linalg.norm(axes, axis=1, keepdims=True)
-    ua = mix(nominal.end_effector.axial, perturbed.end_effector.axial)
-    ua /= np.linalg.norm(ua)
-    ut = mix(nominal.end_effector.transverse, perturbed.end_effector.transverse)
-    ut -= (ut @ ua) * ua
-    ut /= np.linalg.norm(ut)
-    return perturbed.with_arrays(axes=axes, bodies=mix(nominal.bodies, perturbed.bodies),
-                                 axial=ua, transverse=ut,
-                                 name=f"{perturbed.name} (errors x{f:g})")
-
-
-def nice_factor(x: float) -> float:
-    """Largest 1, 2 or 5 times a power of ten not above ``x`` (x > 0); 1 for x <= 0."""
-    if not (x > 0 and math.isfinite(x)):
-        return 1.0
-    e = math.floor(math.log10(x))
-    for m in (5.0, 2.0, 1.0):
-        if m * 10**e <= x:
-            return m * 10**e
-    return 10.0**e
 
 
 
@@ -176,6 +160,13 @@ class _Segment:
     drawn: BuiltArm | None = None  # the opaque arm drawn (perturbed, maybe exaggerated)
 
 
+def _hide_triad(arm: BuiltArm) -> None:
+    """Make the end effector's RGB triad invisible: its red axis looked like the deviation."""
+    for g in range(arm.model.ngeom):
+        if "hand_" in (mujoco.mj_id2name(arm.model, mujoco.mjtObj.mjOBJ_GEOM, g) or ""):
+            arm.model.geom_rgba[g, 3] = 0.0
+
+
 def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: ArrayLike,
              frames: int, label: str, ghost_alpha: float, size: tuple[int, int]) -> _Segment:
     if not isinstance(nominal, Manipulator) or not isinstance(perturbed, Manipulator):
@@ -192,9 +183,11 @@ def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: Arra
         raise InputError("t: expected finite, strictly increasing times (s)")
     tf = np.linspace(t[0], t[-1], frames)
     qf = np.stack([np.interp(tf, t, q[:, j]) for j in range(nominal.n)], axis=1)
-    arm_a = build(perturbed, MJCFOptions(offscreen_size=size))
+    arm_a = build(perturbed, MJCFOptions(offscreen_size=size, link_rgba=ARM_RGBA))
     arm_n = build(nominal, MJCFOptions(alpha=ghost_alpha, floor=False, prefix="ghost_",
                                        tint=GHOST_RGBA, offscreen_size=size))
+    for arm in (arm_a, arm_n):
+        _hide_triad(arm)
     des = kinematic_playback(arm_n, qf)
     act = kinematic_playback(arm_a, qf)
     dp = np.linalg.norm(act.position - des.position, axis=-1)
@@ -204,59 +197,61 @@ def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: Arra
                     act.position * arm_a.scale, dp, dr, theta, label)
 
 
+def _arm_points(seg: _Segment) -> F64:
+    """Body origins of the drawn arm at up to 24 frames of the segment (m), shape
+    (frames, bodies, 3)."""
+    arm = seg.drawn or seg.actual
+    d = mujoco.MjData(arm.model)
+    pts = []
+    for f in np.linspace(0, len(seg.t) - 1, min(len(seg.t), 24)).astype(int):
+        d.qpos[arm.qpos_adr] = arm.qpos(seg.q[f])
+        mujoco.mj_kinematics(arm.model, d)
+        pts.append(d.xpos[1:].copy())
+    return np.stack(pts)
+
+
 def _camera(r: OffscreenRenderer, segs: Sequence[_Segment], opts: VideoOptions) -> None:
-    """Frame the whole arm and the path: look between the base and the path's centre."""
-    seg = segs[0]
-    path_c = seg.p_des.mean(axis=0)
-    bodies = np.asarray(seg.nominal.manipulator.bodies) * seg.nominal.scale
-    reach = max(float(np.sum(np.linalg.norm(bodies, axis=1))), 0.2)
-    centre = 0.5 * path_c
-    r.look_at(centre, 1.5 * reach, opts.azimuth, opts.elevation)
+    """Look along the normal of the first path's plane and frame every arm and path
+    (:func:`sim.framing.frame_on_path`); hide the floor and the pedestal (geom group 2)."""
+    path = np.vstack([s.p_des for s in segs])
+    arm = np.concatenate([_arm_points(s) for s in segs])
+    # the scene left of the right-hand column of text and plot (PANEL_PX wide at font scale
+    # 100) and below the two title lines
+    w, h = opts.width, opts.height
+    frame_on_path(r, path, arm.reshape(-1, 3),
+                  box=(0.01, max(0.5, 1 - (PANEL_PX + 10) / w), 0.01, max(0.7, 1 - 55 / h)),
+                  margin=opts.fill)
+    r.option.geomgroup[2] = 0
+    r.option.frame = mujoco.mjtFrame.mjFRAME_NONE
 
 
-def _delta_p_figure(seg: _Segment, opts: VideoOptions, unit: str, plot_top: float | None
-                    ) -> mujoco.MjvFigure:
-    """The live delta_p(t) plot (empty when ``opts.plot`` is off)."""
-    fig = mujoco.MjvFigure()
-    if not opts.plot:
-        return fig
-    mujoco.mjv_defaultFigure(fig)
-    fig.flg_extend = 0
-    fig.flg_ticklabel[0] = 1
-    fig.flg_ticklabel[1] = 1
-    fig.gridsize[:] = [3, 3]
-    fig.title = f"delta_p ({unit})"
-    fig.xlabel = "t (s)"
-    fig.range[0][:] = [seg.t[0], seg.t[-1]]
-    top = plot_top if plot_top is not None else float(seg.delta_p.max())
-    fig.range[1][:] = [0.0, 1.1 * (top or 1e-12)]
-    fig.linergb[0][:] = ACTUAL_RGBA[:3]
-    fig.figurergba[:] = [0.05, 0.05, 0.08, 0.85]
-    fig.panergba[:] = [0.12, 0.12, 0.15, 1.0]
-    fig.linewidth = 2.0
-    fig.legendrgba[3] = 0.0
-    return fig
+def _magnified(seg: _Segment, magnify: float) -> F64:
+    """The actual path drawn: desired + magnify (actual - desired), m, shape (F, 3)."""
+    return seg.p_des + magnify * (seg.p_act - seg.p_des)
 
 
 def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: VideoOptions,
-                    unit: str, title: str, plot_top: float | None = None) -> Iterator[U8]:
+                    unit: str, title: str, plot_top: float | None = None,
+                    earlier: Sequence[F64] = ()) -> Iterator[U8]:
+    """The frames of one segment; ``earlier``: magnified actual paths of the segments before
+    it (m, each shape (F, 3)), kept on screen dimmed."""
     drawn = seg.drawn or seg.actual
     m_a, m_n = drawn.model, seg.nominal.model
     d_a, d_n = mujoco.MjData(m_a), mujoco.MjData(m_n)
     n_frames = len(seg.t)
-    magnified = seg.p_des + magnify * (seg.p_act - seg.p_des)
+    magnified = _magnified(seg, magnify)
     stride = max(1, math.ceil((n_frames - 1) / opts.trace_segments))
     idx_all = np.unique(np.r_[np.arange(0, n_frames, stride), n_frames - 1])
     path_size = float(np.linalg.norm(seg.p_des.max(axis=0) - seg.p_des.min(axis=0))) or 0.1
     arrow_r = 0.006 * max(path_size, 0.1)
-    fig = _delta_p_figure(seg, opts, unit, plot_top)
+    fig = delta_p_figure(seg.t, seg.delta_p, opts.plot, unit, plot_top)
     max_pts = len(fig.linedata[0]) // 2 if opts.plot else 0
     plot_idx = np.linspace(0, n_frames - 1, min(n_frames, max_pts)).astype(int) if opts.plot \
         else np.zeros(0, int)
     pw, ph = int(opts.width * 0.36), int(opts.height * 0.27)
-    legend = "blue: desired (nominal)\nred: actual (perturbed)\npale ghost: nominal arm"
-    if seg.drawn is not None:
-        legend += f"\narm: perturbed, errors x{magnify:g}"
+    col = max(pw, PANEL_PX)   # the right-hand column: legend, numbers, plot
+    numbers = (opts.width - col - 4, ph + 8, col, max(1, opts.height - ph - 8))
+    legend = LEGEND.format(m=magnify, arm=f", errors x{magnify:g}" if seg.drawn else "")
     for f in range(n_frames):
         d_a.qpos[drawn.qpos_adr] = drawn.qpos(seg.q[f])
         d_n.qpos[seg.nominal.qpos_adr] = seg.nominal.qpos(seg.q[f])
@@ -264,6 +259,8 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
         mujoco.mj_kinematics(m_n, d_n)
         r.update_scene(d_a, [(m_n, d_n)], model=m_a)
         r.add_polyline(seg.p_des[idx_all], DESIRED_RGBA, 2.0)
+        for prev in earlier:
+            r.add_polyline(prev[idx_all[idx_all < len(prev)]], EARLIER_RGBA, 1.5)
         done = idx_all[idx_all <= f]
         if len(done) and done[-1] != f:
             done = np.r_[done, f]
@@ -271,12 +268,14 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
             r.add_polyline(magnified[done], ACTUAL_RGBA, 2.5)
         if np.linalg.norm(magnified[f] - seg.p_des[f]) > 1e-9:
             r.add_arrow(seg.p_des[f], magnified[f], ARROW_RGBA, arrow_r)
+            r.add_sphere(magnified[f], 2.5 * arrow_r, ARROW_RGBA)
         r.render()
-        r.text(f"{title}\n{seg.label}\ndeviations drawn x{magnify:g}",
+        r.text(f"{title}\n{seg.label}",
                corner=mujoco.mjtGridPos.mjGRID_TOPLEFT)
-        r.text("t\ndelta_p\ndelta_R (eq 15)\ntheta",
-               f"{seg.t[f]:.2f} s\n{seg.delta_p[f]:.4g} {unit}\n{seg.delta_r[f]:.3e}\n"
-               f"{seg.theta[f]:.3e} rad", corner=mujoco.mjtGridPos.mjGRID_BOTTOMLEFT)
+        r.text(f"t\ndelta_p\ndelta_R (eq 15)\ntheta\n(< {NOISE_FLOOR:g} shown as 0)",
+               f"{seg.t[f]:.2f} s\n{shown_value(seg.delta_p[f], '.4g')} {unit}\n"
+               f"{shown_value(seg.delta_r[f], '.3e')}\n{shown_value(seg.theta[f], '.3e')} rad\n",
+               corner=mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport=numbers)
         r.text(legend, corner=mujoco.mjtGridPos.mjGRID_TOPRIGHT)
         if opts.plot:
             shown = plot_idx[plot_idx <= f]
@@ -335,7 +334,9 @@ def _prepare(segments: Sequence[VideoSegment | tuple[Manipulator, Manipulator, A
                 shown = exaggerated_model(seg_in.nominal, seg_in.perturbed, magnify)
             except ZRPError:  # a degenerate exaggeration: draw the true arm
                 shown = seg_in.perturbed
-            drawn.append(replace(s, drawn=build(shown, MJCFOptions(offscreen_size=size))))
+            arm = build(shown, MJCFOptions(offscreen_size=size, link_rgba=ARM_RGBA))
+            _hide_triad(arm)
+            drawn.append(replace(s, drawn=arm))
         segs = drawn
     return _Prepared(tuple(segs), magnify, top)
 
@@ -345,11 +346,14 @@ def _frames(prep: _Prepared, opts: VideoOptions, title: str, r: OffscreenRendere
     segs = prep.segments
     unit = segs[0].nominal.manipulator.length_unit
     _camera(r, segs, opts)
+    earlier: list[F64] = []
     for seg in segs:
         if (seg.drawn or seg.actual).model.nbody != r.model.nbody:
             raise InputError("segments: every perturbed model must have the same structure "
                              "as the first")
-        yield from _segment_frames(r, seg, prep.magnify, opts, unit, title, prep.top)
+        yield from _segment_frames(r, seg, prep.magnify, opts, unit, title, prep.top,
+                                   tuple(earlier))
+        earlier.append(_magnified(seg, prep.magnify))
 
 
 def video_frames(segments: Sequence[VideoSegment], *, title: str = "nominal vs perturbed",

@@ -192,9 +192,12 @@ class OffscreenRenderer:
 
     def text(self, text: str, text2: str = "", *,
              corner: mujoco.mjtGridPos = mujoco.mjtGridPos.mjGRID_TOPLEFT,
-             font: mujoco.mjtFont = mujoco.mjtFont.mjFONT_NORMAL) -> None:
-        """Two-column text block (``text`` left, ``text2`` right) in a corner."""
-        mujoco.mjr_overlay(font, corner, self.rect, text, text2, self._require_open())
+             font: mujoco.mjtFont = mujoco.mjtFont.mjFONT_NORMAL,
+             viewport: tuple[int, int, int, int] | None = None) -> None:
+        """Two-column text block (``text`` left, ``text2`` right) in a corner of the frame,
+        or of ``viewport`` (left, bottom, width, height in pixels)."""
+        rect = self.rect if viewport is None else mujoco.MjrRect(*(int(v) for v in viewport))
+        mujoco.mjr_overlay(font, corner, rect, text, text2, self._require_open())
 
     def figure(self, fig: mujoco.MjvFigure, left: int, bottom: int, width: int,
                height: int) -> None:

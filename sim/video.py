@@ -21,7 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
-from sim.frames import VideoOptions, VideoSegment, _frames, _prepare
+from sim.frames import VideoOptions, VideoSegment, _arm_points, _frames, _prepare
+from sim.framing import framing_report
 from sim.render import OffscreenRenderer
 from zrp.errors import InputError, ZRPError
 from zrp.model.manipulator import Manipulator
@@ -74,6 +75,10 @@ class VideoResult:
         rows = [f"{self.path}: {self.frames} frames in {self.wall_seconds:.1f} s "
                 f"({self.frames / self.wall_seconds:.1f} frames/s end to end, {self.backend}), "
                 f"deviations drawn x{self.magnify:g}"]
+        fr = self.extra.get("framing")
+        if isinstance(fr, dict):
+            rows.append(f"  framing: circle aspect {fr['circle_aspect']:.3f}, arm "
+                        f"{fr['arm_height_fraction']:.0%} of the frame height")
         for lab, dp, dr, th in zip(self.labels, self.max_delta_p, self.max_delta_r,
                                    self.max_theta, strict=False):
             lab = lab.replace("\n", "; ")
@@ -192,6 +197,9 @@ def render_video(
                 for frame in _frames(prep, opts, title, r):
                     write(frame)
                     bar.update(1)
+            framing = framing_report(r.scene, np.vstack([s.p_des for s in segs]),
+                                     np.concatenate([_arm_points(s) for s in segs]),
+                                     opts.width, opts.height)
     except InputError as exc:  # from atomic_path: the file could not be written or moved
         cause = exc.__cause__
         if isinstance(cause, VideoWriteError):
@@ -204,7 +212,7 @@ def render_video(
                        tuple(float(np.max(s.delta_r)) for s in segs),
                        tuple(float(np.max(s.theta)) for s in segs),
                        tuple(s.label for s in segs), backend,
-                       segs[0].nominal.manipulator.length_unit)
+                       segs[0].nominal.manipulator.length_unit, {"framing": framing})
 
 
 def render_comparison_video(

@@ -2,7 +2,9 @@
 (:mod:`.scenario`), its perturbation study (:mod:`.example`), the published Tables 2-3 as data
 (:mod:`.published`), the comparison with them (:mod:`.comparison`), the paper's claims checked
 (:mod:`.claims`), and the outputs: tables, report and JSON (:mod:`.report`), Figures 2-7
-(:mod:`.figures`), and the scenes of its videos (:mod:`.scenes`). See README.md in this folder.
+(:mod:`.figures`), the scenes of its videos (:mod:`.scenes`), the circle recovered from the
+published tables (:mod:`.placement`, :mod:`.inverse`, :mod:`.circles`) and the renders/ index
+page (:mod:`.index`). See README.md in this folder.
 """
 
 from zrp.paper.claims import check_claims as check_claims
@@ -13,6 +15,16 @@ from zrp.paper.comparison import table_value as table_value
 from zrp.paper.example import PaperExample as PaperExample
 from zrp.paper.example import default_parameters as default_parameters
 from zrp.paper.example import run_paper_example as run_paper_example
+from zrp.paper.index import write_index as write_index
+from zrp.paper.inverse import CellFit as CellFit
+from zrp.paper.inverse import RecoveryResult as RecoveryResult
+from zrp.paper.inverse import fit_cells as fit_cells
+from zrp.paper.inverse import local_pinning as local_pinning
+from zrp.paper.inverse import recover_circle as recover_circle
+from zrp.paper.placement import DEFAULT_PLACEMENT as DEFAULT_PLACEMENT
+from zrp.paper.placement import RECOVERED as RECOVERED
+from zrp.paper.placement import CirclePlacement as CirclePlacement
+from zrp.paper.placement import placement_path as placement_path
 from zrp.paper.published import CELL_STATUSES as CELL_STATUSES
 from zrp.paper.published import JE_PARAMS as JE_PARAMS
 from zrp.paper.published import LE_PARAMS as LE_PARAMS
@@ -24,6 +36,7 @@ from zrp.paper.published import PUBLISHED_TABLE3 as PUBLISHED_TABLE3
 from zrp.paper.published import PUBLISHED_TABLE3_ZERO as PUBLISHED_TABLE3_ZERO
 from zrp.paper.published import half_ulp as half_ulp
 from zrp.paper.published import implied_joint_angles as implied_joint_angles
+from zrp.paper.published import le3_readings as le3_readings
 from zrp.paper.report import comparison_csv as comparison_csv
 from zrp.paper.report import comparison_markdown as comparison_markdown
 from zrp.paper.report import output_names as output_names
@@ -41,6 +54,7 @@ from zrp.paper.scenario import puma_circle_ik as puma_circle_ik
 from zrp.paper.scenes import PAPER_LEVELS as PAPER_LEVELS
 from zrp.paper.scenes import Scene as Scene
 from zrp.paper.scenes import SceneSegment as SceneSegment
+from zrp.paper.scenes import paper_magnification as paper_magnification
 from zrp.paper.scenes import paper_video_file_name as paper_video_file_name
 from zrp.paper.scenes import paper_video_scene as paper_video_scene
 from zrp.paper.scenes import perturbed_puma as perturbed_puma
@@ -48,6 +62,7 @@ from zrp.paper.scenes import teaching_sweep_scene as teaching_sweep_scene
 
 __all__ = [
     "CELL_STATUSES",
+    "DEFAULT_PLACEMENT",
     "JE_PARAMS",
     "LE_PARAMS",
     "LIKELY_TYPOS",
@@ -60,9 +75,13 @@ __all__ = [
     "PUMA_DURATION_S",
     "PUMA_Q0_DEG",
     "PUMA_RADIUS_MM",
+    "RECOVERED",
     "Cell",
+    "CellFit",
+    "CirclePlacement",
     "CircleSetup",
     "PaperExample",
+    "RecoveryResult",
     "Scene",
     "SceneSegment",
     "check_claims",
@@ -71,20 +90,27 @@ __all__ = [
     "comparison_csv",
     "comparison_markdown",
     "default_parameters",
+    "fit_cells",
     "half_ulp",
     "implied_joint_angles",
     "is_paper_model",
     "kind_columns",
+    "le3_readings",
+    "local_pinning",
     "output_names",
+    "paper_magnification",
     "paper_start",
     "paper_summary",
     "paper_video_file_name",
     "paper_video_scene",
     "perturbed_puma",
+    "placement_path",
     "puma_circle",
     "puma_circle_ik",
+    "recover_circle",
     "run_paper_example",
     "table_value",
     "teaching_sweep_scene",
+    "write_index",
     "write_paper_outputs",
 ]

@@ -49,10 +49,11 @@ from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
 from zrp.paper.claims import check_claims
 from zrp.paper.comparison import Cell, compare_with_published, kind_columns, table_value
+from zrp.paper.placement import RECOVERED, placement_path
 from zrp.paper.published import PUBLISHED_ROWS, PUBLISHED_TABLE2
 from zrp.paper.scenario import circle_joint_path, is_paper_model
 
-__all__ = ["PaperExample", "default_parameters", "run_paper_example"]
+__all__ = ["CIRCLES", "PaperExample", "default_parameters", "run_paper_example"]
 
 
 def default_parameters(model: Manipulator) -> tuple[str, ...]:
@@ -78,6 +79,10 @@ class PaperExample:
         cells: the comparison (:func:`compare_with_published`).
         checks: the paper's claims checked with numbers.
         timings_s: compute time per stage (s).
+        circle: "default" (:func:`zrp.paper.scenario.puma_circle`), "recovered"
+            (:data:`zrp.paper.placement.RECOVERED`) or "custom" (a given path / other model).
+        other_circle: for the paper's PUMA on one of the two named circles, the study on the
+            other one (comparison.md shows both; Figures 5-7 are drawn on it too), else None.
     """
 
     model: Manipulator
@@ -88,14 +93,26 @@ class PaperExample:
     cells: list[Cell]
     checks: dict[str, Any]
     timings_s: dict[str, float] = field(default_factory=dict)
+    circle: str = "custom"
+    other_circle: StudyResult | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.study, StudyResult) or not isinstance(self.path, JointPath):
             raise InputError("PaperExample: study must be a StudyResult and path a JointPath")
 
 
+CIRCLES = ("default", "recovered")
+
+
+def _circle_path(name: str, steps: int) -> JointPath:
+    """The joint path of a named circle on the Table 1 PUMA."""
+    if name == "recovered":
+        return placement_path(RECOVERED, steps)
+    return circle_joint_path(load_model("puma"), steps=steps)
+
+
 def run_paper_example(model: Manipulator | None = None, path: JointPath | None = None, *,
-                      steps: int = 360) -> PaperExample:
+                      steps: int = 360, circle: str | None = None) -> PaperExample:
     """The whole numerical example: IK, study, alternative conventions, comparison, checks.
 
     Args:
@@ -103,12 +120,24 @@ def run_paper_example(model: Manipulator | None = None, path: JointPath | None =
         path: default the 125 mm circle of :func:`zrp.paper.scenario.circle_joint_path` with
             ``steps`` integration steps (T = steps + 1 samples); required for models other
             than the paper's PUMA, which have no default start configuration.
+        circle: "default" or "recovered" (:data:`zrp.paper.placement.RECOVERED`, the circle
+            recovered from the published tables), paper's PUMA only, without ``path``;
+            default "default" when neither ``path`` nor another model is given.
     """
     timings: dict[str, float] = {}
     t0 = time.perf_counter()
     model = load_model("puma") if model is None else model
+    if circle is not None:
+        if circle not in CIRCLES:
+            raise InputError(f"circle: expected one of {CIRCLES}, got {circle!r}")
+        if path is not None or not is_paper_model(model):
+            raise InputError("circle: a named circle belongs to the paper's Table 1 PUMA and "
+                             "replaces path; give one or the other")
+    elif path is None and is_paper_model(model):
+        circle = "default"
     if path is None:
-        path = circle_joint_path(model, steps=steps)
+        path = (_circle_path(circle, steps) if circle is not None
+                else circle_joint_path(model, steps=steps))
     timings["inverse_kinematics"] = time.perf_counter() - t0
     t0 = time.perf_counter()
     published = is_paper_model(model)
@@ -124,7 +153,13 @@ def run_paper_example(model: Manipulator | None = None, path: JointPath | None =
                               sign_zero_links=PAPER_SIGN_ZERO["links"], sign_zero_axes=0)
     timings["alternative_conventions"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    cells = compare_with_published(study, model) if published else []
+    cells = (compare_with_published(study, model, recovered=circle == "recovered")
+             if published else [])
+    other = None
+    if circle is not None:
+        name = "default" if circle == "recovered" else "recovered"
+        other = one_at_a_time(model, _circle_path(name, steps), default_parameters(model),
+                              PAPER_XI)
     checks = check_claims(study, path, published)
     first = le[0]
     checks["published_values_apply"] = published
@@ -138,4 +173,5 @@ def run_paper_example(model: Manipulator | None = None, path: JointPath | None =
     }
     timings["comparison"] = time.perf_counter() - t0
     timings["total_compute"] = sum(timings.values())
-    return PaperExample(model, path, study, alt_l, alt_a, cells, checks, timings)
+    return PaperExample(model, path, study, alt_l, alt_a, cells, checks, timings,
+                        circle or "custom", other)

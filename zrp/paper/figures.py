@@ -13,9 +13,14 @@ from zrp.paper.comparison import kind_columns
 from zrp.paper.example import PaperExample
 from zrp.paper.published import LIKELY_TYPOS, PUBLISHED_ROWS, PUBLISHED_TABLE2, PUBLISHED_TABLE3
 
-__all__ = ["FIGURES", "figure_names", "paper_figures"]
+__all__ = ["FIGURES", "coincident_with", "figure_names", "paper_figures"]
 
 F64 = NDArray[np.float64]
+#: One line style and marker per series, so that no series hides another.
+LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1)))
+MARKERS = ("o", "s", "^", "v", "D", "P", "X", "*")
+#: Published markers of neighbouring columns are shifted by this (percent of xi) apart.
+PUBLISHED_OFFSET = 0.0025
 
 #: Figures 2-7: file name, the parameter kind it shows, "sweep" (max over t against xi, with
 #: the published values) or "history" (deviation against t at xi = 0.1 %), the quantity
@@ -38,7 +43,7 @@ def figure_names(ex: PaperExample) -> list[str]:
 def _labels(name: str, unit: str, typos_noted: bool) -> tuple[str, str]:
     """(y label, title) of a figure."""
     pos = f"positional deviation ({unit})"
-    rot = "rotational deviation, eq (15)"
+    rot = "rotational deviation, eq (15) (dimensionless)"
     return {
         "fig2_je_max_position.png": (
             f"max {pos}", "Fig. 2: joint-axis misalignments vs max positional deviation"
@@ -56,32 +61,84 @@ def _labels(name: str, unit: str, typos_noted: bool) -> tuple[str, str]:
     }[name]
 
 
+def coincident_with(data: F64, names: list[str], rtol: float = 1e-2) -> dict[str, str]:
+    """For each series equal to an earlier one (every sample within ``rtol`` of its largest
+    value), the earlier
+    one's name: these are drawn with open markers and named in the legend ("= X within 1 %"),
+    never hidden."""
+    out: dict[str, str] = {}
+    for i in range(len(names)):
+        for j in range(i):
+            a, b = data[j].ravel(), data[i].ravel()
+            if np.max(np.abs(a - b)) <= rtol * max(float(np.abs(a).max()), 1e-300):
+                out[names[i]] = out.get(names[j], names[j])
+                break
+    return out
+
+
+def _style(c: int, colors: list[str]) -> dict[str, Any]:
+    return {"color": colors[c % len(colors)], "ls": LINESTYLES[c % len(LINESTYLES)],
+            "marker": MARKERS[c % len(MARKERS)]}
+
+
 def _sweep(ax: Any, ex: PaperExample, params: list[str], data: F64,
            pub: dict[str, tuple[float, ...]] | None, table: int, colors: list[str]) -> None:
     st = ex.study
+    rows = [st.index(p) for p in params]
+    same = coincident_with(data[rows], params)
     for c, p in enumerate(params):
         i = st.index(p)
-        ax.plot(st.xi_percent, data[i], "-o", ms=3, color=colors[c % 10], label=f"{p} ours")
+        sty = _style(c, colors)
+        note = f" (= {same[p]} within 1 %)" if p in same else ""
+        ax.plot(st.xi_percent, data[i], ms=4 + 2 * (p in same), mfc="none" if p in same else
+                sty["color"], lw=1.2, label=f"{p} ours{note}", **sty)
         if pub is not None and p in pub:
-            xs = [x for x in PUBLISHED_ROWS if (table, p, x) not in LIKELY_TYPOS]
+            dx = PUBLISHED_OFFSET * (c - (len(params) - 1) / 2)
+            xs = [x + dx for x in PUBLISHED_ROWS if (table, p, x) not in LIKELY_TYPOS]
             ys = [v for x, v in zip(PUBLISHED_ROWS, pub[p], strict=True)
                   if (table, p, x) not in LIKELY_TYPOS]
-            ax.plot(xs, ys, "s", mfc="none", color=colors[c % 10], ms=7,
+            ax.plot(xs, ys, "s", mfc="none", color=sty["color"], ms=7, mew=1.2,
                     label=f"{p} published")
     ax.set_xlabel("perturbation xi (%)")
 
 
 def _history(ax: Any, ex: PaperExample, params: list[str], data: F64,
-             colors: list[str]) -> None:
+             colors: list[str], suffix: str = "") -> None:
     st = ex.study
     j = int(np.argmin(np.abs(st.xi_percent - 0.1)))
+    rows = data[[st.index(p) for p in params], j]
+    same = coincident_with(rows, params)
+    every = max(1, st.t.size // 12)
     for c, p in enumerate(params):
-        ax.plot(st.t, data[st.index(p), j], color=colors[c % 10], label=f"{p}, xi = 0.1 %")
+        note = f" (= {same[p]} within 1 %)" if p in same else ""
+        ax.plot(st.t, data[st.index(p), j], lw=1.3, markevery=(c * every // 6 or 1, every),
+                ms=5, mfc="none", label=f"{p}, xi = 0.1 %{note}{suffix}", **_style(c, colors))
     ax.set_xlabel("time (s)")
 
 
-def paper_figures(ex: PaperExample, out: OutputDir) -> list[Path]:
-    """Draw Figures 2-7 (:func:`figure_names`) into the open output folder ``out``."""
+def _angle_twin(ax: Any) -> None:
+    """A right-hand axis with the plain error angle theta (mrad) of an eq (15) value
+    delta_R = 2 sqrt(2) sin(theta / 2)."""
+    def to_theta(v: Any) -> Any:
+        return 2e3 * np.arcsin(np.clip(np.asarray(v, dtype=float) / np.sqrt(8.0), -1, 1))
+
+    def to_dr(th: Any) -> Any:
+        return np.sqrt(8.0) * np.sin(np.asarray(th, dtype=float) / 2e3)
+
+    ax.secondary_yaxis("right", functions=(to_theta, to_dr)).set_ylabel(
+        "error angle theta (mrad)")
+
+
+def paper_figures(ex: PaperExample, out: OutputDir, *, suffix: str = "",
+                  only: tuple[str, ...] | None = None, circle: str = "") -> list[Path]:
+    """Draw Figures 2-7 (:func:`figure_names`) into the open output folder ``out``.
+
+    Args:
+        suffix: appended to each file's stem (``fig5_je_position_time<suffix>.png``).
+        only: the file names (without suffix) to draw; default all.
+        circle: appended to each title (e.g. "on the recovered circle").
+    """
+    suffix_title = f"\n({circle})" if circle else ""
     import matplotlib  # a plotting dependency: loaded on first use only
 
     matplotlib.use("Agg")
@@ -95,26 +152,28 @@ def paper_figures(ex: PaperExample, out: OutputDir) -> list[Path]:
     files: list[Path] = []
     for name, kind, style, quantity, table in FIGURES:
         params = kind_columns(st, kind)
-        if not params:
+        if not params or (only is not None and name not in only):
             continue
         ylabel, title = _labels(name, st.unit, bool(pubs))
-        fig, ax = plt.subplots(figsize=(7, 4.6))
+        fig, ax = plt.subplots(figsize=(9.5, 4.8))
         try:
             if style == "sweep":
                 _sweep(ax, ex, params, getattr(st, quantity), pubs.get(table), table, colors)
             else:
                 _history(ax, ex, params, getattr(st, quantity), colors)
             ax.set_ylabel(ylabel)
-            ax.set_title(title)
+            if quantity.endswith("delta_r"):
+                _angle_twin(ax)
+            ax.set_title(title + suffix_title)
             ax.grid(alpha=0.3)
-            if style == "sweep":
-                ax.legend(fontsize=7, ncol=2)
-            else:
-                ax.legend(fontsize=8)
-            fig.text(0.99, 0.01, f"{conv}; {ex.path.label}", ha="right", va="bottom",
+            ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.12 if "delta_r" in
+                      quantity else 1.01, 1.0), borderaxespad=0.0)
+            note = ("published squares offset in xi for legibility; "
+                    if style == "sweep" and pubs else "")
+            fig.text(0.99, 0.01, f"{note}{conv}; {ex.path.label}", ha="right", va="bottom",
                      fontsize=7, color="0.4")
             fig.tight_layout(rect=(0, 0.03, 1, 1))
-            files.append(out.savefig(name, fig, dpi=110))
+            files.append(out.savefig(name.replace(".png", f"{suffix}.png"), fig, dpi=110))
         finally:
             plt.close(fig)
     return files

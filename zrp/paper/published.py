@@ -53,7 +53,9 @@ LIKELY_TYPOS: dict[tuple[int, str, float], float] = {
     (2, "JE1", 0.1): 7.88e-1,
     (2, "JE2", 0.1): 1.33e0,
 }
-CELL_STATUSES = ("match", "discrepancy", "typo", "trajectory-dependent")
+#: "reproduced": a joint-axis cell within 5 % (not to the printed digits) on the circle
+#: recovered from the tables (:data:`zrp.paper.placement.RECOVERED`).
+CELL_STATUSES = ("match", "discrepancy", "typo", "trajectory-dependent", "reproduced")
 LE_PARAMS = ("LE2", "LE3", "LE4", "LE7")
 JE_PARAMS = ("JE1", "JE2", "JE3", "JE4", "JE5", "JE6")
 
@@ -88,4 +90,32 @@ def implied_joint_angles(table3: dict[str, tuple[float, ...]] | None = None,
                 r = np.sin(theta / 4.0) / np.sin(alpha / 2.0)
                 est.append(np.degrees(2.0 * np.arcsin(min(r, 1.0))))
         out[col] = {"deg_min": float(min(est)), "deg_max": float(max(est))}
+    return out
+
+
+#: Readings of ||b_3|| (mm) that Table 1 or the PUMA 560 literature could give: (name, mm).
+LE3_READINGS: tuple[tuple[str, float], ...] = (
+    ("Table 1 as printed: b_3 = (431.8, 0, 0) = 17 in", 431.8),
+    ("PUMA 560 d4 = 433.07 mm (17.05 in, Craig; the '433 mm' of the literature)", 433.07),
+    ("431.8 mm with the PUMA 560 forearm offset a3 = 20.32 mm (0.8 in) at right angles",
+     float(np.hypot(431.8, 20.32))),
+    ("433.07 mm with a3 = 20.32 mm at right angles", float(np.hypot(433.07, 20.32))),
+    ("431.8 mm plus a3 = 20.32 mm along the link", 431.8 + 20.32),
+    ("431.8 mm with the PUMA 560 shoulder offset d3 = 149.09 mm at right angles",
+     float(np.hypot(431.8, 149.09))),
+    ("431.8 mm with the tool length 127 mm at right angles", float(np.hypot(431.8, 127.0))),
+    ("17.5 in = 444.5 mm (17 in misread or mistyped by half an inch)", 17.5 * 25.4),
+)
+
+
+def le3_readings() -> list[dict[str, object]]:
+    """Each :data:`LE3_READINGS` entry beside the published LE3 column: the cells xi ||b_3||
+    it predicts and how many of the four equal the printed value to its 3 digits."""
+    out: list[dict[str, object]] = []
+    pub = PUBLISHED_TABLE2["LE3"]
+    for name, length in LE3_READINGS:
+        pred = [x / 100.0 * length for x in PUBLISHED_ROWS]
+        hits = sum(abs(p - v) <= half_ulp(v) * 1.0001 for p, v in zip(pred, pub, strict=True))
+        out.append({"reading": name, "b3_mm": round(length, 2), "predicted": pred,
+                    "cells_matching": int(hits)})
     return out

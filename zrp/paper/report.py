@@ -6,10 +6,12 @@ written into one output folder through :class:`zrp.output.OutputDir`
 from __future__ import annotations
 
 from collections.abc import Callable
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from zrp.output import OutputDir
+from zrp.paper.circles import RECOVERED_FIGURES, circles_markdown
 from zrp.paper.comparison import kind_columns
 from zrp.paper.example import PaperExample
 from zrp.paper.figures import FIGURES, figure_names, paper_figures
@@ -177,6 +179,7 @@ def comparison_markdown(ex: PaperExample) -> str:
                   "trajectory, not the model. The paper does not publish its circle's centre, "
                   "plane, orientation law or start configuration, so the JE cells are flagged as "
                   "trajectory-dependent rather than tuned."]
+    lines += ["", *circles_markdown(ex)]
     lines += ["", "## Compute time", "",
               *(f"- {k}: {v * 1e3:.1f} ms" for k, v in ex.timings_s.items()), ""]
     return "\n".join(lines)
@@ -187,7 +190,13 @@ def output_names(ex: PaperExample | None = None, *, figures: bool = True) -> lis
     ``ex``, or (without it) every name it may write, e.g. to check a folder before computing."""
     tables = [t[0] for t in TABLES if ex is None or not t[2] or kind_columns(ex.study, t[2])]
     figs = [f[0] for f in FIGURES] if ex is None else figure_names(ex)
+    if ex is None or (ex.circle == "default" and ex.other_circle is not None):
+        figs += [_recovered_name(f) for f in RECOVERED_FIGURES]
     return [*tables, *REPORTS, *(figs if figures else [])]
+
+
+def _recovered_name(name: str) -> str:
+    return name.replace(".png", "_recovered.png")
 
 
 def _captions(ex: PaperExample) -> dict[str, str]:
@@ -238,6 +247,10 @@ def _write(ex: PaperExample, out: OutputDir, figures: bool,
         if progress:
             progress("figures")
         paper_figures(ex, out)
+        if ex.circle == "default" and ex.other_circle is not None:
+            other = replace(ex, study=ex.other_circle, path=ex.other_circle.path, cells=[])
+            paper_figures(other, out, suffix="_recovered", only=RECOVERED_FIGURES,
+                          circle="on the circle recovered from the published Tables 2-3")
     return list(out.written)
 
 

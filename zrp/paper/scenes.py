@@ -17,6 +17,7 @@ Typical use (the command line's ``zrp render`` and ``zrp paper`` do this)::
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
@@ -25,16 +26,19 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
+from zrp.kinematics.forward import end_effector_pose
 from zrp.manufacturing.perturb import Perturbation
 from zrp.manufacturing.study import PAPER_XI
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
+from zrp.paper.placement import RECOVERED, placement_path
 from zrp.paper.scenario import puma_circle_ik
 
 __all__ = [
     "PAPER_LEVELS",
     "Scene",
     "SceneSegment",
+    "paper_magnification",
     "paper_video_file_name",
     "paper_video_scene",
     "perturbed_puma",
@@ -67,11 +71,14 @@ class Scene:
         segments: drawn one after the other, at one magnification.
         title: first line of the text on every frame.
         file_name: the video's file name (``.mp4``) in the output folder.
+        magnify: the deviation magnification to draw (:func:`paper_magnification`: the same
+            for every video of one parameter), or None for the renderer's automatic factor.
     """
 
     segments: tuple[SceneSegment, ...]
     title: str
     file_name: str
+    magnify: float | None = None
 
 
 def perturbed_puma(parameter: str, xi_percent: float) -> tuple[Manipulator, Manipulator, str]:
@@ -79,20 +86,53 @@ def perturbed_puma(parameter: str, xi_percent: float) -> tuple[Manipulator, Mani
     ``xi_percent``, and the label (perturbation and sign(0) convention)."""
     nominal = load_model("puma")
     pert = Perturbation.single(parameter, xi_percent)
-    label = f"{parameter} xi = {xi_percent:+g} %\n{pert.convention}"
+    label = (f"{parameter} xi = {xi_percent:+g} %; sign(0): links {pert.sign_zero_links:d}, "
+             f"axes {pert.sign_zero_axes:+d}")
     return nominal, pert.apply(nominal), label
 
 
+def paper_magnification(parameter: str, q: F64) -> float:
+    """The magnification every video of ``parameter`` is drawn at: the largest 1, 2 or 5 x
+    10^k that makes the deviation at the paper's largest level (0.1 %) along the joint path
+    ``q`` (rad, shape (N, 6)) at most a quarter of the circle's diameter (the rule of
+    ``sim.nice_factor``), so a single video and a sweep of the same parameter match."""
+    nominal, perturbed, _ = perturbed_puma(parameter, max(PAPER_LEVELS))
+    p_n, _ = end_effector_pose(nominal, q)
+    p_a, _ = end_effector_pose(perturbed, q)
+    worst = float(np.max(np.linalg.norm(p_a - p_n, axis=-1)))
+    span = float(np.linalg.norm(p_n.max(axis=0) - p_n.min(axis=0)))
+    if not worst > 0:
+        return 1.0
+    x = 0.25 * span / worst
+    e = math.floor(math.log10(x))
+    return next((m * 10.0**e for m in (5.0, 2.0, 1.0) if m * 10.0**e <= x), 10.0**e)
+
+
+def _circle(circle: str, steps: int) -> tuple[F64, F64]:
+    """(t, q) of the named circle: "default" (:func:`puma_circle_ik`) or "recovered"
+    (:data:`zrp.paper.placement.RECOVERED`)."""
+    if circle == "recovered":
+        path = placement_path(RECOVERED, steps)
+        return np.asarray(path.t), np.asarray(path.q)
+    if circle != "default":
+        raise InputError(f"circle: expected 'default' or 'recovered', got {circle!r}")
+    ik = puma_circle_ik(steps=steps)
+    return np.asarray(ik.t), np.asarray(ik.q)
+
+
 def paper_video_scene(parameter: str = "JE2", xi_percent: float = 0.1, *,
-                      steps: int = 360) -> Scene:
+                      steps: int = 360, circle: str = "default") -> Scene:
     """The paper's 125 mm PUMA circle: nominal ghost vs one perturbed parameter.
 
-    File ``puma_circle_<parameter>_<xi>pct.mp4``; ``steps``: inverse-kinematics steps.
+    File ``puma_circle_<parameter>_<xi>pct.mp4``; ``steps``: inverse-kinematics steps;
+    ``circle``: "default" or "recovered".
     """
-    ik = puma_circle_ik(steps=steps)
+    t, q = _circle(circle, steps)
     nominal, perturbed, label = perturbed_puma(parameter, xi_percent)
-    seg = SceneSegment(nominal, perturbed, np.asarray(ik.t), np.asarray(ik.q), label)
-    return Scene((seg,), "PUMA, 125 mm circle", paper_video_file_name(parameter, xi_percent))
+    seg = SceneSegment(nominal, perturbed, t, q, label)
+    title = "PUMA, 125 mm circle" + (" (recovered)" if circle == "recovered" else "")
+    return Scene((seg,), title, paper_video_file_name(parameter, xi_percent),
+                 paper_magnification(parameter, seg.q))
 
 
 def paper_video_file_name(parameter: str = "JE2", xi_percent: float = 0.1) -> str:
@@ -115,5 +155,5 @@ def teaching_sweep_scene(parameter: str = "JE2", levels: Sequence[float] = PAPER
     for xi in levels:
         nominal, perturbed, label = perturbed_puma(parameter, float(xi))
         segs.append(SceneSegment(nominal, perturbed, t, q, label))
-    return Scene(tuple(segs), f"PUMA circle: {parameter} swept over the paper's levels",
-                 f"puma_sweep_{parameter}.mp4")
+    return Scene(tuple(segs), f"PUMA circle: {parameter} at the paper's levels",
+                 f"puma_sweep_{parameter}.mp4", paper_magnification(parameter, q))

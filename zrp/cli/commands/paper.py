@@ -13,10 +13,12 @@ from typing import Any
 
 from zrp.cli.app import emit
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
+from zrp.errors import InputError
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
 from zrp.output import OutputDir
-from zrp.paper.example import PaperExample, run_paper_example
+from zrp.paper.example import CIRCLES, PaperExample, run_paper_example
+from zrp.paper.index import INDEX_NAME, write_index
 from zrp.paper.report import output_names, write_paper_outputs
 from zrp.paper.scenario import is_paper_model
 from zrp.paper.scenes import paper_video_file_name, paper_video_scene
@@ -31,17 +33,42 @@ def register(sub: argparse._SubParsersAction) -> None:
         "study (LE2, LE3, LE4, LE7, JE1-JE6 at 0, +-0.02, +-0.05, +-0.07, +-0.1 %), Tables 2-3 "
         "(CSV, Markdown), Figures 2-7 (PNG), the comparison with the published values "
         "(comparison.md) and a JSON summary, written into renders/.")
-    p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
-                   help="output directory (default renders/: generated output, replaced on "
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="output directory (default renders/, renders/recovered/ with --circle "
+                        "recovered: generated output, replaced on "
                         "every run; in any other directory existing files are never replaced "
                         "without --force, checked before anything is computed)")
     p.add_argument("--force", action="store_true",
                    help="replace existing output files in --out")
     add_path_options(p)
+    p.add_argument("--circle", choices=CIRCLES, default=None,
+                   help="the paper's PUMA on a named circle: default (documented choice, "
+                        "held hand) or recovered (fitted to the published Tables 2-3, hand "
+                        "turning; output into renders/recovered/ unless --out). Without "
+                        "trajectory options the default circle is used")
     p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
     p.add_argument("--no-video", action="store_true",
                    help="skip the video of the nominal and perturbed arm")
-    p.set_defaults(func=_paper, api_names={"q0": "--q0", "steps": "--steps"})
+    p.set_defaults(func=_paper, api_names={"q0": "--q0", "steps": "--steps",
+                                           "circle": "--circle"})
+
+
+_TRAJECTORY_DEFAULTS = {"joints": None, "q0": None, "radius": 125.0, "normal": None,
+                        "toward": None, "duration": 4.0, "time_law": "quintic"}
+
+
+def _named_circle(args: argparse.Namespace, model: Manipulator) -> str | None:
+    """The named circle to run ("default" / "recovered"), or None for a custom trajectory;
+    --circle with trajectory options or another model is an error naming them."""
+    custom = [f"--{k.replace('_', '-')}" for k, v in _TRAJECTORY_DEFAULTS.items()
+              if getattr(args, k) != v]
+    if args.circle is None:
+        return "default" if not custom and is_paper_model(model) else None
+    if custom or not is_paper_model(model):
+        what = ", ".join(custom) if custom else f"--model {args.model}"
+        raise InputError(f"--circle: names a circle of the paper's Table 1 PUMA; it cannot be "
+                         f"combined with {what}")
+    return str(args.circle)
 
 
 def _video_name(args: argparse.Namespace, model: Manipulator) -> str | None:
@@ -55,7 +82,7 @@ def _video_name(args: argparse.Namespace, model: Manipulator) -> str | None:
 
 
 def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
-           model: Manipulator) -> dict[str, Any]:
+           model: Manipulator, circle: str) -> dict[str, Any]:
     """Render the nominal-vs-perturbed video of the paper's circle into the locked folder."""
     if args.no_video:
         return {"status": "skipped (--no-video)"}
@@ -64,10 +91,11 @@ def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
     # sim loads MuJoCo and its GL backend (about 0.3 s measured): only when a video is made
     import sim
 
-    scene = paper_video_scene(steps=args.steps)
+    scene = paper_video_scene(steps=args.steps, circle=circle)
     try:
         with folder.path(name) as tmp:
             sim.render_video(scene.segments, tmp, title=scene.title, overwrite=True,
+                             options=sim.VideoOptions(magnify=scene.magnify),
                              progress=not args.json)
     except (sim.GLUnavailableError, sim.GLBackendError) as exc:
         # no OpenGL backend on this machine: the tables and figures are still valid
@@ -79,10 +107,12 @@ def _compute(args: argparse.Namespace, model: Manipulator, out: OutputDir
              ) -> tuple[PaperExample, list[Path], float]:
     """IK, study, comparison and claims, written into the (checked and locked) folder."""
     t0 = time.perf_counter()
-    path = path_from_args(args, model)
+    circle = _named_circle(args, model)
+    path = None if circle else path_from_args(args, model)
     t_path = time.perf_counter() - t0
-    ex = run_paper_example(model, path, steps=args.steps)
-    ex.timings_s["inverse_kinematics"] = t_path
+    ex = run_paper_example(model, path, steps=args.steps, circle=circle)
+    if path is not None:
+        ex.timings_s["inverse_kinematics"] = t_path
     ex.timings_s["total_compute"] = sum(v for k, v in ex.timings_s.items()
                                         if k != "total_compute")
     t0 = time.perf_counter()
@@ -91,21 +121,27 @@ def _compute(args: argparse.Namespace, model: Manipulator, out: OutputDir
 
 
 def _paper(args: argparse.Namespace) -> int:
+    if args.out is None:
+        args.out = DEFAULT_OUT + ("/recovered" if args.circle == "recovered" else "")
     out = Path(args.out)
-    overwrite = args.force or out == Path(DEFAULT_OUT)
+    overwrite = args.force or out in (Path(DEFAULT_OUT), Path(DEFAULT_OUT) / "recovered")
     model = load_model(args.model)
     check_path_options(args, model)
+    _named_circle(args, model)
     video_name = _video_name(args, model)
-    names = [*output_names(figures=not args.no_figures), *([video_name] if video_name else [])]
+    names = [*output_names(figures=not args.no_figures), *([video_name] if video_name else []),
+             INDEX_NAME]
     with OutputDir(out, overwrite=overwrite, names=names) as folder:
         ex, files, t_write = _compute(args, model, folder)
-        video = _video(args, folder, video_name, model)
+        video = _video(args, folder, video_name, model, ex.circle)
+        index = write_index(folder)
     counts: dict[str, int] = {}
     for c in ex.cells:
         counts[c.status] = counts.get(c.status, 0) + 1
     ch = ex.checks
     payload = {
         "output_dir": str(out), "files": [str(f) for f in files], "video": video,
+        "circle": ex.circle, "index": str(index),
         "sign_convention": ex.study.convention, "trajectory": ex.path.label,
         "compute_s": ex.timings_s, "write_s": t_write, "cell_status_counts": counts,
         "cells": [vars(c) for c in ex.cells], "checks": ch,
@@ -122,17 +158,24 @@ def _paper(args: argparse.Namespace) -> int:
         le_ratio = [c.ratio for c in ex.cells if c.status == "match"]
         le3 = [c.ratio for c in ex.cells if c.column == "LE3" and c.table == 2]
         lines += [
-            "comparison with the published Tables 2-3 (ratio = ours / published):",
-            f"  match to the printed digits: {counts.get('match', 0)} cells (LE2, LE4, LE7; "
-            f"ratios {min(le_ratio):.4f}..{max(le_ratio):.4f})",
+            f"comparison with the published Tables 2-3 on the {ex.circle} circle (ratio = ours "
+            "/ published):",
+            f"  match to the printed digits: {counts.get('match', 0)} cells (ratios "
+            f"{min(le_ratio):.4f}..{max(le_ratio):.4f})",
             f"  LE3 discrepancy: ratios {min(le3):.3f}..{max(le3):.3f} (published values imply "
-            f"||b_3|| = 444.x mm vs 431.8 mm in Table 1)",
+            f"||b_3|| = 444.5 mm = 17.5 in vs 431.8 mm = 17 in in Table 1)",
             f"  likely typos (Table 2, 0.1 %): JE1 7.88E+0, JE2 1.33E-1 -> "
             f"{counts.get('typo', 0)} cells",
-            f"  trajectory-dependent JE cells: {counts.get('trajectory-dependent', 0)} (the "
-            "paper's circle placement is unpublished; see comparison.md)",
-            "",
         ]
+        if ex.circle == "recovered":
+            lines.append(f"  reproduced within 5 % (not to the printed digits): "
+                         f"{counts.get('reproduced', 0)} cells")
+        else:
+            lines.append(f"  trajectory-dependent JE cells: "
+                         f"{counts.get('trajectory-dependent', 0)} (on the circle recovered "
+                         "from the tables they are reproduced: `zrp paper --circle recovered`, "
+                         "comparison.md)")
+        lines.append("")
     else:
         lines += ["no published values for this model: the paper's checks only", ""]
     jl = ch["je_greater_than_le_at_0.1pct"]
@@ -150,7 +193,7 @@ def _paper(args: argparse.Namespace) -> int:
         "",
         f"video: {video['status']}" + (f" -> {video['path']}" if "path" in video else ""),
         f"wrote {len(files)} files into {out}/ (tables, figures, comparison.md, "
-        "paper_example.json)",
+        "paper_example.json); index of every output: " + str(index),
     ]
     emit(args, payload, "\n".join(lines))
     return 0

@@ -42,7 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--seconds", type=float, default=None,
                    help="video length (default: the trajectory's duration; 3 s per sweep level)")
     p.add_argument("--magnify", type=float, default=None,
-                   help="deviation magnification (default: automatic round factor)")
+                   help="deviation magnification (default: one round factor per parameter, "
+                        "the same for the video and the sweep)")
     p.add_argument("--format", choices=("auto", "mp4", "gif"), default="auto")
     p.add_argument("--backend", default=None, help="egl or osmesa (default: MUJOCO_GL, else "
                    "the first that works)")
@@ -70,8 +71,10 @@ def _run(args: argparse.Namespace) -> int:
     opts = sim.VideoOptions(width=args.width, height=args.height, fps=args.fps,
                             seconds=args.seconds, magnify=args.magnify, format=args.format,
                             backend=args.backend)
-    videos: list[tuple[Scene, sim.VideoOptions]] = [
-        (paper_video_scene(args.parameter, args.xi, steps=args.steps), opts)]
+    scene = paper_video_scene(args.parameter, args.xi, steps=args.steps)
+    # one magnification for every video of the parameter (the scene's), unless --magnify
+    opts = replace(opts, magnify=args.magnify or scene.magnify)
+    videos: list[tuple[Scene, sim.VideoOptions]] = [(scene, opts)]
     if args.sweep:
         levels = tuple(args.levels) if args.levels else PAPER_LEVELS
         videos.append((teaching_sweep_scene(args.parameter, levels, steps=args.steps),
