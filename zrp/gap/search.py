@@ -58,6 +58,8 @@ class SearchSettings:
         rb0: initial instrument-from-base rotation of every fit.
         alpha, min_gain, max_steps: see :func:`zrp.gap.diagnose`.
         progress: show a progress bar.
+        resolution: numerical resolution of the fits (length unit); a model that fits the
+            fitting poses to within it is not improved further (noise-free data).
     """
 
     fitting: NDArray[np.int64]
@@ -68,6 +70,7 @@ class SearchSettings:
     min_gain: float
     max_steps: int
     progress: bool = False
+    resolution: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -210,6 +213,8 @@ def greedy_search(ctx: Context, reg: FitResult, effects: Sequence[str],
     bar = tqdm(total=s.max_steps * len(effects), desc="diagnose", disable=not s.progress,
                leave=False)
     for _ in range(s.max_steps):
+        if Metrics.of(current.residual).rms <= s.resolution:
+            break  # fits to numerical precision: nothing left to explain
         trials = []
         for eff in effects:
             bar.update(1)
