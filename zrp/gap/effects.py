@@ -41,10 +41,12 @@ __all__ = [
     "EFFECTS",
     "KINDS",
     "MIN_EXCITATION_RAD",
+    "PER_JOINT_ANGLE",
     "REGISTRATION",
     "Context",
     "ParamSpec",
     "effect_parameters",
+    "excited_only",
     "registration_parameters",
 ]
 
@@ -307,16 +309,15 @@ def _joint_offset(ctx: Context) -> Built:
 
 
 def _encoder_scale(ctx: Context) -> Built:
-    specs = [_dq(ctx, f"q{k + 1}.scale", "1", "encoder_scale", k, ctx.q[:, k])
-             for k in range(ctx.n) if ctx.excited[k]]
-    return specs, (None if specs else "no joint moves enough")
+    return [_dq(ctx, f"q{k + 1}.scale", "1", "encoder_scale", k, ctx.q[:, k])
+            for k in range(ctx.n)], None
 
 
 def _cyclic_error(ctx: Context) -> Built:
     q = ctx.q
-    rev = [k for k in range(ctx.n) if not ctx.model.prismatic[k] and ctx.excited[k]]
+    rev = [k for k in range(ctx.n) if not ctx.model.prismatic[k]]
     if not rev:
-        return [], "no revolute joint moves enough"
+        return [], "no revolute joint"
     return [_dq(ctx, f"q{k + 1}.{fn}{h}", "rad", "cyclic_error", k,
                 np.sin(h * q[:, k]) if fn == "sin" else np.cos(h * q[:, k]))
             for k in rev for h in ctx.harmonics for fn in ("sin", "cos")], None
@@ -328,11 +329,10 @@ def _backlash(ctx: Context) -> Built:
     junit = _junits(ctx)
     basis = 0.5 * ctx.backlash_basis()
     specs = [_dq(ctx, f"q{k + 1}.backlash", junit[k], "backlash", k, basis[:, k])
-             for k in range(ctx.n) if ctx.excited[k] and np.any(basis[:, k] > 0)
-             and np.any(basis[:, k] < 0)]
+             for k in range(ctx.n) if np.any(basis[:, k] > 0) and np.any(basis[:, k] < 0)]
     if not specs:
-        return [], ("no joint that moves enough approaches its poses from both directions "
-                    "or sees gravity torques of both signs")
+        return [], ("no joint approaches its poses from both directions or sees gravity "
+                    "torques of both signs")
     return specs, None
 
 
@@ -412,6 +412,21 @@ _BUILDERS: dict[str, Callable[[Context], Built]] = {
     "thermal_expansion": _thermal_expansion,
     "cyclic_error": _cyclic_error,
 }
+
+
+#: effects that are a function of one joint's own angle: only on joints the data excite.
+PER_JOINT_ANGLE = ("encoder_scale", "cyclic_error", "backlash")
+
+
+def excited_only(ctx: Context, built: Built) -> Built:
+    """``built`` without the parameters of :data:`PER_JOINT_ANGLE` effects on joints that
+    :attr:`Context.excited` says barely move (the survey still sees them all)."""
+    specs, why = built
+    keep = [s for s in specs if s.effect not in PER_JOINT_ANGLE or s.joint == 0
+            or ctx.excited[s.joint - 1]]
+    if specs and not keep:
+        return [], "no joint moves enough"
+    return keep, why
 
 
 def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str | None]:

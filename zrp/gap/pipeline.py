@@ -36,6 +36,7 @@ from zrp.gap.effects import (
     MIN_EXCITATION_RAD,
     Context,
     effect_parameters,
+    excited_only,
     registration_parameters,
 )
 from zrp.gap.identifiability import ReferencePoses, registration_identifiable, survey
@@ -194,7 +195,8 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
     specs_of = {e: effect_parameters(ctx, e) for e in opts.effects}
     identifiability = survey(ctx, reg, specs_of, prep.reference)
     resolution = RESOLUTION * model.characteristic_length
-    found = greedy_search(ctx, reg, opts.effects, specs_of, SearchSettings(
+    found = greedy_search(ctx, reg, opts.effects,
+                          {e: excited_only(ctx, v) for e, v in specs_of.items()}, SearchSettings(
         prep.fitting, prep.withheld, prep.folds, regd.rb0, opts.alpha, opts.min_gain,
         opts.max_steps, opts.progress, resolution))
     after = withheld_residual(ctx, found.final_fit, prep.withheld)

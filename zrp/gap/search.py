@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.gap.effects import Context, ParamSpec, effect_parameters
+from zrp.gap.effects import Context, ParamSpec, effect_parameters, excited_only
 from zrp.gap.identifiability import GEOMETRIC, geometric_overlap
 from zrp.gap.leastsq import (
     Aliased,
@@ -161,7 +161,7 @@ def _try_backlash(ctx: Context, current: FitResult, current_cv: float,
                   s: SearchSettings) -> _Trial:
     """``backlash`` with its flank model profiled on top of the current model."""
     ctx_b = with_backlash_switch(ctx, current, s.fitting)
-    specs, why = effect_parameters(ctx_b, "backlash")
+    specs, why = excited_only(ctx_b, effect_parameters(ctx_b, "backlash"))
     switch = ctx_b.backlash_switch or ()
     flank = BacklashSwitch(tuple(None if not np.isfinite(v) else v for v in switch),
                            tuple(switch_bands(ctx_b.backlash_switch_weights)),
