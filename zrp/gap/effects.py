@@ -41,12 +41,10 @@ __all__ = [
     "EFFECTS",
     "KINDS",
     "MIN_EXCITATION_RAD",
-    "PER_JOINT_ANGLE",
     "REGISTRATION",
     "Context",
     "ParamSpec",
     "effect_parameters",
-    "excited_only",
     "registration_parameters",
 ]
 
@@ -412,21 +410,6 @@ _BUILDERS: dict[str, Callable[[Context], Built]] = {
     "thermal_expansion": _thermal_expansion,
     "cyclic_error": _cyclic_error,
 }
-
-
-#: effects that are a function of one joint's own angle: only on joints the data excite.
-PER_JOINT_ANGLE = ("encoder_scale", "cyclic_error", "backlash")
-
-
-def excited_only(ctx: Context, built: Built) -> Built:
-    """``built`` without the parameters of :data:`PER_JOINT_ANGLE` effects on joints that
-    :attr:`Context.excited` says barely move (the survey still sees them all)."""
-    specs, why = built
-    keep = [s for s in specs if s.effect not in PER_JOINT_ANGLE or s.joint == 0
-            or ctx.excited[s.joint - 1]]
-    if specs and not keep:
-        return [], "no joint moves enough"
-    return keep, why
 
 
 def effect_parameters(ctx: Context, effect: str) -> tuple[list[ParamSpec], str | None]:

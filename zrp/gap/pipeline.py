@@ -36,9 +36,9 @@ from zrp.gap.effects import (
     MIN_EXCITATION_RAD,
     Context,
     effect_parameters,
-    excited_only,
     registration_parameters,
 )
+from zrp.gap.excitation import excited_only
 from zrp.gap.identifiability import ReferencePoses, registration_identifiable, survey
 from zrp.gap.leastsq import FitResult, fit, initial_registration
 from zrp.gap.metrics import Metrics

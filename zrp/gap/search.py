@@ -16,7 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.gap.effects import Context, ParamSpec, effect_parameters, excited_only
+from zrp.gap.effects import Context, ParamSpec, effect_parameters
+from zrp.gap.excitation import excited_only
 from zrp.gap.identifiability import GEOMETRIC, geometric_overlap
 from zrp.gap.leastsq import (
     Aliased,
