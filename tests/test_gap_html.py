@@ -105,5 +105,7 @@ def test_report_html_real_irb120(tmp_path):
     assert "complete geometric calibration" in md
     a = d.assessment
     assert a is not None
+    # no cause is stated that conflicts with the IRB 120's specified repeatability
+    assert "conflict with the specified repeatability" in d.verdict
     # the final model is at or below the complete geometric calibration on withheld poses
     assert d.final.rms <= a.baseline.withheld.rms

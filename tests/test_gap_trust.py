@@ -277,3 +277,19 @@ def test_periodic_progress_lines():
     assert lines[0] == "diagnose: 1/4 candidate fits (25 %), 0 s"
     assert lines[-1].startswith("diagnose: 4/4 candidate fits (100 %)")
     assert "\r" not in buf.getvalue()
+
+
+def test_measure_and_diagnose_share_the_backlash_definition(tmp_path):
+    """`zrp measure --effect backlash:1=0.8mrad` (MuJoCo, the full play) is recovered as 0.8
+    mrad by the diagnosis, not as half of it."""
+    pytest.importorskip("mujoco")
+    run = subprocess.run([sys.executable, "-m", "zrp", "measure", "--out",
+                          str(tmp_path / "d.csv"), "--effect", "backlash:1=0.8mrad",
+                          "--poses", "100", "--approach", "random", "--seed", "3"],
+                         capture_output=True, text=True, cwd=ROOT, timeout=600)
+    assert run.returncode == 0, run.stderr
+    meas = zrp.gap.load_measurements(tmp_path / "d.csv", PUMA)
+    d = _quiet(PUMA, meas, seed=0)
+    assert d.top_effect == "backlash"
+    p = d.parameter("q1.backlash")
+    assert p.value == pytest.approx(8e-4, rel=0.05)
