@@ -25,6 +25,10 @@ def value_ci(v: float, lo: float, hi: float, unit: str) -> tuple[str, str]:
     k, u = (1e3, "mrad") if unit == "rad" else (1.0, unit)
     if not (math.isfinite(lo) and math.isfinite(hi)):
         return f"{v * k:.4g} {u}", "undetermined"
+    big = max(abs(v), abs(lo), abs(hi)) * k
+    if unit != "rad" and 0 < big < 1e-2:  # tiny (compliance, kappa): a power of ten
+        e = math.floor(math.log10(big))
+        k, u = k * 10.0**-e, f"x 1e{e} {u}".rstrip()
     d = decimals(0.5 * (hi - lo) * k)
     return f"{v * k:.{d}f} {u}", f"[{lo * k:.{d}f}, {hi * k:.{d}f}] {u}"
 
