@@ -26,8 +26,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Register the measurements (base frame, tool offsets), then find which "
         "unmodelled effects explain the remaining gap and how far it shrinks on withheld poses. "
         "Writes DIR/diagnosis.json, DIR/report.md, DIR/report.html, DIR/residuals.csv and "
-        "PNG plots "
-        "(zrp/gap/README.md).")
+        "PNG plots (zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml",
                    help="model TOML file or built-in name")
     p.add_argument("--mjcf", metavar="M.xml",
