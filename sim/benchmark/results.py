@@ -12,7 +12,7 @@ import numpy as np
 from sim.benchmark.scenarios import BenchmarkConfig
 from sim.benchmark.scoring import ScenarioScore
 
-__all__ = ["BenchmarkResult", "confusion_matrix", "summary_rows"]
+__all__ = ["BenchmarkResult", "confusion_matrix", "coverage", "summary_rows"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,7 +68,19 @@ def _group(scores: Sequence[ScenarioScore], target: float) -> dict[str, Any]:
             "ratio_ok": _pct(sum(s.ratio <= target for s in scores), n),
             "all_three": _pct(sum(s.success for s in scores), n),
             "median_ratio": float(np.median(ratios)) if ratios else math.nan,
-            "median_shrink": float(np.median(shr)) if shr else math.nan}
+            "median_shrink": float(np.median(shr)) if shr else math.nan,
+            **coverage(scores)}
+
+
+def coverage(scores: Sequence[ScenarioScore]) -> dict[str, Any]:
+    """Share of the compared parameters whose 95 % interval covers the truth, and share of
+    the scenarios (with a comparison) in which every one does."""
+    cov = sum(int(s.values.get("ci_covered", 0)) for s in scores)
+    tot = sum(int(s.values.get("ci_compared", 0)) for s in scores)
+    with_cmp = [s for s in scores if s.values.get("ci_compared", 0)]
+    full = sum(s.values["ci_covered"] == s.values["ci_compared"] for s in with_cmp)
+    return {"ci95_parameters": _pct(cov, tot), "ci95_scenarios": _pct(full, len(with_cmp)),
+            "ci95_fraction": cov / tot if tot else math.nan}
 
 
 def summary_rows(result: BenchmarkResult) -> list[dict[str, Any]]:

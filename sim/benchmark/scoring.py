@@ -6,7 +6,9 @@
   sqrt(3) sigma. Below 1 the effect hides in the noise or in the registration, and the right
   answer is ``none``;
 * **effect named first** is the right one; **joints located**; **withheld RMS after
-  correction** over the true noise RMS, and the shrink ratio (:func:`score`).
+  correction** over the true noise RMS, and the shrink ratio (:func:`score`);
+* **interval coverage**: the final 95 % intervals of the hidden effect's parameters against
+  the true values (:mod:`sim.benchmark.coverage`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from sim.benchmark.coverage import interval_coverage
 from sim.benchmark.scenarios import BenchmarkConfig
 from sim.effects import HiddenEffects, motor_map, true_geometry
 from zrp.kinematics.forward import forward_kinematics
@@ -253,7 +256,9 @@ def score(model: Manipulator, truth: dict[str, Any], diagnosis: dict[str, Any],
                      + (" (the diagnosis says unexplained)" if diagnosis.get("unexplained")
                         else ""))
     note = "; ".join(notes)
-    values = {"success": bool(top_correct and joints_ok and ratio <= config.ratio_target)}
+    covered, compared, misses = interval_coverage(eff, hidden, diagnosis)
+    values = {"success": bool(top_correct and joints_ok and ratio <= config.ratio_target),
+              "ci_covered": covered, "ci_compared": compared, "ci_misses": misses}
     return ScenarioScore(int(scn.get("index", -1)), str(scn.get("kind", "")), hidden, hj, snr,
                          expected, found, found_joints, bool(top_correct), tied,
                          bool(joints_ok),

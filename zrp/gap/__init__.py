@@ -13,6 +13,9 @@ The engine (every module but :mod:`zrp.gap.report`) never imports the report; th
 wording of the verdict is installed into :class:`Diagnosis` here.
 """
 
+from zrp.gap.assessment import Assessment as Assessment
+from zrp.gap.assessment import Remainder as Remainder
+from zrp.gap.baseline import GeometricBaseline as GeometricBaseline
 from zrp.gap.csvfile import load_measurements as load_measurements
 from zrp.gap.data import DataWarning as DataWarning
 from zrp.gap.data import Measurements as Measurements
@@ -29,6 +32,7 @@ from zrp.gap.metrics import NoiseFloor as NoiseFloor
 from zrp.gap.noise import noise_floor as noise_floor
 from zrp.gap.options import DiagnosisOptions as DiagnosisOptions
 from zrp.gap.pipeline import diagnose as diagnose
+from zrp.gap.registration import Registration as Registration
 from zrp.gap.report import write_outputs as write_outputs
 from zrp.gap.report.verdict import verdict_text as _verdict_text
 from zrp.gap.results import Candidate as Candidate
@@ -49,6 +53,7 @@ __all__ = [
     "EFFECTS",
     "REGISTRATION",
     "Aliased",
+    "Assessment",
     "Candidate",
     "Context",
     "DataWarning",
@@ -57,12 +62,15 @@ __all__ = [
     "FitResult",
     "FitWarning",
     "GapWarning",
+    "GeometricBaseline",
     "Injection",
     "Measurements",
     "Metrics",
     "NoiseFloor",
     "ParamSpec",
     "ParameterEstimate",
+    "Registration",
+    "Remainder",
     "Step",
     "Where",
     "WhereAnalysis",

@@ -63,8 +63,32 @@ def check_gravity_torque(gravity_torque: ArrayLike | None, n_poses: int, n_joint
     return tau
 
 
+#: a tool point must be measured in at least this many poses to locate it on the tool.
+MIN_POINT_POSES = 3
+
+
 def check_points(meas: Measurements, fitting: NDArray[np.int64]) -> None:
-    """Every point label is measured in some fitting pose."""
+    """Every point label is measured in at least :data:`MIN_POINT_POSES` poses and in some
+    fitting pose; no two labels are the same point (identical coordinates in every pose)."""
+    counts = np.bincount(meas.point_index, minlength=len(meas.point_labels))
+    few = [f"{lab} ({c})" for lab, c in zip(meas.point_labels, counts, strict=True)
+           if c < MIN_POINT_POSES]
+    if few:
+        raise InputError(f"{meas.source}: point(s) {', '.join(few)} measured in fewer than "
+                         f"{MIN_POINT_POSES} poses; a tool point must be measured in several "
+                         "poses to be located (drop it or measure it more)")
+    M = len(meas.point_labels)
+    pos = np.full((len(meas.pose_ids), M, 3), np.nan)
+    pos[meas.pose_index, meas.point_index] = meas.xyz
+    tol = 1e-9 * max(float(np.ptp(meas.xyz)), 1e-300)
+    for a in range(M):
+        for b in range(a + 1, M):
+            d = np.linalg.norm(pos[:, a] - pos[:, b], axis=1)
+            d = d[np.isfinite(d)]
+            if d.size and float(d.max()) <= tol:
+                raise InputError(f"{meas.source}: points {meas.point_labels[a]} and "
+                                 f"{meas.point_labels[b]} have identical coordinates in every "
+                                 "pose: one reflector under two labels? (keep one)")
     seen = meas.point_index[np.isin(meas.pose_index, fitting)]
     missing = [lab for m, lab in enumerate(meas.point_labels) if not np.any(seen == m)]
     if missing:

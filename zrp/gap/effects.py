@@ -10,8 +10,9 @@ corrected model (see :mod:`zrp.gap.problem`, which also gives the analytic Jacob
 * ``dq``: a joint correction q_actual = q + sum_i theta_i B_i(pose), with a fixed basis B of
   shape (P, n) per parameter. ``joint_offset`` (B = 1), ``encoder_scale`` (B = q),
   ``joint_compliance`` (B = gravity torque or a lumped-mass moment arm), ``backlash``
-  (B = -approach direction, or the sign of the gravity torque where it exceeds a per-joint
-  threshold so that the joint rests on the loaded flank of its play), ``cyclic_error``
+  (B = -approach direction / 2 per unit of full play, or half the sign of the gravity torque
+  where it exceeds a per-joint threshold so that the joint rests on the loaded flank of its
+  play), ``cyclic_error``
   (B = sin(h q), cos(h q)) are all of this kind.
 * ``link``: one component of a body-vector correction db_{k,0} (length unit).
 * ``tilt``: a tilt of a joint axis towards one of its tangents t1, t2 (rad), exact:
@@ -39,6 +40,7 @@ from zrp.units import G_STANDARD, metres_per_unit
 __all__ = [
     "EFFECTS",
     "KINDS",
+    "MIN_EXCITATION_RAD",
     "REGISTRATION",
     "Context",
     "ParamSpec",
@@ -52,6 +54,9 @@ F64 = NDArray[np.float64]
 EFFECTS = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment",
            "joint_compliance", "backlash", "thermal_expansion", "cyclic_error")
 REGISTRATION = ("base_frame", "tool_offset")
+#: A revolute joint must span at least this range (rad, 2 deg) over the poses to carry an
+#: encoder scale, a cyclic error or backlash (prismatic: this fraction of the reach).
+MIN_EXCITATION_RAD = float(np.radians(2.0))
 KINDS = ("rot", "trans", "tool", "dq", "link", "tilt", "thermal")
 
 
@@ -151,6 +156,17 @@ class Context:
     def q(self) -> F64:
         """Joint values per pose, shape (P, n)."""
         return self.meas.q_pose
+
+    @cached_property
+    def excited(self) -> NDArray[np.bool_]:
+        """Joints that move enough for a per-joint function of their angle (scale, cyclic
+        error, backlash) to be told from noise: spread of the joint value over the poses of at
+        least :data:`MIN_EXCITATION_RAD` (revolute) or that fraction of the reach (prismatic),
+        shape (n,). A joint below it (e.g. a 0.1 deg jitter) carries none of these effects."""
+        spread = np.ptp(self.q, axis=0) if len(self.q) else np.zeros(self.n)
+        lim = np.where(np.asarray(self.model.prismatic), MIN_EXCITATION_RAD
+                       * self.model.characteristic_length, MIN_EXCITATION_RAD)
+        return spread >= lim
 
     @cached_property
     def tangents(self) -> F64:
@@ -306,8 +322,10 @@ def _cyclic_error(ctx: Context) -> Built:
 
 
 def _backlash(ctx: Context) -> Built:
+    """One full play b per joint (the definition of ``zrp measure``): the joint sits b/2 off
+    the centre of its play, so the basis is half the flank side."""
     junit = _junits(ctx)
-    basis = ctx.backlash_basis()
+    basis = 0.5 * ctx.backlash_basis()
     specs = [_dq(ctx, f"q{k + 1}.backlash", junit[k], "backlash", k, basis[:, k])
              for k in range(ctx.n) if np.any(basis[:, k] > 0) and np.any(basis[:, k] < 0)]
     if not specs:

@@ -25,7 +25,7 @@ class DiagnosisOptions:
         alpha: significance level of the F test that admits an effect; joint groups are kept
             when their Wald p-value is below alpha / (number of groups).
         min_gain: an effect must lower the cross-validated RMS by at least this fraction.
-        max_steps: most effects added (0: registration only).
+        max_steps: most effects added (>= 1).
         noise_sigma: known per-coordinate instrument noise (length unit), or None to estimate
             it from the data.
         harmonics: harmonics of ``cyclic_error``.
@@ -62,8 +62,8 @@ class DiagnosisOptions:
                              f"{self.alpha}")
         if not 0.0 <= self.min_gain < 1.0:
             raise InputError(f"min_gain: expected a fraction in [0, 1), got {self.min_gain}")
-        if int(self.max_steps) != self.max_steps or self.max_steps < 0:
-            raise InputError(f"max_steps: expected a whole number >= 0, got {self.max_steps}")
+        if int(self.max_steps) != self.max_steps or self.max_steps < 1:
+            raise InputError(f"max_steps: expected a whole number >= 1, got {self.max_steps}")
         if self.noise_sigma is not None and not (self.noise_sigma > 0
                                                  and math.isfinite(self.noise_sigma)):
             raise InputError(f"noise_sigma: expected a positive number (length unit), got "

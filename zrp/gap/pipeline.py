@@ -21,6 +21,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
+from zrp.gap.assessment import Assessment, remainder_evidence
+from zrp.gap.baseline import geometric_baseline
 from zrp.gap.checks import (
     check_gravity_torque,
     check_points,
@@ -29,22 +31,39 @@ from zrp.gap.checks import (
     check_units,
 )
 from zrp.gap.data import Measurements
-from zrp.gap.effects import EFFECTS, Context, effect_parameters, registration_parameters
+from zrp.gap.effects import (
+    EFFECTS,
+    MIN_EXCITATION_RAD,
+    Context,
+    effect_parameters,
+    registration_parameters,
+)
+from zrp.gap.excitation import excited_only
 from zrp.gap.identifiability import ReferencePoses, registration_identifiable, survey
 from zrp.gap.leastsq import FitResult, fit, initial_registration
 from zrp.gap.metrics import Metrics
 from zrp.gap.noise import noise_floor
 from zrp.gap.options import DiagnosisOptions
 from zrp.gap.profiles import with_gravity_side
-from zrp.gap.results import UNEXPLAINED_RATIO, Diagnosis, Where, parameter_estimates
+from zrp.gap.registration import registration_of
+from zrp.gap.results import (
+    UNEXPLAINED_RATIO,
+    Diagnosis,
+    GapWarning,
+    Where,
+    parameter_estimates,
+)
 from zrp.gap.search import SearchSettings, greedy_search, withheld_residual
 from zrp.gap.split import split_poses
-from zrp.gap.where import where_analysis
+from zrp.gap.uncertainty import correlations, plausibility, robust_covariance
+from zrp.gap.where import WhereAnalysis, where_analysis
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["diagnose", "run_diagnosis"]
 
 F64 = NDArray[np.float64]
+#: numerical resolution of the fits as a fraction of the model's characteristic length.
+RESOLUTION = 1e-9
 
 
 def diagnose(model: Manipulator, measurements: Measurements, *,
@@ -175,17 +194,51 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
         ctx = with_gravity_side(ctx, reg, prep.fitting, regd.rb0, opts.alpha)
     specs_of = {e: effect_parameters(ctx, e) for e in opts.effects}
     identifiability = survey(ctx, reg, specs_of, prep.reference)
-    found = greedy_search(ctx, reg, opts.effects, specs_of, SearchSettings(
+    resolution = RESOLUTION * model.characteristic_length
+    found = greedy_search(ctx, reg, opts.effects,
+                          {e: excited_only(ctx, v) for e, v in specs_of.items()}, SearchSettings(
         prep.fitting, prep.withheld, prep.folds, regd.rb0, opts.alpha, opts.min_gain,
-        opts.max_steps, opts.progress))
+        opts.max_steps, opts.progress, resolution))
     after = withheld_residual(ctx, found.final_fit, prep.withheld)
     final = Metrics.of(after)
     unexplained = (None if floor.rms is None
-                   else bool(final.rms > UNEXPLAINED_RATIO * floor.rms))
+                   else bool(final.rms > UNEXPLAINED_RATIO * max(floor.rms, resolution)))
     where = Where(where_nominal, identifiability, found.backlash, found.last_candidates,
                   found.pruned, where_analysis(ctx, found.final_fit) if found.steps else None)
+    assessment = _assess(ctx, prep, regd, found.final_fit,
+                         where.after_final_model or where_nominal, resolution)
     return Diagnosis(model.name, model.length_unit, Metrics.of(regd.withheld_residual),
                      regd.fitting, parameter_estimates(reg, 0), found.steps, final, floor,
                      unexplained, _split_ids(meas, prep, opts), where, found.aliased, (), reg,
                      found.final_fit, regd.withheld_residual, after, ctx, prep.fitting,
-                     prep.withheld, _settings(ctx, opts))
+                     prep.withheld, _settings(ctx, opts), assessment)
+
+
+def _assess(ctx: Context, prep: _Prepared, regd: _Registered, final: FitResult,
+            where_final: WhereAnalysis, resolution: float) -> Assessment:
+    """The geometric baseline, robust intervals, correlations, plausibility, the full
+    registration and the evidence on what remains (warns on implausible values and on joints
+    the data do not excite)."""
+    cov = robust_covariance(ctx, final)
+    rob = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    se = np.maximum(rob, final.stderr)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.where(rob > 0, se / rob, 1.0)
+    cov = cov * np.outer(scale, scale)  # the correlations of the robust one, diag se^2
+    nreg = len(regd.fit.specs)
+    implausible = tuple(m for i, sp in enumerate(final.specs) if i >= nreg and (
+        m := plausibility(sp.name, sp.effect, float(final.theta[i]), float(se[i]), sp.unit)))
+    for m in implausible:
+        warnings.warn(m, GapWarning, stacklevel=2)
+    unexcited = tuple(k + 1 for k in range(ctx.n) if not ctx.excited[k])
+    if unexcited:
+        warnings.warn(f"joint(s) {', '.join(map(str, unexcited))} move less than "
+                      f"{np.degrees(MIN_EXCITATION_RAD):.0f} deg over the poses: these data "
+                      "cannot identify an encoder scale, cyclic error or backlash there (none "
+                      "is placed on them)", GapWarning, stacklevel=2)
+    names = tuple(sp.name for sp in final.specs)
+    frame = registration_of(final, se, cov, ctx.meas.point_labels, ctx.model.length_unit)
+    baseline = geometric_baseline(ctx, regd.fit, final, prep.fitting, prep.withheld,
+                                  prep.folds, regd.rb0)
+    return Assessment(baseline, frame, correlations(names, cov), se, implausible, unexcited,
+                      remainder_evidence(ctx, final, where_final), resolution)

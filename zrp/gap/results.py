@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError, ZRPWarning
+from zrp.gap.assessment import Assessment
 from zrp.gap.effects import EFFECTS, Context
 from zrp.gap.leastsq import Aliased, FitResult
 from zrp.gap.metrics import Metrics, NoiseFloor
@@ -74,11 +75,11 @@ class ParameterEstimate:
                 "ci95": list(self.ci95)}
 
 
-def parameter_estimates(result: FitResult, first: int, last: int | None = None
-                        ) -> tuple[ParameterEstimate, ...]:
+def parameter_estimates(result: FitResult, first: int, last: int | None = None,
+                        stderr: F64 | None = None) -> tuple[ParameterEstimate, ...]:
     """The parameters ``first`` .. ``last`` (default: all after ``first``) of a fit, with
-    their 95 % intervals."""
-    se = result.stderr
+    their 95 % intervals (from ``stderr``, shape (p,), default the normal-theory ones)."""
+    se = result.stderr if stderr is None else stderr
     out = []
     for i in range(first, len(result.specs) if last is None else last):
         s = result.specs[i]
@@ -293,6 +294,9 @@ class Diagnosis:
         context: the data context.
         withheld_poses, fitting_poses: pose indices, shapes (Pw,), (Pf,).
         settings: the options of the run.
+        assessment: the geometric baseline, robust intervals, correlations, plausibility,
+            the full registration and the evidence on what remains
+            (:class:`~zrp.gap.assessment.Assessment`).
     """
 
     model_name: str
@@ -316,6 +320,7 @@ class Diagnosis:
     fitting_poses: NDArray[np.int64]
     withheld_poses: NDArray[np.int64]
     settings: dict[str, Any] = field(default_factory=dict)
+    assessment: Assessment | None = None
 
     def __post_init__(self) -> None:
         if not all(isinstance(st, Step) for st in self.steps):
@@ -365,9 +370,10 @@ class Diagnosis:
     @property
     def final_parameters(self) -> tuple[ParameterEstimate, ...]:
         """All effect parameters of the final model, estimated jointly (after the backward
-        pass), with 95 % intervals. The per-step values are each estimated without the effects
-        added later, so these are the ones to use."""
-        return parameter_estimates(self.final_fit, len(self.registration))
+        pass), with robust 95 % intervals (:mod:`zrp.gap.uncertainty`). The per-step values
+        are each estimated without the effects added later, so these are the ones to use."""
+        se = None if self.assessment is None else self.assessment.stderr
+        return parameter_estimates(self.final_fit, len(self.registration), stderr=se)
 
     @property
     def final_joints(self) -> dict[str, tuple[int, ...]]:
@@ -410,4 +416,5 @@ class Diagnosis:
             "where": self.where.to_dict(),
             "aliased": [alias_dict(a) for a in self.aliased],
             "warnings": list(self.warnings),
+            **({} if self.assessment is None else self.assessment.to_dict()),
         }

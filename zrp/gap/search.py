@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.gap.effects import Context, ParamSpec, effect_parameters
+from zrp.gap.excitation import excited_only
 from zrp.gap.identifiability import GEOMETRIC, geometric_overlap
 from zrp.gap.leastsq import (
     Aliased,
@@ -31,6 +32,7 @@ from zrp.gap.leastsq import (
 from zrp.gap.metrics import Metrics
 from zrp.gap.problem import Problem
 from zrp.gap.profiles import switch_bands, with_backlash_switch
+from zrp.gap.progress import progress_bar
 from zrp.gap.results import (
     BacklashSwitch,
     Candidate,
@@ -57,7 +59,9 @@ class SearchSettings:
         fitting, withheld: pose indices; folds: the CV folds of the fitting poses.
         rb0: initial instrument-from-base rotation of every fit.
         alpha, min_gain, max_steps: see :func:`zrp.gap.diagnose`.
-        progress: show a progress bar.
+        progress: show progress (a bar on a terminal, periodic lines otherwise).
+        resolution: numerical resolution of the fits (length unit); a model that fits the
+            fitting poses to within it is not improved further (noise-free data).
     """
 
     fitting: NDArray[np.int64]
@@ -68,6 +72,7 @@ class SearchSettings:
     min_gain: float
     max_steps: int
     progress: bool = False
+    resolution: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -158,7 +163,7 @@ def _try_backlash(ctx: Context, current: FitResult, current_cv: float,
                   s: SearchSettings) -> _Trial:
     """``backlash`` with its flank model profiled on top of the current model."""
     ctx_b = with_backlash_switch(ctx, current, s.fitting)
-    specs, why = effect_parameters(ctx_b, "backlash")
+    specs, why = excited_only(ctx_b, effect_parameters(ctx_b, "backlash"))
     switch = ctx_b.backlash_switch or ()
     flank = BacklashSwitch(tuple(None if not np.isfinite(v) else v for v in switch),
                            tuple(switch_bands(ctx_b.backlash_switch_weights)),
@@ -199,17 +204,15 @@ def greedy_search(ctx: Context, reg: FitResult, effects: Sequence[str],
                   s: SearchSettings) -> SearchResult:
     """Add effects to the registration ``reg`` one at a time (see the module docstring),
     then drop what the final model no longer needs (:func:`backward_pass`)."""
-    # tqdm.auto probes for a notebook when imported: only when a search runs
-    from tqdm.auto import tqdm
-
     current, current_cv = reg, cv_rms(ctx, reg, s.folds)
     steps: list[Step] = []
     aliased: list[Aliased] = []
     backlash: BacklashSwitch | None = None
     last: tuple[Candidate, ...] | None = None
-    bar = tqdm(total=s.max_steps * len(effects), desc="diagnose", disable=not s.progress,
-               leave=False)
+    bar = progress_bar(s.max_steps * len(effects), "diagnose", s.progress)
     for _ in range(s.max_steps):
+        if Metrics.of(current.residual).rms <= s.resolution:
+            break  # fits to numerical precision: nothing left to explain
         trials = []
         for eff in effects:
             bar.update(1)

@@ -33,9 +33,10 @@ class Injection:
     Attributes:
         joint_offset: rad (length unit for prismatic joints) per joint.
         encoder_scale: dimensionless scale error per joint (q_actual = q (1 + s)).
-        backlash: rad per joint; the joint lags against its direction of approach.
-        backlash_gravity: rad per joint; the joint rests against the side of its play that the
-            gravity torque of ``masses`` pushes it to.
+        backlash: the full play b per joint, rad (as in ``zrp measure`` and ``zrp diagnose``);
+            the joint lags by b/2 against its direction of approach.
+        backlash_gravity: the full play b per joint, rad; the joint rests b/2 off centre on
+            the side of its play that the gravity torque of ``masses`` pushes it to.
         backlash_friction: N m per joint (with ``backlash``): where the gravity torque of
             ``masses`` exceeds it, the joint rests on the loaded flank instead of lagging
             against its approach direction.
@@ -105,7 +106,7 @@ def _actual_joint_values(model: Manipulator, q: F64, inj: Injection) -> F64:
         for k, v in inj.backlash.items():
             f = inj.backlash_friction.get(k, np.inf)
             t = tau_b[:, k - 1]
-            qa[:, k - 1] += v * np.where(np.abs(t) > f, np.sign(t), -d[:, k - 1])
+            qa[:, k - 1] += 0.5 * v * np.where(np.abs(t) > f, np.sign(t), -d[:, k - 1])
     for k, (h, a, b) in inj.cyclic_error.items():
         qa[:, k - 1] += a * np.sin(h * q[:, k - 1]) + b * np.cos(h * q[:, k - 1])
     if inj.compliance or inj.backlash_gravity:
@@ -113,7 +114,7 @@ def _actual_joint_values(model: Manipulator, q: F64, inj: Injection) -> F64:
         for k, c in inj.compliance.items():
             qa[:, k - 1] += c * tau[:, k - 1]
         for k, b in inj.backlash_gravity.items():
-            qa[:, k - 1] += b * np.sign(tau[:, k - 1])
+            qa[:, k - 1] += 0.5 * b * np.sign(tau[:, k - 1])
     return qa
 
 

@@ -5,7 +5,10 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
+import warnings
+from collections.abc import Iterator
 from pathlib import Path
+from typing import TextIO
 
 from zrp.cli.app import emit
 from zrp.errors import InputError
@@ -22,8 +25,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "diagnose", help="sim-to-real gap diagnosis from measured tool positions",
         description="Register the measurements (base frame, tool offsets), then find which "
         "unmodelled effects explain the remaining gap and how far it shrinks on withheld poses. "
-        "Writes DIR/diagnosis.json, DIR/report.md, DIR/residuals.csv and PNG plots "
-        "(zrp/gap/README.md).")
+        "Writes DIR/diagnosis.json, DIR/report.md, DIR/report.html, DIR/residuals.csv and "
+        "PNG plots (zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml",
                    help="model TOML file or built-in name")
     p.add_argument("--mjcf", metavar="M.xml",
@@ -48,8 +51,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="known instrument noise per coordinate (length unit); default: "
                         "estimated from rigidly linked points or repeats")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
-                   help="show a progress bar (default: when stderr is a terminal)")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
+                   help="show progress on stderr: a bar on a terminal, a line every 10 s "
+                        "when piped (default on; --no-progress: silent)")
     p.add_argument("--json", action="store_true", help="print diagnosis.json to stdout")
     p.set_defaults(func=_run, api_names={
         "withheld_fraction": "--withheld",
@@ -61,6 +65,25 @@ def register(sub: argparse._SubParsersAction) -> None:
         "effects": "--effects",
         "gravity_torque": "--mjcf",
     })
+
+
+@contextlib.contextmanager
+def one_line_warnings(prog: str) -> Iterator[None]:
+    """Print each warning as one clean line ``prog: warning: message`` on stderr (not Python's
+    file:line plus source line), each distinct message once."""
+    seen: set[str] = set()
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+             file: TextIO | None = None, line: str | None = None) -> None:
+        text = " ".join(str(message).split())
+        if text not in seen:
+            seen.add(text)
+            print(f"{prog}: warning: {text}", file=sys.stderr if file is None else file)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = show
+        yield
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -78,12 +101,12 @@ def _run(args: argparse.Namespace) -> int:
     try:
         # the folder is this run's from here on: existing outputs are refused before the
         # computation, and a concurrent run into the same folder is refused, never mixed in
-        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES) as out:
+        with (OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES) as out,
+              one_line_warnings("zrp diagnose")):
             diag = run_diagnosis(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, withheld_fraction=args.withheld, folds=args.folds,
                             alpha=args.alpha, max_steps=args.max_steps, noise_sigma=args.noise,
-                            progress=sys.stderr.isatty() if args.progress is None
-                            else args.progress)
+                            progress=args.progress)
             files = write_outputs(diag, out, plots=not args.no_plots)
     except BaseException:
         if created:  # a failed run leaves no empty folder it made

@@ -6,44 +6,56 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from zrp.gap.report.verdict import baseline_text, final_effects_text
 from zrp.gap.results import Candidate, Diagnosis, ParameterEstimate
 from zrp.gap.where import Region, WhereAnalysis
 
-__all__ = ["report_markdown"]
+__all__ = ["decimals", "report_markdown", "value_ci"]
 
 
-def _val(v: float, unit: str) -> str:
-    if unit == "rad":
-        return f"{v * 1e3:.4g} mrad ({math.degrees(v):.4g} deg)"
-    return f"{v:.4g} {unit}"
+def decimals(half_width: float) -> int:
+    """Decimals that show an interval of this half-width with two significant digits."""
+    if not (half_width > 0 and math.isfinite(half_width)):
+        return 4
+    return max(0, 1 - math.floor(math.log10(half_width)))
 
 
-def _ci(p: ParameterEstimate, unit: str) -> str:
-    lo, hi = p.ci95
+def value_ci(v: float, lo: float, hi: float, unit: str) -> tuple[str, str]:
+    """(value, [lo, hi]) at a precision that shows the interval (rad shown as mrad)."""
+    k, u = (1e3, "mrad") if unit == "rad" else (1.0, unit)
     if not (math.isfinite(lo) and math.isfinite(hi)):
-        return "undetermined"
-    if unit == "rad":
-        return f"[{lo * 1e3:.4g}, {hi * 1e3:.4g}] mrad"
-    return f"[{lo:.4g}, {hi:.4g}] {unit}"
+        return f"{v * k:.4g} {u}", "undetermined"
+    big = max(abs(v), abs(lo), abs(hi)) * k
+    if unit != "rad" and 0 < big < 1e-2:  # tiny (compliance, kappa): a power of ten
+        e = math.floor(math.log10(big))
+        k, u = k * 10.0**-e, f"x 1e{e} {u}".rstrip()
+    d = decimals(0.5 * (hi - lo) * k)
+    return f"{v * k:.{d}f} {u}", f"[{lo * k:.{d}f}, {hi * k:.{d}f}] {u}"
 
 
 def _joints(joints: Sequence[int]) -> str:
     return ", ".join(map(str, joints)) or "-"
 
 
-def _parameter_table(params: Sequence[ParameterEstimate]) -> list[str]:
-    return (["| parameter | value | 95 % interval |", "|---|---|---|"]
-            + [f"| {p.name} | {_val(p.value, p.unit)} | {_ci(p, p.unit)} |" for p in params])
+def _parameter_table(params: Sequence[ParameterEstimate], *, flags: Sequence[str] = ()
+                     ) -> list[str]:
+    out = ["| parameter | value | 95 % interval | plausible |", "|---|---|---|---|"]
+    for p in params:
+        v, ci = value_ci(p.value, *p.ci95, p.unit)
+        bad = any(f.startswith(p.name + " = ") for f in flags)
+        out.append(f"| {p.name} | {v} | {ci} | {'NO' if bad else 'yes'} |")
+    return out
 
 
-def _candidate_table(cands: Sequence[Candidate], u: str) -> list[str]:
-    out = [f"| effect | joints | params | CV RMS ({u}) | dBIC | p | added? | note |",
-           "|---|---|---|---|---|---|---|---|"]
+def _candidate_table(cands: Sequence[Candidate], u: str, added: str | None) -> list[str]:
+    out = [f"| effect | joints | params | CV RMS ({u}) | dBIC | p | passes all tests | "
+           "added at this step | note |", "|---|---|---|---|---|---|---|---|---|"]
     for c in cands:
         cv = "" if math.isnan(c.cv_rms) else f"{c.cv_rms:.4g}"
         db = "" if math.isnan(c.bic_delta) else f"{c.bic_delta:.1f}"
         out.append(f"| {c.effect} | {_joints(c.joints)} | {c.n_params} | {cv} | {db} | "
-                   f"{c.p_value:.2g} | {'yes' if c.significant else 'no'} | {c.note} |")
+                   f"{c.p_value:.2g} | {'yes' if c.significant else 'no'} | "
+                   f"{'yes' if c.effect == added else 'no'} | {c.note} |")
     out.append("")
     return out
 
@@ -56,12 +68,13 @@ def _regions(regions: Sequence[Region], u: str) -> list[str]:
 def _header(diag: Diagnosis) -> list[str]:
     s = diag.settings
     return [f"# Sim-to-real gap diagnosis: {diag.model_name}\n",
+            "## Verdict\n",
+            diag.verdict + "\n",
+            "## Data\n",
             f"Data: {diag.context.meas.source}: {s['n_poses']} poses, {s['n_points']} measured "
             f"points ({', '.join(s['point_labels'])}), frame `{s['frame']}`. Fitting set "
             f"{len(diag.fitting_poses)} poses, withheld set {len(diag.withheld_poses)} poses "
-            f"(never used for fitting or selection), {s['folds']} cross-validation folds.\n",
-            "## Verdict\n",
-            diag.verdict + "\n"]
+            f"(never used for fitting or selection), {s['folds']} cross-validation folds.\n"]
 
 
 def _shrink(diag: Diagnosis) -> list[str]:
@@ -76,10 +89,31 @@ def _shrink(diag: Diagnosis) -> list[str]:
         w = st.withheld
         L.append(f"| {i} | {st.effect} | {_joints(st.joints)} | {w.rms:.4g} | {w.p95:.4g} | "
                  f"{w.max:.4g} | {st.cv_rms:.4g} | {st.p_value:.2g} | {st.bic_delta:.1f} |")
+    fin = diag.final
+    L.append(f"| final | final model after pruning: {final_effects_text(diag) or 'none'} | | "
+             f"{fin.rms:.4g} | {fin.p95:.4g} | {fin.max:.4g} | | | |")
+    a = diag.assessment
+    if a is not None:
+        b = a.baseline
+        L.append(f"| baseline | complete geometric calibration ({b.n_parameters} parameters) "
+                 f"| all | {b.withheld.rms:.4g} | {b.withheld.p95:.4g} | {b.withheld.max:.4g} "
+                 f"| {b.cv_rms:.4g} | | |")
+        if b.combined is not None:
+            L.append(f"| baseline + | geometric calibration + {', '.join(b.non_geometric)} | "
+                     f"| {b.combined.rms:.4g} | {b.combined.p95:.4g} | {b.combined.max:.4g} "
+                     "| | | |")
     if nf.rms is not None:
         L.append(f"| | noise floor ({nf.method}) | | {nf.rms:.4g} | {nf.p95:.4g} | | | | |")
+    else:
+        L.append("| | noise floor | | cannot be estimated (one point per pose, no repeats) "
+                 "| | | | | |")
     L.append("")
-    L.append(f"Final withheld RMS / nominal: {diag.shrink:.3f}. ")
+    if a is not None:
+        L.append(baseline_text(diag) + "\n")
+    L.append(f"Steps 1..{len(diag.steps)} show each effect as it was added; the final row is the "
+             "jointly refitted model after the backward pass (the one the verdict, the "
+             "parameter tables and diagnosis.json's `final` describe). Final withheld RMS / "
+             f"nominal: {diag.shrink:.3f}. ")
     if nf.sigma is not None:
         L.append(f"Noise floor: sigma = {nf.sigma:.4g} {u} per coordinate from {nf.method} "
                  f"({nf.n_samples} samples); RMS of pure noise sqrt(3) sigma = {nf.rms:.4g} {u}."
@@ -87,20 +121,25 @@ def _shrink(diag: Diagnosis) -> list[str]:
                     "only; the robot's repeatability adds to it, so the attainable floor is "
                     "somewhat higher." if nf.method == "rigid_links" else ""))
     L += ["\n![shrink](shrink.png)\n", "![residuals](residuals_before_after.png)\n",
-          "![residual vs joint](residual_vs_joint.png)\n"]
+          "![residual vs joint](residual_vs_joint.png)\n", "![workspace](residual_map.png)\n",
+          "![correlation](correlation.png)\n"]
     return L
 
 
 def _parameters(diag: Diagnosis) -> list[str]:
-    L = ["## Identified parameters (final model, 95 % intervals)\n",
+    flags = diag.assessment.implausible if diag.assessment is not None else ()
+    L = ["## Identified parameters (final model, robust 95 % intervals)\n",
          "Estimated jointly in the final model (the per-step values in diagnosis.json were "
-         "each estimated before the later effects were added).\n"]
+         "each estimated before the later effects were added). Intervals: the larger of the "
+         "pose-clustered sandwich and the normal-theory standard error, so they hold when a "
+         "gap remains. Backlash is the full play; compliance is in rad/(N m) with MJCF "
+         "torques (lumped masses without: rad per length unit of moment arm x kg).\n"]
     by_eff: dict[str, list[ParameterEstimate]] = {}
     for p in diag.final_parameters:
         by_eff.setdefault(p.effect, []).append(p)
     for eff, params in by_eff.items():
         L.append(f"### {eff} (joints {_joints(diag.final_joints.get(eff, ()))})\n")
-        L += _parameter_table(params)
+        L += _parameter_table(params, flags=flags)
         L.append("")
     for i, st in enumerate(diag.steps, 1):
         if not math.isnan(st.geometric_overlap):
@@ -115,8 +154,64 @@ def _parameters(diag: Diagnosis) -> list[str]:
     if diag.where.backward_pruned:
         L.append("Dropped in the backward pass (no longer significant in the final model): "
                  + ", ".join(diag.where.backward_pruned) + ".\n")
-    L.append("Registration:\n")
-    L += _parameter_table(diag.registration)
+    L += _frame(diag)
+    return L
+
+
+def _frame(diag: Diagnosis) -> list[str]:
+    a = diag.assessment
+    if a is None:
+        return ["Registration:\n", *_parameter_table(diag.registration), ""]
+    f, u = a.frame, diag.length_unit
+    L = ["## Registration (final model, robust 95 % intervals)\n"]
+    if f.frame == "base":
+        L.append("Data given in the robot's base frame: no instrument transform fitted.\n")
+    else:
+        L.append("Instrument-from-base transform (a point x in the base frame is measured at "
+                 "R x + t); R as Z-Y-X angles (R = Rz(yaw) Ry(pitch) Rx(roll)) and as a "
+                 "rotation vector:\n")
+        L += ["| quantity | value | 95 % interval |", "|---|---|---|"]
+        for q in (*f.zyx, *f.rotvec, *f.translation):
+            v, ci = value_ci(q.value, *q.ci95, q.unit)
+            if q.unit == "rad":
+                v += f" ({math.degrees(q.value):.4f} deg)"
+            L.append(f"| {q.name} | {v} | {ci} |")
+        L.append("")
+    L += ["Tool points (flange frame at the zero reference):\n",
+          f"| point | x ({u}) | y ({u}) | z ({u}) |", "|---|---|---|---|"]
+    for lab, qs in f.tool_points.items():
+        cells = []
+        for q in qs:
+            v, ci = value_ci(q.value, *q.ci95, "")
+            cells.append(f"{v.strip()} {ci.strip()}")
+        L.append(f"| {lab} | " + " | ".join(cells) + " |")
+    L.append("")
+    return L
+
+
+def _trust(diag: Diagnosis) -> list[str]:
+    a = diag.assessment
+    if a is None:
+        return []
+    L = ["## How far to trust the numbers\n"]
+    if a.implausible:
+        L.append("Physically implausible final values:\n")
+        L += [f"- {m}" for m in a.implausible]
+        L.append("")
+    if a.unexcited:
+        L.append(f"Joints the data do not excite (no scale, cyclic error or backlash placed on "
+                 f"them): {', '.join(map(str, a.unexcited))}.\n")
+    c = a.correlations
+    L.append(f"Strongly correlated parameter pairs (|rho| >= {0.9}; their values trade "
+             f"against each other, the sums are better determined than each): "
+             f"{len(c.strong)} of {len(c.names) * (len(c.names) - 1) // 2}. The full matrix is "
+             "in diagnosis.json (`correlation`) and report.html.\n")
+    L += [f"- {x} ~ {y}: {rho:+.3f}" for x, y, rho in c.strong[:20]]
+    if len(c.strong) > 20:
+        L.append(f"- ... and {len(c.strong) - 20} more")
+    L += ["", "What remains, weighed against the data's own evidence:\n",
+          "| explanation | the data | evidence |", "|---|---|---|"]
+    L += [f"| {e} | {st} | {v} |" for e, st, v in a.remainder.findings()]
     L.append("")
     return L
 
@@ -129,12 +224,12 @@ def _ranking(diag: Diagnosis) -> list[str]:
          "1 %.\n"]
     if diag.steps:
         L.append("At step 1:\n")
-        L += _candidate_table(diag.steps[0].candidates, u)
+        L += _candidate_table(diag.steps[0].candidates, u, diag.steps[0].effect)
     last = diag.where.last_candidates
     if last:
         L.append(f"After step {len(diag.steps)} (none added):\n" if diag.steps
                  else "On top of the registration (none added):\n")
-        L += _candidate_table(last, u)
+        L += _candidate_table(last, u, None)
     return L
 
 
@@ -204,16 +299,19 @@ METHOD = ("See zrp/gap/README.md. Registration (base_frame, tool_offset) first; 
           "candidate effect is a parametrised model correction fitted by least squares with "
           "analytic Jacobians; joints whose parameters fail a Wald test are pruned; "
           "candidates are ranked by cross-validated RMS and added greedily while an F test, "
-          "BIC and the CV RMS agree that they help. Intervals are 95 % normal-theory "
-          "intervals from the fit's covariance (they assume the model is right; with an "
-          "unexplained gap they are optimistic).")
+          "BIC and the CV RMS agree that they help; a backward pass drops what the final "
+          "model no longer needs. Final intervals are robust 95 % intervals (pose-clustered "
+          "sandwich covariance, never narrower than the normal-theory ones); per-step "
+          "intervals in diagnosis.json are normal-theory. A complete geometric calibration "
+          "(QR-reduced base set of joint offsets, body vectors and axis tilts) is always "
+          "fitted beside the chosen effects.")
 
 
 def report_markdown(diag: Diagnosis) -> str:
     """The text of report.md."""
     u = diag.length_unit
-    L = (_header(diag) + _shrink(diag) + _parameters(diag) + _ranking(diag) + _aliasing(diag)
-         + _where(diag.where.nominal, u))
+    L = (_header(diag) + _shrink(diag) + _parameters(diag) + _trust(diag) + _ranking(diag)
+         + _aliasing(diag) + _where(diag.where.nominal, u))
     if diag.where.after_final_model is not None:
         L += _remains(diag.where.after_final_model, u)
     if diag.warnings:

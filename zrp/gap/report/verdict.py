@@ -2,14 +2,12 @@
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
-from zrp.gap.results import Diagnosis, Step
+from zrp.gap.results import Diagnosis
 from zrp.gap.where import WhereAnalysis
 
-__all__ = ["remains_text", "verdict_text"]
+__all__ = ["baseline_text", "final_effects_text", "remains_text", "verdict_text"]
 
 #: R^2 below which the residual is said to depend on nothing in particular.
 NO_TREND_R2 = 0.1
@@ -47,19 +45,33 @@ def remains_text(w: WhereAnalysis, unit: str) -> str:
                    f"{unit} in the outer third of the reach")
     out = "What remains: " + "; ".join(txt) + "."
     if common is not None and common > POSE_ERROR_SHARE and no_trend:
-        out += (" This behaves like a pose-to-pose positioning error of the robot that no "
-                "model correction of the joint angles or geometry reproduces (e.g. poor "
-                "repeatability or settling); measuring repeated poses would tell the robot's "
-                "own floor, which the rigid-link estimate (instrument noise only) does not.")
+        out += (" No correction of the joint angles or geometry in the library reproduces a "
+                "residual of this shape.")
     return out
 
 
-def _effects_found(steps: tuple[Step, ...]) -> list[str]:
+def _ranges(joints: tuple[int, ...]) -> str:
+    """1, 2, 3, 5 -> "1-3, 5"."""
+    runs: list[list[int]] = []
+    for j in joints:
+        if runs and runs[-1][1] == j - 1:
+            runs[-1][1] = j
+        else:
+            runs.append([j, j])
+    return ", ".join(f"{a}" if a == b else f"{a}-{b}" for a, b in runs) or "-"
+
+
+def final_effects_text(diag: Diagnosis) -> str:
+    """The effects of the final model (after the backward pass) with their joints."""
+    fj = diag.final_joints
+    return ", ".join(f"{e} (joints {_ranges(j)})" if j else e for e, j in fj.items())
+
+
+def _effects_found(diag: Diagnosis) -> list[str]:
+    steps = diag.steps
     if not steps:
         return ["No effect in the library improves the model significantly (none)."]
-    names = ", ".join(f"{s.effect} (joints {', '.join(map(str, s.joints)) or '-'})"
-                      for s in steps)
-    parts = [f"Effects found, in order: {names}."]
+    parts = [f"Final model (after pruning): {final_effects_text(diag)}."]
     for i, s in enumerate(steps, 1):
         if s.ties:
             parts.append(f"At step {i} {', '.join(s.ties)} explain(s) the data equally well; "
@@ -68,30 +80,94 @@ def _effects_found(steps: tuple[Step, ...]) -> list[str]:
     return parts
 
 
+def baseline_text(diag: Diagnosis) -> str:
+    """One line: the complete geometric calibration and what the non-geometric effects add
+    beyond it on the withheld poses."""
+    a = diag.assessment
+    if a is None:
+        return ""
+    b, u = a.baseline, diag.length_unit
+    txt = (f"A complete geometric calibration ({b.n_parameters} identifiable kinematic "
+           f"parameters) gives {b.withheld.rms:.4g} {u} withheld RMS")
+    if b.combined is None or b.increment is None:
+        return txt + "; the final model adds no non-geometric effect to it."
+    verb = "lower" if b.increment > 0 else "raise"
+    return (txt + f"; the non-geometric effects ({', '.join(b.non_geometric)}) on top of it "
+            f"{verb} that to {b.combined.rms:.4g} {u} ({100 * abs(b.increment):.0f} % "
+            f"{'less' if b.increment > 0 else 'more'}).")
+
+
+def _trust(diag: Diagnosis) -> list[str]:
+    a = diag.assessment
+    if a is None:
+        return []
+    parts = []
+    if a.implausible:
+        names = ", ".join(m.split(" = ")[0] for m in a.implausible)
+        parts.append(f"Physically implausible values (do not use them as physical "
+                     f"properties): {names}.")
+    if a.unexcited:
+        parts.append(f"These data leave joint(s) {_ranges(a.unexcited)} unidentifiable for "
+                     "scale, cyclic error and backlash (they barely move).")
+    return parts
+
+
 def _against_floor(diag: Diagnosis) -> list[str]:
     floor, final, unit = diag.noise_floor, diag.final, diag.length_unit
     if floor.rms is None:
-        return ["The data allow no noise-floor estimate (one point per pose and no repeats), "
-                "so whether a gap remains cannot be judged."]
-    ratio = final.rms / floor.rms if floor.rms > 0 else math.inf
+        return ["No noise floor can be estimated from these data (one point per pose and no "
+                "repeated poses), so whether a gap remains cannot be judged."]
+    if floor.rms <= (diag.assessment.resolution if diag.assessment else 0.0):
+        parts = [f"The noise floor is {floor.rms:.3g} {unit} (noise-free data)."]
+        if diag.unexplained:
+            parts.append(f"A gap of {final.rms:.4g} {unit} RMS remains.")
+        else:
+            parts.append("The final model reproduces the data to numerical precision.")
+        return parts
+    ratio = final.rms / floor.rms
     parts = [f"Noise floor {_fmt(floor.rms, unit)} RMS ({floor.method}); the final error is "
              f"{ratio:.2g}x the floor."]
     if diag.unexplained:
         parts.append(f"A gap of {final.rms:.4g} {unit} RMS remains that no effect in the "
                      "library explains.")
         parts.append(remains_text(diag.where_final, unit))
+        parts += _weighed(diag)
     else:
         parts.append("What remains is at the noise floor.")
     return parts
 
 
+def _weighed(diag: Diagnosis) -> list[str]:
+    a = diag.assessment
+    if a is None:
+        return []
+    f = a.remainder.findings()
+    sup = [e for e, st, _ in f if st == "supported"]
+    cant = [e for e, st, _ in f if st == "cannot tell"]
+    out = []
+    if sup:
+        out.append("The data support: " + "; ".join(sup) + ".")
+    if cant:
+        out.append("They cannot tell: " + "; ".join(cant) + ".")
+    if a.remainder.exceeds_spec and a.remainder.repeat_rms is None:
+        out.append("A robot pose-to-pose error this large would conflict with the specified "
+                   "repeatability of arms of this class (0.01-0.1 mm), so it is not stated as "
+                   "the cause; repeated poses would measure it.")
+    return out
+
+
 def verdict_text(diag: Diagnosis) -> str:
-    """One paragraph: the effects found (and ties), how far the withheld error shrinks, and
-    how it compares with the noise floor (with the structure of an unexplained remainder)."""
+    """One paragraph: the effects of the final model (and ties), how far the withheld error
+    shrinks, the geometric baseline beside it, how the error compares with the noise floor
+    (with the weighed evidence on an unexplained remainder) and what not to trust."""
     nominal, final, unit = diag.nominal, diag.final, diag.length_unit
     shrunk = 100 * (1 - final.rms / nominal.rms) if nominal.rms > 0 else 0
-    parts = _effects_found(diag.steps)
+    parts = _effects_found(diag)
     parts.append(f"Withheld RMS {nominal.rms:.4g} {unit} after registration, "
-                 f"{final.rms:.4g} {unit} after correction ({shrunk:.0f} % smaller).")
+                 f"{final.rms:.4g} {unit} with the final model ({shrunk:.0f} % smaller).")
+    bl = baseline_text(diag)
+    if bl:
+        parts.append(bl)
     parts += _against_floor(diag)
+    parts += _trust(diag)
     return " ".join(parts)

@@ -1,5 +1,6 @@
 """Write a :class:`~zrp.gap.Diagnosis` to a folder: diagnosis.json, residuals.csv, the PNG
-plots and report.md, through the one output policy (:mod:`zrp.output`)."""
+plots, report.md and report.html (the same text with the figures embedded), through the one
+output policy (:mod:`zrp.output`)."""
 
 from __future__ import annotations
 
@@ -10,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from zrp.gap.report.html import report_html
 from zrp.gap.report.markdown import report_markdown
 from zrp.gap.report.plots import DPI, PLOT_FILES, figures, withheld_rows
 from zrp.gap.results import Diagnosis
@@ -19,7 +21,7 @@ __all__ = ["OUTPUT_FILES", "residuals_csv", "write_outputs"]
 
 #: every file :func:`write_outputs` writes (all are checked, even without plots, so that no
 #: plot of an earlier run is left beside the new results).
-OUTPUT_FILES = ("diagnosis.json", "report.md", "residuals.csv", *PLOT_FILES)
+OUTPUT_FILES = ("diagnosis.json", "report.md", "report.html", "residuals.csv", *PLOT_FILES)
 
 
 def residuals_csv(diag: Diagnosis) -> str:
@@ -43,16 +45,23 @@ def _write(diag: Diagnosis, out: OutputDir, plots: bool) -> list[Path]:
     first = len(out.written)
     out.write_json("diagnosis.json", diag.to_dict())
     out.write_text("residuals.csv", residuals_csv(diag))
+    svgs: dict[str, bytes] = {}
     if plots:
         for name, fig in figures(diag):
             out.savefig(name, fig, dpi=DPI)
-    out.write_text("report.md", report_markdown(diag))
+            buf = io.BytesIO()
+            fig.savefig(buf, format="svg", dpi=DPI)
+            svgs[name] = buf.getvalue()
+    md = report_markdown(diag)
+    out.write_text("report.md", md)
+    out.write_text("report.html", report_html(md, svgs, f"Gap diagnosis: {diag.model_name}"))
     return out.written[first:]
 
 
 def write_outputs(diag: Diagnosis, out_dir: str | os.PathLike[str] | OutputDir, *,
                   overwrite: bool = False, plots: bool = True) -> list[Path]:
-    """Write diagnosis.json, residuals.csv, (with ``plots``) the PNGs and report.md.
+    """Write diagnosis.json, residuals.csv, (with ``plots``) the PNGs, report.md and
+    report.html.
 
     Args:
         out_dir: the folder, or an :class:`~zrp.output.OutputDir` the caller has entered

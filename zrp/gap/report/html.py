@@ -1,0 +1,126 @@
+"""report.html: one self-contained page (no network, no script), rendered from the same text
+as report.md so the two can never disagree, with the figures embedded as SVG (vector: they
+stay sharp at any browser zoom) and a click on any figure opening it full-window (a CSS
+``:target`` overlay; "close" or the browser's back button closes it).
+
+Only the small subset of Markdown that :func:`~zrp.gap.report.markdown.report_markdown`
+writes is translated: headings, paragraphs, ``- `` lists, pipe tables, ``**bold**``,
+```code``` and ``![alt](file.png)`` figures (scatter points are rasterised inside the SVG).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import re
+from collections.abc import Mapping
+
+__all__ = ["report_html"]
+
+_CSS = """
+body{font-family:system-ui,-apple-system,Segoe UI,Helvetica,Arial,sans-serif;max-width:1100px;
+margin:1.5em auto;padding:0 1em;color:#1b1b1b;line-height:1.45}
+h1{font-size:1.5em;margin-bottom:.2em}h2{border-bottom:1px solid #ccc;padding-bottom:.2em;
+margin-top:1.6em}
+#verdict{background:#fff4d6;border-left:6px solid #d08c00;padding:.8em 1.1em;font-size:1.08em}
+table{border-collapse:collapse;margin:.6em 0;font-size:.9em}
+td,th{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:top}
+th{background:#f0f0f0}tr:nth-child(even) td{background:#fafafa}
+code{background:#f2f2f2;padding:0 .2em}
+figure{margin:1em 0}figure img{max-width:100%;cursor:zoom-in;border:1px solid #ddd}
+figcaption{font-size:.85em;color:#555}
+figure:target{position:fixed;inset:0;margin:0;background:rgba(0,0,0,.85);z-index:10;
+display:flex;flex-direction:column;align-items:center;justify-content:center}
+figure:target img{max-width:98vw;max-height:92vh;background:#fff;cursor:default}
+figure .close{display:none}figure:target .close{display:block;color:#fff;font-size:1.2em}
+figure:target figcaption{color:#eee}
+"""
+
+
+def _inline(text: str) -> str:
+    t = html.escape(text, quote=False)
+    t = re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", t)
+    return re.sub(r"`([^`]+)`", r"<code>\1</code>", t)
+
+
+def _table(rows: list[str]) -> str:
+    cells = [[c.strip() for c in r.strip().strip("|").split("|")] for r in rows]
+    head, body = cells[0], [c for c in cells[1:] if not all(set(x) <= {"-", ":"} for x in c)]
+    out = ["<table><thead><tr>" + "".join(f"<th>{_inline(c)}</th>" for c in head)
+           + "</tr></thead><tbody>"]
+    out += ["<tr>" + "".join(f"<td>{_inline(c)}</td>" for c in r) + "</tr>" for r in body]
+    return "\n".join(out) + "</tbody></table>"
+
+
+def _figure(alt: str, name: str, svgs: Mapping[str, bytes]) -> str:
+    svg = svgs.get(name)
+    if svg is None:
+        return ""
+    src = "data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")
+    fid = "zoom-" + re.sub(r"[^a-z0-9]+", "-", name.lower())
+    return (f'<figure id="{fid}"><a class="close" href="#_">close x</a><a href="#{fid}">'
+            f'<img src="{src}" alt="{html.escape(alt)}"></a><figcaption>{html.escape(alt)} '
+            f"(click to enlarge; {html.escape(name)} beside this file)</figcaption></figure>")
+
+
+def _blocks(md: str, svgs: Mapping[str, bytes]) -> list[str]:
+    out: list[str] = []
+    lines = md.splitlines()
+    i, first_h2 = 0, True
+    while i < len(lines):
+        ln = lines[i]
+        if not ln.strip():
+            i += 1
+            continue
+        m = re.match(r"^(#{1,3}) (.*)$", ln)
+        if m:
+            lvl = len(m.group(1))
+            out.append(f"<h{lvl}>{_inline(m.group(2))}</h{lvl}>")
+            if lvl == 2 and first_h2 and m.group(2).strip() == "Verdict":
+                first_h2 = False
+                j = i + 1
+                para = []
+                while j < len(lines) and not lines[j].startswith("#"):
+                    if lines[j].strip():
+                        para.append(lines[j])
+                    j += 1
+                out.append(f'<div id="verdict">{_inline(" ".join(para))}</div>')
+                i = j
+                continue
+            i += 1
+            continue
+        if ln.startswith("|"):
+            j = i
+            while j < len(lines) and lines[j].startswith("|"):
+                j += 1
+            out.append(_table(lines[i:j]))
+            i = j
+            continue
+        fm = re.match(r"^!\[(.*)\]\((.*)\)\s*$", ln)
+        if fm:
+            out.append(_figure(fm.group(1), fm.group(2), svgs))
+            i += 1
+            continue
+        if ln.lstrip().startswith("- "):
+            j = i
+            items = []
+            while j < len(lines) and lines[j].lstrip().startswith("- "):
+                items.append(f"<li>{_inline(lines[j].lstrip()[2:])}</li>")
+                j += 1
+            out.append("<ul>" + "".join(items) + "</ul>")
+            i = j
+            continue
+        out.append(f"<p>{_inline(ln)}</p>")
+        i += 1
+    return out
+
+
+def report_html(markdown: str, svgs: Mapping[str, bytes], title: str) -> str:
+    """The page for the text of report.md and the figures as SVG (keyed by their PNG file
+    names, as report.md references them)."""
+    body = "\n".join(_blocks(markdown, svgs))
+    return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
+            "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+            "<link rel=\"icon\" href=\"data:,\">"
+            f"<title>{html.escape(title)}</title><style>{_CSS}</style></head>"
+            f"<body>\n{body}\n</body></html>\n")

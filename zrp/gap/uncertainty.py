@@ -1,0 +1,149 @@
+"""Uncertainty that holds when the model is imperfect: a pose-clustered sandwich covariance,
+the parameter correlations, and physical plausibility checks of the final values.
+
+The normal-theory covariance sigma^2 (J^T J)^-1 assumes the model is right and the errors
+independent per coordinate. When a gap remains, the residuals of one pose are correlated (a
+common shift of its points) and their size depends on the pose; the robust covariance
+
+    C = (J^T J)^-1 (G/(G-1) sum_g J_g^T r_g r_g^T J_g) (J^T J)^-1           (sandwich, HC1)
+
+sums the score of each pose g (its 3 M rows) before squaring, so it stays honest in both
+cases (Huber 1967; White 1980; clustered: Liang & Zeger 1986). The reported standard error
+is the larger of the robust and the normal-theory one.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.errors import InputError
+from zrp.gap.effects import Context
+from zrp.gap.leastsq import FitResult
+
+__all__ = [
+    "STRONG_CORRELATION",
+    "Correlations",
+    "correlations",
+    "plausibility",
+    "robust_covariance",
+    "robust_stderr",
+]
+
+F64 = NDArray[np.float64]
+#: |correlation| above which a pair of parameters is named as strongly correlated.
+STRONG_CORRELATION = 0.9
+
+#: Typical magnitudes above which a value is implausible for an industrial arm (per unit).
+_TYPICAL_MAX = {
+    "joint_offset": 0.05,      # rad (~3 deg): an encoder zero error beyond it is a setup error
+    "encoder_scale": 0.01,     # 1 %
+    "backlash": 0.01,          # rad (~0.6 deg) of full play
+    "cyclic_error": 0.005,     # rad amplitude
+    "axis_misalignment": 0.02,  # rad
+    "thermal_expansion": 5e-5,  # 1/degC
+}
+
+
+def _row_pose(ctx: Context, result: FitResult) -> NDArray[np.int64]:
+    """Pose index of every measured point fitted, in the Problem's row order, shape (R,)."""
+    rows = np.flatnonzero(np.isin(ctx.meas.pose_index, result.poses))
+    return ctx.meas.pose_index[rows]
+
+
+def robust_covariance(ctx: Context, result: FitResult) -> F64:
+    """Pose-clustered sandwich covariance of ``result.theta``, shape (p, p) (see the module
+    docstring; columns scaled for conditioning; inf where the normal-theory one is)."""
+    J, r = result.jac, result.residual
+    p = J.shape[1]
+    if p == 0:
+        return np.zeros((0, 0))
+    d = np.linalg.norm(J, axis=0)
+    d = np.where(d > 0, d, 1.0)
+    js = J / d
+    w, v = np.linalg.eigh(js.T @ js)
+    ok = w > max(w.max(), 1e-300) * 1e-12
+    bread = (v[:, ok] / w[ok]) @ v[:, ok].T
+    pose = _row_pose(ctx, result)
+    score = js.reshape(pose.size, 3, p) * r.reshape(pose.size, 3, 1)
+    _, inv = np.unique(pose, return_inverse=True)
+    G = int(inv.max()) + 1 if inv.size else 0
+    per_pose = np.zeros((G, p))
+    np.add.at(per_pose, inv, score.sum(axis=1))
+    meat = per_pose.T @ per_pose * (G / max(G - 1, 1))
+    cov = bread @ meat @ bread / np.outer(d, d)
+    bad = ~np.isfinite(np.diag(result.cov))
+    cov[bad, :] = np.inf
+    cov[:, bad] = np.inf
+    return cov
+
+
+def robust_stderr(ctx: Context, result: FitResult) -> F64:
+    """Per parameter the larger of the robust (sandwich) and the normal-theory standard
+    error, shape (p,)."""
+    rob = np.sqrt(np.clip(np.diag(robust_covariance(ctx, result)), 0.0, None))
+    return np.maximum(rob, result.stderr)
+
+
+@dataclass(frozen=True)
+class Correlations:
+    """The correlation matrix of a set of parameters and its strongly correlated pairs.
+
+    Attributes:
+        names: the parameters (p).
+        matrix: correlations, shape (p, p) (NaN where a variance is not finite).
+        strong: pairs (a, b, rho) with |rho| >= :data:`STRONG_CORRELATION`, largest first.
+    """
+
+    names: tuple[str, ...]
+    matrix: F64
+    strong: tuple[tuple[str, str, float], ...]
+
+    def __post_init__(self) -> None:
+        if self.matrix.shape != (len(self.names), len(self.names)):
+            raise InputError(f"Correlations: matrix shape {self.matrix.shape} does not match "
+                             f"{len(self.names)} names")
+
+    def to_dict(self) -> dict[str, Any]:
+        m = [[None if not math.isfinite(x) else round(float(x), 4) for x in row]
+             for row in self.matrix]
+        return {"names": list(self.names), "matrix": m,
+                "strong_pairs": [{"a": a, "b": b, "rho": rho} for a, b, rho in self.strong],
+                "threshold": STRONG_CORRELATION}
+
+
+def correlations(names: tuple[str, ...], cov: F64) -> Correlations:
+    """Correlations of a covariance ``cov`` (p, p) and the pairs above the threshold."""
+    sd = np.sqrt(np.clip(np.diag(cov), 0.0, None))
+    with np.errstate(invalid="ignore", divide="ignore"):
+        m = cov / np.outer(sd, sd)
+    m[~np.isfinite(m)] = np.nan
+    iu = np.triu_indices(len(names), 1)
+    pairs = [(names[i], names[j], float(m[i, j])) for i, j in zip(*iu, strict=True)
+             if np.isfinite(m[i, j]) and abs(m[i, j]) >= STRONG_CORRELATION]
+    pairs.sort(key=lambda t: -abs(t[2]))
+    return Correlations(tuple(names), m, tuple(pairs))
+
+
+def plausibility(name: str, effect: str, value: float, stderr: float, unit: str) -> str | None:
+    """Why a final value is physically implausible, or None.
+
+    Negative backlash (a play is never negative) or negative compliance (a joint does not
+    move against the load) by more than 2 standard errors; a magnitude beyond the typical range
+    of an industrial arm (:data:`_TYPICAL_MAX`)."""
+    neg = value < -2.0 * stderr
+    if effect == "backlash" and neg:
+        return (f"{name} = {value:.3g} {unit} is negative: a play cannot be; the approach-"
+                "direction model does not describe this joint (or another effect mimics it)")
+    if effect == "joint_compliance" and name.endswith(".compliance") and neg:
+        return (f"{name} = {value:.3g} {unit} is negative: a joint does not deflect against "
+                "its load; the gravity torques or another effect are wrong for this joint")
+    lim = _TYPICAL_MAX.get(effect)
+    if lim is not None and unit in ("rad", "1", "1/degC") and abs(value) > lim:
+        return (f"{name} = {value:.3g} {unit} exceeds the typical range of an industrial arm "
+                f"(|value| <= {lim:g} {unit}); check the model or the data")
+    return None
