@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError, ZRPWarning
+from zrp.model.manipulator import MAX_LENGTH
 from zrp.output import write_text
 
 __all__ = [
@@ -113,12 +114,12 @@ class Measurements:
             a = np.array(arr, dtype=float)
             if a.shape != shape:
                 raise InputError(f"{self.source}: {name}: expected shape {shape}, got {a.shape}")
-            bad = ~np.isfinite(a)
+            bad = ~(np.abs(a) <= MAX_LENGTH)  # NaN fails the comparison too
             if bad.any():
                 i, c = (int(v) for v in np.argwhere(bad)[0])
                 col = f"q{c + 1}" if name == "q" else "xyz"[c]
                 raise InputError(f"{self.source} line {lines[i]}: column {col} is {a[i, c]}; "
-                                 "expected a finite number")
+                                 f"expected a finite number of magnitude up to {MAX_LENGTH:g}")
             object.__setattr__(self, name, _freeze(a))
         for name in OPTIONAL_SCALARS:
             object.__setattr__(self, name, _opt(getattr(self, name), (r,), name))

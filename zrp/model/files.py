@@ -128,8 +128,8 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
     joints_raw = data.get("joint")
     if not isinstance(joints_raw, list) or not joints_raw \
             or not all(isinstance(j, dict) for j in joints_raw):
-        raise fail("joint: expected one or more [[joint]] tables (keys type, axis, body, name); "
-                   "a model needs at least one joint", _line_of(r"joint\s*="))
+        raise fail("joint: no [[joint]] tables (keys type, axis, body, name); a model needs "
+                   "at least one joint", _line_of(r"joint\s*="))
     if "end_effector" not in data or not isinstance(data["end_effector"], dict):
         raise fail("missing [end_effector] table (keys body, axial, transverse)", None)
     if not isinstance(data.get("name", ""), str):
