@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arguments import check_instance, check_seed
 from zrp.errors import InputError
 from zrp.gap.checks import (
     check_gravity_torque,
@@ -84,6 +85,15 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         InputError: too few poses, units that do not fit the model, unidentifiable
             registration, unknown effect names, invalid options (naming the argument).
     """
+    check_instance(model, Manipulator, "model", "a zrp.Manipulator (zrp.load_model)")
+    check_instance(measurements, Measurements, "measurements",
+                   "zrp.gap.Measurements (zrp.load_measurements)")
+    check_seed(seed)
+    if rng is not None:
+        check_instance(rng, np.random.Generator, "rng", "a numpy.random.Generator")
+    if isinstance(effects, str):
+        raise InputError(f"effects: expected a sequence of effect names, got the string "
+                         f"{effects!r}")
     opts = DiagnosisOptions(tuple(effects), withheld_fraction, folds, alpha, min_gain,
                             max_steps, noise_sigma, tuple(harmonics), tuple(gravity_dir),
                             progress)

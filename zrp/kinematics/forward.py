@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
-from zrp.kinematics._range import all_in_range, joint_limits
+from zrp.kinematics._range_kernels import all_in_range, joint_limits
 from zrp.model.manipulator import Manipulator, hand_frame
 from zrp.rotations.rodrigues import (
     er_from_axis_angle,
@@ -38,7 +38,7 @@ def check_q(model: Manipulator, q: ArrayLike, name: str = "q") -> F64:
     """Coerce joint values to a float array of shape (..., n), or raise naming the joint.
 
     Revolute values are in rad, prismatic ones in the model's length unit; only real numbers
-    (no complex, date, masked or boolean arrays) within the range of :mod:`._range`.
+    (no complex, date, masked or boolean arrays) within the range of :mod:`._range_kernels`.
     """
     kind = getattr(getattr(q, "dtype", None), "kind", "f")
     if kind not in "iuf" or isinstance(q, np.ma.MaskedArray):

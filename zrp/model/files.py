@@ -19,6 +19,7 @@ from __future__ import annotations
 import os
 import re
 import sys
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -111,6 +112,30 @@ def load_model(path: str | Path) -> Manipulator:
     return loads_model(text, str(p))
 
 
+def _check_top(data: dict[str, Any], lines: _Lines,
+               fail: Callable[[str, int | None], ModelFileError]) -> str:
+    """The top-level tables and values: [[joint]] tables, [end_effector], name, length_unit.
+    Returns the length unit."""
+    joints_raw = data.get("joint")
+    if not isinstance(joints_raw, list) or not joints_raw \
+            or not all(isinstance(j, dict) for j in joints_raw):
+        raise fail("joint: no [[joint]] tables (keys type, axis, body, name); a model needs "
+                   "at least one joint", lines.first(r"joint\s*="))
+    if "end_effector" not in data or not isinstance(data["end_effector"], dict):
+        raise fail("missing [end_effector] table (keys body, axial, transverse)", None)
+    if not isinstance(data.get("name", ""), str):
+        raise fail(f"name: expected a string, got {data['name']!r}", lines.first(r"name\s*="))
+    unit = data.get("length_unit", "mm")
+    if not isinstance(unit, str) or not unit:
+        raise fail(f"length_unit: expected a string such as \"mm\", got {unit!r}",
+                   lines.first(r"length_unit\s*="))
+    try:
+        canonical_length_unit(unit)
+    except InputError as exc:
+        raise fail(str(exc), lines.first(r"length_unit\s*=")) from exc
+    return unit
+
+
 def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
     lines = _Lines(text)
     _line_of = lines.first
@@ -126,22 +151,7 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
         raise fail(f"unknown key {key!r}; expected one of {sorted(_TOP_KEYS)}",
                    _line_of(rf"{re.escape(key)}\s*="))
     joints_raw = data.get("joint")
-    if not isinstance(joints_raw, list) or not joints_raw \
-            or not all(isinstance(j, dict) for j in joints_raw):
-        raise fail("joint: no [[joint]] tables (keys type, axis, body, name); a model needs "
-                   "at least one joint", _line_of(r"joint\s*="))
-    if "end_effector" not in data or not isinstance(data["end_effector"], dict):
-        raise fail("missing [end_effector] table (keys body, axial, transverse)", None)
-    if not isinstance(data.get("name", ""), str):
-        raise fail(f"name: expected a string, got {data['name']!r}", _line_of(r"name\s*="))
-    unit = data.get("length_unit", "mm")
-    if not isinstance(unit, str) or not unit:
-        raise fail(f"length_unit: expected a string such as \"mm\", got {unit!r}",
-                   _line_of(r"length_unit\s*="))
-    try:
-        canonical_length_unit(unit)
-    except InputError as exc:
-        raise fail(str(exc), _line_of(r"length_unit\s*=")) from exc
+    unit = _check_top(data, lines, fail)
 
     def check_table(label: str, table: dict[str, Any], allowed: set[str],
                     required: tuple[str, ...], tline: int | None) -> None:

@@ -8,10 +8,12 @@ import sys
 from pathlib import Path
 
 from zrp.cli.app import emit
+from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
 from zrp.gap import diagnose as run_diagnosis
 from zrp.gap import load_measurements
 from zrp.gap.effects import EFFECTS
+from zrp.gap.options import MAX_WITHHELD
 from zrp.gap.report import OUTPUT_FILES, write_outputs
 from zrp.model.files import load_model
 from zrp.output import OutputDir
@@ -35,16 +37,19 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="frame of x, y, z (default instrument: the base frame is estimated)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
-    p.add_argument("--seed", type=int, default=0, help="seed of the fitting/withheld split")
-    p.add_argument("--withheld", type=float, default=0.25, metavar="FRACTION",
+    p.add_argument("--seed", type=SEED, default=0, help="seed of the fitting/withheld split")
+    p.add_argument("--withheld", type=real(0.0, MAX_WITHHELD, open_lo=True),
+                   default=0.25, metavar="FRACTION",
                    help="share of the poses withheld (default 0.25)")
-    p.add_argument("--folds", type=int, default=5, help="cross-validation folds (default 5)")
+    p.add_argument("--folds", type=whole(2, 100),
+                   default=5, help="cross-validation folds (default 5)")
     p.add_argument("--effects", nargs="+", choices=EFFECTS, default=list(EFFECTS),
                    metavar="EFFECT", help=f"candidate effects (default all: {', '.join(EFFECTS)})")
-    p.add_argument("--max-steps", type=int, default=4, help="most effects added (default 4)")
-    p.add_argument("--alpha", type=float, default=1e-3,
+    p.add_argument("--max-steps", type=whole(0, len(EFFECTS)),
+                   default=4, help="most effects added (default 4)")
+    p.add_argument("--alpha", type=real(0.0, 1.0, open_lo=True, open_hi=True), default=1e-3,
                    help="significance level for adding an effect (default 1e-3)")
-    p.add_argument("--noise", type=float, metavar="SIGMA",
+    p.add_argument("--noise", type=LENGTH, metavar="SIGMA",
                    help="known instrument noise per coordinate (length unit); default: "
                         "estimated from rigidly linked points or repeats")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
