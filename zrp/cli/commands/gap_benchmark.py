@@ -9,7 +9,7 @@ from zrp.cli.app import emit
 from zrp.cli.options import FRACTION, SEED, real, whole
 from zrp.errors import InputError
 from zrp.model.files import builtin_models, load_model
-from zrp.output import OutputDir
+from zrp.output import OutputDir, claim_generated
 
 DEFAULT_OUT = "renders/gap_benchmark"
 
@@ -77,7 +77,7 @@ def _run(args: argparse.Namespace) -> int:
     )
 
     out = Path(args.out or DEFAULT_OUT)
-    overwrite = args.force or args.out is None
+    overwrite = args.force or (args.out is None and claim_generated(out))
     work = Path(args.workdir) if args.workdir else out / "work"
     if work.resolve() == out.resolve():
         raise InputError("--workdir: must differ from --out (it is locked for the run)")

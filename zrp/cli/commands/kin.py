@@ -16,7 +16,7 @@ from zrp.kinematics.ik import CORRECTIONS, track_trajectory
 from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
 from zrp.model.files import builtin_models, load_model
 from zrp.model.manipulator import MAX_LENGTH, Manipulator
-from zrp.output import check_writable
+from zrp.output import check_writable, claim_generated
 from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM, is_paper_model
 from zrp.rotations.rodrigues import er_angle
 
@@ -123,7 +123,7 @@ def _ik(args: argparse.Namespace) -> int:
         q0 = _joint_values(model, args.q0, args.rad, "--q0")
     stem = Path(args.model).stem
     out = Path(args.out) if args.out else Path("renders") / f"{stem}_{args.trajectory}_joints.csv"
-    overwrite = args.force or args.out is None
+    overwrite = args.force or (args.out is None and claim_generated(out.parent))
     check_writable([out], overwrite)
     start = forward_kinematics(model, q0).position
     if args.trajectory == "circle":

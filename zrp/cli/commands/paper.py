@@ -15,7 +15,7 @@ from zrp.cli.app import emit
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
-from zrp.output import OutputDir
+from zrp.output import OutputDir, claim_generated
 from zrp.paper.example import PaperExample, run_paper_example
 from zrp.paper.report import output_names, write_paper_outputs
 from zrp.paper.scenario import is_paper_model
@@ -92,7 +92,7 @@ def _compute(args: argparse.Namespace, model: Manipulator, out: OutputDir
 
 def _paper(args: argparse.Namespace) -> int:
     out = Path(args.out)
-    overwrite = args.force or out == Path(DEFAULT_OUT)
+    overwrite = args.force or (out == Path(DEFAULT_OUT) and claim_generated(out))
     model = load_model(args.model)
     check_path_options(args, model)
     video_name = _video_name(args, model)

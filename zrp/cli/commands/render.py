@@ -9,7 +9,7 @@ from typing import Any
 
 from zrp.cli.app import emit
 from zrp.cli.options import MAX_FPS, MAX_HEIGHT, MAX_SECONDS, MAX_WIDTH, PERCENT, real, whole
-from zrp.output import OutputDir
+from zrp.output import OutputDir, claim_generated
 from zrp.paper.scenes import PAPER_LEVELS, Scene, paper_video_scene, teaching_sweep_scene
 
 DEFAULT_OUT = "renders"
@@ -82,7 +82,7 @@ def _run(args: argparse.Namespace) -> int:
         videos.append((teaching_sweep_scene(args.parameter, levels, steps=args.steps),
                        replace(opts, seconds=args.seconds or 3.0)))
     names = [sim.video_path(scene.file_name, o).name for scene, o in videos]
-    overwrite = args.force or args.out_dir is None
+    overwrite = args.force or (args.out_dir is None and claim_generated(DEFAULT_OUT))
     with OutputDir(Path(args.out_dir or DEFAULT_OUT), overwrite=overwrite, names=names) as out:
         seg = videos[0][0].segments[0]
         checks = [sim.consistency_check(m, seg.q) for m in (seg.nominal, seg.perturbed)]

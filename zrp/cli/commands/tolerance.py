@@ -14,7 +14,7 @@ from zrp.cli.options import LENGTH, SEED, TOLERANCE, real, whole
 from zrp.errors import InputError
 from zrp.manufacturing.allocation import allocate_tolerances
 from zrp.manufacturing.budget import tolerance_report
-from zrp.manufacturing.plots import histogram_png
+from zrp.manufacturing.plots import check_png_path, histogram_png
 from zrp.manufacturing.population import monte_carlo
 from zrp.manufacturing.study import JointPath
 from zrp.manufacturing.tolerance import DISTRIBUTIONS, Tolerances, percentile_ci
@@ -99,6 +99,7 @@ def _tolerance(args: argparse.Namespace) -> int:
     if not 0.0 < args.percentile < 100.0:
         raise InputError(f"--percentile: expected 0 < P < 100 (e.g. 99), got {args.percentile}")
     if args.hist:
+        check_png_path(args.hist, "--hist")
         check_writable([args.hist], args.force)
     path = path_from_args(args, model)
     rng = np.random.default_rng(args.seed)
