@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from zrp.arguments import check_instance, check_seed
+from zrp.arguments import check_instance, check_int, check_seed
 from zrp.errors import InputError
 from zrp.gap.checks import (
     check_gravity_torque,
@@ -40,6 +40,7 @@ from zrp.gap.profiles import with_gravity_side
 from zrp.gap.results import UNEXPLAINED_RATIO, Diagnosis, Where, parameter_estimates
 from zrp.gap.search import SearchSettings, greedy_search, withheld_residual
 from zrp.gap.split import split_poses
+from zrp.gap.subsample import MAX_POINTS, subsample_poses
 from zrp.gap.where import where_analysis
 from zrp.model.manipulator import Manipulator
 
@@ -61,7 +62,8 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
              noise_sigma: float | None = None,
              harmonics: tuple[int, ...] = (1, 2),
              gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0),
-             progress: bool = False) -> Diagnosis:
+             progress: bool = False,
+             max_points: int | None = MAX_POINTS) -> Diagnosis:
     """Diagnose the gap between ``model`` and ``measurements``.
 
     Args:
@@ -77,6 +79,9 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         seed: seed of the default ``rng``.
         withheld_fraction, folds, alpha, min_gain, max_steps, noise_sigma, harmonics,
             gravity_dir, progress: see :class:`~zrp.gap.options.DiagnosisOptions`.
+        max_points: most measured points used; beyond it a seeded random subsample of whole
+            poses (the rule in :mod:`zrp.gap.subsample`, announced in a warning and in the
+            diagnosis's ``warnings``); None uses every point.
 
     Returns:
         the :class:`Diagnosis`.
@@ -100,9 +105,15 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
     if measurements.n_joints != model.n:
         raise InputError(f"{measurements.source}: {measurements.n_joints} joint columns, but "
                          f"the model {model.name!r} has {model.n} joints")
+    if max_points is not None:
+        check_int(max_points, "max_points", 1)
     rng = np.random.default_rng(seed) if rng is None else rng
     with warnings.catch_warnings(record=True) as wlist:
         warnings.simplefilter("always")
+        n_poses = len(measurements.pose_ids)
+        measurements, kept = subsample_poses(measurements, max_points, seed)
+        if kept is not None and gravity_torque is not None:
+            gravity_torque = _kept_rows(gravity_torque, kept, n_poses)
         result = run_diagnosis(model, measurements, gravity_torque, opts, rng)
     # raised again, every one at the caller's line (whatever the stage that found it)
     caller = sys._getframe(1)
@@ -111,6 +122,15 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
                                caller.f_lineno)
     caught = tuple(dict.fromkeys(str(w.message) for w in wlist))
     return dataclasses.replace(result, warnings=caught)
+
+
+def _kept_rows(gravity_torque: ArrayLike, kept: NDArray[np.int64], n_poses: int
+               ) -> NDArray[np.float64]:
+    """The rows of the kept poses of a per-pose torque array (its shape is checked later)."""
+    tau = np.asarray(gravity_torque, dtype=float)
+    if tau.ndim != 2 or tau.shape[0] != n_poses:
+        return tau  # wrong shape: reported by the stage that checks it
+    return tau[kept]
 
 
 @dataclass(frozen=True)

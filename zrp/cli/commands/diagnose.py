@@ -15,6 +15,7 @@ from zrp.gap import load_measurements
 from zrp.gap.effects import EFFECTS
 from zrp.gap.options import MAX_WITHHELD
 from zrp.gap.report import OUTPUT_FILES, write_outputs
+from zrp.gap.subsample import MAX_POINTS
 from zrp.model.files import load_model
 from zrp.output import OutputDir
 
@@ -45,7 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    default=5, help="cross-validation folds (default 5)")
     p.add_argument("--effects", nargs="+", choices=EFFECTS, default=list(EFFECTS),
                    metavar="EFFECT", help=f"candidate effects (default all: {', '.join(EFFECTS)})")
-    p.add_argument("--max-steps", type=whole(0, len(EFFECTS)),
+    p.add_argument("--max-steps", type=whole(1, len(EFFECTS)),
                    default=4, help="most effects added (default 4)")
     p.add_argument("--alpha", type=real(0.0, 1.0, open_lo=True, open_hi=True), default=1e-3,
                    help="significance level for adding an effect (default 1e-3)")
@@ -55,6 +56,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,
                    help="show a progress bar (default: when stderr is a terminal)")
+    p.add_argument("--max-points", type=whole(0), default=MAX_POINTS, metavar="N",
+                   help=f"most measured points diagnosed (default {MAX_POINTS}); beyond it a "
+                        "seeded random subsample of whole poses, announced and recorded in "
+                        "diagnosis.json (rule: zrp/gap/subsample.py); 0 uses every point")
     p.add_argument("--json", action="store_true", help="print diagnosis.json to stdout")
     p.set_defaults(func=_run, api_names={
         "withheld_fraction": "--withheld",
@@ -65,6 +70,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "seed": "--seed",
         "effects": "--effects",
         "gravity_torque": "--mjcf",
+        "max_points": "--max-points",
     })
 
 
@@ -76,7 +82,9 @@ def _run(args: argparse.Namespace) -> int:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")
     # reading the inputs creates nothing: a bad input leaves no output folder behind
     model = load_model(args.model)
-    meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)
+    progress = sys.stderr.isatty() if args.progress is None else args.progress
+    meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame,
+                             progress=progress)
     tau = None if args.mjcf is None else gravity_torques(args.mjcf, meas.q_pose, field="--mjcf")
     out_dir = Path(args.out)
     created = not out_dir.exists()
@@ -87,8 +95,7 @@ def _run(args: argparse.Namespace) -> int:
             diag = run_diagnosis(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, withheld_fraction=args.withheld, folds=args.folds,
                             alpha=args.alpha, max_steps=args.max_steps, noise_sigma=args.noise,
-                            progress=sys.stderr.isatty() if args.progress is None
-                            else args.progress)
+                            progress=progress, max_points=args.max_points or None)
             files = write_outputs(diag, out, plots=not args.no_plots)
     except BaseException:
         if created:  # a failed run leaves no empty folder it made
