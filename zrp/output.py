@@ -86,6 +86,10 @@ def check_writable(paths: Iterable[str | os.PathLike[str]], overwrite: bool) -> 
 
 
 def _mkdir(folder: Path) -> None:
+    for parent in folder.parents:
+        if parent.exists() and not parent.is_dir():
+            raise InputError(f"{folder}: cannot create the folder: {parent} is a file, not a "
+                             "folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except FileExistsError as exc:
