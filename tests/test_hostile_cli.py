@@ -157,8 +157,13 @@ def test_a_users_renders_folder_is_kept(tmp_path, capsys, monkeypatch, out):
     assert mine.read_text() == "mine" and table.read_text() == "mine"
 
 
-def test_a_renders_folder_zrp_made_is_replaced(tmp_path, capsys, monkeypatch):
+@pytest.mark.parametrize("exists", [False, True])
+def test_a_renders_folder_zrp_made_is_replaced(tmp_path, capsys, monkeypatch, exists):
+    """Missing or empty (as in a fresh clone): zrp makes it its own and replaces its files."""
     monkeypatch.chdir(tmp_path)
+    if exists:
+        (tmp_path / "renders").mkdir()
+        (tmp_path / "renders" / ".gitkeep").write_text("")
     assert main(["ik", "--steps", "40"]) == 0
     assert (tmp_path / "renders" / GENERATED_MARK).is_file()
     assert main(["ik", "--steps", "40"]) == 0  # generated output: replaced

@@ -149,15 +149,22 @@ def write_json(path: str | os.PathLike[str], obj: Any, *, overwrite: bool = Fals
 def claim_generated(folder: str | os.PathLike[str]) -> bool:
     """May files in ``folder`` be replaced as generated output, without ``overwrite``?
 
-    True when the folder is missing (it is created now and marked with
-    :data:`GENERATED_MARK`) or carries the mark; False for a folder that exists without it,
-    such as a ``renders/`` the user made in the working directory: its files are then
-    replaced only with ``overwrite=True``. Commands call this for their default folders only.
+    True when the folder is missing or empty (it is created and marked now with
+    :data:`GENERATED_MARK`) or carries the mark; False for a folder that holds files but not
+    the mark, such as a ``renders/`` the user made in the working directory: its files are
+    then replaced only with ``overwrite=True``. Commands call this for their default folders
+    only.
     """
     root = _as_path(folder, "folder")
     if root.is_dir():
-        return (root / GENERATED_MARK).is_file()
-    if root.exists():
+        if (root / GENERATED_MARK).is_file():
+            return True
+        try:  # an empty folder (dot files aside) has nothing to lose: claimed
+            if any(not p.name.startswith(".") for p in root.iterdir()):
+                return False
+        except OSError:
+            return False
+    elif root.exists():
         return False  # a file: OutputDir/check_writable say why it cannot be written
     _mkdir(root)
     write_text(root / GENERATED_MARK, "Generated output of zrp: files here are replaced by "
