@@ -249,3 +249,20 @@ def test_only_project_errors_for_wrong_types(tmp_path):
                  lambda: zrp.jacobian(PUMA, "abc")):
         with pytest.raises(ZRPError):
             call()
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: zrp.track_trajectory(None, zrp.puma_circle().trajectory, np.zeros(6), steps=10),
+     "model: expected a zrp.Manipulator"),
+    (lambda: zrp.uniform_joint_values(PUMA, -1, np.random.default_rng(0)),
+     "count: expected a whole number >= 0"),
+    (lambda: zrp.uniform_joint_values(PUMA, 3, 0), "rng: expected a numpy.random.Generator"),
+    (lambda: synthesize(PUMA, None, Injection(), rng=np.random.default_rng(0)), "q: expected"),
+    (lambda: zrp.from_dh(None), "rows: expected a sequence of DH rows"),
+    (lambda: zrp.from_dh([["a", 0, 0, 0]]), "DH row 1"),
+    (lambda: zrp.gap.Measurements.from_arrays(["a"], [["x"] * 6], [[0, 0, 0]]),
+     "q and xyz: expected numbers"),
+])
+def test_public_api_wrong_types(call, match):
+    with pytest.raises(InputError, match=match):
+        call()

@@ -47,7 +47,10 @@ def _freeze(a: NDArray) -> NDArray:
 def _opt(a: ArrayLike | None, shape: tuple[int, ...], name: str) -> F64 | None:
     if a is None:
         return None
-    arr = np.array(a, dtype=float)
+    try:
+        arr = np.array(a, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: expected numbers ({exc})") from None
     if arr.shape != shape:
         raise InputError(f"{name}: expected shape {shape}, got {arr.shape}")
     bad = ~np.isfinite(arr)
@@ -90,7 +93,11 @@ class Measurements:
     source: str = "measurements"
 
     def __post_init__(self) -> None:
-        q = np.array(self.q, dtype=float)
+        try:
+            q = np.array(self.q, dtype=float)
+            np.array(self.xyz, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"{self.source}: q and xyz: expected numbers ({exc})") from None
         if q.ndim != 2 or q.shape[0] == 0:
             raise InputError(f"{self.source}: q: expected shape (R, n) with R >= 1 rows, got "
                              f"{q.shape}")
@@ -248,11 +255,8 @@ class Measurements:
                     source: str = "measurements") -> Measurements:
         """Build from arrays (q in rad, xyz in the model's length unit); see the class doc."""
         return cls(np.asarray(pose), None if point is None else np.asarray(point),
-                   np.asarray(q, dtype=float), np.asarray(xyz, dtype=float), frame,
-                   None if t is None else np.asarray(t, dtype=float),
-                   None if temp is None else np.asarray(temp, dtype=float),
-                   None if load is None else np.asarray(load, dtype=float), None,
-                   None if direction is None else np.asarray(direction, dtype=float),
+                   q, xyz, frame,  # type: ignore[arg-type]  (converted, checked on init)
+                   t, temp, load, None, direction,  # type: ignore[arg-type]
                    None, source)
 
     def to_csv(self, path: str | os.PathLike[str], *, deg: bool = False,

@@ -40,6 +40,8 @@ def check_q(model: Manipulator, q: ArrayLike, name: str = "q") -> F64:
     Revolute values are in rad, prismatic ones in the model's length unit; only real numbers
     (no complex, date, masked or boolean arrays) within the range of :mod:`._range_kernels`.
     """
+    if not isinstance(model, Manipulator):
+        raise InputError(f"model: expected a zrp.Manipulator, got {type(model).__name__}")
     kind = getattr(getattr(q, "dtype", None), "kind", "f")
     if kind not in "iuf" or isinstance(q, np.ma.MaskedArray):
         what = "a masked array" if isinstance(q, np.ma.MaskedArray) else f"dtype {q.dtype}"
