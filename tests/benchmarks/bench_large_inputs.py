@@ -66,9 +66,13 @@ def _parser_ratio() -> tuple[float, float]:
     ee = "[end_effector]" + text.split("[end_effector]")[1]
     times = []
     for n in (1000, 4000):
-        t0 = time.perf_counter()
-        loads_model(head + joint * n + ee)
-        times.append(time.perf_counter() - t0)
+        text_n = head + joint * n + ee
+        best = float("inf")
+        for _ in range(3):  # best of three: the machine is shared
+            t0 = time.perf_counter()
+            loads_model(text_n)
+            best = min(best, time.perf_counter() - t0)
+        times.append(best)
     return times[0], times[1]
 
 
