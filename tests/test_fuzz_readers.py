@@ -184,3 +184,17 @@ def test_the_unmutated_files_load(tmp_dir):
                              PUMA).t is not None
     assert mjcf.from_mjcf(_write(tmp_dir, "ok.xml", MJCF_TEXT.encode())).n == 3
     assert mjcf.from_mjcf(_write(tmp_dir, "ok.urdf", URDF_TEXT.encode()), body="l2").n == 2
+
+
+def test_non_utf8_names_found_by_the_fuzzer(tmp_dir):
+    """The long run's one finding: MuJoCo accepts a joint name that is not UTF-8, and its
+    name lookup then raised UnicodeDecodeError. The file is refused naming its line; a
+    compiled model with such a name names the joint."""
+    import mujoco
+
+    data = MJCF_TEXT.replace('name="j2"', 'name="\x80j2"').encode("latin-1")
+    path = _write(tmp_dir, "latin.xml", data)
+    with pytest.raises(mjcf.MJCFImportError, match="line 8: byte 0x80 is not UTF-8"):
+        mjcf.from_mjcf(path)
+    with pytest.raises(mjcf.MJCFImportError, match="joint #1: its name is not UTF-8"):
+        mjcf.manipulator_from_mujoco(mujoco.MjModel.from_xml_path(str(path)))
