@@ -18,6 +18,12 @@ One row per measured point, rows in measurement order. Columns (header names, an
 Lines starting with ``#`` are comments (skipped, with a warning after the header). Nothing is
 dropped silently: an unknown column, a missing value, a non-number or a NaN is an error naming
 the file, line and column. :meth:`~zrp.gap.data.Measurements.to_csv` writes this format.
+
+The file is read in one pass, record by record, into compact arrays (memory about 8 bytes a
+number plus the pose ids), as UTF-8 (with or without a byte-order mark) or UTF-16 with its
+byte-order mark; a byte that does not decode, or a field longer than
+``csv.field_size_limit()`` (131,072 characters), is an error naming its line. Only CR/LF end a
+record: a form feed or U+2028 inside a quoted field stays in the field.
 """
 
 from __future__ import annotations
