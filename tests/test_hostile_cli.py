@@ -186,3 +186,9 @@ def test_diagnose_large_file_subsampled_with_notice(tmp_path, capsys, data_csv):
     doc = json.loads((out / "diagnosis.json").read_text())
     assert any("exceed max_points=60" in w for w in doc["warnings"])
     capsys.readouterr()
+
+
+def test_diagnose_max_rows(tmp_path, capsys, data_csv):
+    _refused(capsys, ["diagnose", "--model", "puma", "--data", str(data_csv), "--max-rows",
+                      "10", "--out", str(tmp_path / "o")], "more than --max-rows=10")
+    assert not (tmp_path / "o").exists()

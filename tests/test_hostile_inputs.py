@@ -266,3 +266,10 @@ def test_only_project_errors_for_wrong_types(tmp_path):
 def test_public_api_wrong_types(call, match):
     with pytest.raises(InputError, match=match):
         call()
+
+
+def test_too_many_rows_refused_with_guidance(tmp_path, csv_rows):
+    path = _write_rows(tmp_path, csv_rows)
+    with pytest.raises(InputError, match=r"line 12: more than max_rows=10 data rows.*split the"):
+        load_measurements(path, PUMA, max_rows=10)
+    assert load_measurements(path, PUMA, max_rows=None).n_rows == len(csv_rows) - 1

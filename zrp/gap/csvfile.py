@@ -41,11 +41,16 @@ import numpy as np
 from numpy.typing import NDArray
 from tqdm import tqdm
 
+from zrp.arguments import check_int
 from zrp.errors import InputError
 from zrp.gap.data import FRAMES, OPTIONAL_SCALARS, QUAT_COLUMNS, DataWarning, Measurements
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["load_measurements"]
+__all__ = ["MAX_ROWS", "load_measurements"]
+
+#: Most data rows read by default: about 0.7 GB of memory per million rows at the peak of a
+#: whole diagnosis, so two million stay within 2 GB.
+MAX_ROWS = 2_000_000
 
 F64 = NDArray[np.float64]
 #: plausible temperatures, deg C.
@@ -245,7 +250,7 @@ def _undecodable_line(src: str) -> int | None:
     return None
 
 
-def _read(path: Path, src: str, model: Manipulator, progress: bool
+def _read(path: Path, src: str, model: Manipulator, progress: bool, max_rows: int | None
           ) -> tuple[list[str], _Header, _Columns]:
     """Stream the file once: the header, then each data row checked and appended."""
     required = ["pose", *[f"q{k}" for k in range(1, model.n + 1)], "x", "y", "z"]
@@ -271,6 +276,11 @@ def _read(path: Path, src: str, model: Manipulator, progress: bool
                 h = _check_header(header, src, model)
                 acc = _Accumulator(h)
                 continue
+            if max_rows is not None and len(acc.lines) >= max_rows:  # type: ignore[union-attr]
+                raise InputError(
+                    f"{src} line {lineno}: more than max_rows={max_rows} data rows (about 0.7 GB "
+                    "of memory per million rows); split the file or thin it (every k-th pose), "
+                    "or pass a larger max_rows (--max-rows on the command line)")
             _parse_row(acc, lineno, rec, h, header, src)  # type: ignore[arg-type]
             if len(acc.lines) % 10000 == 0:  # type: ignore[union-attr]
                 bar.update(10000)
@@ -323,7 +333,8 @@ def _check_scalars(scalars: dict[str, F64], lines: NDArray[np.int64], src: str) 
 
 
 def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: bool = False,
-                      frame: str = "instrument", progress: bool = False) -> Measurements:
+                      frame: str = "instrument", progress: bool = False,
+                      max_rows: int | None = MAX_ROWS) -> Measurements:
     """Read a measurement CSV (format in the module docstring) strictly.
 
     Args:
@@ -332,6 +343,8 @@ def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: 
         deg: revolute joint values (and nothing else) are in degrees.
         frame: "instrument" (positions in an unknown instrument frame) or "base".
         progress: show a progress bar (rows read) on stderr.
+        max_rows: most data rows read (:data:`MAX_ROWS`; None: no limit): a larger file is
+            refused at the first row beyond it, before memory runs out.
 
     The file is read in one pass, row by row (memory about 8 bytes per number plus the pose
     ids), UTF-8 or UTF-16 with a byte-order mark.
@@ -350,7 +363,8 @@ def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: 
     if not path.is_file():
         raise InputError(f"{src}: no such file")
     try:
-        _, _, c = _read(path, src, model, progress)
+        _, _, c = _read(path, src, model, progress,
+                        None if max_rows is None else check_int(max_rows, "max_rows", 1))
     except OSError as exc:
         raise InputError(f"{src}: cannot read ({exc.strerror or exc})") from exc
     _joint_units(c.q, model, deg, c.lines, src)

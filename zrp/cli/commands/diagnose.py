@@ -12,6 +12,7 @@ from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
 from zrp.gap import diagnose as run_diagnosis
 from zrp.gap import load_measurements
+from zrp.gap.csvfile import MAX_ROWS
 from zrp.gap.effects import EFFECTS
 from zrp.gap.options import MAX_WITHHELD
 from zrp.gap.report import OUTPUT_FILES, write_outputs
@@ -60,6 +61,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help=f"most measured points diagnosed (default {MAX_POINTS}); beyond it a "
                         "seeded random subsample of whole poses, announced and recorded in "
                         "diagnosis.json (rule: zrp/gap/subsample.py); 0 uses every point")
+    p.add_argument("--max-rows", type=whole(1), default=MAX_ROWS, metavar="N",
+                   help=f"most data rows read (default {MAX_ROWS:,}, about 1.4 GB at the peak);"
+                        " a larger file is refused with guidance")
     p.add_argument("--json", action="store_true", help="print diagnosis.json to stdout")
     p.set_defaults(func=_run, api_names={
         "withheld_fraction": "--withheld",
@@ -71,6 +75,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "effects": "--effects",
         "gravity_torque": "--mjcf",
         "max_points": "--max-points",
+        "max_rows": "--max-rows",
     })
 
 
@@ -84,7 +89,7 @@ def _run(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     progress = sys.stderr.isatty() if args.progress is None else args.progress
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame,
-                             progress=progress)
+                             progress=progress, max_rows=args.max_rows)
     tau = None if args.mjcf is None else gravity_torques(args.mjcf, meas.q_pose, field="--mjcf")
     out_dir = Path(args.out)
     created = not out_dir.exists()
