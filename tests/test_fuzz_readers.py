@@ -5,12 +5,14 @@ nothing else escapes (no TypeError, UnicodeDecodeError, csv.Error, OverflowError
 RuntimeError...).
 
 CI runs a seeded slice (``derandomize=True``: the same cases every run) of
-``ZRP_FUZZ_EXAMPLES`` cases per reader (default 60). The documented long run (README.md of
-``zrp/gap``... see the top README, "Bad input"):
+``ZRP_FUZZ_EXAMPLES`` cases per reader (default 60). The documented long run
 
     ZRP_FUZZ_EXAMPLES=2500 python3 -m pytest -q -p no:cacheprovider tests/test_fuzz_readers.py
 
-runs 2,500 cases for each of the four readers (10,000 in all).
+runs 2,500 cases for each of the four readers (10,000 in all). Its first run found one escape
+(a non-UTF-8 joint name in an MJCF file: UnicodeDecodeError from MuJoCo's name lookup; fixed,
+kept below as a test); the run on the final code: 10,000 cases, none escaped (335 s on the shared
+2-core machine).
 """
 
 from __future__ import annotations

@@ -9,7 +9,9 @@
 * The model-file parser on 1,000 and 4,000 joints: the ratio of the times is about 4 when
   the parser is linear (it was quadratic: 66 s for 4,000 joints).
 
-Run: python tests/benchmarks/bench_large_inputs.py [--quick]   (--quick: 1e5 rows at most)
+Run from the repository root: PYTHONPATH=. python3 tests/benchmarks/bench_large_inputs.py
+[--quick] (--quick: 1e5 rows at most; without PYTHONPATH=. a script in tests/benchmarks imports
+whichever zrp is installed, not the checkout's).
 """
 
 from __future__ import annotations
