@@ -5,6 +5,7 @@
 * :func:`manipulator_from_mujoco` / :func:`from_mjcf` read a serial arm from MJCF or URDF.
 """
 
+from mjcf import _env  # noqa: F401 (checks MUJOCO_GL before any module imports mujoco)
 from mjcf.builder import BuiltArm, MJCFOptions, build, build_spec
 from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
 from mjcf.gravity import gravity_torques

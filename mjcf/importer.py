@@ -47,14 +47,36 @@ def load_mujoco_model(source: str | os.PathLike[str] | mujoco.MjModel) -> mujoco
     if not path.is_file():
         raise MJCFImportError(f"source: no such file {str(path)!r} (expected an MJCF .xml or a "
                               f".urdf file)")
+    _check_utf8(path)
     try:
         return mujoco.MjModel.from_xml_path(str(path))
     except ValueError as exc:
         raise MJCFImportError(f"source {str(path)!r}: MuJoCo could not load it: {exc}") from exc
 
 
+def _check_utf8(path: Path) -> None:
+    """MJCF and URDF files are UTF-8 XML: name the first line that is not."""
+    try:
+        with path.open("rb") as fh:
+            for lineno, raw in enumerate(fh, start=1):
+                try:
+                    raw.decode("utf-8")
+                except UnicodeDecodeError as exc:
+                    raise MJCFImportError(
+                        f"source {str(path)!r}, line {lineno}: byte 0x{raw[exc.start]:02x} is "
+                        "not UTF-8 text; MJCF and URDF files must be UTF-8") from None
+    except OSError as exc:
+        raise MJCFImportError(f"source {str(path)!r}: cannot read ({exc.strerror or exc})"
+                              ) from exc
+
+
 def _name(m: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:
-    return mujoco.mj_id2name(m, obj, i) or f"#{i}"
+    try:
+        return mujoco.mj_id2name(m, obj, i) or f"#{i}"
+    except UnicodeDecodeError as exc:  # MuJoCo keeps names as bytes; ours are text
+        kind = str(obj).rsplit("_", 1)[-1].lower()
+        raise MJCFImportError(f"{kind} #{i}: its name is not UTF-8 text ({exc.reason} at byte "
+                              f"{exc.start}); the file must be UTF-8") from None
 
 
 def _branch_ends(m: mujoco.MjModel) -> list[int]:
@@ -190,7 +212,8 @@ def manipulator_from_mujoco(
     types = ["prismatic" if int(m.jnt_type[j]) == _SLIDE else "revolute"
              for j in joints]
     names = [_name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in joints]
-    model_name = name or bytes(m.names).split(b"\0", 1)[0].decode() or "imported arm"
+    model_name = name or bytes(m.names).split(b"\0", 1)[0].decode(errors="replace") \
+        or "imported arm"
     limits = [None if not m.jnt_limited[j] else
               tuple(m.jnt_range[j] / (scale if int(m.jnt_type[j]) == _SLIDE else 1.0))
               for j in joints]

@@ -24,6 +24,12 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from zrp.environment import check_mujoco_gl
+
+# MuJoCo fails at import on an unknown MUJOCO_GL: say so as a named error first (no mujoco
+# import here; zrp.environment is plain Python).
+check_mujoco_gl()
+
 _EXPORTS = {
     "dynamics": (
         "DynamicPlayback",

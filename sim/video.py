@@ -105,8 +105,12 @@ def _format(out_path: str | os.PathLike[str], fmt: str) -> tuple[Path, str]:
     path = Path(out_path)
     if fmt == "auto":
         fmt = "mp4" if _ffmpeg() else "gif"
-        if fmt == "gif" and path.suffix.lower() == ".mp4":
-            path = path.with_suffix(".gif")
+    suffix = path.suffix.lower()
+    if suffix in ("", ".mp4", ".gif") and suffix != f".{fmt}":
+        path = path.with_suffix(f".{fmt}")  # the name follows the format asked for
+    elif suffix != f".{fmt}":
+        raise InputError(f"out_path: {str(path)!r} ends in {path.suffix!r}; a {fmt} video is "
+                         f"written to a .{fmt} file")
     return path, fmt
 
 

@@ -34,10 +34,12 @@ from zrp.errors import InputError, OutputBusyError, OutputExistsError
 from zrp.jsonio import dumps
 
 __all__ = [
+    "GENERATED_MARK",
     "LOCK_NAME",
     "OutputDir",
     "atomic_path",
     "check_writable",
+    "claim_generated",
     "write_bytes",
     "write_json",
     "write_text",
@@ -45,6 +47,9 @@ __all__ = [
 
 #: Name of the lock file an :class:`OutputDir` holds while a run writes into it.
 LOCK_NAME = ".zrp-output.lock"
+#: Mark of a folder created for generated output (the commands' default folders, such as
+#: ``renders/``): see :func:`claim_generated`.
+GENERATED_MARK = ".zrp-generated"
 
 
 def _as_path(path: str | os.PathLike[str], field: str) -> Path:
@@ -81,6 +86,10 @@ def check_writable(paths: Iterable[str | os.PathLike[str]], overwrite: bool) -> 
 
 
 def _mkdir(folder: Path) -> None:
+    for parent in folder.parents:
+        if parent.exists() and not parent.is_dir():
+            raise InputError(f"{folder}: cannot create the folder: {parent} is a file, not a "
+                             "folder")
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except FileExistsError as exc:
@@ -135,6 +144,32 @@ def write_json(path: str | os.PathLike[str], obj: Any, *, overwrite: bool = Fals
                indent: int | None = 2) -> Path:
     """Write ``obj`` as strict JSON (:func:`zrp.jsonio.dumps`: no NaN) atomically."""
     return write_text(path, dumps(obj, indent), overwrite=overwrite)
+
+
+def claim_generated(folder: str | os.PathLike[str]) -> bool:
+    """May files in ``folder`` be replaced as generated output, without ``overwrite``?
+
+    True when the folder is missing or empty (it is created and marked now with
+    :data:`GENERATED_MARK`) or carries the mark; False for a folder that holds files but not
+    the mark, such as a ``renders/`` the user made in the working directory: its files are
+    then replaced only with ``overwrite=True``. Commands call this for their default folders
+    only.
+    """
+    root = _as_path(folder, "folder")
+    if root.is_dir():
+        if (root / GENERATED_MARK).is_file():
+            return True
+        try:  # an empty folder (dot files aside) has nothing to lose: claimed
+            if any(not p.name.startswith(".") for p in root.iterdir()):
+                return False
+        except OSError:
+            return False
+    elif root.exists():
+        return False  # a file: OutputDir/check_writable say why it cannot be written
+    _mkdir(root)
+    write_text(root / GENERATED_MARK, "Generated output of zrp: files here are replaced by "
+               "the next run of the command that wrote them.\n", overwrite=True)
+    return True
 
 
 def _pid_alive(pid: int) -> bool:

@@ -18,6 +18,7 @@ from zrp.gap.data import DataWarning, Measurements
 from zrp.gap.effects import Context
 from zrp.gap.leastsq import FitResult
 from zrp.gap.metrics import Metrics
+from zrp.gap.noise import noise_floor
 from zrp.gap.results import GapWarning
 from zrp.gap.split import MIN_POSES
 
@@ -122,6 +123,21 @@ def check_units(ctx: Context, poses: NDArray[np.int64]) -> None:
             "with deg=True)")
 
 
+def _noise_explains(ctx: Context, rms: float) -> str | None:
+    """A message when the measurement noise, estimated without any model (rigid links or
+    repeats), accounts for at least half of a registration error of ``rms`` (3-D RMS)."""
+    nf = noise_floor(ctx.meas)
+    if nf.sigma is None or math.sqrt(3.0) * nf.sigma < 0.5 * rms:
+        return None
+    unit = ctx.model.length_unit
+    return (f"{ctx.meas.source}: after registration the model misses the measurements by "
+            f"{rms:.4g} {unit} RMS, but the measurements themselves scatter that much: the "
+            f"noise estimated from the {nf.method.replace('_', ' ')} alone (no model needed) is "
+            f"{nf.sigma:.4g} {unit} per coordinate, {math.sqrt(3.0) * nf.sigma:.4g} {unit} per "
+            "point; the instrument (or points not rigidly fixed to the tool), not the model, is "
+            "at fault, and no diagnosis can see through it")
+
+
 def check_registration(ctx: Context, reg: FitResult) -> Metrics:
     """The registration is determined and leaves a plausible gap; returns its fitting-set
     errors (warns above 2 % of the reach, raises above 10 %)."""
@@ -134,6 +150,9 @@ def check_registration(ctx: Context, reg: FitResult) -> Metrics:
     metrics = Metrics.of(reg.residual)
     unit = model.length_unit
     if metrics.rms > 0.1 * model.characteristic_length:
+        noisy = _noise_explains(ctx, metrics.rms)
+        if noisy:
+            raise InputError(noisy)
         raise InputError(
             f"{meas.source}: after registration the model still misses the measurements by "
             f"{metrics.rms:.4g} {unit} RMS ({100 * metrics.rms / model.reach:.1f} % of the "

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError, ZRPWarning
+from zrp.model.manipulator import MAX_LENGTH
 from zrp.output import write_text
 
 __all__ = [
@@ -46,7 +47,10 @@ def _freeze(a: NDArray) -> NDArray:
 def _opt(a: ArrayLike | None, shape: tuple[int, ...], name: str) -> F64 | None:
     if a is None:
         return None
-    arr = np.array(a, dtype=float)
+    try:
+        arr = np.array(a, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: expected numbers ({exc})") from None
     if arr.shape != shape:
         raise InputError(f"{name}: expected shape {shape}, got {arr.shape}")
     bad = ~np.isfinite(arr)
@@ -89,7 +93,11 @@ class Measurements:
     source: str = "measurements"
 
     def __post_init__(self) -> None:
-        q = np.array(self.q, dtype=float)
+        try:
+            q = np.array(self.q, dtype=float)
+            np.array(self.xyz, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"{self.source}: q and xyz: expected numbers ({exc})") from None
         if q.ndim != 2 or q.shape[0] == 0:
             raise InputError(f"{self.source}: q: expected shape (R, n) with R >= 1 rows, got "
                              f"{q.shape}")
@@ -113,12 +121,12 @@ class Measurements:
             a = np.array(arr, dtype=float)
             if a.shape != shape:
                 raise InputError(f"{self.source}: {name}: expected shape {shape}, got {a.shape}")
-            bad = ~np.isfinite(a)
+            bad = ~(np.abs(a) <= MAX_LENGTH)  # NaN fails the comparison too
             if bad.any():
                 i, c = (int(v) for v in np.argwhere(bad)[0])
                 col = f"q{c + 1}" if name == "q" else "xyz"[c]
                 raise InputError(f"{self.source} line {lines[i]}: column {col} is {a[i, c]}; "
-                                 "expected a finite number")
+                                 f"expected a finite number of magnitude up to {MAX_LENGTH:g}")
             object.__setattr__(self, name, _freeze(a))
         for name in OPTIONAL_SCALARS:
             object.__setattr__(self, name, _opt(getattr(self, name), (r,), name))
@@ -247,11 +255,8 @@ class Measurements:
                     source: str = "measurements") -> Measurements:
         """Build from arrays (q in rad, xyz in the model's length unit); see the class doc."""
         return cls(np.asarray(pose), None if point is None else np.asarray(point),
-                   np.asarray(q, dtype=float), np.asarray(xyz, dtype=float), frame,
-                   None if t is None else np.asarray(t, dtype=float),
-                   None if temp is None else np.asarray(temp, dtype=float),
-                   None if load is None else np.asarray(load, dtype=float), None,
-                   None if direction is None else np.asarray(direction, dtype=float),
+                   q, xyz, frame,  # type: ignore[arg-type]  (converted, checked on init)
+                   t, temp, load, None, direction,  # type: ignore[arg-type]
                    None, source)
 
     def to_csv(self, path: str | os.PathLike[str], *, deg: bool = False,

@@ -2,16 +2,20 @@
 
 from __future__ import annotations
 
-import math
+import numbers
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
+from zrp.arguments import check_float, check_int
 from zrp.errors import InputError
 from zrp.gap.effects import EFFECTS
 
-__all__ = ["DiagnosisOptions"]
+__all__ = ["MAX_WITHHELD", "DiagnosisOptions"]
+
+#: Largest share of poses withheld: at least half of them remain for fitting and ranking.
+MAX_WITHHELD = 0.5
 
 
 @dataclass(frozen=True)
@@ -51,26 +55,22 @@ class DiagnosisOptions:
         bad = [e for e in self.effects if e not in EFFECTS]
         if bad:
             raise InputError(f"effects: unknown {', '.join(bad)}; valid: {', '.join(EFFECTS)}")
-        if not 0.0 < self.withheld_fraction < 1.0:
-            raise InputError(f"withheld_fraction: expected a value in (0, 1), got "
-                             f"{self.withheld_fraction}")
-        if int(self.folds) != self.folds or self.folds < 2:
-            raise InputError(f"folds: expected at least 2 cross-validation folds, got "
-                             f"{self.folds}")
-        if not 0.0 < self.alpha < 1.0:
-            raise InputError(f"alpha: expected a significance level in (0, 1), got "
-                             f"{self.alpha}")
-        if not 0.0 <= self.min_gain < 1.0:
-            raise InputError(f"min_gain: expected a fraction in [0, 1), got {self.min_gain}")
-        if int(self.max_steps) != self.max_steps or self.max_steps < 1:
-            raise InputError(f"max_steps: expected a whole number >= 1, got {self.max_steps}")
-        if self.noise_sigma is not None and not (self.noise_sigma > 0
-                                                 and math.isfinite(self.noise_sigma)):
-            raise InputError(f"noise_sigma: expected a positive number (length unit), got "
-                             f"{self.noise_sigma}")
-        if not self.harmonics or any(int(h) != h or h < 1 for h in self.harmonics):
-            raise InputError(f"harmonics: expected positive integers, got {self.harmonics}")
-        g = np.asarray(self.gravity_dir, dtype=float)
+        check_float(self.withheld_fraction, "withheld_fraction", 0.0, MAX_WITHHELD,
+                    open_lo=True)
+        check_int(self.folds, "folds", 2, 100)
+        check_float(self.alpha, "alpha", 0.0, 1.0, open_lo=True, open_hi=True)
+        check_float(self.min_gain, "min_gain", 0.0, 1.0, open_hi=True)
+        check_int(self.max_steps, "max_steps", 1, len(EFFECTS))
+        if self.noise_sigma is not None:
+            check_float(self.noise_sigma, "noise_sigma", 0.0, open_lo=True, unit="length unit")
+        if not self.harmonics or not all(isinstance(h, numbers.Integral) and 1 <= h <= 100
+                                         for h in self.harmonics):
+            raise InputError(f"harmonics: expected whole numbers 1..100, got {self.harmonics}")
+        try:
+            g = np.asarray(self.gravity_dir, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"gravity_dir: expected a unit 3-vector, got "
+                             f"{self.gravity_dir}") from exc
         if g.shape != (3,) or not np.isclose(np.linalg.norm(g), 1.0):
             raise InputError(f"gravity_dir: expected a unit 3-vector, got {self.gravity_dir}")
 

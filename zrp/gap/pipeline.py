@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arguments import check_instance, check_int, check_seed
 from zrp.errors import InputError
 from zrp.gap.assessment import Assessment, remainder_evidence
 from zrp.gap.baseline import geometric_baseline
@@ -55,6 +56,7 @@ from zrp.gap.results import (
 )
 from zrp.gap.search import SearchSettings, greedy_search, withheld_residual
 from zrp.gap.split import split_poses
+from zrp.gap.subsample import MAX_POINTS, subsample_poses
 from zrp.gap.uncertainty import correlations, plausibility, robust_covariance
 from zrp.gap.where import WhereAnalysis, where_analysis
 from zrp.model.manipulator import Manipulator
@@ -79,7 +81,8 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
              noise_sigma: float | None = None,
              harmonics: tuple[int, ...] = (1, 2),
              gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0),
-             progress: bool = False) -> Diagnosis:
+             progress: bool = False,
+             max_points: int | None = MAX_POINTS) -> Diagnosis:
     """Diagnose the gap between ``model`` and ``measurements``.
 
     Args:
@@ -95,6 +98,9 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         seed: seed of the default ``rng``.
         withheld_fraction, folds, alpha, min_gain, max_steps, noise_sigma, harmonics,
             gravity_dir, progress: see :class:`~zrp.gap.options.DiagnosisOptions`.
+        max_points: most measured points used; beyond it a seeded random subsample of whole
+            poses (the rule in :mod:`zrp.gap.subsample`, announced in a warning and in the
+            diagnosis's ``warnings``); None uses every point.
 
     Returns:
         the :class:`Diagnosis`.
@@ -103,15 +109,30 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         InputError: too few poses, units that do not fit the model, unidentifiable
             registration, unknown effect names, invalid options (naming the argument).
     """
+    check_instance(model, Manipulator, "model", "a zrp.Manipulator (zrp.load_model)")
+    check_instance(measurements, Measurements, "measurements",
+                   "zrp.gap.Measurements (zrp.load_measurements)")
+    check_seed(seed)
+    if rng is not None:
+        check_instance(rng, np.random.Generator, "rng", "a numpy.random.Generator")
+    if isinstance(effects, str):
+        raise InputError(f"effects: expected a sequence of effect names, got the string "
+                         f"{effects!r}")
     opts = DiagnosisOptions(tuple(effects), withheld_fraction, folds, alpha, min_gain,
                             max_steps, noise_sigma, tuple(harmonics), tuple(gravity_dir),
                             progress)
     if measurements.n_joints != model.n:
         raise InputError(f"{measurements.source}: {measurements.n_joints} joint columns, but "
                          f"the model {model.name!r} has {model.n} joints")
+    if max_points is not None:
+        check_int(max_points, "max_points", 1)
     rng = np.random.default_rng(seed) if rng is None else rng
     with warnings.catch_warnings(record=True) as wlist:
         warnings.simplefilter("always")
+        n_poses = len(measurements.pose_ids)
+        measurements, kept = subsample_poses(measurements, max_points, seed)
+        if kept is not None and gravity_torque is not None:
+            gravity_torque = _kept_rows(gravity_torque, kept, n_poses)
         result = run_diagnosis(model, measurements, gravity_torque, opts, rng)
     # raised again, every one at the caller's line (whatever the stage that found it)
     caller = sys._getframe(1)
@@ -120,6 +141,15 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
                                caller.f_lineno)
     caught = tuple(dict.fromkeys(str(w.message) for w in wlist))
     return dataclasses.replace(result, warnings=caught)
+
+
+def _kept_rows(gravity_torque: ArrayLike, kept: NDArray[np.int64], n_poses: int
+               ) -> NDArray[np.float64]:
+    """The rows of the kept poses of a per-pose torque array (its shape is checked later)."""
+    tau = np.asarray(gravity_torque, dtype=float)
+    if tau.ndim != 2 or tau.shape[0] != n_poses:
+        return tau  # wrong shape: reported by the stage that checks it
+    return tau[kept]
 
 
 @dataclass(frozen=True)

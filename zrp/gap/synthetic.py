@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
 from zrp.gap.data import Measurements
-from zrp.kinematics.forward import forward_kinematics
+from zrp.kinematics.forward import check_q, forward_kinematics
 from zrp.manufacturing.sensitivity import axis_tangents, tilt_axes
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import matrix_from_rotvec
@@ -165,10 +165,10 @@ def synthesize(model: Manipulator, q: ArrayLike, injection: Injection, *,
     Returns:
         Measurements with M rows per pose (points "s1".."sM").
     """
-    q = np.array(q, dtype=float)
-    P, n = q.shape
-    if n != model.n:
-        raise InputError(f"q: expected {model.n} columns, got {n}")
+    q = np.array(check_q(model, q), dtype=float)
+    if q.ndim != 2:
+        raise InputError(f"q: expected shape (P, {model.n}), got {q.shape}")
+    P = q.shape[0]
     if injection.thermal and temp is None:
         raise InputError("thermal injection needs temp (deg C per pose)")
     qa = _actual_joint_values(model, q, injection)

@@ -19,6 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
+from zrp.kinematics._range_kernels import all_in_range, joint_limits
 from zrp.model.manipulator import Manipulator, hand_frame
 from zrp.rotations.rodrigues import (
     er_from_axis_angle,
@@ -36,25 +37,35 @@ F64 = NDArray[np.float64]
 def check_q(model: Manipulator, q: ArrayLike, name: str = "q") -> F64:
     """Coerce joint values to a float array of shape (..., n), or raise naming the joint.
 
-    Revolute values are in rad, prismatic ones in the model's length unit.
+    Revolute values are in rad, prismatic ones in the model's length unit; only real numbers
+    (no complex, date, masked or boolean arrays) within the range of :mod:`._range_kernels`.
     """
+    if not isinstance(model, Manipulator):
+        raise InputError(f"model: expected a zrp.Manipulator, got {type(model).__name__}")
+    kind = getattr(getattr(q, "dtype", None), "kind", "f")
+    if kind not in "iuf" or isinstance(q, np.ma.MaskedArray):
+        what = "a masked array" if isinstance(q, np.ma.MaskedArray) else f"dtype {q.dtype}"
+        raise InputError(f"{name}: expected real numbers (rad or length unit), got {what}")
     try:
         arr = np.asarray(q, dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError) as exc:
         raise InputError(f"{name}: expected numbers, got {type(q).__name__}") from exc
     if arr.ndim == 0 or arr.shape[-1] != model.n:
         raise InputError(
             f"{name}: expected shape (..., {model.n}) for the {model.n} joints of "
             f"{model.name!r}, got shape {arr.shape}"
         )
-    if arr.dtype == np.float64 and arr.flags.c_contiguous and K.all_finite(arr):
+    lim = joint_limits(model)
+    if arr.dtype == np.float64 and arr.flags.c_contiguous and all_in_range(arr, lim):
         return arr
-    bad = ~np.isfinite(arr)
+    bad = ~(np.abs(arr) <= lim)
     if bad.any():
         idx = np.argwhere(bad)[0]
         where = f" at index {tuple(int(i) for i in idx[:-1])}" if arr.ndim > 1 else ""
+        unit = model.length_unit if model.prismatic[idx[-1]] else "rad"
         raise InputError(f"{name}: joint {idx[-1] + 1} ({model.joint_names[idx[-1]]}) is "
-                         f"{arr[tuple(idx)]}{where}; expected finite values")
+                         f"{arr[tuple(idx)]}{where}; expected finite values within "
+                         f"+-{lim[idx[-1]]:g} {unit}")
     return arr
 
 

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arguments import check_instance, check_int
 from zrp.errors import InputError
 from zrp.kinematics.forward import end_effector_pose
 from zrp.model.manipulator import Manipulator
@@ -23,6 +24,9 @@ def uniform_joint_values(model: Manipulator, count: int, rng: np.random.Generato
                  limits_rad: ArrayLike | None = None) -> F64:
     """Uniform random joint values within ``limits_rad`` (shape (n, 2); default +-2.5 rad),
     shape (count, n)."""
+    check_instance(model, Manipulator, "model", "a zrp.Manipulator")
+    check_int(count, "count", 0)
+    check_instance(rng, np.random.Generator, "rng", "a numpy.random.Generator")
     lim = (np.tile([-2.5, 2.5], (model.n, 1)) if limits_rad is None
            else np.asarray(limits_rad, dtype=float))
     if lim.shape != (model.n, 2):

@@ -6,10 +6,21 @@ from pathlib import Path
 
 import numpy as np
 
+from zrp.errors import InputError
 from zrp.manufacturing.population import MonteCarloResult
 from zrp.output import atomic_path
 
-__all__ = ["histogram_png"]
+__all__ = ["check_png_path", "histogram_png"]
+
+
+def check_png_path(path: str | Path, name: str = "path") -> Path:
+    """``path`` as a Path when it names a ``.png`` file; else an error naming ``name`` (the
+    file written is exactly the one named, never a different one with a suffix added)."""
+    p = Path(path)
+    if p.suffix.lower() != ".png":
+        raise InputError(f"{name}: {str(path)!r} is not a .png file name; the histogram is a "
+                         f"PNG image (e.g. {p.stem or 'hist'}.png)")
+    return p
 
 
 def histogram_png(mc: MonteCarloResult, path: str | Path, *, overwrite: bool = False,
@@ -19,7 +30,9 @@ def histogram_png(mc: MonteCarloResult, path: str | Path, *, overwrite: bool = F
 
     Raises:
         OutputExistsError: ``path`` exists and ``overwrite`` is False (checked before drawing).
+        InputError: ``path`` does not end in ``.png``.
     """
+    check_png_path(path)
     import matplotlib  # a plotting dependency: loaded on first use only
 
     matplotlib.use("Agg")
@@ -40,7 +53,7 @@ def histogram_png(mc: MonteCarloResult, path: str | Path, *, overwrite: bool = F
             fig.suptitle(title or f"Monte Carlo, {mc.n_robots} robots x {mc.n_points} points, "
                          f"{mc.distribution}")
             fig.tight_layout()
-            fig.savefig(tmp, dpi=110)
+            fig.savefig(tmp, dpi=110, format="png")
         finally:
             plt.close(fig)
     return Path(path)

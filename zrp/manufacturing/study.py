@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import csv
 import io
+import math
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -96,16 +97,30 @@ class JointPath:
                    float(ik.orientation_error.max()))
 
 
+def _check_radians(q: NDArray[np.float64], model: Manipulator, p: Path) -> None:
+    """Refuse revolute values beyond 2 pi: the file is most likely in degrees."""
+    rev = ~np.asarray(model.prismatic)
+    big = np.abs(q[:, rev]) > 2.0 * math.pi + 1e-6
+    if big.any():
+        i, k = (int(v) for v in np.argwhere(big)[0])
+        kk = int(np.flatnonzero(rev)[k])
+        raise InputError(f"{p}, line {i + 2}: q{kk + 1} is {q[i, kk]:g}, more than 2 pi rad: the "
+                         "joint values look like degrees; a joint trajectory is in rad (as "
+                         "`zrp ik` writes it): convert it with numpy.radians")
+
+
 def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
     """Read a joint trajectory CSV: a header row, time (s) in the first column and the n joint
     values in the next n columns (the layout ``zrp ik`` writes; rad / length unit). The IK
     errors are taken from ``position_error`` / ``orientation_error_rad`` columns if present."""
     p = Path(path)
     try:
-        with p.open(newline="") as fh:
+        with p.open(newline="", encoding="utf-8-sig") as fh:
             rows = list(csv.reader(fh))
     except OSError as exc:
         raise ModelFileError(f"{p}: cannot read joint trajectory: {exc}") from exc
+    except (UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{p}: not a CSV text file in UTF-8 ({exc})") from None
     if len(rows) < 3:
         raise InputError(f"{p}: expected a header and at least 2 rows of t, q1..q{model.n}")
     data = []
@@ -117,6 +132,9 @@ def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
             data.append([float(x) for x in row[:model.n + 1]])
         except ValueError as exc:
             raise InputError(f"{p}, line {i}: not a number: {exc}") from exc
+        if not all(math.isfinite(v) for v in data[-1]):
+            raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:model.n + 1]}")
+    _check_radians(np.array(data)[:, 1:], model, p)
     arr = np.array(data)
     header = [h.strip() for h in rows[0]]
     errs: list[float | None] = []

@@ -25,7 +25,7 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.errors import InputError
 from zrp.manufacturing._checks import DISTRIBUTIONS, check_distribution, nonnegative
 from zrp.manufacturing.sensitivity import parameter_space
-from zrp.model.manipulator import Manipulator
+from zrp.model.manipulator import MAX_LENGTH, Manipulator
 
 __all__ = ["DISTRIBUTIONS", "Tolerances", "draw_parameters", "percentile_ci"]
 
@@ -53,11 +53,13 @@ class Tolerances:
         if vals.shape != (len(self.names),) or len(self.units) != len(self.names):
             raise InputError(f"Tolerances.values: expected shape ({len(self.names)},) matching "
                              f"the names and units, got {vals.shape}")
-        bad = ~np.isfinite(vals) | (vals < 0)
+        # an angle beyond pi or a length beyond the model's bound only overflows the sums
+        limit = np.where(np.array(self.units) == "rad", np.pi, MAX_LENGTH)
+        bad = ~(vals >= 0) | ~(vals <= limit)
         if bad.any():
             i = int(np.argmax(bad))
-            raise InputError(f"tolerance of {self.names[i]}: expected a finite value >= 0 "
-                             f"({self.units[i]}), got {vals[i]!r}")
+            raise InputError(f"tolerance of {self.names[i]}: expected a finite value from 0 to "
+                             f"{limit[i]:g} ({self.units[i]}), got {vals[i]!r}")
         vals.setflags(write=False)
         object.__setattr__(self, "values", vals)
 

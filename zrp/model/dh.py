@@ -57,13 +57,17 @@ class DHRow:
             raise InputError(f"DH row type: {self.type!r}; expected 'revolute' or 'prismatic'")
         for name in ("a", "alpha", "d", "theta", "offset"):
             v = getattr(self, name)
-            if not np.isfinite(float(v)):
+            if not isinstance(v, (int, float, np.integer, np.floating)) or isinstance(v, bool) \
+                    or not np.isfinite(float(v)):
                 raise InputError(f"DH row {name}: expected a finite number, got {v!r}")
         if self.limits is not None:
             object.__setattr__(self, "limits", check_limits(self.limits, "DH row limits"))
 
 
 def _rows(rows: Sequence[DHRow | Sequence[float]]) -> list[DHRow]:
+    if isinstance(rows, (str, bytes)) or not hasattr(rows, "__iter__"):
+        raise InputError(f"rows: expected a sequence of DH rows (a, alpha, d, theta), got "
+                         f"{type(rows).__name__}")
     out = []
     known = [f.name for f in fields(DHRow)]
     for i, r in enumerate(rows, start=1):
@@ -82,7 +86,9 @@ def _rows(rows: Sequence[DHRow | Sequence[float]]) -> list[DHRow]:
                 if len(r) > 6:  # flip, limits, name: by name only
                     raise TypeError("too many positional fields")
                 out.append(DHRow(*r))  # type: ignore[arg-type]
-            except TypeError as exc:
+            except (TypeError, ValueError) as exc:
+                if isinstance(exc, InputError):
+                    raise InputError(f"DH row {i}: {exc}") from exc
                 raise InputError(f"DH row {i}: expected (a, alpha, d, theta[, type, offset]) "
                                  f"(other fields by name), got {r!r}") from exc
     if not out:

@@ -16,8 +16,10 @@ transverse = [0, -1, 0]   # u_{t,0}
 
 from __future__ import annotations
 
+import os
 import re
 import sys
+from collections.abc import Callable
 from importlib import resources
 from pathlib import Path
 from typing import Any
@@ -41,29 +43,46 @@ _JOINT_KEYS = {"type", "axis", "body", "name", "limits", "velocity_limit"}
 _EE_KEYS = {"body", "axial", "transverse"}
 
 
-def _line_of(text: str, pattern: str, occurrence: int = 0) -> int | None:
-    """1-based line number of the ``occurrence``-th line matching ``pattern`` (a regex)."""
-    rx = re.compile(pattern)
-    hits = [i for i, line in enumerate(text.splitlines(), start=1) if rx.match(line.strip())]
-    return hits[occurrence] if occurrence < len(hits) else None
+class _Lines:
+    """The lines of a model file, indexed once, so that finding the line of each joint's table
+    and key costs time linear in the file (the parser stays linear in the joint count)."""
 
+    def __init__(self, text: str) -> None:
+        self.lines = [line.strip() for line in text.split("\n")]
+        self._tables: dict[str, list[int]] = {}
 
-def _key_line(text: str, table_line: int | None, key: str) -> int | None:
-    """Line of ``key = ...`` inside the table that starts at ``table_line``."""
-    if table_line is None:
-        return None
-    lines = text.splitlines()
-    for i in range(table_line, len(lines)):
-        s = lines[i].strip()
-        if s.startswith("[") and i + 1 != table_line:
+    def first(self, pattern: str) -> int | None:
+        """1-based line number of the first line matching ``pattern`` (a regex)."""
+        rx = re.compile(pattern)
+        return next((i for i, line in enumerate(self.lines, start=1) if rx.match(line)), None)
+
+    def table(self, pattern: str, occurrence: int) -> int | None:
+        """1-based line of the ``occurrence``-th table header matching ``pattern``."""
+        if pattern not in self._tables:
+            rx = re.compile(pattern)
+            self._tables[pattern] = [i for i, line in enumerate(self.lines, start=1)
+                                     if line.startswith("[") and rx.match(line)]
+        hits = self._tables[pattern]
+        return hits[occurrence] if 0 <= occurrence < len(hits) else None
+
+    def key(self, table_line: int | None, key: str) -> int | None:
+        """Line of ``key = ...`` inside the table that starts at ``table_line``."""
+        if table_line is None:
             return None
-        if re.match(rf"{re.escape(key)}\s*=", s):
-            return i + 1
-    return None
+        rx = re.compile(rf"{re.escape(key)}\s*=")
+        for i in range(table_line, len(self.lines)):
+            s = self.lines[i]
+            if s.startswith("[") and i + 1 != table_line:
+                return None
+            if rx.match(s):
+                return i + 1
+        return None
 
 
 def loads_model(text: str, source: str = "<string>") -> Manipulator:
     """Parse a model from TOML text. Errors name ``source`` and the line at fault."""
+    if not isinstance(text, str):
+        raise ModelFileError(f"text: expected the TOML text as a str, got {type(text).__name__}")
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -73,8 +92,12 @@ def loads_model(text: str, source: str = "<string>") -> Manipulator:
 
 def load_model(path: str | Path) -> Manipulator:
     """Read a model file. ``path`` may also name a built-in model (see :func:`builtin_models`)."""
+    if isinstance(path, (bytes, bytearray)) or not isinstance(path, (str, os.PathLike)) \
+            or not str(path).strip():
+        raise ModelFileError(f"path: expected a model file name or a built-in model "
+                             f"{sorted(builtin_models())}, got {path!r}")
     p = Path(path)
-    if not p.exists():
+    if not p.is_file():
         builtins = builtin_models()
         if str(path) in builtins:
             p = builtins[str(path)]
@@ -89,7 +112,35 @@ def load_model(path: str | Path) -> Manipulator:
     return loads_model(text, str(p))
 
 
+def _check_top(data: dict[str, Any], lines: _Lines,
+               fail: Callable[[str, int | None], ModelFileError]) -> str:
+    """The top-level tables and values: [[joint]] tables, [end_effector], name, length_unit.
+    Returns the length unit."""
+    joints_raw = data.get("joint")
+    if not isinstance(joints_raw, list) or not joints_raw \
+            or not all(isinstance(j, dict) for j in joints_raw):
+        raise fail("joint: no [[joint]] tables (keys type, axis, body, name); a model needs "
+                   "at least one joint", lines.first(r"joint\s*="))
+    if "end_effector" not in data or not isinstance(data["end_effector"], dict):
+        raise fail("missing [end_effector] table (keys body, axial, transverse)", None)
+    if not isinstance(data.get("name", ""), str):
+        raise fail(f"name: expected a string, got {data['name']!r}", lines.first(r"name\s*="))
+    unit = data.get("length_unit", "mm")
+    if not isinstance(unit, str) or not unit:
+        raise fail(f"length_unit: expected a string such as \"mm\", got {unit!r}",
+                   lines.first(r"length_unit\s*="))
+    try:
+        canonical_length_unit(unit)
+    except InputError as exc:
+        raise fail(str(exc), lines.first(r"length_unit\s*=")) from exc
+    return unit
+
+
 def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
+    lines = _Lines(text)
+    _line_of = lines.first
+    _key_line = lines.key
+
     def fail(msg: str, line: int | None) -> ModelFileError:
         where = f"{source}, line {line}" if line else source
         return ModelFileError(f"{where}: {msg}")
@@ -98,20 +149,9 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
     if unknown:
         key = sorted(unknown)[0]
         raise fail(f"unknown key {key!r}; expected one of {sorted(_TOP_KEYS)}",
-                   _line_of(text, rf"{re.escape(key)}\s*="))
+                   _line_of(rf"{re.escape(key)}\s*="))
     joints_raw = data.get("joint")
-    if not isinstance(joints_raw, list) or not joints_raw:
-        raise fail("no [[joint]] tables; a model needs at least one joint", None)
-    if "end_effector" not in data or not isinstance(data["end_effector"], dict):
-        raise fail("missing [end_effector] table (keys body, axial, transverse)", None)
-    unit = data.get("length_unit", "mm")
-    if not isinstance(unit, str) or not unit:
-        raise fail(f"length_unit: expected a string such as \"mm\", got {unit!r}",
-                   _line_of(text, r"length_unit\s*="))
-    try:
-        canonical_length_unit(unit)
-    except InputError as exc:
-        raise fail(str(exc), _line_of(text, r"length_unit\s*=")) from exc
+    unit = _check_top(data, lines, fail)
 
     def check_table(label: str, table: dict[str, Any], allowed: set[str],
                     required: tuple[str, ...], tline: int | None) -> None:
@@ -119,7 +159,7 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
         if bad:
             key = sorted(bad)[0]
             raise fail(f"{label}: unknown key {key!r}; expected one of {sorted(allowed)}",
-                       _key_line(text, tline, key) or tline)
+                       _key_line(tline, key) or tline)
         for key in required:
             if key not in table:
                 raise fail(f"{label}: missing {key!r}", tline)
@@ -128,13 +168,16 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
         """The line of the field a validation message names (its text before the colon)."""
         head = str(exc).split(":")[0]
         field = next((f for f in fields if f in head), None)
-        return (_key_line(text, tline, field) if field else None) or tline
+        return (_key_line(tline, field) if field else None) or tline
 
     joint_fields = ("type", "axis", "body", "velocity_limit", "limits")
     joints = []
     for k, jd in enumerate(joints_raw, start=1):
-        tline = _line_of(text, r"\[\[\s*joint\s*\]\]", k - 1)
+        tline = lines.table(r"\[\[\s*joint\s*\]\]", k - 1)
         check_table(f"joint {k}", jd, _JOINT_KEYS, joint_fields[:3], tline)
+        if not isinstance(jd.get("name", ""), str):
+            raise fail(f"joint {k} name: expected a string, got {jd['name']!r}",
+                       _key_line(tline, "name") or tline)
         try:
             joints.append(Joint(type=jd["type"], axis=jd["axis"], body=jd["body"],
                                 name=str(jd.get("name", "")), index=k,
@@ -143,7 +186,7 @@ def _from_dict(data: dict[str, Any], text: str, source: str) -> Manipulator:
             raise fail(str(exc), line_of_error(exc, joint_fields, tline)) from exc
 
     ed = data["end_effector"]
-    eline = _line_of(text, r"\[\s*end_effector\s*\]")
+    eline = _line_of(r"\[\s*end_effector\s*\]")
     ee_fields = ("axial", "transverse", "body")
     check_table("end_effector", ed, _EE_KEYS, ee_fields, eline)
     try:
@@ -178,7 +221,16 @@ def dumps_model(model: Manipulator) -> str:
 
 
 def _toml_str(s: str) -> str:
-    return '"' + s.replace("\\", "\\\\").replace('"', '\\"') + '"'
+    """A TOML basic string: backslash, quote and every control character escaped."""
+    out = []
+    for ch in s:
+        if ch in '"\\':
+            out.append("\\" + ch)
+        elif ord(ch) < 0x20 or ord(ch) == 0x7F:
+            out.append(f"\\u{ord(ch):04X}")
+        else:
+            out.append(ch)
+    return '"' + "".join(out) + '"'
 
 
 def save_model(model: Manipulator, path: str | Path, *, overwrite: bool = False) -> Path:

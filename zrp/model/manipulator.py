@@ -48,19 +48,44 @@ UNIT_EXACT_TOL = 1e-12
 UNIT_WARN_TOL = 1e-3
 #: Largest |u_a . u_t| accepted as perpendicular.
 PERP_TOL = 1e-9
+#: Largest magnitude of a model vector component, in the model's length unit (1e9 mm is
+#: 1000 km): beyond it sums and products of lengths lose all precision or overflow.
+MAX_LENGTH = 1e9
 
 
 def check_vector3(value: ArrayLike, where: str) -> NDArray[np.float64]:
-    """Coerce ``value`` to a finite float vector of shape (3,), or raise naming ``where``."""
+    """Coerce ``value`` to a finite float vector of shape (3,), or raise naming ``where``.
+
+    Only real numbers are accepted (not strings, booleans or complex numbers), each of
+    magnitude at most :data:`MAX_LENGTH`.
+    """
+    raw = np.asarray(value, dtype=object) if not isinstance(value, np.ndarray) else value
+    if raw.dtype.kind not in "iuf" and not (
+            raw.dtype == object and all(_is_real(v) for v in np.ravel(raw))):
+        raise ModelError(f"{where}: expected 3 numbers, got {_short(value)}")
     try:
         arr = np.array(value, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ModelError(f"{where}: expected 3 numbers, got {value!r}") from exc
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ModelError(f"{where}: expected 3 numbers, got {_short(value)}") from exc
     if arr.shape != (3,):
         raise ModelError(f"{where}: expected 3 numbers (shape (3,)), got shape {arr.shape}")
     if not np.all(np.isfinite(arr)):
         raise ModelError(f"{where}: expected finite numbers, got {arr.tolist()}")
+    if np.max(np.abs(arr)) > MAX_LENGTH:
+        raise ModelError(f"{where}: component {np.max(np.abs(arr)):g} is out of range; expected "
+                         f"magnitudes up to {MAX_LENGTH:g} (in the model's length unit)")
     return arr
+
+
+def _is_real(v: object) -> bool:
+    """A real number: int or float (NumPy's included), not a bool, string or complex."""
+    return isinstance(v, (int, float, np.integer, np.floating)) and not isinstance(
+        v, (bool, np.bool_))
+
+
+def _short(value: object) -> str:
+    text = repr(value)
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def check_unit_vector(value: ArrayLike, where: str) -> NDArray[np.float64]:
@@ -262,9 +287,12 @@ class Manipulator:
         if len(types) != n:
             raise ModelError(f"types: expected {n} joint types, got {len(types)}")
         names = list(joint_names) if joint_names is not None else [""] * n
+        if len(names) != n or not all(isinstance(s, str) for s in names):
+            raise ModelError(f"joint_names: expected {n} strings (one per joint), got "
+                             f"{_short(joint_names)}")
         lims = list(limits) if limits is not None else [None] * n
         vels = list(velocity_limits) if velocity_limits is not None else [None] * n
-        for label, seq in (("joint_names", names), ("limits", lims), ("velocity_limits", vels)):
+        for label, seq in (("limits", lims), ("velocity_limits", vels)):
             if len(seq) != n:
                 raise ModelError(f"{label}: expected {n} entries (one per joint), got {len(seq)}")
         joints = tuple(

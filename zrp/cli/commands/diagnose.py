@@ -11,11 +11,15 @@ from pathlib import Path
 from typing import TextIO
 
 from zrp.cli.app import emit
+from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
 from zrp.gap import diagnose as run_diagnosis
 from zrp.gap import load_measurements
+from zrp.gap.csvfile import MAX_ROWS
 from zrp.gap.effects import EFFECTS
+from zrp.gap.options import MAX_WITHHELD
 from zrp.gap.report import OUTPUT_FILES, write_outputs
+from zrp.gap.subsample import MAX_POINTS
 from zrp.model.files import load_model
 from zrp.output import OutputDir
 
@@ -38,22 +42,32 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="frame of x, y, z (default instrument: the base frame is estimated)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
     p.add_argument("--force", action="store_true", help="overwrite existing output files")
-    p.add_argument("--seed", type=int, default=0, help="seed of the fitting/withheld split")
-    p.add_argument("--withheld", type=float, default=0.25, metavar="FRACTION",
+    p.add_argument("--seed", type=SEED, default=0, help="seed of the fitting/withheld split")
+    p.add_argument("--withheld", type=real(0.0, MAX_WITHHELD, open_lo=True),
+                   default=0.25, metavar="FRACTION",
                    help="share of the poses withheld (default 0.25)")
-    p.add_argument("--folds", type=int, default=5, help="cross-validation folds (default 5)")
+    p.add_argument("--folds", type=whole(2, 100),
+                   default=5, help="cross-validation folds (default 5)")
     p.add_argument("--effects", nargs="+", choices=EFFECTS, default=list(EFFECTS),
                    metavar="EFFECT", help=f"candidate effects (default all: {', '.join(EFFECTS)})")
-    p.add_argument("--max-steps", type=int, default=4, help="most effects added (default 4)")
-    p.add_argument("--alpha", type=float, default=1e-3,
+    p.add_argument("--max-steps", type=whole(1, len(EFFECTS)),
+                   default=4, help="most effects added (default 4)")
+    p.add_argument("--alpha", type=real(0.0, 1.0, open_lo=True, open_hi=True), default=1e-3,
                    help="significance level for adding an effect (default 1e-3)")
-    p.add_argument("--noise", type=float, metavar="SIGMA",
+    p.add_argument("--noise", type=LENGTH, metavar="SIGMA",
                    help="known instrument noise per coordinate (length unit); default: "
                         "estimated from rigidly linked points or repeats")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
                    help="show progress on stderr: a bar on a terminal, a line every 10 s "
                         "when piped (default on; --no-progress: silent)")
+    p.add_argument("--max-points", type=whole(0), default=MAX_POINTS, metavar="N",
+                   help=f"most measured points diagnosed (default {MAX_POINTS}); beyond it a "
+                        "seeded random subsample of whole poses, announced and recorded in "
+                        "diagnosis.json (rule: zrp/gap/subsample.py); 0 uses every point")
+    p.add_argument("--max-rows", type=whole(1), default=MAX_ROWS, metavar="N",
+                   help=f"most data rows read (default {MAX_ROWS:,}, about 1.4 GB at the peak);"
+                        " a larger file is refused with guidance")
     p.add_argument("--json", action="store_true", help="print diagnosis.json to stdout")
     p.set_defaults(func=_run, api_names={
         "withheld_fraction": "--withheld",
@@ -64,6 +78,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "seed": "--seed",
         "effects": "--effects",
         "gravity_torque": "--mjcf",
+        "max_points": "--max-points",
+        "max_rows": "--max-rows",
     })
 
 
@@ -94,7 +110,9 @@ def _run(args: argparse.Namespace) -> int:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")
     # reading the inputs creates nothing: a bad input leaves no output folder behind
     model = load_model(args.model)
-    meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)
+    progress = args.progress
+    meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame,
+                             progress=progress, max_rows=args.max_rows)
     tau = None if args.mjcf is None else gravity_torques(args.mjcf, meas.q_pose, field="--mjcf")
     out_dir = Path(args.out)
     created = not out_dir.exists()
@@ -106,7 +124,7 @@ def _run(args: argparse.Namespace) -> int:
             diag = run_diagnosis(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, withheld_fraction=args.withheld, folds=args.folds,
                             alpha=args.alpha, max_steps=args.max_steps, noise_sigma=args.noise,
-                            progress=args.progress)
+                            progress=args.progress, max_points=args.max_points or None)
             files = write_outputs(diag, out, plots=not args.no_plots)
     except BaseException:
         if created:  # a failed run leaves no empty folder it made

@@ -6,9 +6,10 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
+from zrp.cli.options import FRACTION, SEED, real, whole
 from zrp.errors import InputError
 from zrp.model.files import builtin_models, load_model
-from zrp.output import OutputDir
+from zrp.output import OutputDir, claim_generated
 
 DEFAULT_OUT = "renders/gap_benchmark"
 
@@ -23,20 +24,22 @@ def register(sub: argparse._SubParsersAction) -> None:
         "measurement CSV alone, then score it against the truth: effect named first, joints "
         "located, withheld RMS after correction vs the noise, shrink. Prints and writes a "
         "confusion matrix and a summary table (sim/README.md).")
-    p.add_argument("--scenarios", type=int, default=50, metavar="K",
+    p.add_argument("--scenarios", type=whole(1, 100_000), default=50, metavar="K",
                    help="number of scenarios (default 50)")
-    p.add_argument("--seed", type=int, default=0, metavar="S", help="master seed (default 0)")
+    p.add_argument("--seed", type=SEED, default=0, metavar="S", help="master seed (default 0)")
     p.add_argument("--model", default="puma", metavar="M.toml",
                    help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
                         "; default puma)")
-    p.add_argument("--poses", type=int, default=200, help="poses per scenario (default 200)")
-    p.add_argument("--none", type=float, default=0.1, metavar="FRACTION",
+    p.add_argument("--poses", type=whole(8, 100_000),
+                   default=200, help="poses per scenario (default 200)")
+    p.add_argument("--none", type=FRACTION, default=0.1, metavar="FRACTION",
                    help="share of scenarios with no hidden effect (default 0.1)")
-    p.add_argument("--pairs", type=float, default=0.15, metavar="FRACTION",
+    p.add_argument("--pairs", type=FRACTION, default=0.15, metavar="FRACTION",
                    help="share of scenarios with two hidden effects (default 0.15)")
     p.add_argument("--effects", nargs="+", choices=EFFECT_NAMES, default=list(EFFECT_NAMES),
                    metavar="EFFECT", help="effects to draw from (default all)")
-    p.add_argument("--noise", type=float, nargs=2, default=(0.01, 0.03), metavar=("LO", "HI"),
+    p.add_argument("--noise", type=real(0.0, 1e3),
+                   nargs=2, default=(0.01, 0.03), metavar=("LO", "HI"),
                    help="range of the tracker noise sigma per coordinate (default 0.01 0.03)")
     p.add_argument("--poses-from", choices=("random", "circle"), default="random",
                    help="random reachable poses (default) or the PUMA circle")
@@ -53,7 +56,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workdir", default=None, metavar="DIR",
                    help="where the measurement CSVs, truth files and diagnoses go (default "
                         "OUT/work)")
-    p.add_argument("--jobs", type=int, default=1, metavar="N",
+    p.add_argument("--jobs", type=whole(1, 256), default=1, metavar="N",
                    help="worker processes (default 1; results are the same for any N)")
     p.add_argument("--force", action="store_true",
                    help="replace existing output files in --out (checked before the run)")
@@ -74,7 +77,7 @@ def _run(args: argparse.Namespace) -> int:
     )
 
     out = Path(args.out or DEFAULT_OUT)
-    overwrite = args.force or args.out is None
+    overwrite = args.force or (args.out is None and claim_generated(out))
     work = Path(args.workdir) if args.workdir else out / "work"
     if work.resolve() == out.resolve():
         raise InputError("--workdir: must differ from --out (it is locked for the run)")

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from zrp.cli.app import emit
+from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, real, whole
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.ik import CORRECTIONS, track_trajectory
@@ -16,8 +17,8 @@ from zrp.kinematics.posture import solve_pose
 from zrp.kinematics.redundant import track_posture
 from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
 from zrp.model.files import builtin_models, load_model
-from zrp.model.manipulator import Manipulator
-from zrp.output import check_writable
+from zrp.model.manipulator import MAX_LENGTH, Manipulator
+from zrp.output import check_writable, claim_generated
 from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM, is_paper_model
 from zrp.rotations.rodrigues import er_angle
 
@@ -47,7 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                        description="End-effector point, u_a, u_t, hand rotation and its "
                        "Euler-Rodrigues parameters, and the current joint axes and points.")
     _add_model(p)
-    p.add_argument("--q", nargs="+", type=float, required=True, metavar="Q",
+    p.add_argument("--q", nargs="+", type=FINITE, required=True, metavar="Q",
                    help="joint values q1..qn")
     p.set_defaults(func=_fk)
 
@@ -56,22 +57,24 @@ def register(sub: argparse._SubParsersAction) -> None:
                        "corrector, RK4 start, Newton drift correction). Default: the paper's "
                        "125 mm circle on the Table 1 PUMA (see README).")
     _add_model(p)
-    p.add_argument("--q0", nargs="+", type=float, metavar="Q",
+    p.add_argument("--q0", nargs="+", type=FINITE, metavar="Q",
                    help="start configuration (default "
                         f"{' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg for the paper's PUMA, "
                         "the built-in puma; required for every other model)")
     p.add_argument("--trajectory", choices=("circle", "line"), default="circle")
-    p.add_argument("--radius", type=float, default=PUMA_RADIUS_MM,
+    p.add_argument("--radius", type=LENGTH, default=PUMA_RADIUS_MM,
                    help="circle radius in length units (default 125)")
-    p.add_argument("--normal", nargs=3, type=float, default=[1.0, 0.0, 0.0],
+    p.add_argument("--normal", nargs=3, type=FINITE, default=[1.0, 0.0, 0.0],
                    help="circle plane normal (default 1 0 0)")
-    p.add_argument("--toward", nargs=3, type=float, default=[0.0, 0.0, 1.0],
+    p.add_argument("--toward", nargs=3, type=FINITE, default=[0.0, 0.0, 1.0],
                    help="direction from the start point to the circle centre (default 0 0 1)")
-    p.add_argument("--displacement", nargs=3, type=float, default=[0.0, 100.0, 0.0],
+    p.add_argument("--displacement", nargs=3, type=real(-MAX_LENGTH, MAX_LENGTH),
+                   default=[0.0, 100.0, 0.0],
                    help="line: end minus start point (default 0 100 0)")
-    p.add_argument("--duration", type=float, default=PUMA_DURATION_S, help="s (default 4)")
+    p.add_argument("--duration", type=DURATION, default=PUMA_DURATION_S, help="s (default 4)")
     p.add_argument("--time-law", choices=TIME_LAWS, default="quintic")
-    p.add_argument("--steps", type=int, default=1000, help="integration steps (default 1000)")
+    p.add_argument("--steps", type=whole(1, MAX_STEPS),
+                   default=1000, help="integration steps (default 1000)")
     p.add_argument("--task", choices=("pose", "position"), default=None)
     p.add_argument("--correction", choices=CORRECTIONS, default="newton")
     p.add_argument("--posture", action="store_true",
@@ -139,7 +142,7 @@ def _ik(args: argparse.Namespace) -> int:
         return _ik_target(args, model, q0)
     stem = Path(args.model).stem
     out = Path(args.out) if args.out else Path("renders") / f"{stem}_{args.trajectory}_joints.csv"
-    overwrite = args.force or args.out is None
+    overwrite = args.force or (args.out is None and claim_generated(out.parent))
     check_writable([out], overwrite)
     start = forward_kinematics(model, q0).position
     if args.trajectory == "circle":

@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from zrp.cli.app import emit
+from zrp.cli.options import SEED, real, whole
 from zrp.errors import InputError
 from zrp.kinematics import reachable_poses
 from zrp.model.files import builtin_models, load_model
@@ -35,9 +36,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "link_length:4=0.1,0.2,-0.1mm, axis_misalignment:3=0.5,0.2mrad, "
                         "joint_compliance:2=20urad/Nm, backlash:1=0.8mrad, "
                         "thermal_expansion=12ppm/K")
-    p.add_argument("--payload", type=float, default=0.0, metavar="KG",
+    p.add_argument("--payload", type=real(0.0, 1e4, unit="kg"), default=0.0, metavar="KG",
                    help="payload at the tool point, kg (logged in the load column)")
-    p.add_argument("--poses", type=int, default=200, help="number of poses (default 200)")
+    p.add_argument("--poses", type=whole(1, 100_000),
+                   default=200, help="number of poses (default 200)")
     p.add_argument("--trajectory", choices=("random", "circle"), default="random",
                    help="random reachable poses (default) or poses along the PUMA circle")
     p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
@@ -45,11 +47,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "gravity torque, the others from a random side (default; written as "
                         "dir columns), every joint from a random side, or straight moves in "
                         "measurement order")
-    p.add_argument("--noise", type=float, default=0.02, metavar="SIGMA",
+    p.add_argument("--noise", type=real(0.0, 1e3), default=0.02, metavar="SIGMA",
                    help="tracker noise per coordinate, model length unit (default 0.02)")
-    p.add_argument("--temp-rise", type=float, default=10.0, metavar="K",
+    p.add_argument("--temp-rise", type=real(-100.0, 100.0, unit="K"), default=10.0, metavar="K",
                    help="warm-up of the robot during the session, K (default 10)")
-    p.add_argument("--seed", type=int, default=0, help="seed of poses, noise and instrument")
+    p.add_argument("--seed", type=SEED, default=0, help="seed of poses, noise and instrument")
     p.add_argument("--deg", action="store_true", help="write q in degrees (then diagnose "
                                                       "with --deg)")
     p.add_argument("--force", action="store_true",

@@ -7,6 +7,7 @@ import re
 from pathlib import Path
 
 from zrp.cli.app import emit
+from zrp.cli.options import real
 from zrp.errors import InputError
 from zrp.manufacturing.perturb import Perturbation
 from zrp.model.files import builtin_models, load_model, save_model
@@ -39,8 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "values, 6R PUMA-type only)")
     p.add_argument("--actuators", action="store_true",
                    help="add PD servos (position + rate actuators) per joint")
-    p.add_argument("--kp", type=float, default=2000.0, help="servo gain, N m/rad")
-    p.add_argument("--kv", type=float, default=100.0, help="rate gain, N m s/rad")
+    p.add_argument("--kp", type=real(0.0, 1e12, open_lo=True),
+                   default=2000.0, help="servo gain, N m/rad")
+    p.add_argument("--kv", type=real(0.0, 1e12), default=100.0, help="rate gain, N m s/rad")
     p.add_argument("--from", dest="source", metavar="XML", default=None,
                    help="import: MJCF or URDF file to read (writes a model TOML)")
     p.add_argument("--site", default=None, help="import: end-effector site name")

@@ -16,7 +16,7 @@ from zrp.cli.commands.study import add_path_options, check_path_options, path_fr
 from zrp.errors import InputError
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
-from zrp.output import OutputDir
+from zrp.output import OutputDir, claim_generated
 from zrp.paper.example import CIRCLES, PaperExample, run_paper_example
 from zrp.paper.index import INDEX_NAME, write_index
 from zrp.paper.report import output_names, write_paper_outputs
@@ -124,7 +124,8 @@ def _paper(args: argparse.Namespace) -> int:
     if args.out is None:
         args.out = DEFAULT_OUT + ("/recovered" if args.circle == "recovered" else "")
     out = Path(args.out)
-    overwrite = args.force or out in (Path(DEFAULT_OUT), Path(DEFAULT_OUT) / "recovered")
+    overwrite = args.force or (out in (Path(DEFAULT_OUT), Path(DEFAULT_OUT) / "recovered")
+                               and claim_generated(out))
     model = load_model(args.model)
     check_path_options(args, model)
     _named_circle(args, model)

@@ -8,7 +8,8 @@ from pathlib import Path
 from typing import Any
 
 from zrp.cli.app import emit
-from zrp.output import OutputDir
+from zrp.cli.options import MAX_FPS, MAX_HEIGHT, MAX_SECONDS, MAX_WIDTH, PERCENT, real, whole
+from zrp.output import OutputDir, claim_generated
 from zrp.paper.scenes import PAPER_LEVELS, Scene, paper_video_scene, teaching_sweep_scene
 
 DEFAULT_OUT = "renders"
@@ -24,24 +25,28 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Also runs the MuJoCo-vs-ZRP consistency check on the trajectory.")
     p.add_argument("--parameter", default="JE2",
                    help="perturbed parameter, LE<k> or JE<k> (default JE2)")
-    p.add_argument("--xi", type=float, default=0.1, help="perturbation in percent (default 0.1)")
+    p.add_argument("--xi", type=PERCENT, default=0.1, help="perturbation in percent (default 0.1)")
     p.add_argument("--sweep", action="store_true",
                    help="also render the teaching sweep over xi = 0, 0.02, 0.05, 0.07, 0.1 %%")
-    p.add_argument("--levels", nargs="+", type=float, default=None, metavar="PCT",
+    p.add_argument("--levels", nargs="+", type=PERCENT, default=None, metavar="PCT",
                    help="levels of the sweep (default the paper's)")
-    p.add_argument("--steps", type=int, default=360, help="inverse-kinematics steps (360)")
+    p.add_argument("--steps", type=whole(2, 100_000),
+                   default=360, help="inverse-kinematics steps (360)")
     p.add_argument("--out-dir", default=None, metavar="DIR",
                    help=f"output folder (default {DEFAULT_OUT}/, generated output whose videos "
                         "are replaced; in any other folder an existing video needs --force). "
                         "One run at a time per folder: a second run into it is refused")
     p.add_argument("--force", action="store_true",
                    help="replace existing videos in --out-dir (checked before rendering)")
-    p.add_argument("--width", type=int, default=640)
-    p.add_argument("--height", type=int, default=480)
-    p.add_argument("--fps", type=int, default=30)
-    p.add_argument("--seconds", type=float, default=None,
+    p.add_argument("--width", type=whole(16, MAX_WIDTH), default=640,
+                   help=f"pixels, 16 to {MAX_WIDTH} (default 640)")
+    p.add_argument("--height", type=whole(16, MAX_HEIGHT), default=480,
+                   help=f"pixels, 16 to {MAX_HEIGHT} (default 480)")
+    p.add_argument("--fps", type=whole(1, MAX_FPS), default=30,
+                   help=f"frames per second, 1 to {MAX_FPS} (default 30)")
+    p.add_argument("--seconds", type=real(0.0, MAX_SECONDS, open_lo=True, unit="s"), default=None,
                    help="video length (default: the trajectory's duration; 3 s per sweep level)")
-    p.add_argument("--magnify", type=float, default=None,
+    p.add_argument("--magnify", type=real(0.0, 1e9, open_lo=True), default=None,
                    help="deviation magnification (default: one round factor per parameter, "
                         "the same for the video and the sweep)")
     p.add_argument("--format", choices=("auto", "mp4", "gif"), default="auto")
@@ -80,7 +85,7 @@ def _run(args: argparse.Namespace) -> int:
         videos.append((teaching_sweep_scene(args.parameter, levels, steps=args.steps),
                        replace(opts, seconds=args.seconds or 3.0)))
     names = [sim.video_path(scene.file_name, o).name for scene, o in videos]
-    overwrite = args.force or args.out_dir is None
+    overwrite = args.force or (args.out_dir is None and claim_generated(DEFAULT_OUT))
     with OutputDir(Path(args.out_dir or DEFAULT_OUT), overwrite=overwrite, names=names) as out:
         seg = videos[0][0].segments[0]
         checks = [sim.consistency_check(m, seg.q) for m in (seg.nominal, seg.perturbed)]

@@ -11,6 +11,7 @@ import warnings
 import numpy as np
 
 from zrp.cli.app import emit
+from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, PERCENT, whole
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.trajectory import TIME_LAWS
 from zrp.manufacturing.perturb import PAPER_SIGN_ZERO
@@ -41,19 +42,19 @@ def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
     g.add_argument("--joints", metavar="CSV", default=None,
                    help="joint trajectory CSV: header, then t (s) and q1..qn (rad / length unit)"
                         " per row, e.g. written by `zrp ik`; replaces the circle")
-    g.add_argument("--q0", nargs="+", type=float, metavar="DEG", default=None,
+    g.add_argument("--q0", nargs="+", type=FINITE, metavar="DEG", default=None,
                    help="start configuration in deg (prismatic joints in the length unit); "
                         f"default {' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} for the paper's "
                         "PUMA (the built-in puma), required for every other model")
-    g.add_argument("--radius", type=float, default=125.0,
+    g.add_argument("--radius", type=LENGTH, default=125.0,
                    help="circle radius, length unit (default 125)")
-    g.add_argument("--normal", nargs=3, type=float, default=None, metavar=("X", "Y", "Z"),
+    g.add_argument("--normal", nargs=3, type=FINITE, default=None, metavar=("X", "Y", "Z"),
                    help="circle plane normal (default: the tool's axial direction at q0)")
-    g.add_argument("--toward", nargs=3, type=float, default=None, metavar=("X", "Y", "Z"),
+    g.add_argument("--toward", nargs=3, type=FINITE, default=None, metavar=("X", "Y", "Z"),
                    help="from the start point towards the centre (default: base +z)")
-    g.add_argument("--duration", type=float, default=4.0, help="s (default 4)")
+    g.add_argument("--duration", type=DURATION, default=4.0, help="s (default 4)")
     g.add_argument("--time-law", choices=TIME_LAWS, default="quintic")
-    g.add_argument("--steps", type=int, default=steps,
+    g.add_argument("--steps", type=whole(2, MAX_STEPS), default=steps,
                    help=f"integration steps, samples = steps + 1 (default {steps})")
     p.add_argument("--json", action="store_true", help="print JSON")
 
@@ -107,7 +108,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_path_options(p)
     p.add_argument("--params", nargs="+", default=list(PAPER_PARAMETERS), metavar="NAME",
                    help="parameters (default: the paper's LE2 LE3 LE4 LE7 JE1..JE6)")
-    p.add_argument("--xi", nargs="+", type=float, default=list(PAPER_XI), metavar="PCT",
+    p.add_argument("--xi", nargs="+", type=PERCENT, default=list(PAPER_XI), metavar="PCT",
                    help="levels in percent (default: 0, +-0.02, +-0.05, +-0.07, +-0.1)")
     add_sign_options(p)
     p.add_argument("--out", default=None, metavar="DIR",

@@ -3,16 +3,18 @@
 from __future__ import annotations
 
 import argparse
+import math
 from typing import Any
 
 import numpy as np
 
 from zrp.cli.app import emit
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
+from zrp.cli.options import LENGTH, SEED, TOLERANCE, real, whole
 from zrp.errors import InputError
 from zrp.manufacturing.allocation import allocate_tolerances
 from zrp.manufacturing.budget import tolerance_report
-from zrp.manufacturing.plots import histogram_png
+from zrp.manufacturing.plots import check_png_path, histogram_png
 from zrp.manufacturing.population import monte_carlo
 from zrp.manufacturing.study import JointPath
 from zrp.manufacturing.tolerance import DISTRIBUTIONS, Tolerances, percentile_ci
@@ -44,11 +46,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "tolerances (reciprocal cost model) meeting a percentile requirement.")
     add_path_options(p)
     g = p.add_argument_group("tolerances")
-    g.add_argument("--length", type=float, default=0.02,
+    g.add_argument("--length", type=TOLERANCE, default=0.02,
                    help="tolerance of every body-vector component, length unit (default 0.02)")
-    g.add_argument("--angle", type=float, default=5e-5,
+    g.add_argument("--angle", type=real(0.0, math.pi, unit="rad"), default=5e-5,
                    help="tolerance of every axis tilt, rad (default 5e-5, about 10 arcsec)")
-    g.add_argument("--offsets", type=float, default=None, metavar="TOL",
+    g.add_argument("--offsets", type=TOLERANCE, default=None, metavar="TOL",
                    help="also perturb joint zero offsets with this tolerance (rad / length unit)")
     g.add_argument("--tol", action="append", metavar="NAME=VALUE",
                    help="per-parameter tolerance, name or glob: b3.x=0.01, 'u*.*=1e-4', "
@@ -56,23 +58,28 @@ def register(sub: argparse._SubParsersAction) -> None:
     g.add_argument("--distribution", choices=DISTRIBUTIONS, default="uniform",
                    help="uniform: U(-tol, tol); normal: N(0, (tol/3)^2) (default uniform)")
     m = p.add_argument_group("Monte Carlo")
-    m.add_argument("-n", "--robots", type=int, default=20000, help="robots N (default 20000)")
-    m.add_argument("--seed", type=int, default=1, help="random seed (default 1)")
-    m.add_argument("--percentile", type=float, default=99.0, help="reported percentile (99)")
+    m.add_argument("-n", "--robots", type=whole(1, 10_000_000),
+                   default=20000, help="robots N (default 20000)")
+    m.add_argument("--seed", type=SEED, default=1, help="random seed (default 1)")
+    m.add_argument("--percentile", type=real(0.0, 100.0),
+                   default=99.0, help="reported percentile (99)")
     m.add_argument("--hist", default=None, metavar="PNG",
                    help="write a histogram PNG (checked before the Monte Carlo runs)")
-    m.add_argument("--top", type=int, default=10, help="rows of the contribution table (10)")
+    m.add_argument("--top", type=whole(1, 100_000),
+                   default=10, help="rows of the contribution table (10)")
     m.add_argument("--no-progress", action="store_true", help="hide the progress bar")
     a = p.add_argument_group("allocation")
     a.add_argument("--allocate", action="store_true",
                    help="find per-parameter tolerances meeting --max-dp/--max-angle at "
                         "--percentile, as loose as possible")
-    a.add_argument("--max-dp", type=float, default=0.1,
+    a.add_argument("--max-dp", type=LENGTH, default=0.1,
                    help="requirement on max delta_p, length unit (default 0.1)")
-    a.add_argument("--max-angle", type=float, default=None, help="requirement on the angle, rad")
-    a.add_argument("--angle-scale", type=float, default=100.0,
+    a.add_argument("--max-angle", type=real(0.0, math.pi, open_lo=True, unit="rad"),
+                   default=None, help="requirement on the angle, rad")
+    a.add_argument("--angle-scale", type=LENGTH, default=100.0,
                    help="length-equivalent of 1 rad in the cost, mm (default 100)")
-    a.add_argument("--n-search", type=int, default=4000, help="robots per bisection step")
+    a.add_argument("--n-search", type=whole(10, 10_000_000),
+                   default=4000, help="robots per bisection step")
     a.add_argument("--fixed", action="append", metavar="NAME=VALUE",
                    help="tolerances kept fixed during allocation (repeatable)")
     p.add_argument("--force", action="store_true",
@@ -92,6 +99,7 @@ def _tolerance(args: argparse.Namespace) -> int:
     if not 0.0 < args.percentile < 100.0:
         raise InputError(f"--percentile: expected 0 < P < 100 (e.g. 99), got {args.percentile}")
     if args.hist:
+        check_png_path(args.hist, "--hist")
         check_writable([args.hist], args.force)
     path = path_from_args(args, model)
     rng = np.random.default_rng(args.seed)

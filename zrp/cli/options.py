@@ -1,0 +1,99 @@
+"""Converters for command-line options (argparse ``type=``): every number a command takes is
+checked here, once, with its range, so a bad value is one line naming the option
+(``argument --seed: expected a whole number >= 0, got -1``) before any work starts.
+
+The limits are stated where the options are declared; ``tests/test_hostile_inputs.py`` checks
+that no command declares a bare ``type=int`` or ``type=float``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+from collections.abc import Callable
+
+from zrp.arguments import MAX_SEED
+from zrp.model.manipulator import MAX_LENGTH
+
+__all__ = [
+    "DURATION",
+    "FINITE",
+    "FRACTION",
+    "LENGTH",
+    "MAX_FPS",
+    "MAX_HEIGHT",
+    "MAX_SECONDS",
+    "MAX_STEPS",
+    "MAX_WIDTH",
+    "PERCENT",
+    "SEED",
+    "TOLERANCE",
+    "real",
+    "whole",
+]
+
+#: Most integration steps of a trajectory (ik, study, tolerance): the joint CSV of a million
+#: steps is about 200 MB; finer steps change nothing measurable.
+MAX_STEPS = 1_000_000
+#: Largest video frame, pixels (4K UHD); MuJoCo's offscreen buffer fails far beyond it.
+MAX_WIDTH, MAX_HEIGHT = 3840, 2160
+#: Highest frame rate and longest video per segment: at most 72,000 frames, each rendered.
+MAX_FPS, MAX_SECONDS = 120, 600.0
+
+
+def whole(lo: int, hi: int | None = None) -> Callable[[str], int]:
+    """A whole number in [lo, hi] (``hi`` None: no upper limit)."""
+
+    def convert(text: str) -> int:
+        try:
+            v = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a whole number, got {text!r}") from None
+        if v < lo or (hi is not None and v > hi):
+            rng = f">= {lo}" if hi is None else f"from {lo} to {hi}"
+            raise argparse.ArgumentTypeError(f"expected a whole number {rng}, got {text}")
+        return v
+
+    convert.__name__ = "whole number"
+    return convert
+
+
+def real(lo: float = -math.inf, hi: float = math.inf, *, open_lo: bool = False,
+         open_hi: bool = False, unit: str = "") -> Callable[[str], float]:
+    """A finite number in [lo, hi] (open ends with ``open_lo``/``open_hi``)."""
+
+    def convert(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected a number, got {text!r}") from None
+        ok = math.isfinite(v) and (v > lo if open_lo else v >= lo) and (
+            v < hi if open_hi else v <= hi)
+        if not ok:
+            if math.isinf(lo) and math.isinf(hi):
+                what = "a finite number"
+            else:
+                left, right = "(" if open_lo else "[", ")" if open_hi else "]"
+                what = f"a number in {left}{lo:g}, {hi:g}{right}"
+            raise argparse.ArgumentTypeError(f"expected {what}{' ' + unit if unit else ''}, "
+                                             f"got {text}")
+        return v
+
+    convert.__name__ = "number"
+    return convert
+
+
+#: A random seed: 0 .. 2**63 - 1 (NumPy refuses negative seeds).
+SEED = whole(0, MAX_SEED)
+#: Any finite number (joint values, direction components).
+FINITE = real()
+#: A positive length (model length unit), at most the model's bound on lengths.
+LENGTH = real(0.0, MAX_LENGTH, open_lo=True)
+#: A tolerance or noise level: a length >= 0.
+TOLERANCE = real(0.0, MAX_LENGTH)
+#: A perturbation in percent, -1 < xi < 1 (eqs 8-12).
+PERCENT = real(-1.0, 1.0, open_lo=True, open_hi=True, unit="%")
+#: A fraction in [0, 1].
+FRACTION = real(0.0, 1.0)
+#: A duration, s.
+DURATION = real(0.0, 1e6, open_lo=True, unit="s")
