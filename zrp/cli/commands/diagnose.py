@@ -110,7 +110,8 @@ def _run(args: argparse.Namespace) -> int:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")
     # reading the inputs creates nothing: a bad input leaves no output folder behind
     model = load_model(args.model)
-    progress = args.progress
+    # the reader's bar only on a terminal; piped runs get the diagnosis's periodic lines
+    progress = args.progress and sys.stderr.isatty()
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame,
                              progress=progress, max_rows=args.max_rows)
     tau = None if args.mjcf is None else gravity_torques(args.mjcf, meas.q_pose, field="--mjcf")

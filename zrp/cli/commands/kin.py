@@ -84,10 +84,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--limits", choices=("error", "warn", "ignore"), default="error",
                    help="when the path needs a joint beyond its limits (default error, naming "
                         "the joint and time)")
-    p.add_argument("--target", nargs=3, type=float, default=None, metavar=("X", "Y", "Z"),
+    p.add_argument("--target", nargs=3, type=FINITE, default=None, metavar=("X", "Y", "Z"),
                    help="single-pose IK: reach this point (length unit) from --q0 instead of "
                         "following a trajectory; with --target-er also the hand rotation")
-    p.add_argument("--target-er", nargs=4, type=float, default=None,
+    p.add_argument("--target-er", nargs=4, type=FINITE, default=None,
                    metavar=("E0", "E1", "E2", "E3"),
                    help="hand rotation for --target (Euler-Rodrigues, relative to the zero "
                         "reference, as zrp fk prints it)")

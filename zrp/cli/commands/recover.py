@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 
 from zrp.cli.app import emit
+from zrp.cli.options import SEED, whole
 from zrp.errors import InputError
 from zrp.paper.inverse import local_pinning, recover_circle
 from zrp.paper.placement import CELL_LABELS, ORIENTATION_LAWS
@@ -20,10 +21,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Prints the best placement, the ratio ours / published per cell, the spread of each "
         "unknown over the good starts and the local 1-sigma. The defaults took 516 s on 2 "
         "shared cores and found zrp.paper.RECOVERED.")
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
-    p.add_argument("--popsize", type=int, default=15, help="population multiplier (15)")
-    p.add_argument("--maxiter", type=int, default=120, help="generations per law (120)")
-    p.add_argument("--starts", type=int, default=6, help="polished starts per law (6)")
+    p.add_argument("--seed", type=SEED, default=0, help="random seed (default 0)")
+    p.add_argument("--popsize", type=whole(1, 1000), default=15, help="population multiplier (15)")
+    p.add_argument("--maxiter", type=whole(1, 100_000), default=120,
+                   help="generations per law (120)")
+    p.add_argument("--starts", type=whole(1, 1000), default=6, help="polished starts per law (6)")
     p.add_argument("--laws", nargs="+", choices=ORIENTATION_LAWS, default=list(ORIENTATION_LAWS))
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=_run, api_names={"popsize": "--popsize", "maxiter": "--maxiter",

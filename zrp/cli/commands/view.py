@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 
 from zrp.cli.app import emit
+from zrp.cli.options import MAX_STEPS, PERCENT, whole
 from zrp.paper.scenes import paper_video_scene
 
 
@@ -17,10 +18,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "path (green) and the actual path magnified (magenta). Without a display it says so "
         "and exits with code 2; `zrp render` makes an offscreen video instead.")
     p.add_argument("--parameter", default="JE2", help="perturbed parameter (default JE2)")
-    p.add_argument("--xi", type=float, default=0.1,
+    p.add_argument("--xi", type=PERCENT, default=0.1,
                    help="perturbation in percent (default 0.1; 0 for the nominal arm)")
-    p.add_argument("--steps", type=int, default=360, help="inverse-kinematics steps (360)")
-    p.add_argument("--loops", type=int, default=None, help="stop after this many rounds")
+    p.add_argument("--steps", type=whole(1, MAX_STEPS), default=360,
+                   help="inverse-kinematics steps (360)")
+    p.add_argument("--loops", type=whole(1), default=None, help="stop after this many rounds")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=_run)
 
