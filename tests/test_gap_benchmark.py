@@ -103,8 +103,11 @@ def test_benchmark_runs_are_reproducible_from_the_seed(puma, tmp_path):
     for name in ("scenario_000.csv", "scenario_001.csv"):
         assert (tmp_path / "a/measurements" / name).read_bytes() == \
             (tmp_path / "b/measurements" / name).read_bytes()
-    # worker processes give the same results
-    c = run_benchmark(puma, cfg, tmp_path / "c", progress=False, jobs=2)
+    # an interrupted run resumes: the score written as it arrived is kept, the missing one
+    # is run again and the result is the same (worker processes: tests/test_cluster.py)
+    (tmp_path / "a/scores/scenario_001.score.json").unlink()
+    c = run_benchmark(puma, cfg, tmp_path / "a", progress=False, resume=True)
+    assert c.resumed == 1 and not c.failures
     assert _strip_times([s.to_dict() for s in c.scores]) == \
         _strip_times([s.to_dict() for s in a.scores])
     # a different seed gives different scenarios and measurements

@@ -66,7 +66,7 @@ def test_no_command_declares_an_unchecked_number():
     (["fk", "--q", "0", "0", "nan", "0", "0", "0"], "argument --q: expected a finite number"),
     (["diagnose", "--model", "puma", "--data", "D", "--out", "o", "--withheld", "0.99"],
      "argument --withheld: expected a number in (0, 0.5]"),
-    (["gap-benchmark", "--jobs", "0"], "argument --jobs"),
+    (["gap-benchmark", "--workers", "0"], "argument --workers"),
     (["measure", "--out", "m.csv", "--poses", "-5"], "argument --poses"),
     (["study", "--xi", "1.5"], "argument --xi: expected a number in (-1, 1) %"),
 ])

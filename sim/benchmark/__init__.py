@@ -19,12 +19,12 @@ judge the diagnosis:
 * **withheld RMS after correction** over the true noise RMS (target <= 1.5), and the shrink
   ratio final / nominal withheld RMS.
 
-:func:`run_benchmark` does all of it with a progress bar (optionally in worker processes);
+:func:`run_benchmark` does all of it with a progress bar (optionally on any executor, e.g. Dask);
 :func:`write_outputs` writes the confusion matrix and summary tables.
 
 The package, by concept: :mod:`.scenarios` (configuration, drawing - the truth),
 :mod:`.blind` (simulation and the blind diagnosis), :mod:`.scoring`, :mod:`.results` (the
-result and its tables), :mod:`.runner` (the run and its process pool) and :mod:`.report`
+result and its tables), :mod:`.runner` (the run, on any executor, resumable) and :mod:`.report`
 (Markdown, CSV, JSON, the plot).
 """
 

@@ -88,6 +88,11 @@ def render_text(result: BenchmarkResult) -> str:
                                                           strict=False)) or "none",
               s.ratio, s.note]
              for s in bad])]
+    if result.failures:
+        out += ["", "## Scenarios that failed (the others completed)", "", _md_table(
+            ["input", "error"], [[f.task, f.error] for f in result.failures])]
+    if result.resumed:
+        out += ["", f"Resumed: {result.resumed} scores taken from the interrupted run."]
     out += ["", f"Wall time {result.wall_s:.1f} s: simulation {result.sim_s:.1f} s, diagnosis "
             f"{result.diag_s:.1f} s ({result.wall_s / max(len(sc), 1):.2f} s per scenario)."]
     return "\n".join(out) + "\n"

@@ -11,13 +11,15 @@ import numpy as np
 
 from sim.benchmark.scenarios import BenchmarkConfig
 from sim.benchmark.scoring import ScenarioScore
+from zrp.tasks import TaskFailure
 
 __all__ = ["BenchmarkResult", "confusion_matrix", "coverage", "summary_rows"]
 
 
 @dataclass(frozen=True, eq=False)
 class BenchmarkResult:
-    """Scores of all scenarios plus timings (s)."""
+    """Scores of all scenarios plus timings (s); the scenarios that raised (``failures``, each
+    with its input) and how many scores a resumed run took from the previous one."""
 
     config: BenchmarkConfig
     model_name: str
@@ -26,6 +28,8 @@ class BenchmarkResult:
     sim_s: float
     diag_s: float
     workdir: str
+    failures: tuple[TaskFailure, ...] = ()
+    resumed: int = 0
 
     def to_dict(self) -> dict[str, Any]:
         cfg = {k: (list(v) if isinstance(v, tuple) else v)
@@ -33,7 +37,8 @@ class BenchmarkResult:
         return {"model": self.model_name, "config": cfg, "wall_s": self.wall_s,
                 "sim_s": self.sim_s, "diag_s": self.diag_s, "workdir": self.workdir,
                 "summary": summary_rows(self), "confusion": confusion_matrix(self),
-                "scenarios": [s.to_dict() for s in self.scores]}
+                "scenarios": [s.to_dict() for s in self.scores],
+                "failures": [f.to_dict() for f in self.failures], "resumed": self.resumed}
 
 
 

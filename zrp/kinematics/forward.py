@@ -141,6 +141,23 @@ def _karrays(model: Manipulator) -> tuple:
     return cache
 
 
+def _packed(model: Manipulator) -> F64:
+    packed = model.__dict__.get("_kernel_packed")
+    if packed is None:
+        packed = K.pack_model(model.axes, model.bodies, model.prismatic)
+        model.__dict__["_kernel_packed"] = packed
+    return packed
+
+
+_F64 = np.dtype(np.float64)
+
+
+def _one(q: object) -> bool:
+    """q may be one joint vector for the single-pose kernels (a 1-D float64 array; they check
+    its length and values and decline otherwise). Kept to ~0.1 us: attribute reads only."""
+    return type(q) is np.ndarray and q.ndim == 1 and q.dtype is _F64  # type: ignore[union-attr]
+
+
 def end_effector_pose(model: Manipulator, q: ArrayLike) -> tuple[F64, F64]:
     """Fast forward kinematics of the end effector only.
 
@@ -150,6 +167,10 @@ def end_effector_pose(model: Manipulator, q: ArrayLike) -> tuple[F64, F64]:
     Returns:
         position p, shape (..., 3), and Euler-Rodrigues parameters of R_n, shape (..., 4).
     """
+    if _one(q):  # one pose: ~1 us per call (one kernel call, three arguments)
+        out = np.empty(7)
+        if K.fk_pose_packed(q, _packed(model), out):
+            return out[:3], out[3:]
     qf, batch = _flat(model, q)
     out = np.empty((qf.shape[0], 7))
     K.fk_pose_batch(qf, *_karrays(model), out)
@@ -163,6 +184,10 @@ def jacobian(model: Manipulator, q: ArrayLike) -> F64:
     Revolute column k: [u_k; u_k x (p - p_k)]; prismatic column k: [0; u_k]. Rows 0-2 are in
     rad per joint unit, rows 3-5 in length unit per joint unit.
     """
+    if _one(q):  # one pose: one kernel call, three arguments
+        jac = np.empty((6, model.n))
+        if K.jac_packed(q, _packed(model), jac):
+            return jac
     qf, batch = _flat(model, q)
     jac = np.empty((qf.shape[0], 6, model.n))
     K.jac_batch(qf, *_karrays(model), np.empty((0, 7)), jac)

@@ -12,6 +12,10 @@ from zrp.manufacturing.budget import Contribution as Contribution
 from zrp.manufacturing.budget import contributions as contributions
 from zrp.manufacturing.budget import tolerance_report as tolerance_report
 from zrp.manufacturing.budget import worst_case_bound as worst_case_bound
+from zrp.manufacturing.chunks import ChunkResult as ChunkResult
+from zrp.manufacturing.chunks import ChunkTask as ChunkTask
+from zrp.manufacturing.chunks import chunk_rng as chunk_rng
+from zrp.manufacturing.chunks import run_chunk as run_chunk
 from zrp.manufacturing.deviation import Deviation as Deviation
 from zrp.manufacturing.deviation import check_times as check_times
 from zrp.manufacturing.deviation import delta_r_eq15 as delta_r_eq15
@@ -29,7 +33,9 @@ from zrp.manufacturing.perturb import perturb_components as perturb_components
 from zrp.manufacturing.perturb import perturbation_names as perturbation_names
 from zrp.manufacturing.plots import histogram_png as histogram_png
 from zrp.manufacturing.population import MonteCarloResult as MonteCarloResult
+from zrp.manufacturing.population import chunk_tasks as chunk_tasks
 from zrp.manufacturing.population import first_order_max as first_order_max
+from zrp.manufacturing.population import gather_chunks as gather_chunks
 from zrp.manufacturing.population import monte_carlo as monte_carlo
 from zrp.manufacturing.sensitivity import ParameterSpace as ParameterSpace
 from zrp.manufacturing.sensitivity import apply_parameters as apply_parameters
@@ -59,6 +65,8 @@ __all__ = [
     "PAPER_SIGN_ZERO",
     "PAPER_XI",
     "Allocation",
+    "ChunkResult",
+    "ChunkTask",
     "Contribution",
     "Deviation",
     "JointPath",
@@ -74,12 +82,15 @@ __all__ = [
     "axis_tangents",
     "check_times",
     "check_xi_percent",
+    "chunk_rng",
+    "chunk_tasks",
     "contributions",
     "delta_r_eq15",
     "delta_r_literal",
     "draw_parameters",
     "first_order_max",
     "fit_linearity",
+    "gather_chunks",
     "histogram_png",
     "load_joint_csv",
     "monte_carlo",
@@ -96,6 +107,7 @@ __all__ = [
     "perturbed_arrays",
     "pose_deviation",
     "pose_error",
+    "run_chunk",
     "tilt_axes",
     "tolerance_report",
     "trajectory_deviation",

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import fnmatch
 from collections.abc import Callable, Mapping
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from typing import Any
 
@@ -243,6 +244,7 @@ def allocate_tolerances(
     margin: float = 0.01,
     refine: bool = True,
     progress: bool = False,
+    executor: Executor | Any | None = None,
 ) -> Allocation:
     """Loosest tolerances (reciprocal cost model, see the module docstring) meeting a
     percentile requirement along the trajectory, verified by a fresh nonlinear Monte Carlo.
@@ -261,6 +263,9 @@ def allocate_tolerances(
         refine: also tune the split between length and angle tolerances (one factor on all
             body components, golden-section search in [1/4, 4] on the nonlinear percentile):
             the RSS shape is optimal within each kind only to first order.
+        executor: where the verification Monte Carlo runs (see
+            :func:`~zrp.manufacturing.population.monte_carlo`; the robots are drawn here from
+            ``rng``, so the result does not depend on it).
     """
     req_p, req_r, pct = _requirement(model, max_delta_p, max_angle_rad, percentile)
     angle_scale_mm, n_search, n_verify = _check_search(distribution, angle_scale_mm, margin,
@@ -308,7 +313,7 @@ def allocate_tolerances(
         rounds += 1
         tol = tolerances(alpha, shape)
         ver = monte_carlo(model, arrays[0], tol, n_verify, rng=rng, distribution=distribution,
-                          progress=progress)
+                          progress=progress, executor=executor)
         dp, ang = ver.percentile(pct)
         r = max(dp / req_p if req_p else 0.0, ang / req_r if req_r else 0.0)
         if r <= 1.0 or rounds >= 6:

@@ -10,7 +10,7 @@ maxima for the same draws. Histograms: :func:`zrp.manufacturing.plots.histogram_
 
 from __future__ import annotations
 
-import time
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -18,17 +18,22 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
-from zrp.kinematics.forward import check_q, end_effector_pose
-from zrp.manufacturing import _mc_kernels as MK
 from zrp.manufacturing._checks import check_distribution, check_percentile, positive_int
-from zrp.manufacturing.sensitivity import parameter_jacobian, parameter_space, perturbed_arrays
+from zrp.manufacturing.chunks import ChunkResult, ChunkTask, run_chunk
+from zrp.manufacturing.maxima import first_order_max as first_order_max
+from zrp.manufacturing.maxima import nonlinear_maxima as nonlinear_maxima
+from zrp.manufacturing.maxima import trajectory_arrays as trajectory_arrays
+from zrp.manufacturing.sensitivity import parameter_space
 from zrp.manufacturing.tolerance import Tolerances, draw_parameters
 from zrp.model.manipulator import Manipulator
+from zrp.tasks import map_tasks
 
 __all__ = [
     "DEFAULT_PERCENTILES",
     "MonteCarloResult",
+    "chunk_tasks",
     "first_order_max",
+    "gather_chunks",
     "monte_carlo",
     "nonlinear_maxima",
     "trajectory_arrays",
@@ -117,78 +122,7 @@ class MonteCarloResult:
         return out
 
 
-def trajectory_arrays(model: Manipulator, q: ArrayLike) -> tuple[F64, F64, F64, F64, F64]:
-    """The Monte Carlo kernel's view of a nominal joint trajectory q, shape (T, n):
-    (q, cos(q/2), sin(q/2), nominal p, nominal E), each C-contiguous."""
-    q = check_q(model, q)
-    if q.ndim != 2:
-        raise InputError(f"q: expected a joint trajectory of shape (T, {model.n}), got {q.shape}")
-    q = np.ascontiguousarray(q, dtype=float)
-    pd, ed = end_effector_pose(model, q)
-    return (q, np.ascontiguousarray(np.cos(0.5 * q)), np.ascontiguousarray(np.sin(0.5 * q)),
-            np.ascontiguousarray(pd), np.ascontiguousarray(ed))
-
-
-def nonlinear_maxima(model: Manipulator, arrays: tuple[F64, F64, F64, F64, F64], dx: F64,
-                     joint_offsets: bool) -> tuple[F64, F64]:
-    """Exact per-robot maxima along the trajectory for parameter steps ``dx`` (N, P):
-    max_t delta_p (length unit) and max_t error angle (rad), each shape (N,)."""
-    q, ch, sh, pd, ed = arrays
-    axes, bodies, off = perturbed_arrays(model, dx, joint_offsets=joint_offsets)
-    n_r = dx.shape[0]
-    out_dp = np.empty(n_r)
-    out_s = np.empty(n_r)
-    MK.mc_max_deviation(ch, sh, q, np.ascontiguousarray(axes), np.ascontiguousarray(bodies),
-                        np.array(model.prismatic, dtype=np.bool_), np.ascontiguousarray(off),
-                        bool(joint_offsets), pd, ed, out_dp, out_s)
-    return out_dp, 2.0 * np.arcsin(np.minimum(out_s, 1.0))
-
-
-def first_order_max(jac: ArrayLike, dx: ArrayLike, chunk: int = 2048) -> tuple[F64, F64]:
-    """First-order per-robot maxima: max_t ||J_p(t) dx|| and max_t ||J_r(t) dx||.
-
-    Args:
-        jac: identification Jacobian along the trajectory, shape (T, 6, P).
-        dx: parameter steps, shape (N, P).
-
-    Returns:
-        max delta_p (length unit) and max angle (rad), each shape (N,).
-    """
-    jac = np.asarray(jac, dtype=float)
-    dx = np.asarray(dx, dtype=float)
-    t_n, _, p = jac.shape
-    flat = jac.reshape(t_n * 6, p).T  # (P, T*6)
-    out_p = np.empty(dx.shape[0])
-    out_r = np.empty(dx.shape[0])
-    for i in range(0, dx.shape[0], chunk):
-        y = (dx[i:i + chunk] @ flat).reshape(-1, t_n, 6)
-        out_r[i:i + chunk] = np.linalg.norm(y[..., 0:3], axis=-1).max(axis=1)
-        out_p[i:i + chunk] = np.linalg.norm(y[..., 3:6], axis=-1).max(axis=1)
-    return out_p, out_r
-
-
-def monte_carlo(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robots: int, *,
-                rng: np.random.Generator, distribution: str = "uniform",
-                chunk: int = 8192, progress: bool = False, first_order: bool = False,
-                percentiles: tuple[float, ...] = DEFAULT_PERCENTILES) -> MonteCarloResult:
-    """Nonlinear Monte Carlo of N robots along the nominal joint trajectory.
-
-    Args:
-        model: the nominal arm.
-        q: nominal inverse-kinematics joint values, shape (T, n).
-        tolerances: from :meth:`Tolerances.build` for the same model.
-        n_robots: N.
-        rng: seeded generator, e.g. ``np.random.default_rng(1)``.
-        distribution: "uniform" or "normal" (see the module docstring).
-        chunk: robots per kernel call (progress-bar granularity).
-        progress: show a tqdm progress bar.
-        first_order: also evaluate the first-order model with the same draws.
-    """
-    check_distribution(distribution)
-    for pct in percentiles:
-        check_percentile(pct, "percentiles")
-    n_robots = positive_int(n_robots, "n_robots")
-    chunk = positive_int(chunk, "chunk")
+def _check_tolerances(model: Manipulator, tolerances: Tolerances) -> None:
     if not isinstance(tolerances, Tolerances):
         raise InputError(f"tolerances: expected a zrp.manufacturing.tolerance.Tolerances, got "
                          f"{type(tolerances).__name__}")
@@ -196,26 +130,95 @@ def monte_carlo(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robo
     if space.names != tolerances.names:
         raise InputError(f"tolerances: built for another model (expected {space.size} parameters "
                          f"{space.names[0]}..{space.names[-1]}, got {len(tolerances.names)})")
+
+
+def _seed_or_rng(rng: np.random.Generator | None, seed: int | None) -> None:
+    if (rng is None) == (seed is None):
+        raise InputError("rng, seed: give exactly one (rng: draws here, in order; seed: each "
+                         "chunk draws its own robots, for executors and clusters)")
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer))
+                             or seed < 0):
+        raise InputError(f"seed: expected an integer >= 0, got {seed!r}")
+
+
+def chunk_tasks(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robots: int, *,
+                rng: np.random.Generator | None = None, seed: int | None = None,
+                distribution: str = "uniform", chunk: int = 8192,
+                first_order: bool = False) -> list[ChunkTask]:
+    """The chunks of :func:`monte_carlo` (same arguments), for an application that maps
+    :func:`~zrp.manufacturing.chunks.run_chunk` itself (checkpointing, its own scheduler)."""
+    check_distribution(distribution)
+    n_robots = positive_int(n_robots, "n_robots")
+    chunk = positive_int(chunk, "chunk")
+    _seed_or_rng(rng, seed)
+    _check_tolerances(model, tolerances)
     arrays = trajectory_arrays(model, q)
-    jac = parameter_jacobian(model, arrays[0], joint_offsets=tolerances.joint_offsets) \
-        if first_order else None
-    dp = np.empty(n_robots)
-    ang = np.empty(n_robots)
-    fo_p = np.empty(n_robots) if first_order else None
-    fo_r = np.empty(n_robots) if first_order else None
-    elapsed = 0.0
+    tasks = []
+    for idx, start in enumerate(range(0, n_robots, chunk)):
+        m = min(chunk, n_robots - start)
+        dx = None if rng is None else draw_parameters(tolerances, m, distribution, rng)
+        tasks.append(ChunkTask(idx, start, m, model, arrays, tolerances, distribution,
+                               None if seed is None else int(seed), dx, bool(first_order)))
+    return tasks
+
+
+def gather_chunks(model: Manipulator, tasks: list[ChunkTask], results: list[ChunkResult],
+                  percentiles: tuple[float, ...] = DEFAULT_PERCENTILES) -> MonteCarloResult:
+    """One :class:`MonteCarloResult` from every chunk's result (in any order)."""
+    by_index = {r.index: r for r in results}
+    missing = [t.index for t in tasks if t.index not in by_index]
+    if missing:
+        raise InputError(f"results: chunks {missing[:5]} are missing")
+    ordered = [by_index[t.index] for t in tasks]
+    cat = np.concatenate
+    first = tasks[0].first_order
+    return MonteCarloResult(
+        cat([r.max_delta_p for r in ordered]), cat([r.max_angle_rad for r in ordered]),
+        tasks[0].tolerances, tasks[0].distribution, int(tasks[0].arrays[0].shape[0]),
+        float(sum(r.elapsed_s for r in ordered)), model.length_unit,
+        cat([r.first_order_delta_p for r in ordered]) if first else None,
+        cat([r.first_order_angle_rad for r in ordered]) if first else None,
+        tuple(percentiles))
+
+
+def monte_carlo(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robots: int, *,
+                rng: np.random.Generator | None = None, seed: int | None = None,
+                distribution: str = "uniform", chunk: int = 8192, progress: bool = False,
+                first_order: bool = False,
+                percentiles: tuple[float, ...] = DEFAULT_PERCENTILES,
+                executor: Executor | Any | None = None) -> MonteCarloResult:
+    """Nonlinear Monte Carlo of N robots along the nominal joint trajectory.
+
+    Args:
+        model: the nominal arm.
+        q: nominal inverse-kinematics joint values, shape (T, n).
+        tolerances: from :meth:`Tolerances.build` for the same model.
+        n_robots: N.
+        rng: seeded generator, e.g. ``np.random.default_rng(1)``: the robots are drawn here,
+            in order, and shipped to the executor; or
+        seed: master seed: chunk i draws its own robots (:func:`~.chunks.chunk_rng`), so
+            nothing but the seed travels (give exactly one of ``rng`` and ``seed``).
+        distribution: "uniform" or "normal" (see the module docstring).
+        chunk: robots per task (the seeded draws depend on it; the result never depends on
+            the executor or its number of workers).
+        progress: show a tqdm progress bar (advanced as chunks finish, also on a cluster).
+        first_order: also evaluate the first-order model with the same draws.
+        executor: None (this process; the kernel uses numba's threads) or any
+            ``concurrent.futures``-style executor, e.g. a Dask ``Client.get_executor()``.
+
+    ``elapsed_s`` of the result sums the kernel time of every chunk (CPU-seconds on the
+    workers, not wall time).
+    """
+    for pct in percentiles:
+        check_percentile(pct, "percentiles")
+    tasks = chunk_tasks(model, q, tolerances, n_robots, rng=rng, seed=seed,
+                        distribution=distribution, chunk=chunk, first_order=first_order)
     from tqdm import tqdm
 
+    results: list[ChunkResult] = []
     with tqdm(total=n_robots, disable=not progress, unit="robot", desc="Monte Carlo") as bar:
-        for i in range(0, n_robots, chunk):
-            m = min(chunk, n_robots - i)
-            dx = draw_parameters(tolerances, m, distribution, rng)
-            t0 = time.perf_counter()
-            dp[i:i + m], ang[i:i + m] = nonlinear_maxima(model, arrays, dx,
-                                                          tolerances.joint_offsets)
-            elapsed += time.perf_counter() - t0
-            if jac is not None and fo_p is not None and fo_r is not None:
-                fo_p[i:i + m], fo_r[i:i + m] = first_order_max(jac, dx)
-            bar.update(m)
-    return MonteCarloResult(dp, ang, tolerances, distribution, int(arrays[0].shape[0]), elapsed,
-                            model.length_unit, fo_p, fo_r, tuple(percentiles))
+        for i, res in map_tasks(run_chunk, tasks, executor):
+            assert isinstance(res, ChunkResult)  # without capture, a failed chunk raises
+            results.append(res)
+            bar.update(tasks[i].size)
+    return gather_chunks(model, tasks, results, tuple(percentiles))

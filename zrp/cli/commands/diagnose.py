@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TextIO
 
 from zrp.cli.app import emit
+from zrp.cli.fleet import add_fleet_options, is_fleet, refuse_fleet_options, run_fleet
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
 from zrp.gap import diagnose as run_diagnosis
@@ -36,7 +37,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--mjcf", metavar="M.xml",
                    help="MJCF with the robot's inertias (gravity torques for joint_compliance; "
                         "one hinge/slide joint per model joint, same order and zero)")
-    p.add_argument("--data", required=True, metavar="D.csv", help="measurement CSV")
+    p.add_argument("--data", required=True, metavar="D.csv",
+                   help="measurement CSV, or a quoted glob ('fleet/*.csv') for a fleet")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
     p.add_argument("--frame", choices=("instrument", "base"), default="instrument",
                    help="frame of x, y, z (default instrument: the base frame is estimated)")
@@ -69,6 +71,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help=f"most data rows read (default {MAX_ROWS:,}, about 1.4 GB at the peak);"
                         " a larger file is refused with guidance")
     p.add_argument("--json", action="store_true", help="print diagnosis.json to stdout")
+    add_fleet_options(p)
     p.set_defaults(func=_run, api_names={
         "withheld_fraction": "--withheld",
         "noise_sigma": "--noise",
@@ -108,6 +111,9 @@ def _run(args: argparse.Namespace) -> int:
 
     if args.max_steps < 1:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")
+    if is_fleet(args.data):  # one diagnosis per file, on a cluster or here (zrp/cli/fleet)
+        return run_fleet(args)
+    refuse_fleet_options(args)
     # reading the inputs creates nothing: a bad input leaves no output folder behind
     model = load_model(args.model)
     # the reader's bar only on a terminal; piped runs get the diagnosis's periodic lines

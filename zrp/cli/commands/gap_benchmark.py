@@ -6,6 +6,7 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
+from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.options import FRACTION, SEED, real, whole
 from zrp.errors import InputError
 from zrp.model.files import builtin_models, load_model
@@ -56,8 +57,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workdir", default=None, metavar="DIR",
                    help="where the measurement CSVs, truth files and diagnoses go (default "
                         "OUT/work)")
-    p.add_argument("--jobs", type=whole(1, 256), default=1, metavar="N",
-                   help="worker processes (default 1; results are the same for any N)")
+    add_cluster_options(p)
+    p.add_argument("--resume", action="store_true",
+                   help="keep the scores an interrupted run of the same configuration wrote "
+                        "into WORKDIR/scores and run only the other scenarios")
     p.add_argument("--force", action="store_true",
                    help="replace existing output files in --out (checked before the run)")
     p.add_argument("--no-plots", action="store_true", help="skip confusion.png")
@@ -81,8 +84,7 @@ def _run(args: argparse.Namespace) -> int:
     work = Path(args.workdir) if args.workdir else out / "work"
     if work.resolve() == out.resolve():
         raise InputError("--workdir: must differ from --out (it is locked for the run)")
-    if args.jobs < 1:
-        raise InputError(f"--jobs: expected at least 1 worker, got {args.jobs}")
+    check_cluster_options(args)
     cfg = BenchmarkConfig(scenarios=args.scenarios, seed=args.seed, poses=args.poses,
                           none_fraction=args.none, pair_fraction=args.pairs,
                           effects=tuple(args.effects), noise=tuple(args.noise),
@@ -91,7 +93,10 @@ def _run(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     # the folder is locked and its files checked before the (long) run
     with OutputDir(out, overwrite=overwrite, names=output_names(not args.no_plots)) as folder:
-        result = run_benchmark(model, cfg, work, progress=not args.no_progress, jobs=args.jobs)
+        # the work folder must be visible to the workers (same path on a remote cluster)
+        with executor_from_args(args) as ex:
+            result = run_benchmark(model, cfg, work, progress=not args.no_progress, executor=ex,
+                                   resume=args.resume)
         files = write_outputs(result, folder, plots=not args.no_plots)
     text = render_text(result) + "\n" + "\n".join(f"wrote {f}" for f in files)
     emit(args, result.to_dict(), text)

@@ -4,11 +4,13 @@ from __future__ import annotations
 
 import argparse
 import math
+from concurrent.futures import Executor
 from typing import Any
 
 import numpy as np
 
 from zrp.cli.app import emit
+from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
 from zrp.cli.options import LENGTH, SEED, TOLERANCE, real, whole
 from zrp.errors import InputError
@@ -82,6 +84,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    default=4000, help="robots per bisection step")
     a.add_argument("--fixed", action="append", metavar="NAME=VALUE",
                    help="tolerances kept fixed during allocation (repeatable)")
+    add_cluster_options(p)
     p.add_argument("--force", action="store_true",
                    help="replace the --hist file if it exists (without it, an existing file is "
                         "never replaced)")
@@ -98,25 +101,29 @@ def _tolerance(args: argparse.Namespace) -> int:
     check_path_options(args, model)
     if not 0.0 < args.percentile < 100.0:
         raise InputError(f"--percentile: expected 0 < P < 100 (e.g. 99), got {args.percentile}")
+    check_cluster_options(args)
     if args.hist:
         check_png_path(args.hist, "--hist")
         check_writable([args.hist], args.force)
     path = path_from_args(args, model)
-    rng = np.random.default_rng(args.seed)
-    if args.allocate:
-        return _allocate(args, model, path, rng)
-    return _analyse(args, model, path, rng)
+    with executor_from_args(args) as ex:
+        if args.allocate:
+            return _allocate(args, model, path, ex)
+        return _analyse(args, model, path, ex)
 
 
 def _allocate(args: argparse.Namespace, model: Manipulator, path: JointPath,
-              rng: np.random.Generator) -> int:
-    """--allocate: the loosest tolerances meeting the requirement, verified."""
+              ex: Executor | None) -> int:
+    """--allocate: the loosest tolerances meeting the requirement, verified (the verification
+    Monte Carlo runs on the executor)."""
+    rng = np.random.default_rng(args.seed)
     u = model.length_unit
     al = allocate_tolerances(model, path.q, rng=rng, max_delta_p=args.max_dp,
                              max_angle_rad=args.max_angle, percentile=args.percentile,
                              distribution=args.distribution, angle_scale_mm=args.angle_scale,
                              fixed=_parse_tol(args.fixed), n_search=args.n_search,
-                             n_verify=args.robots, progress=not args.no_progress)
+                             n_verify=args.robots, progress=not args.no_progress,
+                             executor=ex)
     s = al.summary()
     s["trajectory"] = path.label
     s["distribution"] = args.distribution
@@ -153,15 +160,18 @@ def _allocate(args: argparse.Namespace, model: Manipulator, path: JointPath,
 
 
 def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
-             rng: np.random.Generator) -> int:
-    """Monte Carlo of the given tolerances, with the first-order budget beside it."""
+             ex: Executor | None) -> int:
+    """Monte Carlo of the given tolerances, with the first-order budget beside it. Chunk i
+    draws its robots from (--seed, i), so the result is the same in this process and on any
+    number of workers."""
     u = model.length_unit
     offsets = args.offsets is not None
     tol = Tolerances.build(model, length=args.length, angle_rad=args.angle,
                            offset=args.offsets or 0.0, per_parameter=_parse_tol(args.tol),
                            joint_offsets=offsets)
-    mc = monte_carlo(model, path.q, tol, args.robots, rng=rng, distribution=args.distribution,
-                     progress=not args.no_progress, first_order=True)
+    mc = monte_carlo(model, path.q, tol, args.robots, seed=args.seed,
+                     distribution=args.distribution, progress=not args.no_progress,
+                     first_order=True, executor=ex)
     rep = tolerance_report(model, path.q, tol, mc)
     pct = args.percentile
     dp, ang = mc.percentile(pct)
@@ -186,7 +196,8 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
         f"length {args.length:g} {u}, angle {args.angle:g} rad"
         + (f", offsets {args.offsets:g}" if offsets else "")
         + (f", overrides {args.tol}" if args.tol else ""),
-        f"kernel: {mc.elapsed_s:.3f} s, {mc.poses_per_s / 1e6:.2f} M poses/s",
+        f"kernel: {mc.elapsed_s:.3f} s summed over chunks, {mc.poses_per_s / 1e6:.2f} M "
+        "poses/s per kernel",
         "",
         f"max_t delta_p ({u}) percentiles: "
         + ", ".join(f"{p.upper()} {v:.4g}" for p, v in

@@ -1,0 +1,272 @@
+"""Speed against the issue-15 targets, every figure beside a baseline measured in the same run.
+
+Run: python tests/benchmarks/bench_speed.py [--quick]   (from the repository root)
+
+One core for the kernels (NUMBA_NUM_THREADS=1, set before numba loads). Prints one table:
+figure, measured value, target, the baseline of the same run and the ratio:
+
+* batched FK kernel (1e6 PUMA poses) and the API; baseline: the kernel (API within 1.2x);
+* batched Jacobians; baseline: the FK kernel (a Jacobian needs ~2.5x the work of a pose);
+* one FK call and one Jacobian from Python; baselines: Pinocchio (``pin``)
+  forwardKinematics / computeJointJacobians + getJointJacobian, MuJoCo mj_kinematics /
+  mj_kinematics + mj_comPos + mj_jacBody, on the same arm (where installed);
+* Monte Carlo 1e5 robots x 360 points on one core; then on a Dask LocalCluster of 1 and of
+  2 workers (baseline: 1 worker);
+* the full diagnosis of the IRB 120 laser-tracker data in ../shared (2,946 points) and of its
+  first 999 points; baseline: the registration fit alone (skipped without ../shared);
+* the blind benchmark's simulation of a 200-pose scenario; baseline: the same poses measured
+  by forward kinematics only.
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ["NUMBA_NUM_THREADS"] = "1"  # one core: must precede the first numba import
+
+import argparse
+import tempfile
+import time
+import timeit
+import warnings
+from pathlib import Path
+
+import numpy as np
+
+import zrp
+from zrp.kinematics import _kernels as K
+from zrp.kinematics.forward import _karrays
+
+ROOT = Path(__file__).resolve().parents[2]
+SHARED = ROOT.parent / "shared" / "data" / "irb120-lasertracker"
+ROWS: list[tuple[str, str, str, str, str]] = []
+
+
+def row(what: str, value: str, target: str, baseline: str, ratio: str) -> None:
+    ROWS.append((what, value, target, baseline, ratio))
+    print(f"  {what:<44} {value:>14}  target {target:<12} baseline {baseline:<28} {ratio}",
+          flush=True)
+
+
+def best(*fns, repeat=5):
+    """Best wall time of each function, measured interleaved (the load changes within
+    seconds); one function -> a float, several -> a list."""
+    for fn in fns:
+        fn()
+    out: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for times, fn in zip(out, fns, strict=True):
+            t = time.perf_counter()
+            fn()
+            times.append(time.perf_counter() - t)
+    mins = [min(t) for t in out]
+    return mins[0] if len(fns) == 1 else mins
+
+
+def per_call(*fns, number=20000, repeat=9) -> list[float]:
+    """Best time per call of each function, measured interleaved (the machine's load changes
+    within seconds: each repeat times every function once, back to back)."""
+    for fn in fns:
+        fn()
+    times: list[list[float]] = [[] for _ in fns]
+    for _ in range(repeat):
+        for t, fn in zip(times, fns, strict=True):
+            t.append(timeit.timeit(fn, number=number) / number)
+    return [min(t) for t in times]
+
+
+def batched(model: zrp.Manipulator, n: int) -> None:
+    q = np.random.default_rng(0).uniform(-np.pi, np.pi, (n, model.n))
+    arrays = _karrays(model)
+    out = np.empty((n, 7))
+    t_k, t_api = best(lambda: K.fk_pose_batch(q, *arrays, out),
+                      lambda: zrp.end_effector_pose(model, q), repeat=7)
+    jac = np.empty((n, 6, model.n))
+    t_j, t_japi = best(lambda: K.jac_batch(q, *arrays, np.empty((0, 7)), jac),
+                       lambda: zrp.jacobian(model, q), repeat=4)
+    row("batched FK, kernel (M poses/s/core)", f"{n / t_k / 1e6:.1f}", ">= 50", "-", "")
+    row("batched FK, end_effector_pose (M/s)", f"{n / t_api / 1e6:.1f}", "<= 1.2x kernel",
+        f"kernel {n / t_k / 1e6:.1f} M/s", f"{t_api / t_k:.2f}x")
+    row("batched Jacobian, kernel (M/s)", f"{n / t_j / 1e6:.1f}", ">= 15",
+        f"FK kernel {n / t_k / 1e6:.1f} M/s", f"{t_j / t_k:.2f}x the FK time")
+    row("batched Jacobian, jacobian() (M/s)", f"{n / t_japi / 1e6:.1f}", "",
+        f"kernel {n / t_j / 1e6:.1f} M/s", f"{t_japi / t_j:.2f}x")
+
+
+def pinocchio_model(model: zrp.Manipulator):
+    """The same arm in Pinocchio: joint k at p_k with axis u_{k,0}, the tool at b_{n+1}."""
+    import pinocchio as pin
+
+    pm = pin.Model()
+    parent = 0
+    for k in range(model.n):
+        place = pin.SE3(np.eye(3), np.asarray(model.bodies[k], dtype=float))
+        axis = np.asarray(model.axes[k], dtype=float)
+        jm = (pin.JointModelPrismaticUnaligned(axis) if model.prismatic[k]
+              else pin.JointModelRevoluteUnaligned(axis))
+        parent = pm.addJoint(parent, jm, place, f"j{k + 1}")
+    tool = pin.SE3(np.eye(3), np.asarray(model.bodies[model.n], dtype=float))
+    pm.addFrame(pin.Frame("tool", parent, 0, tool, pin.FrameType.OP_FRAME))
+    return pm
+
+
+def single_calls(model: zrp.Manipulator) -> None:
+    q = np.array([0.1, -0.4, 0.3, 0.7, 1.2, -0.5])
+    t_fk, t_j = per_call(lambda: zrp.end_effector_pose(model, q),
+                         lambda: zrp.jacobian(model, q))
+    base_fk = base_j = "not installed"
+    r_fk = r_j = ""
+    try:
+        import pinocchio as pin
+
+        pm = pinocchio_model(model)
+        pd = pm.createData()
+        fid = pm.getFrameId("tool")
+        pin.forwardKinematics(pm, pd, q)
+        pin.updateFramePlacements(pm, pd)
+        assert np.allclose(pd.oMf[fid].translation, zrp.end_effector_pose(model, q)[0])
+        t_fk, t_pin, t_j, t_pinj = per_call(
+            lambda: zrp.end_effector_pose(model, q), lambda: pin.forwardKinematics(pm, pd, q),
+            lambda: zrp.jacobian(model, q),
+            lambda: (pin.computeJointJacobians(pm, pd, q),
+                     pin.getJointJacobian(pm, pd, model.n, pin.LOCAL_WORLD_ALIGNED)))
+        base_fk = f"Pinocchio {t_pin * 1e6:.2f} us"
+        base_j = f"Pinocchio {t_pinj * 1e6:.2f} us"
+        r_fk = f"{t_fk / t_pin:.2f}x Pinocchio"
+        r_j = f"{t_j / t_pinj:.2f}x Pinocchio"
+    except ImportError:
+        pass
+    row("one FK call, end_effector_pose (us)", f"{t_fk * 1e6:.2f}", "<= 1.5", base_fk, r_fk)
+    row("one Jacobian call, jacobian (us)", f"{t_j * 1e6:.2f}", "<= 2", base_j, r_j)
+    try:
+        import mujoco
+
+        import mjcf
+
+        m = mjcf.build(model).model
+        d = mujoco.MjData(m)
+        d.qpos[:] = q
+        jp = np.empty((3, m.nv))
+        jr = np.empty((3, m.nv))
+
+        def mj_fk():
+            d.qpos[:] = q
+            mujoco.mj_kinematics(m, d)
+
+        def mj_jac():
+            d.qpos[:] = q
+            mujoco.mj_kinematics(m, d)
+            mujoco.mj_comPos(m, d)
+            mujoco.mj_jacBody(m, d, jp, jr, m.nbody - 1)
+
+        t_fk, t_m, t_j, t_mj = per_call(lambda: zrp.end_effector_pose(model, q), mj_fk,
+                                        lambda: zrp.jacobian(model, q), mj_jac)
+        row("  MuJoCo mj_kinematics per call (us)", f"{t_m * 1e6:.2f}", "",
+            f"zrp {t_fk * 1e6:.2f} us", f"zrp {t_fk / t_m:.2f}x")
+        row("  MuJoCo kinematics+comPos+jacBody (us)", f"{t_mj * 1e6:.2f}", "",
+            f"zrp {t_j * 1e6:.2f} us", f"zrp {t_j / t_mj:.2f}x")
+    except ImportError:
+        pass
+
+
+def monte_carlo(n_robots: int, workers: bool) -> None:
+    from zrp.manufacturing import Tolerances
+    from zrp.manufacturing import monte_carlo as mc
+
+    setup = zrp.puma_circle()
+    res = zrp.track_trajectory(setup.model, setup.trajectory, setup.q0, 359)
+    q = res.q  # 360 points
+    tol = Tolerances.build(setup.model, length=0.02, angle_rad=5e-5)
+    mc(setup.model, q, tol, 512, seed=1)  # warm-up
+    t1 = best(lambda: mc(setup.model, q, tol, n_robots, seed=1), repeat=2)
+    row(f"Monte Carlo {n_robots:.0e} x {q.shape[0]}, one core (s)", f"{t1:.2f}", "<= 0.7",
+        "-", f"{n_robots * q.shape[0] / t1 / 1e6:.1f} M poses/s")
+    if not workers:
+        return
+    from zrp.cli.cluster import executor
+
+    times: dict[int, list[float]] = {1: [], 2: []}
+    with executor(1) as e1, executor(2) as e2:
+        for ex in (e1, e2):
+            mc(setup.model, q, tol, 4096, seed=1, chunk=512, executor=ex)  # warm-up
+        for _ in range(3):  # interleaved: both see the same load
+            for w, ex in ((1, e1), (2, e2)):
+                t = time.perf_counter()
+                mc(setup.model, q, tol, n_robots, seed=1, executor=ex)
+                times[w].append(time.perf_counter() - t)
+    t1, t2 = min(times[1]), min(times[2])
+    row("Monte Carlo on a Dask LocalCluster, 2 workers (s)", f"{t2:.2f}", ">= 1.8x faster",
+        f"1 worker {t1:.2f} s", f"{t1 / t2:.2f}x faster")
+
+
+def diagnosis() -> None:
+    if not (SHARED / "measurements.csv").exists():
+        row("diagnosis of the IRB 120 data", "skipped", "<= 3 s", "../shared absent", "")
+        return
+    from zrp.gap import diagnose, load_measurements
+    from zrp.gap.effects import Context, registration_parameters
+    from zrp.gap.leastsq import fit, initial_registration
+
+    model = zrp.load_model(str(SHARED / "irb120.toml"))
+    lines = (SHARED / "measurements.csv").read_text(encoding="utf-8").splitlines()
+    with tempfile.TemporaryDirectory() as tmp:
+        part = Path(tmp) / "first999.csv"
+        part.write_text("\n".join(lines[:1000]) + "\n", encoding="utf-8")
+        for label, path, goal in (("2,946 points", SHARED / "measurements.csv", "<= 3 s"),
+                                  ("999 points", part, "<= 1 s")):
+            meas = load_measurements(path, model, deg=True)
+            ctx = Context(model, meas)
+            poses = np.arange(len(meas.pose_ids))
+            specs = registration_parameters(ctx)
+
+            def registration(ctx=ctx, specs=specs, poses=poses):
+                th0, rb0 = initial_registration(ctx, specs, poses)
+                return fit(ctx, specs, poses, th0, rb0)
+
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                t_reg, t_full = best(registration,
+                                     lambda model=model, meas=meas: diagnose(model, meas, seed=0),
+                                     repeat=2)
+            row(f"diagnosis, IRB 120 {label} (s)", f"{t_full:.2f}", goal,
+                f"registration {t_reg:.3f} s", f"{t_full / t_reg:.0f}x")
+
+
+def simulation(poses: int) -> None:
+    from sim.benchmark import BenchmarkConfig, draw_scenarios, simulate_scenario
+    from sim.effects import default_tool_points, true_geometry
+    from zrp.kinematics import reachable_poses
+
+    model = zrp.load_model("puma")
+    cfg = BenchmarkConfig(scenarios=3, seed=0, poses=poses, none_fraction=0.0,
+                          pair_fraction=0.0)
+    scns = draw_scenarios(model, cfg)
+    tool = default_tool_points(model)
+    with tempfile.TemporaryDirectory() as tmp:
+        times = [simulate_scenario(model, s, cfg, Path(tmp), Path(tmp))[2] for s in scns]
+    t0 = time.perf_counter()
+    for s in scns:
+        q = reachable_poses(model, poses, np.random.default_rng(s.seed))
+        fk = zrp.forward_kinematics(true_geometry(model, s.effects), q)
+        _ = fk.position[:, None, :] + np.einsum("pij,mj->pmi", fk.rotation, tool)
+    t_kin = (time.perf_counter() - t0) / len(scns)
+    row(f"blind-benchmark simulation, {poses} poses (s)", f"{np.median(times):.2f}",
+        "<= 1 s", f"kinematics only {t_kin * 1e3:.1f} ms", f"{np.median(times) / t_kin:.0f}x")
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="smaller sizes, no cluster")
+    args = ap.parse_args()
+    print(f"issue-15 speed figures (one core for the kernels; load {os.getloadavg()[0]:.1f})")
+    model = zrp.load_model("puma")
+    batched(model, 200_000 if args.quick else 1_000_000)
+    single_calls(model)
+    monte_carlo(10_000 if args.quick else 100_000, workers=not args.quick)
+    diagnosis()
+    simulation(50 if args.quick else 200)
+    print(f"(load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,131 @@
+"""``zrp diagnose --data 'fleet/*.csv'``: one diagnosis per file, on a cluster or here, then the
+fleet summary (fleet.md, fleet.csv, fleet.json, fleet.png)."""
+
+from __future__ import annotations
+
+import argparse
+import glob
+import json
+import sys
+from pathlib import Path
+from typing import Any
+
+from tqdm.auto import tqdm
+
+from zrp.cli.app import emit
+from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
+from zrp.cli.fleet.summary import fleet_csv, fleet_figure, fleet_markdown, fleet_summary
+from zrp.cli.fleet.tasks import RobotTask, diagnose_robot, robot_row
+from zrp.errors import InputError
+from zrp.gap.report import OUTPUT_FILES
+from zrp.model.files import load_model
+from zrp.output import OutputDir, check_writable
+from zrp.tasks import TaskFailure, map_tasks
+
+__all__ = ["FLEET_FILES", "add_fleet_options", "is_fleet", "refuse_fleet_options", "run_fleet"]
+
+FLEET_FILES = ("fleet.md", "fleet.csv", "fleet.json", "fleet.png")
+#: Written last by the per-robot report writer: its presence marks a finished robot.
+DONE_MARKER = "report.md"
+
+
+def is_fleet(data: str) -> bool:
+    """``--data`` names a fleet: a glob pattern that is not itself an existing file."""
+    return glob.has_magic(data) and not Path(data).exists()
+
+
+def refuse_fleet_options(args: argparse.Namespace) -> None:
+    """A single file: the fleet's options would be silently ignored, so refuse them."""
+    for opt, given in (("--workers", args.workers is not None),
+                       ("--scheduler", args.scheduler is not None), ("--resume", args.resume)):
+        if given:
+            raise InputError(f"{opt}: only for a fleet (--data with a quoted glob such as "
+                             f"'fleet/*.csv'); {args.data!r} is one file")
+
+
+def add_fleet_options(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("fleet (--data with a glob, e.g. 'fleet/*.csv')")
+    g.add_argument("--tolerance", type=float, default=0.5, metavar="T",
+                   help="a robot is out of tolerance when its largest withheld error after "
+                        "registration exceeds T (length unit; default 0.5)")
+    g.add_argument("--resume", action="store_true",
+                   help="keep the robots an interrupted fleet run finished (OUT/robots/NAME/) "
+                        "and diagnose only the others")
+    add_cluster_options(p)
+
+
+def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[RobotTask]:
+    model = load_model(args.model)
+    names = [f.stem for f in files]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        raise InputError(f"--data: robot names (file stems) must be unique; repeated: {dup}")
+    mjcf = None if args.mjcf is None else Path(args.mjcf)
+    if mjcf is not None and not mjcf.is_file():
+        raise InputError(f"--mjcf: {mjcf} is not a file")
+    opts = {"effects": args.effects, "seed": args.seed, "withheld_fraction": args.withheld,
+            "folds": args.folds, "alpha": args.alpha, "max_steps": args.max_steps,
+            "noise_sigma": args.noise, "progress": False}
+    read = {"deg": args.deg, "frame": args.frame}
+    return [RobotTask(f.stem, f.resolve(), (out / "robots" / f.stem).resolve(), model, mjcf,
+                      read, opts, not args.no_plots) for f in files]
+
+
+def _previous(tasks: list[RobotTask]) -> dict[str, dict[str, Any]]:
+    """Rows of the robots an interrupted run finished."""
+    done = {}
+    for t in tasks:
+        if (t.out / DONE_MARKER).exists() and (t.out / "diagnosis.json").exists():
+            d = json.loads((t.out / "diagnosis.json").read_text(encoding="utf-8"))
+            done[t.name] = robot_row(t.name, str(t.data), d)
+    return done
+
+
+def _diagnose_all(args: argparse.Namespace, todo: list[RobotTask]
+                  ) -> tuple[list[dict[str, Any]], list[TaskFailure]]:
+    rows: list[dict[str, Any]] = []
+    failures: list[TaskFailure] = []
+    show = sys.stderr.isatty() if args.progress is None else args.progress
+    with executor_from_args(args) as ex, \
+            tqdm(total=len(todo), desc="fleet", unit="robot", disable=not show) as bar:
+        for _, res in map_tasks(diagnose_robot, todo, ex, capture=True, describe=str):
+            if isinstance(res, TaskFailure):
+                failures.append(res)
+            else:
+                rows.append(res)
+            bar.update(1)
+            bar.set_postfix(failed=len(failures))
+    return rows, failures
+
+
+def run_fleet(args: argparse.Namespace) -> int:
+    """The fleet run; exit code 1 when some robot could not be diagnosed (the rest was)."""
+    check_cluster_options(args)
+    if not args.tolerance > 0:
+        raise InputError(f"--tolerance: expected a positive length, got {args.tolerance}")
+    files = sorted(Path(f) for f in glob.glob(args.data) if Path(f).is_file())
+    if not files:
+        raise InputError(f"--data: no file matches {args.data!r}")
+    out = Path(args.out)
+    tasks = _tasks(args, files, out)
+    done = _previous(tasks) if args.resume else {}
+    todo = [t for t in tasks if t.name not in done]
+    overwrite = args.force or args.resume
+    names = [n for n in FLEET_FILES if not (args.no_plots and n.endswith(".png"))]
+    per_robot = [n for n in OUTPUT_FILES if not (args.no_plots and n.endswith(".png"))]
+    # every file this run writes is checked before the first diagnosis
+    check_writable([t.out / n for t in todo for n in per_robot], overwrite)
+    with OutputDir(out, overwrite=overwrite, names=names) as folder:
+        rows, failures = _diagnose_all(args, todo)
+        unit = tasks[0].model.length_unit
+        doc = fleet_summary(rows + list(done.values()), failures, args.tolerance, unit,
+                            resumed=len(done))
+        folder.write_json("fleet.json", doc)
+        folder.write_text("fleet.csv", fleet_csv(doc))
+        if not args.no_plots and doc["rows"]:
+            folder.savefig("fleet.png", fleet_figure(doc), dpi=110)
+        folder.write_text("fleet.md", fleet_markdown(doc))
+        files_written = list(folder.written)
+    text = fleet_markdown(doc) + "\n".join(f"wrote {f}" for f in files_written)
+    emit(args, doc, text)
+    return 1 if failures else 0

@@ -1,0 +1,69 @@
+"""Per-robot maxima along a nominal trajectory: the exact (nonlinear) ones from the compiled
+kernel (:mod:`zrp.manufacturing._mc_kernels`) and the first-order model's, for given parameter
+steps. The building blocks of :mod:`.population` and :mod:`.chunks`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from zrp.errors import InputError
+from zrp.kinematics.forward import check_q, end_effector_pose
+from zrp.manufacturing import _mc_kernels as MK
+from zrp.manufacturing.sensitivity import perturbed_arrays
+from zrp.model.manipulator import Manipulator
+
+__all__ = ["first_order_max", "nonlinear_maxima", "trajectory_arrays"]
+
+F64 = NDArray[np.float64]
+
+
+def trajectory_arrays(model: Manipulator, q: ArrayLike) -> tuple[F64, F64, F64, F64, F64]:
+    """The Monte Carlo kernel's view of a nominal joint trajectory q, shape (T, n):
+    (q, cos(q/2), sin(q/2), nominal p, nominal E), each C-contiguous."""
+    q = check_q(model, q)
+    if q.ndim != 2:
+        raise InputError(f"q: expected a joint trajectory of shape (T, {model.n}), got {q.shape}")
+    q = np.ascontiguousarray(q, dtype=float)
+    pd, ed = end_effector_pose(model, q)
+    return (q, np.ascontiguousarray(np.cos(0.5 * q)), np.ascontiguousarray(np.sin(0.5 * q)),
+            np.ascontiguousarray(pd), np.ascontiguousarray(ed))
+
+
+def nonlinear_maxima(model: Manipulator, arrays: tuple[F64, F64, F64, F64, F64], dx: F64,
+                     joint_offsets: bool) -> tuple[F64, F64]:
+    """Exact per-robot maxima along the trajectory for parameter steps ``dx`` (N, P):
+    max_t delta_p (length unit) and max_t error angle (rad), each shape (N,)."""
+    q, ch, sh, pd, ed = arrays
+    axes, bodies, off = perturbed_arrays(model, dx, joint_offsets=joint_offsets)
+    n_r = dx.shape[0]
+    out_dp = np.empty(n_r)
+    out_s = np.empty(n_r)
+    MK.mc_max_deviation(ch, sh, q, np.ascontiguousarray(axes), np.ascontiguousarray(bodies),
+                        np.array(model.prismatic, dtype=np.bool_), np.ascontiguousarray(off),
+                        bool(joint_offsets), pd, ed, out_dp, out_s)
+    return out_dp, 2.0 * np.arcsin(np.minimum(out_s, 1.0))
+
+
+def first_order_max(jac: ArrayLike, dx: ArrayLike, chunk: int = 2048) -> tuple[F64, F64]:
+    """First-order per-robot maxima: max_t ||J_p(t) dx|| and max_t ||J_r(t) dx||.
+
+    Args:
+        jac: identification Jacobian along the trajectory, shape (T, 6, P).
+        dx: parameter steps, shape (N, P).
+
+    Returns:
+        max delta_p (length unit) and max angle (rad), each shape (N,).
+    """
+    jac = np.asarray(jac, dtype=float)
+    dx = np.asarray(dx, dtype=float)
+    t_n, _, p = jac.shape
+    flat = jac.reshape(t_n * 6, p).T  # (P, T*6)
+    out_p = np.empty(dx.shape[0])
+    out_r = np.empty(dx.shape[0])
+    for i in range(0, dx.shape[0], chunk):
+        y = (dx[i:i + chunk] @ flat).reshape(-1, t_n, 6)
+        out_r[i:i + chunk] = np.linalg.norm(y[..., 0:3], axis=-1).max(axis=1)
+        out_p[i:i + chunk] = np.linalg.norm(y[..., 3:6], axis=-1).max(axis=1)
+    return out_p, out_r
