@@ -21,6 +21,7 @@ import contextlib
 from collections.abc import Iterator
 from concurrent.futures import Executor
 
+from zrp.cli.options import whole
 from zrp.errors import InputError
 
 __all__ = ["add_cluster_options", "check_cluster_options", "executor", "executor_from_args"]
@@ -33,7 +34,7 @@ WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_TH
 def add_cluster_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("where it runs (zrp/cli/README.md)")
     x = g.add_mutually_exclusive_group()
-    x.add_argument("--workers", type=int, default=None, metavar="N",
+    x.add_argument("--workers", type=whole(1, 1024), default=None, metavar="N",
                    help="run on a local Dask cluster of N worker processes (default: in this "
                         "process); results are the same for any N")
     x.add_argument("--scheduler", default=None, metavar="ADDRESS",

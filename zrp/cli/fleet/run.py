@@ -16,6 +16,7 @@ from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.fleet.summary import fleet_csv, fleet_figure, fleet_markdown, fleet_summary
 from zrp.cli.fleet.tasks import RobotTask, diagnose_robot, robot_row
+from zrp.cli.options import LENGTH
 from zrp.errors import InputError
 from zrp.gap.report import OUTPUT_FILES
 from zrp.model.files import load_model
@@ -45,7 +46,7 @@ def refuse_fleet_options(args: argparse.Namespace) -> None:
 
 def add_fleet_options(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("fleet (--data with a glob, e.g. 'fleet/*.csv')")
-    g.add_argument("--tolerance", type=float, default=0.5, metavar="T",
+    g.add_argument("--tolerance", type=LENGTH, default=0.5, metavar="T",
                    help="a robot is out of tolerance when its largest withheld error after "
                         "registration exceeds T (length unit; default 0.5)")
     g.add_argument("--resume", action="store_true",
