@@ -437,12 +437,14 @@ def jac_batch(q, axes, bodies, prism, pose, jac):
 @njit(cache=True, fastmath=_FM)
 def fk_pose_packed(q, packed, out):
     """:func:`fk_pose_one` on the packed model; returns False (out untouched) when q has a
-    non-finite value or not the model's n values."""
+    non-finite value, |q| > 1e6 or not the model's n values."""
     n = (packed.shape[0] - 3) // 7
     if q.shape[0] != n:
         return False
     for k in range(n):
-        if not math.isfinite(q[k]):
+        # declines non-finite values and |q| > 1e6 (the revolute range of _range_kernels): the
+        # general path then names the joint in its error
+        if not abs(q[k]) <= 1e6:
             return False
     nb = 3 * n
     npr = nb + 3 * (n + 1)
@@ -484,7 +486,9 @@ def jac_packed(q, packed, jac):
     if q.shape[0] != n or jac.shape[1] != n:
         return False
     for k in range(n):
-        if not math.isfinite(q[k]):
+        # declines non-finite values and |q| > 1e6 (the revolute range of _range_kernels): the
+        # general path then names the joint in its error
+        if not abs(q[k]) <= 1e6:
             return False
     nb = 3 * n
     npr = nb + 3 * (n + 1)
