@@ -8,3 +8,5 @@ from zrp.gap.motion.pipeline import diagnose_motion as diagnose_motion
 from zrp.gap.motion.results import MotionDiagnosis as MotionDiagnosis
 from zrp.gap.motion.results import MotionEstimate as MotionEstimate
 from zrp.gap.motion.results import MotionStep as MotionStep
+from zrp.gap.motion.trajcsv import load_trajectory as load_trajectory
+from zrp.gap.motion.trajcsv import write_trajectory as write_trajectory

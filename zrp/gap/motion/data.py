@@ -79,9 +79,9 @@ class Trajectory:
         dt = np.diff(t)
         if np.any(dt <= 0):
             i = int(np.argmax(dt <= 0)) + 1
-            raise InputError(f"{self.source} line {lines[i]}: t = {t[i]!r} s does not increase "
-                             f"(previous sample t = {t[i - 1]!r} s); samples must be in time "
-                             "order")
+            raise InputError(f"{self.source} line {lines[i]}: t = {float(t[i])!r} s does not "
+                             f"increase (previous sample t = {float(t[i - 1])!r} s); samples "
+                             "must be in time order")
         if len(self.point_labels) != xyz.shape[1]:
             raise InputError(f"{self.source}: {xyz.shape[1]} points per sample but "
                              f"{len(self.point_labels)} point labels")

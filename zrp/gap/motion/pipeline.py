@@ -64,8 +64,8 @@ def _registration(ctx: Context, poses: I64) -> tuple[list, F64, F64]:
     for i in range(J.shape[1]):
         c = J[:, i] / max(np.linalg.norm(J[:, i]), 1e-300)
         r = c - basis @ (basis.T @ c)
-        if np.linalg.norm(r) < ALIAS_TOL * 1e3:
-            continue
+        if specs[i].kind == "tool" and np.linalg.norm(r) < ALIAS_TOL * 1e3:
+            continue  # the base frame always stays (the Problem needs all six)
         keep.append(i)
         basis = np.column_stack([basis, r / np.linalg.norm(r)])
     return [specs[i] for i in keep], theta0[keep], rb0
