@@ -14,7 +14,7 @@ effect                  parameter (per joint k)        unit  d(t; theta)
                                                              F against a servo of stiffness kp,
                                                              r = F / kp (eq. M2, stick-slip at
                                                              velocity reversals)
-``dynamic_compliance``  ``q{k}.dyn_compliance``        rad/  c tau_k(t): deflection under the full
+``dynamic_compliance``  ``q{k}.dyn_compliance``        rad/  -c tau_k(t): deflection under the full
                                                        (N m) inverse-dynamics torque (MJCF inertias,
                                                              ``mj_inverse``; passed in as an array)
 ======================= ============================== ===== =====================================
@@ -40,11 +40,13 @@ from zrp.gap.effects import KINDS, Context, ParamSpec
 from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.kernels import first_order_lag, play
 
-__all__ = ["MOTION_EFFECTS", "Column", "MotionContext", "MotionParam", "effect_columns",
+__all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
            "linearise"]
 
 F64 = NDArray[np.float64]
 MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance")
+#: effects whose parameters are physically positive (a negative estimate is not that effect)
+POSITIVE = ("servo_lag", "reversal_friction", "dynamic_compliance")
 #: a joint must move at least this far (rad or length unit) to carry a per-joint effect.
 MIN_TRAVEL = 1e-4
 
@@ -149,7 +151,7 @@ def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | Non
             continue
         name = f"q{k + 1}.dyn_compliance"
         c = float(values.get(name, 0.0))
-        D = _one_joint(s, n, k, torque[:, k])
+        D = _one_joint(s, n, k, -torque[:, k])  # the joint yields to the torque it carries
         out.append(Column(name, "rad/(N m)", "dynamic_compliance", k + 1, c, c * D, D))
     return out
 

@@ -21,7 +21,7 @@ from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.effects import MOTION_EFFECTS
 from zrp.gap.motion.fitting import Engine, ModelFit
 from zrp.gap.motion.results import MotionDiagnosis, MotionEstimate, MotionStep, PhaseError
-from zrp.gap.motion.search import backward_check, greedy
+from zrp.gap.motion.search import backward_check, drop_effects, greedy
 from zrp.gap.motion.segments import PHASES, phases, split_segments, stream_noise_sigma
 from zrp.gap.problem import Problem
 from zrp.model.manipulator import Manipulator
@@ -135,7 +135,7 @@ def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
     start = eng.fit({}, search, reg_theta=reg0)
     clock["register"] = time.perf_counter()
     final, trace = greedy(eng, start, list(effects), search, sfolds, alpha, 0.01, max_steps)
-    final = backward_check(eng, final, search, alpha)
+    final = drop_effects(eng, backward_check(eng, final, search, alpha), search, alpha)
     clock["search"] = time.perf_counter()
     nominal = eng.fit({}, split.fitting, reg_theta=start.result.theta)
     final_all = eng.fit(final.effects, split.fitting, final.values,

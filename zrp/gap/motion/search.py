@@ -13,10 +13,10 @@ from numpy.typing import NDArray
 
 from zrp.gap.effects import EFFECTS, effect_parameters
 from zrp.gap.leastsq import check_identifiable, cv_rms, f_test, group_key, wald_groups
-from zrp.gap.motion.effects import effect_columns, linearise
+from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise
 from zrp.gap.motion.fitting import Engine, ModelFit
 
-__all__ = ["Trial", "backward_check", "greedy"]
+__all__ = ["Trial", "backward_check", "drop_effects", "greedy"]
 
 I64 = NDArray[np.int64]
 
@@ -74,6 +74,9 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
     mf = eng.fit(effects, poses, current.values, current.result.theta[:eng.nreg])
     pw = wald_groups(mf.result, first)
     sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
+    if effect in POSITIVE:  # a negative lag, friction or compliance is not that effect
+        sig -= {group_key(s) for s, v in zip(mf.specs[first:], mf.result.theta[first:],
+                                             strict=True) if v <= 0.0}
     if not sig:
         return Trial(effect, None, note="no joint group significant", aliased=al)
     if len(sig) < len(pw):
@@ -125,3 +128,19 @@ def backward_check(eng: Engine, mf: ModelFit, poses: I64, alpha: float) -> Model
         if names:
             effects[e] = names
     return eng.fit(effects, poses, mf.values, mf.result.theta[:eng.nreg])
+
+
+def drop_effects(eng: Engine, mf: ModelFit, poses: I64, alpha: float) -> ModelFit:
+    """Backward elimination of whole effects: an effect whose removal does not make the fit
+    significantly worse (F test p >= alpha, or a lower BIC without it) is dropped - e.g. a
+    servo lag on every joint that stood in for a sync delay found later."""
+    changed = True
+    while changed and len(mf.effects) > 1:
+        changed = False
+        for e in list(mf.effects):
+            rest = {k: v for k, v in mf.effects.items() if k != e}
+            small = eng.fit(rest, poses, mf.values, mf.result.theta[:eng.nreg])
+            if f_test(small.result, mf.result) >= alpha or small.result.bic < mf.result.bic:
+                mf, changed = small, True
+                break
+    return mf
