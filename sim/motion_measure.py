@@ -21,14 +21,15 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.interpolate import CubicSpline
 
-from sim.motion_robot import MOTION_HIDDEN, MotionEffects
+from sim.measurement import random_instrument
+from sim.motion_robot import MOTION_HIDDEN, MotionEffects, MotionRun, execute_trajectory
 from zrp.errors import InputError
 from zrp.gap.motion.paths import exercise_moves
 from zrp.kinematics.ik import track_trajectory
 from zrp.model.manipulator import Manipulator
 from zrp.paper.scenario import puma_circle
 
-__all__ = ["TRAJECTORIES", "named_command", "parse_motion_effects"]
+__all__ = ["TRAJECTORIES", "measure_stream", "named_command", "parse_motion_effects"]
 
 F64 = NDArray[np.float64]
 Command = Callable[[F64, int], F64]
@@ -91,3 +92,14 @@ def named_command(model: Manipulator, name: str, rng: np.random.Generator, moves
                             np.where((tt > t[-1])[..., None], q_end, val))
         return circle, float(t[-1] + pad)
     raise InputError(f"trajectory: {name!r}; expected one of {', '.join(TRAJECTORIES)}")
+
+
+def measure_stream(model: Manipulator, trajectory: str, specs: Sequence[str], rate_hz: float,
+                   noise_sigma: float, seed: int, field: str = "specs") -> MotionRun:
+    """Execute the named trajectory on the real robot with the hidden effects ``specs`` and
+    stream time-stamped tracker points at ``rate_hz`` (seeded instrument frame and noise)."""
+    effects = parse_motion_effects(specs, model, field)
+    rng = np.random.default_rng(seed)
+    command, duration = named_command(model, trajectory, rng)
+    inst = random_instrument(model, rng, noise_sigma)
+    return execute_trajectory(model, command, duration, effects, inst, rng, rate_hz=rate_hz)

@@ -15,6 +15,7 @@ times the noise or more); the benchmark does not test the edge of visibility.
 from __future__ import annotations
 
 import itertools
+import json
 import math
 import time
 from dataclasses import dataclass
@@ -33,7 +34,7 @@ from zrp import jsonio
 from zrp.errors import InputError
 from zrp.gap.motion import diagnose_motion, load_trajectory, write_trajectory
 from zrp.model.manipulator import Manipulator
-from zrp.output import OutputDir
+from zrp.output import OutputDir, write_text
 
 __all__ = ["MotionScenario", "MotionScore", "draw_motion_scenarios", "run_motion_benchmark"]
 
@@ -137,22 +138,21 @@ def _run_one(model: Manipulator, scn: MotionScenario, work: Path, arm_model: Any
     csv_path = work / "measurements" / f"motion_{scn.index:03d}.csv"
     truth_path = work / "truth" / f"motion_{scn.index:03d}.truth.json"
     write_trajectory(run.trajectory, csv_path, overwrite=True)
-    truth_path.parent.mkdir(parents=True, exist_ok=True)
-    truth_path.write_text(jsonio.dumps(run.truth))
+    write_text(truth_path, jsonio.dumps(run.truth), overwrite=True)
     sim_s = time.perf_counter() - t0
     # blind: the diagnosis sees the CSV, the nominal model and the nominal MJCF only
     t1 = time.perf_counter()
     traj = load_trajectory(csv_path, model)
     tau = inverse_dynamics_torques(arm_model, traj.q, traj.qd, traj.qdd)
-    diag = diagnose_motion(model, traj, torque=tau, seed=scn.seed % 1000)
+    # the thorough setting: a denser search and every fitting sample in the final fit
+    diag = diagnose_motion(model, traj, torque=tau, seed=scn.seed % 1000,
+                           max_search_samples=4000, max_fit_samples=10**9)
     diag_s = time.perf_counter() - t1
-    truth = jsonio_load(truth_path)
+    truth = _load_truth(truth_path)
     return _score(scn, diag, truth, sim_s, diag_s)
 
 
-def jsonio_load(path: Path) -> dict[str, Any]:
-    import json  # noqa: PLC0415 - the truth file is plain strict JSON written by jsonio
-
+def _load_truth(path: Path) -> dict[str, Any]:
     return json.loads(path.read_text())
 
 
