@@ -11,7 +11,7 @@ from zrp.gap.effects import EFFECTS
 from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
 from zrp.jsonio import dumps
 from zrp.model.files import load_model
-from zrp.output import OutputDir
+from zrp.output import OutputDir, check_writable
 
 OUTPUT_FILES = ("diagnosis_motion.json", "report_motion.md")
 
@@ -40,10 +40,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help=f"candidates (default: {', '.join(MOTION_EFFECTS)}; static ones allowed)")
     p.add_argument("--noise", type=float, metavar="SIGMA",
                    help="known tracker noise per coordinate (default: from the stream)")
+    p.add_argument("--video", metavar="V.mp4", help="also render the arm along the path with "
+                   "the measured path and the simulated paths before and after overlaid")
+    p.add_argument("--magnify", type=float, default=50.0,
+                   help="magnification of the path differences in the video (default 50)")
     p.add_argument("--json", action="store_true", help="print the diagnosis JSON")
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "n_segments": "--segments",
                                          "seed": "--seed", "effects": "--effects",
-                                         "torque": "--mjcf"})
+                                         "torque": "--mjcf", "magnify": "--magnify",
+                                         "overwrite": "--force"})
 
 
 def _torque(args: argparse.Namespace, model: object, traj: object) -> object:
@@ -61,6 +66,8 @@ def _torque(args: argparse.Namespace, model: object, traj: object) -> object:
 
 def _run(args: argparse.Namespace) -> int:
     model = load_model(args.model)
+    if args.video:
+        check_writable([args.video], args.force)  # before the work
     traj = load_trajectory(args.data, model, deg=args.deg, frame=args.frame)
     tau = _torque(args, model, traj)
     with OutputDir(Path(args.out), overwrite=args.force, names=OUTPUT_FILES) as folder:
@@ -69,6 +76,12 @@ def _run(args: argparse.Namespace) -> int:
         doc = diag.to_dict()
         folder.write_text("diagnosis_motion.json", dumps(doc))
         folder.write_text("report_motion.md", _report(diag))
+    if args.video:
+        # sim loads MuJoCo and the renderer: only when a video is asked for.
+        from sim.motion_video import render_motion_video
+
+        render_motion_video(model, traj, diag, args.video, magnify=args.magnify,
+                            overwrite=args.force)
     emit(args, doc, diag.verdict + f"\nwrote {args.out}/diagnosis_motion.json, "
          f"{args.out}/report_motion.md")
     return 0

@@ -184,4 +184,5 @@ def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
         {"withheld_segments": list(split.withheld_segments),
          "n_fitting": int(split.fitting.size), "n_withheld": int(split.withheld.size)},
         {k: clock[k] - clock["start"] for k in ("register", "search", "final_fit", "end")},
-        trajectory.xyz + r_before, trajectory.xyz + r_after, tuple(warn))
+        trajectory.xyz + r_before, trajectory.xyz + r_after, tuple(warn),
+        Problem(final_all.ctx, final_all.specs, fitting, rb0).base(final_all.result.theta))

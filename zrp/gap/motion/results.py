@@ -115,6 +115,8 @@ class MotionDiagnosis:
         path_before, path_after: the model's predicted points in the measurement frame,
             before (registration only) and after (final model), shape (S, M, 3).
         warnings: plain-words notes.
+        registration: the final model's instrument-from-base rotation (3, 3) and translation
+            (3,) (length unit): a base-frame point p is R p + t in the measurement frame.
     """
 
     model: str
@@ -132,6 +134,7 @@ class MotionDiagnosis:
     path_before: F64
     path_after: F64
     warnings: tuple[str, ...] = ()
+    registration: tuple[F64, F64] | None = None
 
     def __post_init__(self) -> None:
         if self.path_before.shape != self.path_after.shape:
