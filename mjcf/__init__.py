@@ -7,6 +7,7 @@
 
 from mjcf import _env  # noqa: F401 (checks MUJOCO_GL before any module imports mujoco)
 from mjcf.builder import BuiltArm, MJCFOptions, build, build_spec
+from mjcf.dynamics import inverse_dynamics_torques
 from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
 from mjcf.gravity import gravity_torques
 from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
@@ -27,6 +28,7 @@ __all__ = [
     "build_spec",
     "from_mjcf",
     "gravity_torques",
+    "inverse_dynamics_torques",
     "load_mujoco_model",
     "manipulator_from_mujoco",
     "metres_per_unit",

@@ -11,9 +11,11 @@ import numpy as np
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, real, whole
 from zrp.errors import InputError
+from zrp.gap.motion import write_trajectory
+from zrp.jsonio import dumps
 from zrp.kinematics import reachable_poses
 from zrp.model.files import builtin_models, load_model
-from zrp.output import check_writable
+from zrp.output import check_writable, write_text
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -40,8 +42,16 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="payload at the tool point, kg (logged in the load column)")
     p.add_argument("--poses", type=whole(1, 100_000),
                    default=200, help="number of poses (default 200)")
-    p.add_argument("--trajectory", choices=("random", "circle"), default="random",
-                   help="random reachable poses (default) or poses along the PUMA circle")
+    p.add_argument("--trajectory", choices=("random", "circle", "moves"), default="random",
+                   help="random reachable poses (default) or poses along the PUMA circle; with "
+                        "--stream: the circle or random joint moves, executed in motion")
+    p.add_argument("--stream", type=real(1.0, 1000.0), metavar="HZ",
+                   help="execute the trajectory in motion and stream time-stamped tracker "
+                        "points at HZ (1-1000) as a trajectory CSV (zrp diagnose-motion)")
+    p.add_argument("--motion-effect", action="append", default=[], metavar="NAME[:J]=VALUE",
+                   help="with --stream, a hidden motion effect, repeatable: sync_delay=2ms, "
+                        "servo_lag:2=5ms, reversal_friction:2=15Nm, "
+                        "dynamic_compliance:3=20urad/Nm")
     p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
                    help="final approach against gravity for the joints that carry a "
                         "gravity torque, the others from a random side (default; written as "
@@ -59,7 +69,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "anything is simulated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
-    p.set_defaults(func=_run, api_names={"count": "--poses", "specs": "--effect"})
+    p.set_defaults(func=_run, api_names={"count": "--poses", "specs": "--effect",
+                                         "rate_hz": "--stream"})
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -79,6 +90,8 @@ def _run(args: argparse.Namespace) -> int:
         raise InputError("--truth: must differ from --out")
     check_writable([out, truth], args.force)  # before the simulation, which takes a while
     model = load_model(args.model)
+    if args.stream is not None:
+        return _stream(args, model, out, truth)
     effects = sim.parse_effects(args.effect, model, args.payload, field="--effect")
     rng = np.random.default_rng(args.seed)
     q = (reachable_poses(model, args.poses, rng) if args.trajectory == "random"
@@ -99,5 +112,32 @@ def _run(args: argparse.Namespace) -> int:
             f"{model.name} with hidden effects: {', '.join(effects.active) or 'none'}; "
             f"noise {args.noise:g} {model.length_unit} per coordinate; {wall:.1f} s\n"
             f"wrote {out}\nwrote {truth} (the truth: keep it away from the diagnosis)")
+    emit(args, payload, text)
+    return 0
+
+
+def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> int:
+    """``--stream``: the real robot in motion (sim/motion_measure.py)."""
+    from sim.motion_measure import measure_stream  # MuJoCo: only when this command runs
+
+    if args.effect:
+        raise InputError("--effect: static effects are not simulated with --stream; use "
+                         "--motion-effect")
+    traj_name = "moves" if args.trajectory == "random" else args.trajectory
+    t0 = time.perf_counter()
+    run = measure_stream(model, traj_name, args.motion_effect, args.stream,  # type: ignore[arg-type]
+                         args.noise, args.seed, field="--motion-effect")
+    wall = time.perf_counter() - t0
+    write_trajectory(run.trajectory, out, deg=args.deg, model=model,  # type: ignore[arg-type]
+                     overwrite=args.force)
+    write_text(truth, dumps(run.truth), overwrite=args.force)
+    tr = run.trajectory
+    payload = {"measurements": str(out), "truth": str(truth), "samples": tr.n_samples,
+               "rate_hz": args.stream, "duration_s": tr.duration, "trajectory": traj_name,
+               "effects": list(run.effects.active), "noise_sigma": args.noise, "wall_s": wall}
+    text = (f"streamed {tr.n_samples} samples ({tr.duration:.1f} s at {args.stream:g} Hz) of "
+            f"the real robot drawing '{traj_name}' with hidden motion effects: "
+            f"{', '.join(run.effects.active) or 'none'}; {wall:.1f} s\nwrote {out}\n"
+            f"wrote {truth} (the truth: keep it away from the diagnosis)")
     emit(args, payload, text)
     return 0

@@ -1,0 +1,62 @@
+"""Inverse-dynamics torques along a trajectory (``mj_inverse``), for the motion diagnosis's
+``dynamic_compliance`` effect (computed here, passed into the core as an array)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from zrp.errors import InputError
+
+__all__ = ["inverse_dynamics_torques"]
+
+F64 = NDArray[np.float64]
+
+
+def inverse_dynamics_torques(source: str | Path | mujoco.MjModel, q: ArrayLike, qd: ArrayLike,
+                             qdd: ArrayLike, field: str = "path") -> F64:
+    """Joint torques that move an MJCF arm along (q, qd, qdd): MuJoCo's ``qfrc_inverse`` from
+    ``mj_inverse`` (M(q) qdd + bias(q, qd), gravity included; N m for hinges), shape (S, n).
+
+    The MJCF must have exactly n hinge/slide joints in the model's order with the same zero
+    (as the project's MJCF export writes them); constraints are off (no limits or friction
+    enter the torques).
+
+    Args:
+        source: an MJCF/URDF path or a compiled ``mujoco.MjModel``.
+        q, qd, qdd: joint values (rad), velocities (rad/s), accelerations (rad/s^2), shape
+            (S, n) each (MuJoCo units: metres for slide joints).
+        field: how error messages name ``source``.
+    """
+    q, qd, qdd = (np.atleast_2d(np.asarray(a, dtype=float)) for a in (q, qd, qdd))
+    if not (q.shape == qd.shape == qdd.shape):
+        raise InputError(f"q, qd, qdd: expected equal shapes (S, n), got {q.shape}, "
+                         f"{qd.shape}, {qdd.shape}")
+    if isinstance(source, mujoco.MjModel):
+        m = source
+    else:
+        try:
+            m = mujoco.MjModel.from_xml_path(str(source))
+        except Exception as exc:  # mujoco raises ValueError with its own message
+            raise InputError(f"{field} {source}: cannot load: {exc}") from exc
+    n = q.shape[1]
+    if m.nq != n or m.nv != n:
+        raise InputError(f"{field}: has {m.nq} position coordinates, but the trajectory has {n} "
+                         "joints; the MJCF must have one hinge/slide joint per model joint")
+    d = mujoco.MjData(m)
+    saved = m.opt.disableflags
+    m.opt.disableflags = saved | int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    out = np.empty(q.shape)
+    try:
+        for i in range(q.shape[0]):
+            d.qpos[:] = q[i]
+            d.qvel[:] = qd[i]
+            d.qacc[:] = qdd[i]
+            mujoco.mj_inverse(m, d)
+            out[i] = d.qfrc_inverse
+    finally:
+        m.opt.disableflags = saved
+    return out

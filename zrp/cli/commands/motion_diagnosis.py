@@ -1,0 +1,107 @@
+"""``zrp diagnose-motion``: the sim-to-real gap along a measured trajectory."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from zrp.cli.app import emit
+from zrp.cli.options import LENGTH, SEED, real, whole
+from zrp.errors import InputError
+from zrp.gap.effects import EFFECTS
+from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
+from zrp.jsonio import dumps
+from zrp.model.files import load_model
+from zrp.output import OutputDir, check_writable
+
+OUTPUT_FILES = ("diagnosis_motion.json", "report_motion.md")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "diagnose-motion", help="sim-to-real gap diagnosis along a measured trajectory",
+        description="Register a time-stamped trajectory measurement (t, q1..qn, x, y, z; "
+        "optional point, tq), then find which motion effect (sync delay, servo lag, friction "
+        "at reversals, compliance under the dynamic torque) explains the gap, where along the "
+        "path it lies and how far it shrinks on withheld time segments (zrp/gap/README.md).")
+    p.add_argument("--model", required=True, metavar="M.toml", help="model file or built-in name")
+    p.add_argument("--data", required=True, metavar="D.csv", help="trajectory CSV")
+    p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
+    p.add_argument("--mjcf", metavar="M.xml", help="MJCF with the inertias (inverse-dynamics "
+                   "torques for dynamic_compliance; one hinge/slide joint per model joint)")
+    p.add_argument("--inertia", choices=("puma560", "rods"),
+                   help="instead of --mjcf: build the nominal MJCF with these inertias")
+    p.add_argument("--frame", choices=("instrument", "base"), default="instrument")
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    p.add_argument("--seed", type=SEED, default=0, help="seed of the time-segment split")
+    p.add_argument("--segments", type=whole(4, 10_000), default=20,
+                   help="time segments (default 20)")
+    p.add_argument("--effects", nargs="+", choices=MOTION_EFFECTS + EFFECTS,
+                   default=list(MOTION_EFFECTS), metavar="EFFECT",
+                   help=f"candidates (default: {', '.join(MOTION_EFFECTS)}; static ones allowed)")
+    p.add_argument("--noise", type=LENGTH, metavar="SIGMA",
+                   help="known tracker noise per coordinate (default: from the stream)")
+    p.add_argument("--video", metavar="V.mp4", help="also render the arm along the path with "
+                   "the measured path and the simulated paths before and after overlaid")
+    p.add_argument("--magnify", type=real(0.0, 1e9, open_lo=True), default=50.0,
+                   help="magnification of the path differences in the video (default 50)")
+    p.add_argument("--json", action="store_true", help="print the diagnosis JSON")
+    p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "n_segments": "--segments",
+                                         "seed": "--seed", "effects": "--effects",
+                                         "torque": "--mjcf", "magnify": "--magnify",
+                                         "overwrite": "--force"})
+
+
+def _torque(args: argparse.Namespace, model: object, traj: object) -> object:
+    if args.mjcf and args.inertia:
+        raise InputError("--mjcf and --inertia: give one of them")
+    if not (args.mjcf or args.inertia):
+        return None
+    # mjcf loads MuJoCo: only when torques are asked for.
+    from mjcf import MJCFOptions, build, inverse_dynamics_torques
+
+    src = args.mjcf or build(model, MJCFOptions(inertia=args.inertia)).model  # type: ignore[arg-type]
+    return inverse_dynamics_torques(src, traj.q, traj.qd, traj.qdd,  # type: ignore[attr-defined]
+                                    field="--mjcf")
+
+
+def _run(args: argparse.Namespace) -> int:
+    model = load_model(args.model)
+    if args.video:
+        check_writable([args.video], args.force)  # before the work
+    traj = load_trajectory(args.data, model, deg=args.deg, frame=args.frame)
+    tau = _torque(args, model, traj)
+    with OutputDir(Path(args.out), overwrite=args.force, names=OUTPUT_FILES) as folder:
+        diag = diagnose_motion(model, traj, torque=tau, effects=args.effects, seed=args.seed,
+                               n_segments=args.segments, noise_sigma=args.noise)
+        doc = diag.to_dict()
+        folder.write_text("diagnosis_motion.json", dumps(doc))
+        folder.write_text("report_motion.md", _report(diag))
+    if args.video:
+        # sim loads MuJoCo and the renderer: only when a video is asked for.
+        from sim.motion_video import render_motion_video
+
+        render_motion_video(model, traj, diag, args.video, magnify=args.magnify,
+                            overwrite=args.force)
+    emit(args, doc, diag.verdict + f"\nwrote {args.out}/diagnosis_motion.json, "
+         f"{args.out}/report_motion.md")
+    return 0
+
+
+def _report(diag: object) -> str:
+    d = diag  # MotionDiagnosis
+    u = d.length_unit  # type: ignore[attr-defined]
+    lines = ["# Motion diagnosis", "", d.verdict, "",  # type: ignore[attr-defined]
+             f"| phase | samples | RMS before ({u}) | after | withheld before | after |",
+             "|---|---|---|---|---|---|"]
+    for p in d.phases:  # type: ignore[attr-defined]
+        cells = [p.phase, str(p.n_samples)] + [
+            "-" if v is None else f"{v:.4g}"
+            for v in (p.rms_before, p.rms_after, p.withheld_before, p.withheld_after)]
+        lines.append("| " + " | ".join(cells) + " |")
+    lines += ["", "| parameter | value | 95 % interval |", "|---|---|---|"]
+    for e in d.parameters:  # type: ignore[attr-defined]
+        lo, hi = e.ci95
+        lines.append(f"| {e.name} | {e.value:.4g} {e.unit} | [{lo:.4g}, {hi:.4g}] |")
+    return "\n".join(lines) + "\n"

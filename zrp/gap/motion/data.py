@@ -1,0 +1,143 @@
+"""Trajectory measurements: time-stamped tracker points while the robot moves.
+
+:class:`Trajectory` holds S samples (time stamps of the tracker, s), the controller's commanded
+joint values at those times, and the M tool points measured at each sample. Each sample is a
+"pose" of the static engine (:class:`zrp.gap.Measurements`, pose id ``s<i>``), so the static
+fitting (:mod:`zrp.gap.problem`, :mod:`zrp.gap.leastsq`) and the static effects run unchanged
+on the same data. The commanded joint values are interpolated by a cubic spline (eq. M0) for
+the velocities, accelerations and time shifts the motion effects need.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy.interpolate import CubicSpline
+
+from zrp.errors import InputError
+from zrp.gap.data import FRAMES, Measurements
+
+__all__ = ["MIN_SAMPLES", "Trajectory"]
+
+F64 = NDArray[np.float64]
+#: fewest samples a trajectory diagnosis accepts.
+MIN_SAMPLES = 50
+
+
+def _frozen(a: ArrayLike) -> F64:
+    arr = np.array(a, dtype=float)
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class Trajectory:
+    """Validated time-stamped measurements (S samples, n joints, M tool points).
+
+    Attributes:
+        t: tracker time stamps, s, strictly increasing, shape (S,).
+        q: commanded joint values at t (controller), rad or model length unit, shape (S, n).
+        xyz: measured tool points, model length unit, shape (S, M, 3).
+        point_labels: the M point labels.
+        frame: "instrument" (unknown rigid transform, estimated) or "base".
+        lines: source line of each sample's first row (messages), shape (S,).
+        source: file name or description.
+    """
+
+    t: F64
+    q: F64
+    xyz: F64
+    point_labels: tuple[str, ...] = ("p1",)
+    frame: str = "instrument"
+    lines: NDArray[np.int64] | None = None
+    source: str = "trajectory"
+
+    def __post_init__(self) -> None:
+        t = np.asarray(self.t, dtype=float)
+        q = np.asarray(self.q, dtype=float)
+        xyz = np.asarray(self.xyz, dtype=float)
+        if xyz.ndim == 2:
+            xyz = xyz[:, None, :]
+        s = t.shape[0] if t.ndim == 1 else -1
+        if t.ndim != 1 or q.ndim != 2 or q.shape[0] != s or xyz.shape[:1] != (s,) \
+                or xyz.ndim != 3 or xyz.shape[2] != 3:
+            raise InputError(f"{self.source}: expected t (S,), q (S, n), xyz (S, M, 3); got "
+                             f"{t.shape}, {q.shape}, {xyz.shape}")
+        if s < MIN_SAMPLES:
+            raise InputError(f"{self.source}: {s} samples; a trajectory diagnosis needs at "
+                             f"least {MIN_SAMPLES}")
+        lines = (np.arange(s, dtype=np.int64) + 2 if self.lines is None
+                 else np.asarray(self.lines, dtype=np.int64))
+        for name, a in (("t", t), ("q", q), ("xyz", xyz)):
+            bad = ~np.isfinite(a.reshape(s, -1)).all(axis=1)
+            if bad.any():
+                i = int(np.argmax(bad))
+                raise InputError(f"{self.source} line {lines[i]}: {name} is not a finite number")
+        dt = np.diff(t)
+        if np.any(dt <= 0):
+            i = int(np.argmax(dt <= 0)) + 1
+            raise InputError(f"{self.source} line {lines[i]}: t = {float(t[i])!r} s does not "
+                             f"increase (previous sample t = {float(t[i - 1])!r} s); samples "
+                             "must be in time order")
+        if len(self.point_labels) != xyz.shape[1]:
+            raise InputError(f"{self.source}: {xyz.shape[1]} points per sample but "
+                             f"{len(self.point_labels)} point labels")
+        if self.frame not in FRAMES:
+            raise InputError(f"frame: {self.frame!r} is not a frame; expected one of {FRAMES}")
+        object.__setattr__(self, "t", _frozen(t))
+        object.__setattr__(self, "q", _frozen(q))
+        object.__setattr__(self, "xyz", _frozen(xyz))
+        object.__setattr__(self, "lines", lines)
+        object.__setattr__(self, "point_labels", tuple(str(p) for p in self.point_labels))
+
+    @property
+    def n_samples(self) -> int:
+        return int(self.t.shape[0])
+
+    @property
+    def n_joints(self) -> int:
+        return int(self.q.shape[1])
+
+    @property
+    def duration(self) -> float:
+        """s."""
+        return float(self.t[-1] - self.t[0])
+
+    @property
+    def rate_hz(self) -> float:
+        """Median sample rate, Hz."""
+        return float(1.0 / np.median(np.diff(self.t)))
+
+    @cached_property
+    def spline(self) -> CubicSpline:
+        """q(t), the commanded joints as a cubic spline (eq. M0; natural ends)."""
+        return CubicSpline(self.t, self.q, axis=0, bc_type="natural")
+
+    @cached_property
+    def qd(self) -> F64:
+        """Commanded joint velocities at the samples, shape (S, n)."""
+        return _frozen(self.spline(self.t, 1))
+
+    @cached_property
+    def qdd(self) -> F64:
+        """Commanded joint accelerations at the samples, shape (S, n)."""
+        return _frozen(self.spline(self.t, 2))
+
+    @cached_property
+    def measurements(self) -> Measurements:
+        """The same data as static measurements: one pose per sample (``s<i>``)."""
+        s, m = self.xyz.shape[:2]
+        pose = np.repeat(np.array([f"s{i}" for i in range(s)], dtype=object), m)
+        point = np.tile(np.array(self.point_labels, dtype=object), s)
+        return Measurements(pose, point, np.repeat(self.q, m, axis=0),
+                            self.xyz.reshape(-1, 3), self.frame, np.repeat(self.t, m),
+                            None, None, None, None, np.repeat(self.lines, m), self.source)
+
+    def subset(self, samples: ArrayLike) -> Trajectory:
+        """The samples at the given indices (in order)."""
+        i = np.asarray(samples, dtype=np.int64)
+        return Trajectory(self.t[i], self.q[i], self.xyz[i], self.point_labels, self.frame,
+                          self.lines[i], self.source)

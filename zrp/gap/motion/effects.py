@@ -1,0 +1,192 @@
+"""Effects that live in motion, as joint corrections of the static engine's ``dq`` kind.
+
+Each effect maps the commanded joint trajectory u(t) (:class:`~zrp.gap.motion.data.Trajectory`)
+to the actual one, q'(t) = u(t) + d(t; theta), and gives the exact derivative D = dd/dtheta:
+
+======================= ============================== ===== =====================================
+effect                  parameter (per joint k)        unit  d(t; theta)
+======================= ============================== ===== =====================================
+``sync_delay``          ``sync.delay`` (one, shared)   s     u(t - delta) - u(t): the tracker's
+                                                             clock runs delta ahead (eq. M3)
+``servo_lag``           ``q{k}.lag``                   s     first-order servo, tau y' + y = u
+                                                             (eq. M1, ``kernels.first_order_lag``)
+``reversal_friction``   ``q{k}.friction``              rad   play of half-width r: Coulomb friction
+                                                             F against a servo of stiffness kp,
+                                                             r = F / kp (eq. M2, stick-slip at
+                                                             velocity reversals)
+``dynamic_compliance``  ``q{k}.dyn_compliance``        rad/  -c tau_k(t): deflection under the full
+                                                       (N m) inverse-dynamics torque (MJCF inertias,
+                                                             ``mj_inverse``; passed in as an array)
+======================= ============================== ===== =====================================
+
+The nonlinear ones (delay, lag, play) are linearised at the current estimate theta0:
+q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the *shift*) goes into
+the joint values of :class:`MotionContext` and D into a ``dq`` basis, so the static
+:class:`~zrp.gap.problem.Problem` and its analytic Jacobian apply unchanged; the search
+re-linearises until theta stops moving (Gauss-Newton on the exact model).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.errors import InputError
+from zrp.gap.effects import KINDS, Context, ParamSpec
+from zrp.gap.motion.data import Trajectory
+from zrp.gap.motion.kernels import first_order_lag, play
+
+__all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
+           "linearise"]
+
+F64 = NDArray[np.float64]
+MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance")
+#: effects whose parameters are physically positive (a negative estimate is not that effect)
+POSITIVE = ("servo_lag", "reversal_friction", "dynamic_compliance")
+#: a joint must move at least this far (rad or length unit) to carry a per-joint effect.
+MIN_TRAVEL = 1e-4
+
+
+class MotionParam(ParamSpec):
+    """A :class:`~zrp.gap.effects.ParamSpec` of a motion effect (kind ``dq``)."""
+
+    def __post_init__(self) -> None:
+        if self.effect not in MOTION_EFFECTS or self.kind not in KINDS or self.kind != "dq":
+            raise InputError(f"MotionParam {self.name}: effect {self.effect!r} must be one of "
+                             f"{MOTION_EFFECTS} with kind 'dq'")
+        if self.basis is None:
+            raise InputError(f"MotionParam {self.name}: a basis is required")
+        if not self.group:
+            object.__setattr__(self, "group", self.name)
+
+
+@dataclass(frozen=True, eq=False)
+class MotionContext(Context):
+    """A :class:`~zrp.gap.effects.Context` whose joint values carry the linearisation shift of
+    the nonlinear motion effects: q = commanded + shift, shape (S, n)."""
+
+    shift: F64 | None = None
+
+    @cached_property
+    def q(self) -> F64:  # type: ignore[override]
+        q = self.meas.q_pose
+        return q if self.shift is None else q + self.shift
+
+
+@dataclass(frozen=True, eq=False)
+class Column:
+    """One motion parameter evaluated at a value.
+
+    Attributes:
+        name, unit, effect: as in :class:`~zrp.gap.effects.ParamSpec`.
+        joint: 1-based joint, 0 for a parameter acting on all joints.
+        value: the value at which d and D are evaluated.
+        d: the joint deviation d(theta), shape (S, n).
+        D: its derivative, shape (S, n).
+    """
+
+    name: str
+    unit: str
+    effect: str
+    joint: int
+    value: float
+    d: F64
+    D: F64
+
+
+def _one_joint(s: int, n: int, k: int, col: F64) -> F64:
+    out = np.zeros((s, n))
+    out[:, k] = col
+    return out
+
+
+def _moving(traj: Trajectory) -> list[int]:
+    return [k for k in range(traj.n_joints) if np.ptp(traj.q[:, k]) > MIN_TRAVEL]
+
+
+def _sync(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+    delta = float(values.get("sync.delay", 0.0))
+    ts = traj.t - delta
+    d = traj.spline(ts) - traj.q
+    D = -traj.spline(ts, 1)
+    return [Column("sync.delay", "s", "sync_delay", 0, delta, d, D)]
+
+
+def _lag(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+    s, n = traj.q.shape
+    out = []
+    for k in _moving(traj):
+        name = f"q{k + 1}.lag"
+        tau = float(values.get(name, 0.0))
+        y, dy = first_order_lag(traj.t, traj.q[:, k], tau)
+        out.append(Column(name, "s", "servo_lag", k + 1, tau,
+                          _one_joint(s, n, k, y - traj.q[:, k]), _one_joint(s, n, k, dy)))
+    return out
+
+
+def _friction(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+    s, n = traj.q.shape
+    out = []
+    for k in _moving(traj):
+        name = f"q{k + 1}.friction"
+        r = float(values.get(name, 0.0))
+        y, dy = play(traj.q[:, k], r)
+        out.append(Column(name, "rad", "reversal_friction", k + 1, r,
+                          _one_joint(s, n, k, y - traj.q[:, k]), _one_joint(s, n, k, dy)))
+    return out
+
+
+def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | None
+                ) -> list[Column]:
+    if torque is None:
+        return []
+    s, n = traj.q.shape
+    out = []
+    for k in range(n):
+        if not np.any(torque[:, k] != 0.0):
+            continue
+        name = f"q{k + 1}.dyn_compliance"
+        c = float(values.get(name, 0.0))
+        D = _one_joint(s, n, k, -torque[:, k])  # the joint yields to the torque it carries
+        out.append(Column(name, "rad/(N m)", "dynamic_compliance", k + 1, c, c * D, D))
+    return out
+
+
+def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
+                   torque: F64 | None = None) -> list[Column]:
+    """All parameters of one motion effect evaluated at ``values`` (missing names: 0).
+
+    Args:
+        torque: inverse-dynamics torque per sample and joint, N m, shape (S, n), or None
+            (then ``dynamic_compliance`` has no parameters).
+    """
+    if effect == "sync_delay":
+        return _sync(traj, values)
+    if effect == "servo_lag":
+        return _lag(traj, values)
+    if effect == "reversal_friction":
+        return _friction(traj, values)
+    if effect == "dynamic_compliance":
+        return _compliance(traj, values, torque)
+    raise InputError(f"effect: {effect!r} is not a motion effect; valid: "
+                     f"{', '.join(MOTION_EFFECTS)}")
+
+
+def linearise(cols: list[Column]) -> tuple[F64 | None, list[MotionParam]]:
+    """The shift sum_c [d_c - D_c theta_c] (S, n) (None when zero) and the ``dq`` specs with
+    basis D_c, so that q' = commanded + shift + sum_c D_c theta_c."""
+    shift = None
+    specs = []
+    for c in cols:
+        part = c.d - c.D * c.value
+        if np.any(part != 0.0):
+            shift = part if shift is None else shift + part
+        basis = np.array(c.D)
+        basis.setflags(write=False)
+        specs.append(MotionParam(c.name, c.unit, c.effect, "dq", c.joint, 0, basis,
+                                 f"q{c.joint}" if c.joint else "all"))
+    return shift, specs

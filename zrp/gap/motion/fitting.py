@@ -1,0 +1,117 @@
+"""Fitting a model of motion effects on top of the registration, re-linearising the
+nonlinear effects (Gauss-Newton on the exact model): the static engine's least squares
+(:func:`zrp.gap.leastsq.fit`, analytic Jacobian of :class:`zrp.gap.problem.Problem`) does
+each linear step."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.gap.effects import EFFECTS, Context, ParamSpec, effect_parameters
+from zrp.gap.leastsq import FitResult, fit
+from zrp.gap.motion.data import Trajectory
+from zrp.gap.motion.effects import MotionContext, effect_columns, linearise
+from zrp.gap.problem import Problem
+from zrp.model.manipulator import Manipulator
+
+__all__ = ["Engine", "ModelFit"]
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+NONLINEAR = ("sync_delay", "servo_lag", "reversal_friction")
+
+
+@dataclass(frozen=True, eq=False)
+class ModelFit:
+    """A fitted model: registration + effects.
+
+    Attributes:
+        effects: effect name -> the parameter names kept (None: all).
+        values: effect parameter name -> value (the last linearisation point = the estimate).
+        result: the least-squares fit (registration parameters first).
+        ctx: the context of the last linearisation (joint values with the shift).
+        iterations: re-linearisations done.
+    """
+
+    effects: dict[str, frozenset[str] | None]
+    values: dict[str, float]
+    result: FitResult
+    ctx: Context
+    iterations: int
+
+    @property
+    def specs(self) -> tuple[ParamSpec, ...]:
+        return self.result.specs
+
+
+class Engine:
+    """The data and registration shared by all fits of one diagnosis.
+
+    Args:
+        model: the nominal model.
+        traj: the trajectory measurements.
+        torque: inverse-dynamics torques (S, n), N m, or None.
+        reg_specs: registration parameters; base_rotation: R_b0 (3, 3).
+    """
+
+    def __init__(self, model: Manipulator, traj: Trajectory, torque: F64 | None,
+                 reg_specs: Sequence[ParamSpec], base_rotation: F64) -> None:
+        self.model = model
+        self.traj = traj
+        self.torque = torque
+        self.meas = traj.measurements
+        self.base_ctx = Context(model, self.meas)
+        self.reg_specs = tuple(reg_specs)
+        self.base_rotation = base_rotation
+
+    @property
+    def nreg(self) -> int:
+        return len(self.reg_specs)
+
+    def specs_for(self, effects: Mapping[str, frozenset[str] | None],
+                  values: Mapping[str, float]) -> tuple[Context, list[ParamSpec]]:
+        """The context (shifted joints) and the effect specs linearised at ``values``."""
+        cols = []
+        static: list[ParamSpec] = []
+        for e, keep in effects.items():
+            if e in EFFECTS:
+                sp, _ = effect_parameters(self.base_ctx, e)
+                static += [s for s in sp if keep is None or s.name in keep]
+                continue
+            cols += [c for c in effect_columns(self.traj, e, values, self.torque)
+                     if keep is None or c.name in keep]
+        shift, mspecs = linearise(cols)
+        ctx = MotionContext(self.model, self.meas, shift=shift)
+        return ctx, [*mspecs, *static]
+
+    def fit(self, effects: Mapping[str, frozenset[str] | None], poses: I64,
+            values: Mapping[str, float] | None = None, reg_theta: F64 | None = None,
+            max_outer: int = 6, rtol: float = 1e-3) -> ModelFit:
+        """Fit registration + ``effects`` on ``poses`` (sample indices)."""
+        vals = dict(values or {})
+        reg = np.zeros(self.nreg) if reg_theta is None else np.asarray(reg_theta, float)
+        nonlinear = any(e in NONLINEAR for e in effects)
+        it = 0
+        while True:
+            it += 1
+            ctx, specs = self.specs_for(effects, vals)
+            theta0 = np.concatenate([reg, [vals.get(s.name, 0.0) for s in specs]])
+            res = fit(ctx, [*self.reg_specs, *specs], poses, theta0, self.base_rotation)
+            new = {s.name: float(v) for s, v in zip(specs, res.theta[self.nreg:], strict=True)}
+            reg = res.theta[:self.nreg]
+            se = res.stderr[self.nreg:]
+            moved = [abs(new[s.name] - vals.get(s.name, 0.0)) for s in specs]
+            done = all(m <= rtol * max(abs(new[s.name]), 0.0) + 0.05 * e
+                       for m, s, e in zip(moved, specs, se, strict=True))
+            vals = new
+            if not nonlinear or done or it >= max_outer:
+                return ModelFit(dict(effects), vals, res, ctx, it)
+
+    def residual(self, mf: ModelFit, poses: I64) -> F64:
+        """Predicted minus measured on ``poses`` with the fitted model, shape (3R,)."""
+        prob = Problem(mf.ctx, mf.specs, poses, self.base_rotation)
+        return prob.residual(mf.result.theta)

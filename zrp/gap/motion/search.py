@@ -1,0 +1,146 @@
+"""The greedy search over motion effects (forward steps, then a backward check), on the
+static engine's statistics: identifiability (:func:`~zrp.gap.leastsq.check_identifiable`),
+Wald tests per joint group, F test and BIC against the current model, and cross-validated RMS
+over folds of whole time segments (:func:`~zrp.gap.leastsq.cv_rms`)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.gap.effects import EFFECTS, effect_parameters
+from zrp.gap.leastsq import check_identifiable, cv_rms, f_test, group_key, wald_groups
+from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise
+from zrp.gap.motion.fitting import Engine, ModelFit
+
+__all__ = ["Trial", "backward_check", "drop_effects", "greedy"]
+
+I64 = NDArray[np.int64]
+
+
+@dataclass(frozen=True, eq=False)
+class Trial:
+    """One candidate effect tried on top of the current model.
+
+    Attributes:
+        effect: the candidate.
+        fit: the fitted model with it (None when it could not be tried).
+        joints: joints kept (0 for a parameter shared by all joints).
+        cv_rms: cross-validated 3-D RMS (length unit), inf when not tried.
+        p_value: F test against the current model.
+        bic_delta: BIC change against the current model.
+        note: why it was not tried or not significant.
+    """
+
+    effect: str
+    fit: ModelFit | None
+    joints: tuple[int, ...] = ()
+    cv_rms: float = float("inf")
+    p_value: float = 1.0
+    bic_delta: float = 0.0
+    note: str = ""
+    aliased: tuple[str, ...] = field(default=())
+
+    def to_dict(self) -> dict:
+        return {"effect": self.effect, "joints": list(self.joints),
+                "cv_rms": None if not np.isfinite(self.cv_rms) else self.cv_rms,
+                "p_value": self.p_value, "bic_delta": self.bic_delta, "note": self.note,
+                "aliased": list(self.aliased)}
+
+
+def _candidate_specs(eng: Engine, current: ModelFit, effect: str) -> list:
+    if effect in EFFECTS:
+        return effect_parameters(eng.base_ctx, effect)[0]
+    return linearise(effect_columns(eng.traj, effect, {}, eng.torque))[1]
+
+
+def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
+               folds: Sequence[I64], alpha: float) -> Trial:
+    """Fit ``effect`` on top of ``current``: identifiable parameters, Wald pruning of its
+    joint groups at alpha / groups, then the scores."""
+    cand = _candidate_specs(eng, current, effect)
+    if not cand:
+        return Trial(effect, None, note="no parameter applies to these data")
+    keep, aliased = check_identifiable(current.ctx, current.result, cand, poses)
+    al = tuple(a.name for a in aliased if a.dropped)
+    if not keep:
+        return Trial(effect, None, note="not identifiable on top of the current model",
+                     aliased=al)
+    first = len(current.specs)
+    effects = {**current.effects, effect: frozenset(s.name for s in keep)}
+    mf = eng.fit(effects, poses, current.values, current.result.theta[:eng.nreg])
+    pw = wald_groups(mf.result, first)
+    sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
+    if effect in POSITIVE:  # a negative lag, friction or compliance is not that effect
+        sig -= {group_key(s) for s, v in zip(mf.specs[first:], mf.result.theta[first:],
+                                             strict=True) if v <= 0.0}
+    if not sig:
+        return Trial(effect, None, note="no joint group significant", aliased=al)
+    if len(sig) < len(pw):
+        names = frozenset(s.name for s in mf.specs[first:] if group_key(s) in sig)
+        effects[effect] = names
+        mf = eng.fit(effects, poses, mf.values, mf.result.theta[:eng.nreg])
+    joints = tuple(sorted({s.joint for s in mf.specs[first:]}))
+    return Trial(effect, mf, joints, cv_rms(mf.ctx, mf.result, folds),
+                 f_test(current.result, mf.result), mf.result.bic - current.result.bic,
+                 aliased=al)
+
+
+def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
+           folds: Sequence[I64], alpha: float = 1e-3, min_gain: float = 0.01,
+           max_steps: int = 3) -> tuple[ModelFit, list[tuple[Trial, list[Trial]]]]:
+    """Add the best effect (lowest CV RMS) while its F test is significant, BIC falls and the
+    CV RMS improves by at least ``min_gain``. Returns the final model and, per step, the
+    winner and the ranking."""
+    current = start
+    cur_cv = cv_rms(start.ctx, start.result, folds)
+    steps: list[tuple[Trial, list[Trial]]] = []
+    for _ in range(max_steps):
+        left = [e for e in effects if e not in current.effects]
+        if not left:
+            break
+        trials = [try_effect(eng, current, e, poses, folds, alpha) for e in left]
+        ranked = sorted(trials, key=lambda tr: tr.cv_rms)
+        best = ranked[0]
+        if (best.fit is None or best.p_value >= alpha or best.bic_delta >= 0
+                or best.cv_rms > (1.0 - min_gain) * cur_cv):
+            steps.append((Trial(best.effect, None, note="stop"), ranked))
+            break
+        steps.append((best, ranked))
+        current, cur_cv = best.fit, best.cv_rms
+    return current, steps
+
+
+def backward_check(eng: Engine, mf: ModelFit, poses: I64, alpha: float) -> ModelFit:
+    """Drop the joint groups that the final joint model no longer needs (Wald test at
+    alpha / groups) and refit; drop an effect left without parameters."""
+    pw = wald_groups(mf.result, eng.nreg)
+    sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
+    if len(sig) == len(pw):
+        return mf
+    effects: dict[str, frozenset[str] | None] = {}
+    for e in mf.effects:
+        names = frozenset(s.name for s in mf.specs[eng.nreg:]
+                          if s.effect == e and group_key(s) in sig)
+        if names:
+            effects[e] = names
+    return eng.fit(effects, poses, mf.values, mf.result.theta[:eng.nreg])
+
+
+def drop_effects(eng: Engine, mf: ModelFit, poses: I64, alpha: float) -> ModelFit:
+    """Backward elimination of whole effects: an effect whose removal does not make the fit
+    significantly worse (F test p >= alpha, or a lower BIC without it) is dropped - e.g. a
+    servo lag on every joint that stood in for a sync delay found later."""
+    changed = True
+    while changed and len(mf.effects) > 1:
+        changed = False
+        for e in list(mf.effects):
+            rest = {k: v for k, v in mf.effects.items() if k != e}
+            small = eng.fit(rest, poses, mf.values, mf.result.theta[:eng.nreg])
+            if f_test(small.result, mf.result) >= alpha or small.result.bic < mf.result.bic:
+                mf, changed = small, True
+                break
+    return mf
