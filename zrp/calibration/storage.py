@@ -1,21 +1,9 @@
 """Write and read a calibrated robot: a model TOML (geometry) and a compensation JSON.
 
 The compensation file (``schema_version`` 1, lengths in the model's ``length_unit``, angles
-in rad) holds everything the model file cannot:
-
-| key | content |
-|---|---|
-| ``model_file`` | the calibrated model TOML written beside it (its name) |
-| ``nominal_model`` | the nominal model as TOML text (the joint map's lumped moment arms are its) |
-| ``frame`` | "instrument" (R_b, t_b identified) or "base" |
-| ``base_rotation``, ``base_rotvec``, ``base_translation`` | instrument-from-base: m = R_b y + t_b |
-| ``tool_points`` | label -> t'_j: offset of the point from the model's end point in the calibrated zero reference position (rotated with the hand: y = p'(x) + R'_n(x) t'_j) |
-| ``joint_offsets_folded`` | revolute offsets already folded into the model (rad; for the record) |
-| ``joint_map`` | terms ``{name, effect, joint, unit, value, stderr}``: x_k = q_k + sum value B(pose) (bases in zrp/calibration/jointmap.py) |
-| ``thermal`` | ``kappa`` (1/deg C) and ``t_ref_degC``: bodies scale by 1 + kappa (temp - t_ref) |
-| ``backlash`` | ``switch`` per joint (N m or lumped units; null: approach direction only), ``payload_kg`` |
-| ``gravity_dir``, ``harmonics``, ``compliance_model`` | as in the diagnosis |
-| ``withheld_rms`` | the diagnosis's final withheld RMS |
+in rad) holds everything the model file cannot: the nominal model, the instrument-from-base
+transform, the tool points in full, the folded offsets, the joint map, thermal expansion and
+the backlash flank model; its keys are documented in zrp/calibration/README.md.
 """
 
 from __future__ import annotations
