@@ -89,7 +89,7 @@ def test_offsets_are_folded_into_the_model(geometric):
     # of both through the toolkit's forward kinematics
     q = uniform_joint_values(PUMA, 20, np.random.default_rng(3), LIM)
     fit = geometric.final_fit
-    from zrp.gap.problem import Problem  # noqa: PLC0415  the diagnosis's corrected geometry
+    from zrp.gap.problem import Problem
     u, _, bodies = Problem(geometric.context, fit.specs, geometric.fitting_poses[:1],
                            fit.base_rotation).geometry(fit.theta)
     corrected = PUMA.with_arrays(axes=u, bodies=bodies)

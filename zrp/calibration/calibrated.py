@@ -21,7 +21,8 @@ with p', R'_n the forward kinematics of the folded geometry, bodies scaled by
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import dataclasses
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -117,6 +118,9 @@ class CalibratedRobot:
         gravity_dir, harmonics, frame: as in the diagnosis.
         compliance_model: "mjcf" or "lumped_masses".
         withheld_rms: the diagnosis's final withheld RMS (length unit), for the record.
+        gravity_side_weights: without MJCF torques, the lumped masses (per joint and mass
+            point, shape (n, J)) whose gravity torque decides the loaded flank of the backlash
+            (the diagnosis's lumped-mass compliance fit), or None.
     """
 
     model: Manipulator
@@ -136,7 +140,7 @@ class CalibratedRobot:
     frame: str = "instrument"
     compliance_model: str = "lumped_masses"
     withheld_rms: float | None = None
-    notes: tuple[str, ...] = field(default=())
+    gravity_side_weights: F64 | None = None
 
     def __post_init__(self) -> None:
         n = self.model.n
@@ -194,7 +198,7 @@ class CalibratedRobot:
                    0.0 if bl is None else float(bl.payload_kg), tuple(ctx.gravity_dir),
                    tuple(ctx.harmonics), ctx.meas.frame,
                    "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
-                   float(diag.final.rms))
+                   float(diag.final.rms), _side_weights(ctx))
 
     # ---- prediction -----------------------------------------------------------------------
     def context(self, q: ArrayLike, cond: PoseConditions | None = None) -> Context:
@@ -211,8 +215,13 @@ class CalibratedRobot:
             np.inf if v is None else float(v) for v in self.backlash_switch)
         tau = None if cond.gravity_torque is None else np.asarray(cond.gravity_torque,
                                                                   dtype=float)
-        return Context(self.nominal, meas, tau, self.gravity_dir, self.harmonics, self.t_ref,
-                       backlash_switch=sw, payload_kg=self.payload_kg)
+        ctx = Context(self.nominal, meas, tau, self.gravity_dir, self.harmonics, self.t_ref,
+                      backlash_switch=sw, payload_kg=self.payload_kg)
+        if tau is None and self.gravity_side_weights is not None:
+            _, h = ctx.moment_arms()
+            side = np.einsum("pkj,kj->pk", h, np.asarray(self.gravity_side_weights))
+            ctx = dataclasses.replace(ctx, gravity_side=side)
+        return ctx
 
     def actual_joint_values(self, q: ArrayLike, cond: PoseConditions | None = None) -> F64:
         """x = q + dq: the joint values of the calibrated geometry the robot reaches when q is
@@ -252,6 +261,19 @@ class CalibratedRobot:
         if frame != "instrument":
             raise InputError(f"frame: expected 'instrument' or 'base', got {frame!r}")
         return y @ np.asarray(self.base_rotation).T + np.asarray(self.base_translation)
+
+
+def _side_weights(ctx: Context) -> F64 | None:
+    """The lumped masses behind the diagnosis's ``gravity_side`` torques, shape (n, J): per
+    joint, the least-squares combination of the moment-arm columns (exact: the diagnosis built
+    them as such a combination), or None with MJCF torques or without a gravity side."""
+    if ctx.gravity_torque is not None or ctx.gravity_side is None:
+        return None
+    _, h = ctx.moment_arms()
+    w = np.zeros((ctx.n, h.shape[2]))
+    for k in range(ctx.n):
+        w[k] = np.linalg.lstsq(h[:, k, :], ctx.gravity_side[:, k], rcond=None)[0]
+    return w
 
 
 def _fold(model: Manipulator, u: F64, bodies: F64, delta: F64, tools: F64

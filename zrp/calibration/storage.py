@@ -50,6 +50,8 @@ def calibration_document(cal: CalibratedRobot, model_file: str) -> dict[str, Any
         "harmonics": list(cal.harmonics),
         "compliance_model": cal.compliance_model,
         "withheld_rms": cal.withheld_rms,
+        "gravity_side_weights": (None if cal.gravity_side_weights is None
+                                 else np.asarray(cal.gravity_side_weights).tolist()),
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
                   "= R_b (p'(x) + R'_n(x) t'_j) + t_b with p', R'_n the forward kinematics of "
                   "model_file, bodies scaled by 1 + kappa (temp - t_ref)"),
@@ -109,4 +111,6 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
         float(th["kappa"]), float(th["t_ref_degC"]),
         None if bl["switch"] is None else tuple(bl["switch"]), float(bl["payload_kg"]),
         tuple(_get(doc, "gravity_dir", src)), tuple(_get(doc, "harmonics", src)),
-        _get(doc, "frame", src), _get(doc, "compliance_model", src), doc.get("withheld_rms"))
+        _get(doc, "frame", src), _get(doc, "compliance_model", src), doc.get("withheld_rms"),
+        None if doc.get("gravity_side_weights") is None
+        else np.array(doc["gravity_side_weights"], dtype=float))
