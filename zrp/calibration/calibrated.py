@@ -168,10 +168,12 @@ class CalibratedRobot:
 
     # ---- from a diagnosis -----------------------------------------------------------------
     @classmethod
-    def from_diagnosis(cls, diag: Diagnosis) -> CalibratedRobot:
+    def from_diagnosis(cls, diag: Diagnosis, registration_only: bool = False
+                       ) -> CalibratedRobot:
         """The calibrated robot of the final model of ``diag`` (its jointly estimated
-        parameters, registration included)."""
-        fit = diag.final_fit
+        parameters, registration included); with ``registration_only``, the nominal model
+        with the registration alone (base frame and tool points: the usual baseline)."""
+        fit = diag.nominal_fit if registration_only else diag.final_fit
         ctx = diag.context
         prob = Problem(ctx, fit.specs, diag.fitting_poses[:1], fit.base_rotation)
         theta = fit.theta
@@ -191,14 +193,15 @@ class CalibratedRobot:
             elif s.kind == "dq" and s.effect in NON_GEOMETRIC:
                 terms.append(Term(s.name, s.effect, s.joint, s.unit, float(v), float(se)))
         folded, tools_f = _fold(ctx.model, u, bodies, delta, tools)
-        bl = diag.where.backlash
+        bl = None if registration_only else diag.where.backlash
         return cls(folded, ctx.model, rb, tb, tuple(ctx.meas.point_labels), tools_f, delta,
                    tuple(terms), kappa, float(ctx.t_ref_degC),
                    None if bl is None else tuple(bl.switch),
                    0.0 if bl is None else float(bl.payload_kg), tuple(ctx.gravity_dir),
                    tuple(ctx.harmonics), ctx.meas.frame,
                    "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
-                   float(diag.final.rms), _side_weights(ctx))
+                   float(diag.nominal.rms if registration_only else diag.final.rms),
+                   _side_weights(ctx))
 
     # ---- prediction -----------------------------------------------------------------------
     def context(self, q: ArrayLike, cond: PoseConditions | None = None) -> Context:
