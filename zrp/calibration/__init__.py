@@ -15,16 +15,22 @@ from zrp.calibration.compensation import Compensation as Compensation
 from zrp.calibration.compensation import compensate as compensate
 from zrp.calibration.compensation import compensate_program as compensate_program
 from zrp.calibration.jointmap import Term as Term
+from zrp.calibration.planning import Plan as Plan
+from zrp.calibration.planning import PlanWarning as PlanWarning
+from zrp.calibration.planning import plan_poses as plan_poses
 from zrp.calibration.storage import read_calibration as read_calibration
 from zrp.calibration.storage import write_calibration as write_calibration
 
 __all__ = [
     "CalibratedRobot",
     "Compensation",
+    "Plan",
+    "PlanWarning",
     "PoseConditions",
     "Term",
     "compensate",
     "compensate_program",
+    "plan_poses",
     "read_calibration",
     "write_calibration",
 ]
