@@ -62,7 +62,8 @@ def test_predicted_std_matches_repeated_identification(plan):
     effect = [i for i, n in enumerate(plan.names) if not n.startswith(("base", "tool"))]
     ratio = spread[effect] / plan.std[effect]
     print("spread / predicted std:", np.round(ratio, 3))
-    assert np.all(np.abs(ratio - 1.0) < 0.3), dict(zip(np.array(plan.names)[effect], ratio))
+    names = np.array(plan.names)[effect]
+    assert np.all(np.abs(ratio - 1.0) < 0.3), dict(zip(names, ratio, strict=True))
 
 
 def test_too_few_poses():
