@@ -224,8 +224,7 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
     e, _, full = _errors(cal, q, cond, tg)
     ok = np.linalg.norm(e, axis=1) < tol
     near_limit = _check_limits(q, limits, limit_margin, ids)
-    smin = np.linalg.svd(full, compute_uv=False)[:, -1] if cal.n <= 6 else np.linalg.svd(
-        full, compute_uv=False)[:, 5]
+    smin = np.linalg.svd(full, compute_uv=False)[:, -1]
     L = cal.model.characteristic_length
     return Compensation(ids, q, q0, y + e[:, :3], np.linalg.norm(e[:, :3], axis=1),
                         None if rot is None else np.linalg.norm(e[:, 3:], axis=1) / L,
