@@ -39,7 +39,7 @@ from zrp.gap import Diagnosis, Measurements, diagnose
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["CompensationCheck", "compensation_check"]
+__all__ = ["CompensationCheck", "run_compensation_check"]
 
 F64 = NDArray[np.float64]
 
@@ -102,7 +102,7 @@ def _targets(model: Manipulator, rng: np.random.Generator, n_random: int, n_circ
     return np.concatenate(parts), tuple(labels)
 
 
-def compensation_check(model: Manipulator, effects: HiddenEffects, *, poses: int = 200,
+def run_compensation_check(model: Manipulator, effects: HiddenEffects, *, poses: int = 200,
                        n_random: int = 40, n_circle: int = 24, noise_sigma: float = 0.02,
                        seed: int = 0, instrument: Instrument | None = None
                        ) -> CompensationCheck:

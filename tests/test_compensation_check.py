@@ -4,7 +4,7 @@ predicted, errors of the program and of the compensated commands on fresh target
 from __future__ import annotations
 
 import zrp
-from sim.compensation_check import compensation_check
+from sim.compensation_check import run_compensation_check
 from sim.effects import HiddenEffects
 
 
@@ -12,7 +12,7 @@ def test_compensated_targets_land_within_the_tracker_noise():
     puma = zrp.load_model("puma")
     eff = HiddenEffects(joint_offset={2: 1e-3}, joint_compliance={2: 2e-5, 3: 3e-5},
                         link_length={3: (0.3, 0.0, -0.2)}, payload=2.0)
-    r = compensation_check(puma, eff, poses=150, n_random=24, n_circle=12, seed=0)
+    r = run_compensation_check(puma, eff, poses=150, n_random=24, n_circle=12, seed=0)
     assert r.compensation.residual.max() < 1e-6
     assert r.rms_before > 10 * r.noise_rms
     assert r.rms_after <= 1.5 * r.noise_rms, r.summary()

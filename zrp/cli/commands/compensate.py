@@ -6,7 +6,8 @@ import argparse
 
 import numpy as np
 
-from zrp.calibration import compensate, compensate_program, read_calibration
+from zrp.calibration import compensate as compensate_targets
+from zrp.calibration import compensate_program, read_calibration
 from zrp.calibration.targets import load_targets, write_commands
 from zrp.cli.app import emit
 from zrp.errors import InputError
@@ -74,7 +75,7 @@ def _run(args: argparse.Namespace) -> int:
         comp = compensate_program(cal, tg.q, limits=lim, gravity_torque=grav,
                                   target_ids=tg.ids)
     else:
-        comp = compensate(cal, tg.xyz, tg.q, orientations=tg.rotation, point=args.point,
+        comp = compensate_targets(cal, tg.xyz, tg.q, orientations=tg.rotation, point=args.point,
                           frame=args.frame, limits=lim, gravity_torque=grav,
                           target_ids=tg.ids)
     path = write_commands(comp, args.out, deg=args.deg, overwrite=args.force)
