@@ -89,8 +89,32 @@ class _Targets:
     tool: F64               # (3,) t'_j
 
 
+def _approach(q: F64) -> F64:
+    """Approach direction of each joint from the command order (as
+    :meth:`zrp.gap.Measurements.approach_direction`): sign of the change from the previous
+    command, kept when the joint does not move, 0 before it first moves; shape (T, n)."""
+    d = np.zeros_like(q)
+    for i in range(1, len(q)):
+        s = np.sign(q[i] - q[i - 1])
+        d[i] = np.where(s != 0.0, s, d[i - 1])
+    return d
+
+
 def _conditions(cond: PoseConditions, gravity: GravityFn | None, q: F64) -> PoseConditions:
-    return cond if gravity is None else replace(cond, gravity_torque=gravity(q))
+    """The pose conditions at commands q: explicit approach directions (from the order of q
+    unless given) and the gravity torques at q (when a function is given)."""
+    out = cond if cond.direction is not None else replace(cond, direction=_approach(q))
+    return out if gravity is None else replace(out, gravity_torque=gravity(q))
+
+
+def _subset(cond: PoseConditions, tg: _Targets, idx: NDArray[np.int64]
+            ) -> tuple[PoseConditions, _Targets]:
+    def pick(a: ArrayLike | None) -> F64 | None:
+        return None if a is None else np.asarray(a, dtype=float)[idx]
+
+    return (PoseConditions(pick(cond.direction), pick(cond.gravity_torque), pick(cond.temp),
+                           pick(cond.load)),
+            _Targets(tg.y[idx], None if tg.rot is None else tg.rot[idx], tg.tool))
 
 
 def _errors(cal: CalibratedRobot, q: F64, cond: PoseConditions, tg: _Targets
@@ -116,34 +140,34 @@ def _errors(cal: CalibratedRobot, q: F64, cond: PoseConditions, tg: _Targets
 
 
 def _newton(cal: CalibratedRobot, q: F64, cond: PoseConditions, tg: _Targets, tol: float,
-            max_iter: int) -> tuple[F64, F64, F64, NDArray[np.bool_]]:
-    """Gauss-Newton with step halving per target (the error norm never grows)."""
-    e, J, full = _errors(cal, q, cond, tg)
+            max_iter: int) -> F64:
+    """Gauss-Newton with step halving per target (the error norm never grows); only the
+    targets not yet converged (and still improving) are evaluated. ``cond`` must carry
+    explicit directions (a subset keeps them)."""
+    q = q.copy()
+    e, _, _ = _errors(cal, q, cond, tg)
     norm = np.linalg.norm(e, axis=1)
+    active = np.flatnonzero(norm >= tol)
     for _ in range(max_iter):
-        ok = norm < tol
-        if ok.all():
+        if not active.size:
             break
-        step = -np.einsum("tij,tj->ti", np.linalg.pinv(J, rcond=1e-7), e)
+        c, t = _subset(cond, tg, active)
+        qa, na = q[active], norm[active]
+        ea, Ja, _ = _errors(cal, qa, c, t)
+        step = -np.einsum("tij,tj->ti", np.linalg.pinv(Ja, rcond=1e-7), ea)
         big = np.abs(step).max(axis=1, keepdims=True)
         step *= np.minimum(1.0, 0.5 / np.maximum(big, 1e-300))   # at most 0.5 rad a step
-        step[ok] = 0.0
         for _ in range(8):
-            e1, J1, f1 = _errors(cal, q + step, cond, tg)
+            e1, _, _ = _errors(cal, qa + step, c, t)
             n1 = np.linalg.norm(e1, axis=1)
-            better = (n1 < norm) | ok
+            better = n1 < na
             if better.all():
                 break
             step[~better] *= 0.5
-        take = n1 < norm
-        q = np.where(take[:, None], q + step, q)
-        e = np.where(take[:, None], e1, e)
-        J = np.where(take[:, None, None], J1, J)
-        full = np.where(take[:, None, None], f1, full)
-        norm = np.where(take, n1, norm)
-        if not take.any():
-            break
-    return q, e, full, norm < tol
+        q[active[better]] = qa[better] + step[better]
+        norm[active[better]] = n1[better]
+        active = active[better & (n1 >= tol)]
+    return q
 
 
 def _check_limits(q: F64, limits: ArrayLike | None, margin: float, ids: tuple[str, ...]
@@ -214,7 +238,7 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
     q = q0
     adaptive = gravity_torque is not None or base.direction is None
     for _ in range(max_rounds):
-        q, e, full, ok = _newton(cal, q, cond, tg, tol, max_iter)
+        q = _newton(cal, q, cond, tg, tol, max_iter)
         if not adaptive:
             break
         cond = _conditions(base, gravity_torque, q)
