@@ -14,6 +14,8 @@ from zrp.calibration.calibrated import PoseConditions as PoseConditions
 from zrp.calibration.compensation import Compensation as Compensation
 from zrp.calibration.compensation import compensate as compensate
 from zrp.calibration.compensation import compensate_program as compensate_program
+from zrp.calibration.iso9283 import PoseAccuracy as PoseAccuracy
+from zrp.calibration.iso9283 import pose_accuracy as pose_accuracy
 from zrp.calibration.jointmap import Term as Term
 from zrp.calibration.planning import Plan as Plan
 from zrp.calibration.planning import PlanWarning as PlanWarning
@@ -26,11 +28,13 @@ __all__ = [
     "Compensation",
     "Plan",
     "PlanWarning",
+    "PoseAccuracy",
     "PoseConditions",
     "Term",
     "compensate",
     "compensate_program",
     "plan_poses",
+    "pose_accuracy",
     "read_calibration",
     "write_calibration",
 ]
