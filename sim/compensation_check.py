@@ -31,15 +31,17 @@ from numpy.typing import NDArray
 
 from mjcf import MJCFOptions, build, save_mjcf
 from mjcf.gravity import gravity_torques
+from sim.benchmark.scenarios import BenchmarkConfig, draw_scenarios
 from sim.effects import HiddenEffects
 from sim.measurement import Instrument, Procedure, measure, trajectory_poses
 from sim.real_robot import RealRobot
 from zrp.calibration import CalibratedRobot, Compensation, PoseConditions, compensate
+from zrp.errors import InputError
 from zrp.gap import Diagnosis, Measurements, diagnose
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["CompensationCheck", "run_compensation_check"]
+__all__ = ["CompensationCheck", "compensation_scenarios", "run_compensation_check"]
 
 F64 = NDArray[np.float64]
 
@@ -151,3 +153,26 @@ def _conditions(load: F64) -> PoseConditions:
 def _error(meas: Measurements, target: F64) -> F64:
     sel = np.asarray(meas.point) == "smr1"
     return np.linalg.norm(meas.xyz[sel] - target, axis=1)
+
+
+def compensation_scenarios(model: Manipulator, config: BenchmarkConfig, *, poses: int = 200,
+                           n_random: int = 40, n_circle: int = 24) -> list[dict[str, object]]:
+    """The "compensated" column of the blind benchmark: :func:`run_compensation_check` on each
+    scenario the benchmark draws (``config``: its seed, effects, noise; the scenario's own
+    seed), one row per scenario: hidden effects, effects found, measured RMS before and after
+    compensation and after / pure-noise RMS. Thermal expansion is not compensated (the
+    targets' future temperatures are not known when the commands are computed)."""
+    rows: list[dict[str, object]] = []
+    for scn in draw_scenarios(model, config):
+        row: dict[str, object] = {"index": scn.index, "hidden": ", ".join(scn.labels) or "none",
+                                  "payload_kg": scn.effects.payload}
+        try:
+            r = run_compensation_check(model, scn.effects, poses=poses, n_random=n_random,
+                                       n_circle=n_circle, noise_sigma=scn.noise_sigma,
+                                       seed=scn.seed % (2 ** 32))
+        except InputError as exc:  # the diagnosis or compensation refused: report it
+            row["error"] = str(exc)
+        else:
+            row.update(r.summary())
+        rows.append(row)
+    return rows
