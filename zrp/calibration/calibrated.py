@@ -1,0 +1,303 @@
+"""The calibrated robot taken out of a gap diagnosis (:class:`CalibratedRobot`).
+
+Geometric part (a :class:`~zrp.Manipulator`, written as a model TOML): the diagnosis's
+corrected geometry (body vectors b_k + db_k, tilted axes) with the identified revolute joint
+offsets delta folded in. Folding is exact: with R_{k-1}(delta) the rotation before body k at
+q = delta,
+
+    u'_k = R_{k-1}(delta) u_k,   b'_k = R_{k-1}(delta) b_k,   t'_j = R_n(delta) t_j,
+
+and FK'(x) = FK(x + delta) for every x (the zero reference position moves to q = delta; the
+product of axis rotations commutes past R_{k-1}(delta)). Non-geometric part (the
+compensation file): the joint map :mod:`zrp.calibration.jointmap` (encoder scales, cyclic
+error, compliance, backlash, prismatic offsets), thermal expansion kappa, the
+instrument-from-base transform (R_b, t_b) and the tool points t'_j in full. The prediction is
+
+    m_ij = R_b (p'(x_i) + R'_n(x_i) t'_j) + t_b,   x_i = q_i + dq(q_i, pose conditions)
+
+with p', R'_n the forward kinematics of the folded geometry, bodies scaled by
+1 + kappa (temp - t_ref) -- the diagnosis's corrected model (zrp/gap/README.md) term by term.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
+from zrp.errors import InputError
+from zrp.gap.data import Measurements
+from zrp.gap.effects import Context
+from zrp.gap.problem import Problem
+from zrp.gap.results import Diagnosis
+from zrp.model.manipulator import Manipulator
+from zrp.rotations import skew
+
+__all__ = ["CalibratedRobot", "PoseConditions", "chain"]
+
+F64 = NDArray[np.float64]
+
+
+def _rot(u: F64, q: F64) -> F64:
+    """Rotations about unit axis u (3,) by angles q (S,): (S, 3, 3)."""
+    k = skew(u)
+    return (np.eye(3) + np.sin(q)[:, None, None] * k
+            + (1.0 - np.cos(q))[:, None, None] * (k @ k))
+
+
+def chain(model: Manipulator, x: F64, scale: F64 | None = None) -> tuple[F64, F64, F64, F64]:
+    """Forward kinematics of ``model`` at joint values x (S, n), bodies scaled per pose.
+
+    Returns:
+        end point p (S, 3), hand rotation R_n (S, 3, 3), joint points p_k (S, n, 3) and
+        current axes u_k (S, n, 3), all in the base frame (length unit).
+    """
+    S, n = x.shape
+    s = np.ones(S) if scale is None else scale
+    r = np.broadcast_to(np.eye(3), (S, 3, 3))
+    pos = np.zeros((S, 3))
+    pts = np.empty((S, n, 3))
+    axes = np.empty((S, n, 3))
+    u0, b0 = model.axes, model.bodies
+    for k in range(n + 1):
+        pos = pos + s[:, None] * (r @ b0[k])
+        if k == n:
+            break
+        pts[:, k] = pos
+        axes[:, k] = r @ u0[k]
+        if model.prismatic[k]:
+            pos = pos + x[:, k, None] * axes[:, k]
+        else:
+            r = r @ _rot(u0[k], x[:, k])
+    return pos, np.array(r), pts, axes
+
+
+@dataclass(frozen=True)
+class PoseConditions:
+    """What the joint map needs besides the commanded joint values (P poses, n joints).
+
+    Attributes:
+        direction: approach direction per pose and joint (-1/0/+1), shape (P, n), or None
+            (from the order of the poses, as :meth:`zrp.gap.Measurements.approach_direction`).
+        gravity_torque: MJCF gravity torque per pose and joint (N m), shape (P, n), or None
+            (required when the compliance was identified with MJCF torques).
+        temp: temperature per pose, deg C, shape (P,), or None (the reference temperature).
+        load: payload per pose, kg, shape (P,), or None.
+    """
+
+    direction: ArrayLike | None = None
+    gravity_torque: ArrayLike | None = None
+    temp: ArrayLike | None = None
+    load: ArrayLike | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class CalibratedRobot:
+    """A calibrated robot: folded geometry plus the non-geometric corrections.
+
+    Attributes:
+        model: the calibrated geometry (offsets, body vectors, axis tilts folded in).
+        nominal: the nominal model the diagnosis started from (the lumped-mass moment arms of
+            the joint map are its, as in the diagnosis).
+        base_rotation: R_b, instrument-from-base rotation, shape (3, 3) (identity for data
+            in the base frame).
+        base_translation: t_b, shape (3,) (length unit).
+        tool_labels: tool point labels (M,).
+        tool_points: t'_j, offsets of the tool points from the model's end point in the
+            calibrated zero reference position, shape (M, 3) (length unit).
+        joint_offsets: the revolute offsets folded into ``model`` (rad), shape (n,) (for the
+            record: commands are in the robot's own joint values).
+        terms: the joint-map terms.
+        kappa: thermal expansion, 1/deg C (0: none identified); t_ref: its reference, deg C.
+        backlash_switch: per joint, the gravity torque above which the joint rests on its
+            loaded flank (None: approach direction only).
+        payload_kg: the payload the diagnosis profiled for the backlash flank.
+        gravity_dir, harmonics, frame: as in the diagnosis.
+        compliance_model: "mjcf" or "lumped_masses".
+        withheld_rms: the diagnosis's final withheld RMS (length unit), for the record.
+        gravity_side_weights: without MJCF torques, the lumped masses (per joint and mass
+            point, shape (n, J)) whose gravity torque decides the loaded flank of the backlash
+            (the diagnosis's lumped-mass compliance fit), or None.
+    """
+
+    model: Manipulator
+    nominal: Manipulator
+    base_rotation: F64
+    base_translation: F64
+    tool_labels: tuple[str, ...]
+    tool_points: F64
+    joint_offsets: F64
+    terms: tuple[Term, ...] = ()
+    kappa: float = 0.0
+    t_ref: float = 20.0
+    backlash_switch: tuple[float | None, ...] | None = None
+    payload_kg: float = 0.0
+    gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    harmonics: tuple[int, ...] = (1, 2)
+    frame: str = "instrument"
+    compliance_model: str = "lumped_masses"
+    withheld_rms: float | None = None
+    gravity_side_weights: F64 | None = None
+
+    def __post_init__(self) -> None:
+        n = self.model.n
+        if self.nominal.n != n:
+            raise InputError(f"nominal: {self.nominal.n} joints, calibrated model {n}")
+        rb = np.asarray(self.base_rotation, dtype=float)
+        if rb.shape != (3, 3) or not np.allclose(rb @ rb.T, np.eye(3), atol=1e-9):
+            raise InputError("base_rotation: expected a 3x3 rotation matrix")
+        if np.shape(self.base_translation) != (3,):
+            raise InputError("base_translation: expected shape (3,)")
+        tp = np.asarray(self.tool_points, dtype=float)
+        if tp.shape != (len(self.tool_labels), 3):
+            raise InputError(f"tool_points: expected shape ({len(self.tool_labels)}, 3)")
+        if np.shape(self.joint_offsets) != (n,):
+            raise InputError(f"joint_offsets: expected shape ({n},)")
+        if self.frame not in ("instrument", "base"):
+            raise InputError(f"frame: expected 'instrument' or 'base', got {self.frame!r}")
+        bad = [t.name for t in self.terms if not 1 <= t.joint <= n]
+        if bad:
+            raise InputError(f"terms {bad}: joint outside 1..{n}")
+
+    @property
+    def n(self) -> int:
+        return self.model.n
+
+    # ---- from a diagnosis -----------------------------------------------------------------
+    @classmethod
+    def from_diagnosis(cls, diag: Diagnosis, registration_only: bool = False
+                       ) -> CalibratedRobot:
+        """The calibrated robot of the final model of ``diag`` (its jointly estimated
+        parameters, registration included); with ``registration_only``, the nominal model
+        with the registration alone (base frame and tool points: the usual baseline)."""
+        fit = diag.nominal_fit if registration_only else diag.final_fit
+        ctx = diag.context
+        prob = Problem(ctx, fit.specs, diag.fitting_poses[:1], fit.base_rotation)
+        theta = fit.theta
+        u, _, bodies = prob.geometry(theta)
+        tools = prob.tool_offsets(theta)
+        rb, tb = prob.base(theta)
+        n = ctx.n
+        delta = np.zeros(n)
+        terms: list[Term] = []
+        kappa = 0.0
+        for s, v, se in zip(fit.specs, theta, fit.stderr, strict=True):
+            if s.kind == "thermal":
+                kappa = float(v)
+            elif s.kind == "dq" and s.effect == "joint_offset" and not ctx.model.prismatic[
+                    s.joint - 1]:
+                delta[s.joint - 1] = float(v)
+            elif s.kind == "dq" and s.effect in NON_GEOMETRIC:
+                terms.append(Term(s.name, s.effect, s.joint, s.unit, float(v), float(se)))
+        folded, tools_f = _fold(ctx.model, u, bodies, delta, tools)
+        bl = None if registration_only else diag.where.backlash
+        return cls(folded, ctx.model, rb, tb, tuple(ctx.meas.point_labels), tools_f, delta,
+                   tuple(terms), kappa, float(ctx.t_ref_degC),
+                   None if bl is None else tuple(bl.switch),
+                   0.0 if bl is None else float(bl.payload_kg), tuple(ctx.gravity_dir),
+                   tuple(ctx.harmonics), ctx.meas.frame,
+                   "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
+                   float(diag.nominal.rms if registration_only else diag.final.rms),
+                   _side_weights(ctx))
+
+    # ---- prediction -----------------------------------------------------------------------
+    def context(self, q: ArrayLike, cond: PoseConditions | None = None) -> Context:
+        """The diagnosis's :class:`~zrp.gap.Context` on commanded joint values q (P, n)."""
+        cond = cond or PoseConditions()
+        q = np.atleast_2d(np.asarray(q, dtype=float))
+        if q.ndim != 2 or q.shape[1] != self.n:
+            raise InputError(f"q: expected shape (P, {self.n}), got {np.shape(q)}")
+        P = q.shape[0]
+        meas = Measurements.from_arrays(np.arange(P), q, np.zeros((P, 3)), frame=self.frame,
+                                        temp=cond.temp, load=cond.load,
+                                        direction=cond.direction, source="targets")
+        sw = None if self.backlash_switch is None else tuple(
+            np.inf if v is None else float(v) for v in self.backlash_switch)
+        tau = None if cond.gravity_torque is None else np.asarray(cond.gravity_torque,
+                                                                  dtype=float)
+        ctx = Context(self.nominal, meas, tau, self.gravity_dir, self.harmonics, self.t_ref,
+                      backlash_switch=sw, payload_kg=self.payload_kg)
+        if tau is None and self.gravity_side_weights is not None:
+            _, h = ctx.moment_arms()
+            side = np.einsum("pkj,kj->pk", h, np.asarray(self.gravity_side_weights))
+            ctx = dataclasses.replace(ctx, gravity_side=side)
+        return ctx
+
+    def actual_joint_values(self, q: ArrayLike, cond: PoseConditions | None = None) -> F64:
+        """x = q + dq: the joint values of the calibrated geometry the robot reaches when q is
+        commanded, shape (P, n)."""
+        ctx = self.context(q, cond)
+        return ctx.q + joint_correction(self.terms, ctx)
+
+    def body_scale(self, P: int, temp: ArrayLike | None) -> F64:
+        """1 + kappa (temp - t_ref) per pose, shape (P,)."""
+        if temp is None or self.kappa == 0.0:
+            return np.ones(P)
+        return 1.0 + self.kappa * (np.asarray(temp, dtype=float) - self.t_ref)
+
+    def predict(self, q: ArrayLike, point: str | None = None,
+                cond: PoseConditions | None = None, frame: str = "instrument") -> F64:
+        """Predicted position of a tool point (None: the model's end point) when q (P, n) is
+        commanded, shape (P, 3), in the instrument frame (or ``frame="base"``)."""
+        cond = cond or PoseConditions()
+        x = self.actual_joint_values(q, cond)
+        pos, rn, _, _ = chain(self.model, x, self.body_scale(len(x), cond.temp))
+        y = pos + rn @ self.tool_offset(point)
+        return self.to_frame(y, frame)
+
+    def tool_offset(self, point: str | None) -> F64:
+        """t'_j of the tool point ``point`` (zeros for None), shape (3,)."""
+        if point is None:
+            return np.zeros(3)
+        if point not in self.tool_labels:
+            raise InputError(f"point: {point!r} is not a tool point; known: "
+                             f"{', '.join(self.tool_labels)}")
+        return np.asarray(self.tool_points[self.tool_labels.index(point)], dtype=float)
+
+    def to_frame(self, y: F64, frame: str) -> F64:
+        """Base-frame positions (..., 3) in ``frame`` ("instrument" or "base")."""
+        if frame == "base":
+            return y
+        if frame != "instrument":
+            raise InputError(f"frame: expected 'instrument' or 'base', got {frame!r}")
+        return y @ np.asarray(self.base_rotation).T + np.asarray(self.base_translation)
+
+
+def _side_weights(ctx: Context) -> F64 | None:
+    """The lumped masses behind the diagnosis's ``gravity_side`` torques, shape (n, J): per
+    joint, the least-squares combination of the moment-arm columns (exact: the diagnosis built
+    them as such a combination), or None with MJCF torques or without a gravity side."""
+    if ctx.gravity_torque is not None or ctx.gravity_side is None:
+        return None
+    _, h = ctx.moment_arms()
+    w = np.zeros((ctx.n, h.shape[2]))
+    for k in range(ctx.n):
+        w[k] = np.linalg.lstsq(h[:, k, :], ctx.gravity_side[:, k], rcond=None)[0]
+    return w
+
+
+def _fold(model: Manipulator, u: F64, bodies: F64, delta: F64, tools: F64
+          ) -> tuple[Manipulator, F64]:
+    """The corrected geometry (axes u (n, 3), bodies (n + 1, 3)) with the revolute offsets
+    delta (n,) folded in, and the tool offsets t (M, 3) rotated alike (see the module doc)."""
+    n = model.n
+    r = np.eye(3)
+    axes = np.empty((n, 3))
+    new_b = np.empty((n + 1, 3))
+    for k in range(n + 1):
+        new_b[k] = r @ bodies[k]
+        if k == n:
+            break
+        axes[k] = r @ u[k]
+        if not model.prismatic[k]:
+            r = r @ _rot(u[k], np.array([delta[k]]))[0]
+    ee = model.end_effector
+    folded = Manipulator.from_arrays(
+        axes / np.linalg.norm(axes, axis=1, keepdims=True), new_b, axial=r @ ee.axial,
+        transverse=r @ ee.transverse, types=model.joint_types,
+        name=f"{model.name} (calibrated)", length_unit=model.length_unit,
+        joint_names=[j.name for j in model.joints])
+    return folded, tools @ r.T

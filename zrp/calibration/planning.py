@@ -1,0 +1,222 @@
+"""Measurement planning: which poses to measure so that the chosen effects are identifiable.
+
+Criterion: D-optimality of the identification Jacobian of the gap diagnosis's corrected model
+(:class:`zrp.gap.problem.Problem`: registration + the chosen effects, evaluated at the nominal
+parameters), i.e. maximise log det(J^T J) over N poses drawn from a candidate set (uniform in
+the joint limits, above a floor keep-out). Selection: DETMAX-style exchange (Mitchell 1974):
+from a random start, add the candidate that raises log det most, then drop the design pose
+whose removal lowers it least, until the pose added is the one dropped. With A_i the rows of
+pose i (3 per tool point) and M = J^T J (Eq: matrix determinant lemma)
+
+    gain(i) = log det(I + A_i M^-1 A_i^T),   loss(i) = -log det(I - A_i M^-1 A_i^T).
+
+Before anything is measured, the predicted standard deviation of each parameter is
+sigma sqrt(diag(M^-1)) (sigma: the instrument's noise per coordinate). Parameters that even the
+whole candidate set cannot separate from the others (e.g. q1.offset from base.rz) are
+reported as unidentifiable and left out. Backlash needs both approach directions: every
+candidate gets a random approach direction per joint (written with the plan, ``dir`` columns);
+compliance uses the lumped-mass moment arms (or MJCF torques given per candidate). Thermal
+expansion cannot be planned from poses (it needs a temperature spread) and is refused.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from zrp.errors import InputError, ZRPWarning
+from zrp.gap.data import Measurements
+from zrp.gap.effects import Context, ParamSpec, effect_parameters, registration_parameters
+from zrp.gap.problem import Problem
+from zrp.kinematics.forward import forward_kinematics
+from zrp.kinematics.sampling import uniform_joint_values
+from zrp.model.manipulator import Manipulator
+
+__all__ = ["Plan", "PlanWarning", "plan_poses"]
+
+F64 = NDArray[np.float64]
+ALIAS_TOL = 1e-6
+
+
+class PlanWarning(ZRPWarning):
+    """A parameter stays unidentifiable, or the plan is poorly conditioned."""
+
+
+@dataclass(frozen=True, eq=False)
+class Plan:
+    """N planned poses and what they are predicted to identify.
+
+    Attributes:
+        q: the poses, rad, shape (N, n), in measurement order.
+        direction: approach direction per pose and joint (-1/+1), shape (N, n).
+        names: parameters identified (registration first), (p,).
+        std: predicted standard deviation of each, shape (p,) (their units).
+        units: their units (p,).
+        unidentifiable: parameters no candidate set could separate (left out).
+        log_det: log det(J^T J / N) of the plan (columns scaled to unit norm on the candidates).
+        log_det_random: the same for N random candidates (the first start), for comparison.
+    """
+
+    q: F64
+    direction: F64
+    names: tuple[str, ...]
+    std: F64
+    units: tuple[str, ...]
+    unidentifiable: tuple[str, ...]
+    log_det: float
+    log_det_random: float
+
+    def __post_init__(self) -> None:
+        if self.std.shape != (len(self.names),):
+            raise InputError("Plan: std does not match names")
+
+    def predicted_std(self, name: str) -> float:
+        if name not in self.names:
+            raise InputError(f"name: {name!r} is not a planned parameter")
+        return float(self.std[self.names.index(name)])
+
+
+def _candidates(model: Manipulator, count: int, rng: np.random.Generator, limits: F64,
+                tool: F64, floor_z: float | None) -> F64:
+    q = uniform_joint_values(model, count, rng, limits)
+    if floor_z is None:
+        return q
+    fk = forward_kinematics(model, q)
+    pts = np.concatenate([fk.points, fk.position[:, None, :],
+                          fk.position[:, None, :] + np.einsum("sij,mj->smi", fk.rotation,
+                                                              tool)], axis=1)
+    keep = pts[..., 2].min(axis=1) > floor_z
+    if keep.sum() < 2 * model.n:
+        raise InputError(f"floor_z: only {int(keep.sum())} of {count} candidate poses keep "
+                         f"the arm above z = {floor_z}")
+    return q[keep]
+
+
+def _jacobian(model: Manipulator, q: F64, direction: F64, tool: F64, effects: Sequence[str],
+              gravity_torque: F64 | None) -> tuple[list[ParamSpec], F64]:
+    """Jacobian (C, 3M, p) of registration + effects at the nominal parameters."""
+    C, M = len(q), len(tool)
+    labels = [f"s{j + 1}" for j in range(M)]
+    meas = Measurements.from_arrays(np.repeat(np.arange(C), M), np.repeat(q, M, axis=0),
+                                    np.zeros((C * M, 3)), point=np.tile(labels, C),
+                                    direction=np.repeat(direction, M, axis=0), source="plan")
+    ctx = Context(model, meas, gravity_torque)
+    specs = registration_parameters(ctx)
+    for e in effects:
+        if e == "thermal_expansion":
+            raise InputError("effects: thermal_expansion needs a temperature spread, not "
+                             "poses; plan the others and measure while the robot warms up")
+        es, why = effect_parameters(ctx, e)
+        if why:
+            warnings.warn(f"{e}: {why}", PlanWarning, stacklevel=3)
+        specs += es
+    prob = Problem(ctx, specs, np.arange(C))
+    theta = np.zeros(len(specs))
+    for i, s in enumerate(specs):
+        if s.kind == "tool":
+            theta[i] = tool[s.comp // 3, s.comp % 3]
+    _, J = prob.evaluate(theta)
+    return specs, J.reshape(C, M * 3, len(specs))
+
+
+def _identifiable(J: F64) -> NDArray[np.bool_]:
+    """Columns of J (R, p) that keep > ALIAS_TOL of their norm after projection on the
+    columns kept before them (Gram-Schmidt in column order)."""
+    A = J / np.maximum(np.linalg.norm(J, axis=0), 1e-300)
+    keep = np.zeros(A.shape[1], dtype=bool)
+    Q = np.zeros((A.shape[0], 0))
+    for j in range(A.shape[1]):
+        r = A[:, j] - Q @ (Q.T @ A[:, j])
+        r -= Q @ (Q.T @ r)
+        nr = np.linalg.norm(r)
+        if nr > ALIAS_TOL:
+            keep[j] = True
+            Q = np.column_stack([Q, r / nr])
+    return keep
+
+
+def _logdet(A: F64, design: NDArray[np.int64]) -> float:
+    M = np.einsum("skp,skq->pq", A[design], A[design])
+    sign, ld = np.linalg.slogdet(M)
+    return float(ld) if sign > 0 else -np.inf
+
+
+def _exchange(A: F64, design: NDArray[np.int64], max_iter: int) -> NDArray[np.int64]:
+    """DETMAX-style exchange (module doc) on per-pose row blocks A (C, k, p)."""
+    design = design.copy()
+    k = A.shape[1]
+    eye = np.eye(k)
+    for _ in range(max_iter):
+        Mi = np.linalg.inv(np.einsum("skp,skq->pq", A[design], A[design]))
+        G = np.einsum("ckp,pq,clq->ckl", A, Mi, A)
+        gain = np.linalg.slogdet(eye + G)[1]
+        gain[design] = -np.inf
+        add = int(np.argmax(gain))
+        trial = np.append(design, add)
+        Mi = np.linalg.inv(np.einsum("skp,skq->pq", A[trial], A[trial]))
+        Gd = np.einsum("skp,pq,slq->skl", A[trial], Mi, A[trial])
+        sign, ld = np.linalg.slogdet(eye - Gd)
+        loss = np.where(sign > 0, -ld, np.inf)
+        drop = int(np.argmin(loss))
+        if drop == len(design):
+            break
+        design = np.delete(trial, drop)
+    return design
+
+
+def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
+               rng: np.random.Generator, limits: ArrayLike | None = None,
+               tool_points: ArrayLike = ((0.0, 0.0, 0.0),), floor_z: float | None = None,
+               noise_sigma: float = 0.02, candidates: int = 1000, max_iter: int = 300,
+               gravity_torque_fn: object = None) -> Plan:
+    """Choose ``n_poses`` poses that identify registration + ``effects`` (module doc).
+
+    Args:
+        model: the nominal model.
+        n_poses: poses to measure (N).
+        effects: effects to identify (of :data:`zrp.gap.EFFECTS`, not thermal_expansion).
+        rng: draws the candidates, their approach directions and the start.
+        limits: joint limits, shape (n, 2) (default +-2.5 rad).
+        tool_points: tool offsets t_j (zero-reference base frame, length unit), shape (M, 3).
+        floor_z: candidates with any joint point or tool point below this z (base frame) are
+            excluded (None: no keep-out).
+        noise_sigma: instrument noise per coordinate (length unit) for the predicted std.
+        candidates: size of the candidate set.
+        gravity_torque_fn: optional q (C, n) -> MJCF gravity torques (C, n) (N m).
+
+    Raises:
+        InputError: too few poses for the parameters, invalid arguments.
+    """
+    tool = np.atleast_2d(np.asarray(tool_points, dtype=float))
+    lim = (np.tile([-2.5, 2.5], (model.n, 1)) if limits is None
+           else np.asarray(limits, dtype=float))
+    q = _candidates(model, candidates, rng, lim, tool, floor_z)
+    d = rng.choice([-1.0, 1.0], size=q.shape)
+    tau = None if gravity_torque_fn is None else np.asarray(gravity_torque_fn(q))  # type: ignore[operator]
+    specs, J = _jacobian(model, q, d, tool, effects, tau)
+    keep = _identifiable(J.reshape(-1, len(specs)))
+    lost = tuple(s.name for s, k in zip(specs, keep, strict=True) if not k)
+    if lost:
+        warnings.warn(f"{len(lost)} parameter(s) stay unidentifiable with any of these poses "
+                      f"(aliased with others) and are left out: {', '.join(lost)}",
+                      PlanWarning, stacklevel=2)
+    specs = [s for s, k in zip(specs, keep, strict=True) if k]
+    J = J[:, :, keep]
+    p = len(specs)
+    if n_poses * J.shape[1] <= p:
+        raise InputError(f"n_poses: {n_poses} poses give {n_poses * J.shape[1]} coordinates, "
+                         f"not enough for {p} parameters")
+    scale = np.linalg.norm(J.reshape(-1, p), axis=0) / np.sqrt(len(q))
+    A = J / scale
+    start = rng.choice(len(q), size=n_poses, replace=False)
+    design = _exchange(A, start, max_iter)
+    Mi = np.linalg.inv(np.einsum("skp,skq->pq", J[design], J[design]))
+    std = noise_sigma * np.sqrt(np.diag(Mi))
+    order = np.sort(design)
+    return Plan(q[order], d[order], tuple(s.name for s in specs), std,
+                tuple(s.unit for s in specs), lost,
+                _logdet(A, design) - p * np.log(n_poses), _logdet(A, start) - p * np.log(n_poses))

@@ -1,0 +1,76 @@
+"""``zrp calibrate``: diagnose, then write the calibrated robot (model TOML + compensation
+JSON) beside the diagnosis outputs (zrp/calibration/README.md)."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+from pathlib import Path
+
+from zrp.calibration import CalibratedRobot, write_calibration
+from zrp.calibration.storage import calibration_document
+from zrp.cli.app import emit
+from zrp.cli.options import LENGTH, SEED, whole
+from zrp.gap import diagnose, load_measurements
+from zrp.gap.effects import EFFECTS
+from zrp.gap.report import OUTPUT_FILES, write_outputs
+from zrp.model.files import load_model
+from zrp.output import OutputDir
+
+FILES = ("calibrated.toml", "compensation.json")
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "calibrate", help="diagnose and write the calibrated model and compensation file",
+        description="Run the gap diagnosis (as zrp diagnose) and write DIR/calibrated.toml "
+        "(identified offsets, body vectors and axis tilts folded into the geometry) and "
+        "DIR/compensation.json (registration, tool points, joint map, thermal), plus the "
+        "diagnosis outputs without plots.")
+    p.add_argument("--model", required=True, metavar="M.toml", help="model TOML or built-in")
+    p.add_argument("--mjcf", metavar="M.xml", help="MJCF with inertias (gravity torques)")
+    p.add_argument("--data", required=True, metavar="D.csv", help="measurement CSV")
+    p.add_argument("--deg", action="store_true", help="joint values are in degrees")
+    p.add_argument("--frame", choices=("instrument", "base"), default="instrument",
+                   help="frame of x, y, z (default instrument)")
+    p.add_argument("--out", required=True, metavar="DIR", help="output directory")
+    p.add_argument("--force", action="store_true", help="overwrite existing output files")
+    p.add_argument("--seed", type=SEED, default=0, help="seed of the fitting/withheld split")
+    p.add_argument("--effects", nargs="+", choices=EFFECTS, default=list(EFFECTS),
+                   metavar="EFFECT", help="candidate effects (default all)")
+    p.add_argument("--max-steps", type=whole(1, 8), default=4,
+                   help="most effects added (default 4)")
+    p.add_argument("--noise", type=LENGTH, metavar="SIGMA", help="known noise per coordinate")
+    p.add_argument("--json", action="store_true", help="print the compensation file")
+    p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "seed": "--seed",
+                                         "effects": "--effects", "max_steps": "--max-steps",
+                                         "gravity_torque": "--mjcf"})
+
+
+def _run(args: argparse.Namespace) -> int:
+    # mjcf loads MuJoCo (+0.25 s): only when this command runs
+    from mjcf.gravity import gravity_torques
+
+    model = load_model(args.model)
+    meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)
+    tau = None if args.mjcf is None else gravity_torques(args.mjcf, meas.q_pose, field="--mjcf")
+    out_dir = Path(args.out)
+    created = not out_dir.exists()
+    try:
+        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES + FILES) as out:
+            diag = diagnose(model, meas, gravity_torque=tau, effects=args.effects,
+                            seed=args.seed, max_steps=args.max_steps, noise_sigma=args.noise)
+            cal = CalibratedRobot.from_diagnosis(diag)
+            files = write_outputs(diag, out, plots=False)
+            files += list(write_calibration(cal, out_dir / FILES[0], out_dir / FILES[1],
+                                            overwrite=True))
+    except BaseException:
+        if created:
+            with contextlib.suppress(OSError):
+                out_dir.rmdir()
+        raise
+    text = (f"withheld RMS {diag.nominal.rms:.4g} -> {diag.final.rms:.4g} "
+            f"{model.length_unit} (effects: {', '.join(diag.effects)})\n"
+            + "\n".join(f"wrote {f}" for f in files))
+    emit(args, calibration_document(cal, FILES[0]), text)
+    return 0

@@ -1,0 +1,88 @@
+"""``zrp compensate``: joint commands that put the calibrated robot on its targets."""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+from zrp.calibration import compensate as compensate_targets
+from zrp.calibration import compensate_program, read_calibration
+from zrp.calibration.targets import load_targets, write_commands
+from zrp.cli.app import emit
+from zrp.errors import InputError
+from zrp.output import check_writable
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "compensate", help="compensate targets or a joint program with a calibrated robot",
+        description="Read a calibration (compensation.json from zrp calibrate) and a targets "
+        "CSV (target, q1..qn [, x, y, z [, qw, qx, qy, qz]]); write the joint commands with "
+        "the predicted residual and flags per target (zrp/calibration/README.md).")
+    p.add_argument("--calibration", required=True, metavar="C.json",
+                   help="compensation file (its model_file beside it)")
+    p.add_argument("--targets", required=True, metavar="T.csv", help="targets CSV")
+    p.add_argument("--out", required=True, metavar="OUT.csv", help="commands CSV")
+    p.add_argument("--force", action="store_true", help="overwrite the output file")
+    p.add_argument("--deg", action="store_true", help="joint values (in and out) in degrees")
+    p.add_argument("--point", help="tool point the x, y, z targets are for (default: the "
+                   "model's end point)")
+    p.add_argument("--frame", choices=("base", "instrument"), default="base",
+                   help="frame of x, y, z (default base)")
+    p.add_argument("--limits", metavar="LO:HI,...",
+                   help="joint limits, one LO:HI per joint, comma-separated (deg with --deg), "
+                   "e.g. --limits=-165:165,-110:110,...")
+    p.add_argument("--mjcf", metavar="M.xml", help="MJCF with inertias (needed when the "
+                   "compliance was identified with MJCF torques)")
+    p.add_argument("--json", action="store_true", help="print the summary as JSON")
+    p.set_defaults(func=_run, api_names={"limits": "--limits", "point": "--point",
+                                         "gravity_torque": "--mjcf"})
+
+
+def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
+    if args.limits is None:
+        return None
+    pairs = args.limits.split(",")
+    if len(pairs) != n:
+        raise InputError(f"--limits: expected {n} LO:HI pairs, got {len(pairs)}")
+    try:
+        lim = np.array([[float(v) for v in s.split(":")] for s in pairs], dtype=float)
+    except ValueError:
+        raise InputError(f"--limits: expected LO:HI numbers, got {args.limits}") from None
+    if lim.shape != (n, 2):
+        raise InputError(f"--limits: expected LO:HI pairs, got {args.limits}")
+    return np.radians(lim) if args.deg else lim
+
+
+def _run(args: argparse.Namespace) -> int:
+    check_writable([args.out], args.force)
+    cal = read_calibration(args.calibration)
+    tg = load_targets(args.targets, cal.n, deg=args.deg)
+    lim = _limits(args, cal.n)
+    grav = None
+    if args.mjcf is not None:
+        # mjcf loads MuJoCo (+0.25 s): only when asked for
+        from mjcf.gravity import gravity_torques
+
+        def grav(q: np.ndarray) -> np.ndarray:
+            return gravity_torques(args.mjcf, q, field="--mjcf")
+    elif cal.compliance_model == "mjcf" and any(
+            t.name.endswith(".compliance") for t in cal.terms):
+        raise InputError("--mjcf: the calibration's compliance was identified with MJCF "
+                         "gravity torques; pass the MJCF")
+    if tg.xyz is None:
+        comp = compensate_program(cal, tg.q, limits=lim, gravity_torque=grav,
+                                  target_ids=tg.ids)
+    else:
+        comp = compensate_targets(cal, tg.xyz, tg.q, orientations=tg.rotation, point=args.point,
+                          frame=args.frame, limits=lim, gravity_torque=grav,
+                          target_ids=tg.ids)
+    path = write_commands(comp, args.out, deg=args.deg, overwrite=args.force)
+    s = comp.summary()
+    text = (f"{s['targets']} targets: predicted RMS error {s['rms_before']:.4g} -> "
+            f"{s['rms_after']:.3g} {cal.model.length_unit} (max {s['max_after']:.3g}); "
+            f"{s['not_converged']} not converged, {s['near_singular']} near a singularity, "
+            f"{s['near_limit']} near a limit\nwrote {path}")
+    emit(args, s, text)
+    return 0
