@@ -141,7 +141,8 @@ def term_basis(term: Term, ctx: Context) -> F64:
         fn, h = harm
         return np.sin(h * q) if fn == "sin" else np.cos(h * q)
     if what == "backlash":
-        return np.array(ctx.backlash_basis()[:, k], dtype=float)
+        # the parameter is the full play: each flank is half of it away (zrp.gap.effects)
+        return 0.5 * np.array(ctx.backlash_basis()[:, k], dtype=float)
     if term.effect == "joint_compliance":
         return _compliance(ctx, k, what)
     raise InputError(f"term {term.name}: unknown joint-correction term")
