@@ -22,7 +22,7 @@ __all__ = ["Engine", "ModelFit"]
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
-NONLINEAR = ("sync_delay", "servo_lag", "reversal_friction")
+NONLINEAR = ("sync_delay", "servo_lag", "reversal_friction", "residual_vibration")
 
 
 @dataclass(frozen=True, eq=False)

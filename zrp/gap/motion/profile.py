@@ -1,0 +1,81 @@
+"""Starting values of the residual vibration (eq. M5) by a profile search over the mode's
+frequency and damping: the nonlinear omega and zeta are gridded, the linear gain is solved at
+each grid point (against the current residual, projected off the current model's Jacobian
+columns, so the registration and the effects already found are re-fitted implicitly), and the
+best point per joint starts the Gauss-Newton fit of :class:`~zrp.gap.motion.fitting.Engine`.
+
+A joint enters the candidate only when its best gain explains more than ``screen`` times the
+residual variance per degree of freedom (an F-like ratio; the maximum over the grid is taken,
+so the screen is set far above the single-test quantile; the Wald, F and BIC tests of the
+search decide afterwards).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.gap.motion.effects import MotionParam, mode_band
+from zrp.gap.motion.fitting import Engine, ModelFit
+from zrp.gap.motion.kernels import mode_response
+from zrp.gap.problem import Problem
+
+__all__ = ["ZETA_GRID", "vibration_start"]
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+#: damping ratios tried (a lightly damped mode: well below 1)
+ZETA_GRID = (0.01, 0.03, 0.1, 0.3)
+
+
+def _joint_columns(eng: Engine, cur: ModelFit, poses: I64, joints: list[int]
+                   ) -> tuple[F64, F64, F64]:
+    """Current residual and per-joint position sensitivities, both projected off the current
+    model's Jacobian: r (3R,), C (3R, len(joints)); and Q (3R, p) the projector basis."""
+    s, n = eng.traj.q.shape
+    probes = []
+    for k in joints:
+        b = np.zeros((s, n))
+        b[:, k] = 1.0
+        probes.append(MotionParam(f"q{k + 1}.vib_probe", "1", "residual_vibration", "dq",
+                                  k + 1, 0, b, f"q{k + 1}"))
+    prob = Problem(cur.ctx, [*cur.specs, *probes], poses, eng.base_rotation)
+    theta = np.concatenate([cur.result.theta, np.zeros(len(probes))])
+    r, J = prob.residual_and_jacobian(theta)
+    p = len(cur.specs)
+    Q, _ = np.linalg.qr(J[:, :p])
+    return r - Q @ (Q.T @ r), J[:, p:], Q
+
+
+def vibration_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0,
+                    n_omega: int = 36) -> dict[str, float]:
+    """Start values ``q{k}.vib_gain/omega/zeta`` for the joints whose best grid point passes
+    the screen (empty when none does)."""
+    traj = eng.traj
+    joints = [k for k in range(traj.n_joints)
+              if np.ptp(traj.q[:, k]) > 1e-4 and np.any(traj.qdd[:, k] != 0.0)]
+    if not joints:
+        return {}
+    r, C, Q = _joint_columns(eng, cur, poses, joints)
+    rows = r.size // poses.size
+    var = float(r @ r) / max(r.size - Q.shape[1], 1)
+    lo, hi = mode_band(traj.rate_hz)
+    omegas = np.geomspace(lo, min(hi, 2.0 * np.pi * 100.0), n_omega)
+    out: dict[str, float] = {}
+    for j, k in enumerate(joints):
+        best = (0.0, 0.0, 0.0, 0.0)
+        for w in omegas:
+            for z in ZETA_GRID:
+                y = mode_response(traj.t, -traj.qdd[:, k], w, z)[0]
+                col = C[:, j] * np.repeat(y[poses], rows)
+                col -= Q @ (Q.T @ col)
+                cc = float(col @ col)
+                if cc <= 0.0:
+                    continue
+                cr = float(col @ r)
+                if cr * cr / cc > best[0]:
+                    best = (cr * cr / cc, -cr / cc, w, z)
+        if best[0] > screen * var and best[1] > 0.0:
+            p = f"q{k + 1}.vib_"
+            out.update({p + "gain": best[1], p + "omega": best[2], p + "zeta": best[3]})
+    return out
