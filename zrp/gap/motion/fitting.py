@@ -67,6 +67,8 @@ class Engine:
         self.base_ctx = Context(model, self.meas)
         self.reg_specs = tuple(reg_specs)
         self.base_rotation = base_rotation
+        #: results that depend on the data only (e.g. the mode responses of the profile search)
+        self.cache: dict = {}
 
     @property
     def nreg(self) -> int:

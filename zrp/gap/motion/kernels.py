@@ -104,13 +104,14 @@ def play(u: F64, r: float) -> tuple[F64, F64]:
 def _mode(group: NDArray[np.int64], phi: F64, g0: F64, g1: F64, f: F64, z0: F64
           ) -> F64:  # pragma: no cover - compiled
     s = f.size
-    z = np.empty((s, 6))
+    m = z0.size
+    z = np.empty((s, m))
     z[0] = z0
     for i in range(s - 1):
         k = group[i]
-        for r in range(6):
+        for r in range(m):
             acc = g0[k, r] * f[i] + g1[k, r] * f[i + 1]
-            for c in range(6):
+            for c in range(m):
                 acc += phi[k, r, c] * z[i, c]
             z[i + 1, r] = acc
     return z
@@ -129,7 +130,8 @@ def _system(omega: float, zeta: float) -> F64:
     return a
 
 
-def mode_response(t: F64, f: F64, omega: float, zeta: float) -> tuple[F64, F64, F64]:
+def mode_response(t: F64, f: F64, omega: float, zeta: float, derivatives: bool = True
+                  ) -> tuple[F64, F64, F64]:
     """The response y of the mode y'' + 2 zeta omega y' + omega^2 y = f (eq. M5) and its
     derivatives dy/domega, dy/dzeta, exact for f linear between samples.
 
@@ -137,6 +139,8 @@ def mode_response(t: F64, f: F64, omega: float, zeta: float) -> tuple[F64, F64, 
         t: sample times, s, strictly increasing, shape (S,).
         f: forcing (the negated commanded acceleration, rad/s^2), shape (S,).
         omega: natural angular frequency, rad/s, > 0; zeta: damping ratio, >= 0.
+        derivatives: False skips the sensitivities (three times faster; they come back as
+            NaN).
 
     Returns:
         y (rad), dy/domega (rad s), dy/dzeta (rad), shape (S,) each; the mode starts in
@@ -144,24 +148,28 @@ def mode_response(t: F64, f: F64, omega: float, zeta: float) -> tuple[F64, F64, 
     """
     t = np.ascontiguousarray(t, dtype=float)
     f = np.ascontiguousarray(f, dtype=float)
-    a = _system(float(omega), float(zeta))
+    m = 6 if derivatives else 2
+    a = _system(float(omega), float(zeta))[:m, :m]
     h = np.diff(t)
     hs, group = np.unique(np.round(h, 12), return_inverse=True)
     if hs.size > 64:  # irregular stamps: one discretisation per step
         hs, group = h, np.arange(h.size)
-    phi = np.empty((hs.size, 6, 6))
-    g0 = np.empty((hs.size, 6))
-    g1 = np.empty((hs.size, 6))
-    big = np.zeros((8, 8))
+    phi = np.empty((hs.size, m, m))
+    g0 = np.empty((hs.size, m))
+    g1 = np.empty((hs.size, m))
+    big = np.zeros((m + 2, m + 2))
     for i, hi in enumerate(hs):
-        big[:6, :6] = a * hi
-        big[1, 6] = hi  # input f enters y''
-        big[6, 7] = 1.0  # f(t) = f_i + (f_{i+1} - f_i) s / h
+        big[:m, :m] = a * hi
+        big[1, m] = hi  # input f enters y''
+        big[m, m + 1] = 1.0  # f(t) = f_i + (f_{i+1} - f_i) s / h
         e = expm(big)
-        phi[i] = e[:6, :6]
-        g0[i] = e[:6, 6] - e[:6, 7]
-        g1[i] = e[:6, 7]
+        phi[i] = e[:m, :m]
+        g0[i] = e[:m, m] - e[:m, m + 1]
+        g1[i] = e[:m, m + 1]
     w2 = omega * omega
-    z0 = np.array([f[0] / w2, 0.0, -2.0 * f[0] / (w2 * omega), 0.0, 0.0, 0.0])
+    z0 = np.array([f[0] / w2, 0.0, -2.0 * f[0] / (w2 * omega), 0.0, 0.0, 0.0])[:m]
     z = _mode(group.astype(np.int64).ravel(), phi, g0, g1, f, z0)
+    if not derivatives:
+        nan = np.full(f.size, np.nan)
+        return z[:, 0], nan, nan
     return z[:, 0], z[:, 2], z[:, 4]

@@ -47,6 +47,21 @@ def _joint_columns(eng: Engine, cur: ModelFit, poses: I64, joints: list[int]
     return r - Q @ (Q.T @ r), J[:, p:], Q
 
 
+def _grid(eng: Engine, poses: I64, joints: list[int], n_omega: int
+          ) -> dict[int, dict[tuple[float, float], F64]]:
+    """Mode responses y at ``poses`` per joint and grid point; they depend on the command
+    only, so they are computed once per engine and sample set (``eng.cache``)."""
+    key = ("vibration_grid", n_omega, poses.tobytes())
+    if key not in eng.cache:
+        traj = eng.traj
+        lo, hi = mode_band(traj.rate_hz)
+        omegas = np.geomspace(lo, min(hi, 2.0 * np.pi * 100.0), n_omega)
+        eng.cache[key] = {k: {(float(w), z): mode_response(traj.t, -traj.qdd[:, k], w, z,
+                                                           derivatives=False)[0][poses]
+                              for w in omegas for z in ZETA_GRID} for k in joints}
+    return eng.cache[key]
+
+
 def vibration_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0,
                     n_omega: int = 36) -> dict[str, float]:
     """Start values ``q{k}.vib_gain/omega/zeta`` for the joints whose best grid point passes
@@ -59,22 +74,19 @@ def vibration_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0
     r, C, Q = _joint_columns(eng, cur, poses, joints)
     rows = r.size // poses.size
     var = float(r @ r) / max(r.size - Q.shape[1], 1)
-    lo, hi = mode_band(traj.rate_hz)
-    omegas = np.geomspace(lo, min(hi, 2.0 * np.pi * 100.0), n_omega)
+    grid = _grid(eng, poses, joints, n_omega)
     out: dict[str, float] = {}
     for j, k in enumerate(joints):
         best = (0.0, 0.0, 0.0, 0.0)
-        for w in omegas:
-            for z in ZETA_GRID:
-                y = mode_response(traj.t, -traj.qdd[:, k], w, z)[0]
-                col = C[:, j] * np.repeat(y[poses], rows)
-                col -= Q @ (Q.T @ col)
-                cc = float(col @ col)
-                if cc <= 0.0:
-                    continue
-                cr = float(col @ r)
-                if cr * cr / cc > best[0]:
-                    best = (cr * cr / cc, -cr / cc, w, z)
+        for (w, z), y in grid[k].items():
+            col = C[:, j] * np.repeat(y, rows)
+            col -= Q @ (Q.T @ col)
+            cc = float(col @ col)
+            if cc <= 0.0:
+                continue
+            cr = float(col @ r)
+            if cr * cr / cc > best[0]:
+                best = (cr * cr / cc, -cr / cc, w, z)
         if best[0] > screen * var and best[1] > 0.0:
             p = f"q{k + 1}.vib_"
             out.update({p + "gain": best[1], p + "omega": best[2], p + "zeta": best[3]})
