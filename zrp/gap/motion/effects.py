@@ -170,13 +170,16 @@ def _vibration(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
     """Per moving joint: gain (d = g y, D = y), omega and zeta (d = 0, D = g dy/dparameter),
     so that :func:`linearise` gives the Gauss-Newton step of the exact model (eq. M5)."""
     s, n = traj.q.shape
+    lo, hi = mode_band(traj.rate_hz)
     out = []
     for k in _moving(traj):
         p = f"q{k + 1}.vib_"
         g = float(values.get(p + "gain", 0.0))
-        w = float(values.get(p + "omega", VIB_START[0]))
-        z = float(values.get(p + "zeta", VIB_START[1]))
-        y, dw, dz = mode_response(traj.t, -traj.qdd[:, k], max(w, 1e-6), max(z, 0.0))
+        # a Gauss-Newton step may leave the physical range: linearise at the nearest point of
+        # a wide box (the search rejects a final estimate outside the plausible one)
+        w = float(np.clip(values.get(p + "omega", VIB_START[0]), 0.5 * lo, 2.0 * hi))
+        z = float(np.clip(values.get(p + "zeta", VIB_START[1]), 1e-4, 2.0))
+        y, dw, dz = mode_response(traj.t, -traj.qdd[:, k], w, z)
         zero = np.zeros((s, n))
         out += [Column(p + "gain", "1", "residual_vibration", k + 1, g,
                        _one_joint(s, n, k, g * y), _one_joint(s, n, k, y)),

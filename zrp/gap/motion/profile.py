@@ -65,7 +65,9 @@ def _grid(eng: Engine, poses: I64, joints: list[int], n_omega: int
 def vibration_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0,
                     n_omega: int = 36) -> dict[str, float]:
     """Start values ``q{k}.vib_gain/omega/zeta`` for the joints whose best grid point passes
-    the screen (empty when none does)."""
+    the screen (empty when none does). Joints are taken one at a time, best first; each
+    chosen mode is projected off before the next joint is screened (a big mode on one joint
+    otherwise leaks into its neighbours' correlated columns)."""
     traj = eng.traj
     joints = [k for k in range(traj.n_joints)
               if np.ptp(traj.q[:, k]) > 1e-4 and np.any(traj.qdd[:, k] != 0.0)]
@@ -73,21 +75,31 @@ def vibration_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0
         return {}
     r, C, Q = _joint_columns(eng, cur, poses, joints)
     rows = r.size // poses.size
-    var = float(r @ r) / max(r.size - Q.shape[1], 1)
+    dof = max(r.size - Q.shape[1], 1)
     grid = _grid(eng, poses, joints, n_omega)
     out: dict[str, float] = {}
-    for j, k in enumerate(joints):
-        best = (0.0, 0.0, 0.0, 0.0)
-        for (w, z), y in grid[k].items():
-            col = C[:, j] * np.repeat(y, rows)
-            col -= Q @ (Q.T @ col)
-            cc = float(col @ col)
-            if cc <= 0.0:
-                continue
-            cr = float(col @ r)
-            if cr * cr / cc > best[0]:
-                best = (cr * cr / cc, -cr / cc, w, z)
-        if best[0] > screen * var and best[1] > 0.0:
-            p = f"q{k + 1}.vib_"
-            out.update({p + "gain": best[1], p + "omega": best[2], p + "zeta": best[3]})
+    left = list(range(len(joints)))
+    while left:
+        var = float(r @ r) / dof
+        best = (0.0, -1, 0.0, 0.0, 0.0, None)
+        for j in left:
+            for (w, z), y in grid[joints[j]].items():
+                col = C[:, j] * np.repeat(y, rows)
+                col -= Q @ (Q.T @ col)
+                cc = float(col @ col)
+                if cc <= 0.0:
+                    continue
+                cr = float(col @ r)
+                if cr * cr / cc > best[0]:
+                    best = (cr * cr / cc, j, -cr / cc, w, z, col)
+        gain_sq, j, g, w, z, col = best
+        if j < 0 or gain_sq <= screen * var or g <= 0.0:
+            break
+        p = f"q{joints[j] + 1}.vib_"
+        out.update({p + "gain": g, p + "omega": w, p + "zeta": z})
+        u = col / np.linalg.norm(col)
+        r = r - u * float(u @ r)
+        Q = np.column_stack([Q, u])
+        dof -= 3
+        left.remove(j)
     return out
