@@ -48,7 +48,7 @@ from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.kernels import first_order_lag, mode_response, play
 
 __all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
-           "linearise", "mode_band", "plausible", "tested"]
+           "limit_step", "linearise", "mode_band", "plausible", "tested"]
 
 F64 = NDArray[np.float64]
 MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
@@ -206,6 +206,16 @@ def plausible(name: str, value: float, rate_hz: float) -> bool:
         lo, hi = mode_band(rate_hz)
         return lo <= value <= hi
     return True
+
+
+def limit_step(name: str, old: float | None, new: float) -> float:
+    """A trust region for the Gauss-Newton steps of a mode's omega (a factor 1.5 per step)
+    and zeta (a factor 3): far from the optimum, the linearisation of a ringing response
+    overshoots. Other parameters: ``new`` unchanged."""
+    if old is None or old <= 0.0 or not name.endswith((".vib_omega", ".vib_zeta")):
+        return new
+    f = 1.5 if name.endswith(".vib_omega") else 3.0
+    return float(np.clip(new, old / f, old * f))
 
 
 def tested(spec: ParamSpec) -> bool:

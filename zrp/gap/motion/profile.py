@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy.optimize import minimize
 
 from zrp.gap.motion.effects import MotionParam, mode_band
 from zrp.gap.motion.fitting import Engine, ModelFit
@@ -26,6 +27,35 @@ F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
 #: damping ratios tried (a lightly damped mode: well below 1)
 ZETA_GRID = (0.01, 0.03, 0.1, 0.3)
+
+
+def _explained(col: F64, r: F64, Q: F64) -> tuple[float, float, F64]:
+    """Sum of squares of r explained by ``col`` off span(Q), the gain, the projected column."""
+    col = col - Q @ (Q.T @ col)
+    cc = float(col @ col)
+    if cc <= 0.0:
+        return 0.0, 0.0, col
+    cr = float(col @ r)
+    return cr * cr / cc, -cr / cc, col
+
+
+def _refine(eng: Engine, poses: I64, k: int, c: F64, r: F64, Q: F64, w0: float, z0: float
+            ) -> tuple[float, float, float, F64]:
+    """The profile maximum near a grid point (Nelder-Mead on log omega, log zeta; each
+    evaluation solves the gain in closed form): (explained, omega, zeta, column)."""
+    traj = eng.traj
+    rows = r.size // poses.size
+
+    def column(x: F64) -> F64:
+        y = mode_response(traj.t, -traj.qdd[:, k], float(np.exp(x[0])), float(np.exp(x[1])),
+                          derivatives=False)[0]
+        return c * np.repeat(y[poses], rows)
+
+    res = minimize(lambda x: -_explained(column(x), r, Q)[0], np.log([w0, z0]),
+                   method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-9 * float(r @ r),
+                                                  "maxfev": 120})
+    ex, _, col = _explained(column(res.x), r, Q)
+    return ex, float(np.exp(res.x[0])), float(np.exp(res.x[1])), col
 
 
 def _joint_columns(eng: Engine, cur: ModelFit, poses: I64, joints: list[int]
@@ -81,19 +111,18 @@ def vibration_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0
     left = list(range(len(joints)))
     while left:
         var = float(r @ r) / dof
-        best = (0.0, -1, 0.0, 0.0, 0.0, None)
+        best = (0.0, -1, 0.0, 0.0)
         for j in left:
             for (w, z), y in grid[joints[j]].items():
-                col = C[:, j] * np.repeat(y, rows)
-                col -= Q @ (Q.T @ col)
-                cc = float(col @ col)
-                if cc <= 0.0:
-                    continue
-                cr = float(col @ r)
-                if cr * cr / cc > best[0]:
-                    best = (cr * cr / cc, j, -cr / cc, w, z, col)
-        gain_sq, j, g, w, z, col = best
-        if j < 0 or gain_sq <= screen * var or g <= 0.0:
+                ex = _explained(C[:, j] * np.repeat(y, rows), r, Q)[0]
+                if ex > best[0]:
+                    best = (ex, j, w, z)
+        j = best[1]
+        if j < 0 or best[0] <= screen * var:
+            break
+        ex, w, z, col = _refine(eng, poses, joints[j], C[:, j], r, Q, best[2], best[3])
+        _, g, col = _explained(col, r, Q)
+        if g <= 0.0:
             break
         p = f"q{joints[j] + 1}.vib_"
         out.update({p + "gain": g, p + "omega": w, p + "zeta": z})
