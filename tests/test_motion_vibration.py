@@ -141,8 +141,9 @@ def test_servo_lag_is_not_taken_for_a_mode(puma, moves) -> None:
     traj = Trajectory(t, q, _measure(puma, qa, np.random.default_rng(6)))
     d = diagnose_motion(puma, traj, seed=0)
     assert d.effects[0] == "servo_lag" and "residual_vibration" not in d.effects
-    ranked = {c["effect"]: c["cv_rms"] for c in d.steps[0].candidates}
-    assert ranked["residual_vibration"] > 1.01 * ranked["servo_lag"]
+    ranked = {c["effect"]: c for c in d.steps[0].candidates}
+    vib = ranked["residual_vibration"]  # rejected, or behind the lag
+    assert vib["cv_rms"] is None or vib["cv_rms"] > 1.01 * ranked["servo_lag"]["cv_rms"]
 
 
 def test_mujoco_mode_is_named_on_its_joint(puma) -> None:
