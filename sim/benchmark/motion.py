@@ -9,8 +9,9 @@ Scenarios (:func:`draw_motion_scenarios`, seeded): two without an effect, then t
 effects alone in turn, then the ten pairs in turn. Magnitudes: sync delay 1-5 ms; servo lag
 3-10 ms on one of joints 1-3; friction 0.3-1 mrad of play (F = r kp) on one of joints 1-3;
 compliance 10-40 urad/(N m) on joint 2 or 3; residual vibration 4-15 Hz, damping ratio
-0.02-0.1, on one of joints 1-3 (joint 1 when paired with compliance on the same joint). All are chosen visible on these moves (a few
-times the noise or more); the benchmark does not test the edge of visibility.
+0.02-0.1, on one of joints 1-3 (joint 1 when paired with compliance on the same joint). All
+are chosen visible on these moves (a few times the noise or more); the benchmark does not
+test the edge of visibility.
 """
 
 from __future__ import annotations

@@ -26,11 +26,13 @@ effect                  parameter (per joint k)        unit  d(t; theta)
                                                              each stop (g = 1 for a single link)
 ======================= ============================== ===== =====================================
 
-The nonlinear ones (delay, lag, play, the mode's omega and zeta) are linearised at the current estimate theta0:
-q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the *shift*) goes into
-the joint values of :class:`MotionContext` and D into a ``dq`` basis, so the static
-:class:`~zrp.gap.problem.Problem` and its analytic Jacobian apply unchanged; the search
-re-linearises until theta stops moving (Gauss-Newton on the exact model).
+The nonlinear ones (delay, lag, play, the mode's omega and zeta) are linearised at the current
+estimate theta0: q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the
+*shift*) goes into the joint values of :class:`MotionContext` and D into a ``dq`` basis, so the
+static :class:`~zrp.gap.problem.Problem` and its analytic Jacobian apply unchanged; the search
+re-linearises until theta stops moving (Gauss-Newton on the exact model; the mode's omega and
+zeta start from the profile search of :mod:`zrp.gap.motion.profile`, within a trust region,
+:func:`limit_step`).
 """
 
 from __future__ import annotations
