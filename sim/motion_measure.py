@@ -9,7 +9,9 @@ Trajectories (functions of time and derivative order, :data:`Command`):
   exercise_moves`): high speed, acceleration, stops and reversals on every joint.
 
 Effect specs: ``sync_delay=2ms``, ``servo_lag:2=5ms``, ``reversal_friction:2=15Nm``,
-``dynamic_compliance:3=20urad/Nm`` (units optional: s, N m, rad/(N m) by default).
+``dynamic_compliance:3=20urad/Nm``, ``residual_vibration:2=8Hz`` (the transmission mode's
+frequency; damping ratio 0.05, :class:`~sim.motion_robot.MotionEffects`) (units optional: s,
+N m, rad/(N m), Hz by default).
 """
 
 from __future__ import annotations
@@ -37,7 +39,8 @@ TRAJECTORIES = ("circle", "moves")
 _UNITS = {"sync_delay": {"": 1.0, "s": 1.0, "ms": 1e-3, "us": 1e-6},
           "servo_lag": {"": 1.0, "s": 1.0, "ms": 1e-3},
           "reversal_friction": {"": 1.0, "Nm": 1.0},
-          "dynamic_compliance": {"": 1.0, "rad/Nm": 1.0, "mrad/Nm": 1e-3, "urad/Nm": 1e-6}}
+          "dynamic_compliance": {"": 1.0, "rad/Nm": 1.0, "mrad/Nm": 1e-3, "urad/Nm": 1e-6},
+          "residual_vibration": {"": 1.0, "Hz": 1.0}}
 _SPEC = re.compile(r"^([a-z_]+)(?::(\d+))?=([-+0-9.eE]+)\s*([A-Za-z/]*)$")
 
 

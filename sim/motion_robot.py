@@ -16,6 +16,14 @@ micrometres. Hidden motion effects (:class:`MotionEffects`) that emerge from the
 * ``dynamic_compliance`` (rad/(N m), per joint): the joint's servo stiffness is 1/c with no
   feedforward and no integral action, so it deflects by c times the full dynamic torque
   (gravity and inertia) it carries;
+* ``residual_vibration`` (Hz, per joint; damping ratio ``vibration_damping``, default 0.05): a
+  compliant transmission: the joint's link hangs on the stiffly servoed motor through a
+  spring-damper tuned to that frequency and damping for the inertia the joint sees (its
+  diagonal mass-matrix entry, re-evaluated each step), and the feedforward of that joint
+  lacks its own inertial torque (the motor side does not carry it): the link lags under
+  acceleration and rings after each stop (applied as the joint torque M_kk [omega^2 (ref - q)
+  + 2 zeta omega (rate - q') - ref''] + the rest of the inverse-dynamics torque; the joint's
+  position and rate actuators are switched off);
 * ``sync_delay`` (s): the tracker's clock runs ahead of the controller's: a point measured at
   controller time T is stamped T + delta; the logged command is the controller's at the stamp.
 
@@ -45,7 +53,8 @@ from zrp.model.manipulator import Manipulator
 __all__ = ["MOTION_HIDDEN", "MotionEffects", "MotionRun", "execute_trajectory"]
 
 F64 = NDArray[np.float64]
-MOTION_HIDDEN = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance")
+MOTION_HIDDEN = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
+                 "residual_vibration")
 
 
 def _joints(v: Mapping[int, float] | None, name: str, unit: str) -> dict[int, float]:
@@ -67,14 +76,21 @@ class MotionEffects:
         servo_lag: per joint, first-order setpoint filter time constant, s.
         reversal_friction: per joint, Coulomb friction, N m.
         dynamic_compliance: per joint, rad/(N m) (servo stiffness 1/c, no feedforward).
+        residual_vibration: per joint, the transmission mode's natural frequency, Hz.
+        vibration_damping: the modes' damping ratio, in (0, 1).
     """
 
     sync_delay: float = 0.0
     servo_lag: Mapping[int, float] = field(default_factory=dict)
     reversal_friction: Mapping[int, float] = field(default_factory=dict)
     dynamic_compliance: Mapping[int, float] = field(default_factory=dict)
+    residual_vibration: Mapping[int, float] = field(default_factory=dict)
+    vibration_damping: float = 0.05
 
     def __post_init__(self) -> None:
+        if not 0.0 < self.vibration_damping < 1.0:
+            raise InputError(f"vibration_damping: expected a damping ratio in (0, 1), got "
+                             f"{self.vibration_damping!r}")
         if not np.isfinite(self.sync_delay) or abs(self.sync_delay) > 0.1:
             raise InputError(f"sync_delay: expected |delta| <= 0.1 s, got {self.sync_delay!r}")
         object.__setattr__(self, "servo_lag", _joints(self.servo_lag, "servo_lag", "s"))
@@ -82,6 +98,8 @@ class MotionEffects:
                            _joints(self.reversal_friction, "reversal_friction", "N m"))
         object.__setattr__(self, "dynamic_compliance",
                            _joints(self.dynamic_compliance, "dynamic_compliance", "rad/(N m)"))
+        object.__setattr__(self, "residual_vibration",
+                           _joints(self.residual_vibration, "residual_vibration", "Hz"))
 
     @property
     def active(self) -> tuple[str, ...]:
@@ -97,7 +115,8 @@ class MotionEffects:
     def to_dict(self) -> dict[str, Any]:
         return {"sync_delay": self.sync_delay,
                 **{e: {str(k): v for k, v in getattr(self, e).items()}
-                   for e in MOTION_HIDDEN[1:]}}
+                   for e in MOTION_HIDDEN[1:]},
+                "vibration_damping": self.vibration_damping}
 
 
 @dataclass(frozen=True, eq=False)
@@ -130,7 +149,31 @@ def _robot(model: Manipulator, eff: MotionEffects) -> tuple[RealRobot, mujoco.Mj
         m.dof_solref[dof] = [2.0 * m.opt.timestep, 1.0]
         m.dof_solimp[dof] = [0.99999, 0.99999, 0.001, 0.5, 2.0]
         robot._ids["trim"][k - 1] = False  # no integral action: the servo resists by its error
+    n = model.n
+    for k in eff.residual_vibration:  # the transmission spring replaces the joint's servo
+        m.actuator_gainprm[k - 1, 0] = m.actuator_biasprm[k - 1, 1] = 0.0
+        m.actuator_gainprm[n + k - 1, 0] = m.actuator_biasprm[n + k - 1, 2] = 0.0
+        robot._ids["trim"][k - 1] = False
     return robot, ff
+
+
+def _transmission(eff: MotionEffects, ff: mujoco.MjModel, dff: mujoco.MjData, dofs: F64,
+                  reference: tuple[F64, F64, F64], q: F64, qd: F64, tau: F64) -> F64:
+    """The joint torques with the transmission modes (see the module doc): ``tau`` (the
+    feedforward, shape (n,)) with each vibrating joint's entry replaced; ``reference`` holds
+    the reference angle, rate and acceleration, shape (n,) each."""
+    ref, rate, acc = reference
+    out = np.array(tau)
+    z = eff.vibration_damping
+    full = np.zeros((ff.nv, ff.nv))
+    mujoco.mj_fullM(ff, dff, full)  # mj_inverse has just computed the mass matrix at ref
+    for k, f in eff.residual_vibration.items():
+        i = k - 1
+        w = 2.0 * np.pi * f
+        mkk = full[dofs[i], dofs[i]]
+        out[i] = dff.qfrc_inverse[dofs[i]] + mkk * (w * w * (ref[i] - q[i])
+                                                     + 2.0 * z * w * (rate[i] - qd[i]) - acc[i])
+    return out
 
 
 def _references(command: Callable[[F64, int], F64], times: F64, lag: Mapping[int, float],
@@ -185,8 +228,11 @@ def execute_trajectory(model: Manipulator, command: Callable[[F64, int], F64], d
         mujoco.mj_inverse(ff, dff)
         # + dt kv acc: implicitfast integrates the rate servo's damping implicitly,
         # (M + dt kv) dv = dt f, so the feedforward carries that term too
-        d.qfrc_applied[ids["motor_v"]] = np.where(no_ff, 0.0,
-                                                  dff.qfrc_inverse + dt * ids["kv"] * acc)
+        tau = np.where(no_ff, 0.0, dff.qfrc_inverse + dt * ids["kv"] * acc)
+        if effects.residual_vibration:
+            tau = _transmission(effects, ff, dff, ids["motor_v"], (ref[i], rate, acc),
+                                d.qpos[ids["motor_q"]], d.qvel[ids["motor_v"]], tau)
+        d.qfrc_applied[ids["motor_v"]] = tau
         s.ref, s.rate = ref[i], rate
         s._apply()
         mujoco.mj_step(m, d)

@@ -5,11 +5,13 @@ inverse-dynamics torques); only then is the truth file opened and the answer sco
 static scenarios: the right effect first (or ``none``), the hidden joints among those named,
 and the withheld RMS after correction within 1.5x the true noise RMS (sqrt(3) sigma).
 
-Scenarios (:func:`draw_motion_scenarios`, seeded): two without an effect, then the four
-effects alone in turn, then the six pairs in turn. Magnitudes: sync delay 1-5 ms; servo lag
+Scenarios (:func:`draw_motion_scenarios`, seeded): two without an effect, then the five
+effects alone in turn, then the ten pairs in turn. Magnitudes: sync delay 1-5 ms; servo lag
 3-10 ms on one of joints 1-3; friction 0.3-1 mrad of play (F = r kp) on one of joints 1-3;
-compliance 10-40 urad/(N m) on joint 2 or 3. All are chosen visible on these moves (a few
-times the noise or more); the benchmark does not test the edge of visibility.
+compliance 10-40 urad/(N m) on joint 2 or 3; residual vibration 4-15 Hz, damping ratio
+0.02-0.1, on one of joints 1-3 (joint 1 when paired with compliance on the same joint). All
+are chosen visible on these moves (a few times the noise or more); the benchmark does not
+test the edge of visibility.
 """
 
 from __future__ import annotations
@@ -58,7 +60,10 @@ def _one(effect: str, rng: np.random.Generator) -> dict[str, Any]:
     if effect == "reversal_friction":
         return {"reversal_friction": {int(rng.integers(1, 4)):
                                       float(rng.uniform(3e-4, 1e-3) * SERVO_KP)}}
-    return {"dynamic_compliance": {int(rng.integers(2, 4)): float(rng.uniform(1e-5, 4e-5))}}
+    if effect == "dynamic_compliance":
+        return {"dynamic_compliance": {int(rng.integers(2, 4)): float(rng.uniform(1e-5, 4e-5))}}
+    return {"residual_vibration": {int(rng.integers(1, 4)): float(rng.uniform(4.0, 15.0))},
+            "vibration_damping": float(rng.uniform(0.02, 0.1))}
 
 
 def draw_motion_scenarios(count: int, seed: int) -> list[MotionScenario]:
@@ -72,10 +77,13 @@ def draw_motion_scenarios(count: int, seed: int) -> list[MotionScenario]:
     for i in range(count):
         kw: dict[str, Any] = {}
         if i >= 2 and i - 2 < n_single:
-            kw = _one(MOTION_HIDDEN[(i - 2) % 4], rng)
+            kw = _one(MOTION_HIDDEN[(i - 2) % len(MOTION_HIDDEN)], rng)
         elif i >= 2:
             for e in pairs[(i - 2 - n_single) % len(pairs)]:
                 kw.update(_one(e, rng))
+            vib, comp = kw.get("residual_vibration", {}), kw.get("dynamic_compliance", {})
+            if set(vib) & set(comp):  # one joint cannot be both: the mode moves to joint 1
+                kw["residual_vibration"] = {1: vib[next(iter(vib))]}
         out.append(MotionScenario(i, int(rng.integers(2**31)), MotionEffects(**kw)))
     return out
 

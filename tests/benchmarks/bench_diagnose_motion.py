@@ -1,7 +1,7 @@
 """Benchmark: one minute of 1 kHz trajectory data diagnosed (issue 16: within 30 s).
 
 The MuJoCo real robot executes a minute of random joint moves with a hidden 5 ms servo lag
-on joint 2 and the tracker streams 60,000 time-stamped points; the motion diagnosis (all four
+on joint 2 and the tracker streams 60,000 time-stamped points; the motion diagnosis (all five
 motion effects, inverse-dynamics torques from the nominal MJCF, greedy search, backward
 elimination, final fit on all fitting samples) runs on them. The baseline measured in the same
 run is one registration fit on all samples (the least any diagnosis must do).

@@ -5,7 +5,7 @@ statistics (covariance, Wald and F tests, information criteria, linearised cross
 from __future__ import annotations
 
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -314,12 +314,15 @@ def group_key(spec: ParamSpec) -> str:
     return f"{spec.effect}:{spec.group}"
 
 
-def wald_groups(result: FitResult, first: int) -> dict[str, float]:
+def wald_groups(result: FitResult, first: int,
+                tested: Callable[[ParamSpec], bool] | None = None) -> dict[str, float]:
     """p-value of the Wald test (all parameters of a group zero) per :func:`group_key`, for
-    the parameters from index ``first`` on."""
+    the parameters from index ``first`` on; with ``tested``, only the parameters it accepts
+    enter the test (e.g. a mode's amplitude, not its frequency, whose null is not zero)."""
     groups: dict[str, list[int]] = {}
     for i in range(first, len(result.specs)):
-        groups.setdefault(group_key(result.specs[i]), []).append(i)
+        if tested is None or tested(result.specs[i]):
+            groups.setdefault(group_key(result.specs[i]), []).append(i)
     out: dict[str, float] = {}
     for g, idx in groups.items():
         th = result.theta[idx]

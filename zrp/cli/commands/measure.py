@@ -51,7 +51,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--motion-effect", action="append", default=[], metavar="NAME[:J]=VALUE",
                    help="with --stream, a hidden motion effect, repeatable: sync_delay=2ms, "
                         "servo_lag:2=5ms, reversal_friction:2=15Nm, "
-                        "dynamic_compliance:3=20urad/Nm")
+                        "dynamic_compliance:3=20urad/Nm, residual_vibration:2=8Hz")
     p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
                    help="final approach against gravity for the joints that carry a "
                         "gravity torque, the others from a random side (default; written as "

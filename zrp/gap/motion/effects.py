@@ -17,13 +17,22 @@ effect                  parameter (per joint k)        unit  d(t; theta)
 ``dynamic_compliance``  ``q{k}.dyn_compliance``        rad/  -c tau_k(t): deflection under the full
                                                        (N m) inverse-dynamics torque (MJCF inertias,
                                                              ``mj_inverse``; passed in as an array)
+``residual_vibration``  ``q{k}.vib_gain``              1     g y(t): a lightly damped mode driven
+                        ``q{k}.vib_omega``             rad/s by the joint's commanded acceleration,
+                        ``q{k}.vib_zeta``              1     y'' + 2 zeta omega y' + omega^2 y =
+                                                             -u_k'' (eq. M5, ``kernels.
+                                                             mode_response``): the lag under
+                                                             acceleration and the ringing after
+                                                             each stop (g = 1 for a single link)
 ======================= ============================== ===== =====================================
 
-The nonlinear ones (delay, lag, play) are linearised at the current estimate theta0:
-q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the *shift*) goes into
-the joint values of :class:`MotionContext` and D into a ``dq`` basis, so the static
-:class:`~zrp.gap.problem.Problem` and its analytic Jacobian apply unchanged; the search
-re-linearises until theta stops moving (Gauss-Newton on the exact model).
+The nonlinear ones (delay, lag, play, the mode's omega and zeta) are linearised at the current
+estimate theta0: q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the
+*shift*) goes into the joint values of :class:`MotionContext` and D into a ``dq`` basis, so the
+static :class:`~zrp.gap.problem.Problem` and its analytic Jacobian apply unchanged; the search
+re-linearises until theta stops moving (Gauss-Newton on the exact model; the mode's omega and
+zeta start from the profile search of :mod:`zrp.gap.motion.profile`, within a trust region,
+:func:`limit_step`).
 """
 
 from __future__ import annotations
@@ -38,15 +47,18 @@ from numpy.typing import NDArray
 from zrp.errors import InputError
 from zrp.gap.effects import KINDS, Context, ParamSpec
 from zrp.gap.motion.data import Trajectory
-from zrp.gap.motion.kernels import first_order_lag, play
+from zrp.gap.motion.kernels import first_order_lag, mode_response, play
 
 __all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
-           "linearise"]
+           "limit_step", "linearise", "mode_band", "plausible", "tested"]
 
 F64 = NDArray[np.float64]
-MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance")
+MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
+                  "residual_vibration")
 #: effects whose parameters are physically positive (a negative estimate is not that effect)
-POSITIVE = ("servo_lag", "reversal_friction", "dynamic_compliance")
+POSITIVE = ("servo_lag", "reversal_friction", "dynamic_compliance", "residual_vibration")
+#: where the mode's linearisation starts when no value is given (rad/s, 1)
+VIB_START = (2.0 * np.pi * 10.0, 0.1)
 #: a joint must move at least this far (rad or length unit) to carry a per-joint effect.
 MIN_TRAVEL = 1e-4
 
@@ -156,6 +168,64 @@ def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | Non
     return out
 
 
+def _vibration(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+    """Per moving joint: gain (d = g y, D = y), omega and zeta (d = 0, D = g dy/dparameter),
+    so that :func:`linearise` gives the Gauss-Newton step of the exact model (eq. M5)."""
+    s, n = traj.q.shape
+    lo, hi = mode_band(traj.rate_hz)
+    out = []
+    for k in _moving(traj):
+        p = f"q{k + 1}.vib_"
+        g = float(values.get(p + "gain", 0.0))
+        # a Gauss-Newton step may leave the physical range: linearise at the nearest point of
+        # a wide box (the search rejects a final estimate outside the plausible one)
+        w = float(np.clip(values.get(p + "omega", VIB_START[0]), 0.5 * lo, 2.0 * hi))
+        z = float(np.clip(values.get(p + "zeta", VIB_START[1]), 1e-4, 2.0))
+        y, dw, dz = mode_response(traj.t, -traj.qdd[:, k], w, z)
+        zero = np.zeros((s, n))
+        out += [Column(p + "gain", "1", "residual_vibration", k + 1, g,
+                       _one_joint(s, n, k, g * y), _one_joint(s, n, k, y)),
+                Column(p + "omega", "rad/s", "residual_vibration", k + 1, w, zero,
+                       _one_joint(s, n, k, g * dw)),
+                Column(p + "zeta", "1", "residual_vibration", k + 1, z, zero,
+                       _one_joint(s, n, k, g * dz))]
+    return out
+
+
+def mode_band(rate_hz: float) -> tuple[float, float]:
+    """The angular frequencies (rad/s) a mode may have to be seen on a stream sampled at
+    ``rate_hz``: from 0.5 Hz (a few cycles in a dwell-to-dwell stretch of seconds) to 40 % of
+    the Nyquist frequency (at least 5 samples per period)."""
+    return 2.0 * np.pi * 0.5, 0.4 * np.pi * rate_hz
+
+
+def plausible(name: str, value: float, rate_hz: float) -> bool:
+    """Whether a mode parameter's estimate is physical: 0 < zeta < 1 and omega in
+    :func:`mode_band` (other parameters: True; their sign is checked with :data:`POSITIVE`)."""
+    if name.endswith(".vib_zeta"):
+        return 0.0 < value < 1.0
+    if name.endswith(".vib_omega"):
+        lo, hi = mode_band(rate_hz)
+        return lo <= value <= hi
+    return True
+
+
+def limit_step(name: str, old: float | None, new: float) -> float:
+    """A trust region for the Gauss-Newton steps of a mode's omega (a factor 1.5 per step)
+    and zeta (a factor 3): far from the optimum, the linearisation of a ringing response
+    overshoots. Other parameters: ``new`` unchanged."""
+    if old is None or old <= 0.0 or not name.endswith((".vib_omega", ".vib_zeta")):
+        return new
+    f = 1.5 if name.endswith(".vib_omega") else 3.0
+    return float(np.clip(new, old / f, old * f))
+
+
+def tested(spec: ParamSpec) -> bool:
+    """Whether a parameter enters the Wald test of its joint group: all but a mode's omega and
+    zeta (whose "absent" value is not zero: the gain alone says whether the mode is there)."""
+    return not spec.name.endswith((".vib_omega", ".vib_zeta"))
+
+
 def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
                    torque: F64 | None = None) -> list[Column]:
     """All parameters of one motion effect evaluated at ``values`` (missing names: 0).
@@ -172,6 +242,8 @@ def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
         return _friction(traj, values)
     if effect == "dynamic_compliance":
         return _compliance(traj, values, torque)
+    if effect == "residual_vibration":
+        return _vibration(traj, values)
     raise InputError(f"effect: {effect!r} is not a motion effect; valid: "
                      f"{', '.join(MOTION_EFFECTS)}")
 

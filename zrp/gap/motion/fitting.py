@@ -14,7 +14,7 @@ from numpy.typing import NDArray
 from zrp.gap.effects import EFFECTS, Context, ParamSpec, effect_parameters
 from zrp.gap.leastsq import FitResult, fit
 from zrp.gap.motion.data import Trajectory
-from zrp.gap.motion.effects import MotionContext, effect_columns, linearise
+from zrp.gap.motion.effects import MotionContext, effect_columns, limit_step, linearise
 from zrp.gap.problem import Problem
 from zrp.model.manipulator import Manipulator
 
@@ -22,7 +22,7 @@ __all__ = ["Engine", "ModelFit"]
 
 F64 = NDArray[np.float64]
 I64 = NDArray[np.int64]
-NONLINEAR = ("sync_delay", "servo_lag", "reversal_friction")
+NONLINEAR = ("sync_delay", "servo_lag", "reversal_friction", "residual_vibration")
 
 
 @dataclass(frozen=True, eq=False)
@@ -67,6 +67,8 @@ class Engine:
         self.base_ctx = Context(model, self.meas)
         self.reg_specs = tuple(reg_specs)
         self.base_rotation = base_rotation
+        #: results that depend on the data only (e.g. the mode responses of the profile search)
+        self.cache: dict = {}
 
     @property
     def nreg(self) -> int:
@@ -101,7 +103,8 @@ class Engine:
             ctx, specs = self.specs_for(effects, vals)
             theta0 = np.concatenate([reg, [vals.get(s.name, 0.0) for s in specs]])
             res = fit(ctx, [*self.reg_specs, *specs], poses, theta0, self.base_rotation)
-            new = {s.name: float(v) for s, v in zip(specs, res.theta[self.nreg:], strict=True)}
+            new = {s.name: limit_step(s.name, vals.get(s.name), float(v))
+                   for s, v in zip(specs, res.theta[self.nreg:], strict=True)}
             reg = res.theta[:self.nreg]
             se = res.stderr[self.nreg:]
             moved = [abs(new[s.name] - vals.get(s.name, 0.0)) for s in specs]

@@ -13,8 +13,9 @@ from numpy.typing import NDArray
 
 from zrp.gap.effects import EFFECTS, effect_parameters
 from zrp.gap.leastsq import check_identifiable, cv_rms, f_test, group_key, wald_groups
-from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise
+from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise, plausible, tested
 from zrp.gap.motion.fitting import Engine, ModelFit
+from zrp.gap.motion.profile import vibration_start
 
 __all__ = ["Trial", "backward_check", "drop_effects", "greedy"]
 
@@ -51,17 +52,21 @@ class Trial:
                 "aliased": list(self.aliased)}
 
 
-def _candidate_specs(eng: Engine, current: ModelFit, effect: str) -> list:
+def _candidate_specs(eng: Engine, effect: str, start: dict[str, float]) -> list:
     if effect in EFFECTS:
         return effect_parameters(eng.base_ctx, effect)[0]
-    return linearise(effect_columns(eng.traj, effect, {}, eng.torque))[1]
+    specs = linearise(effect_columns(eng.traj, effect, start, eng.torque))[1]
+    if effect == "residual_vibration":  # only the joints the profile search found a mode on
+        specs = [s for s in specs if s.name in start]
+    return specs
 
 
 def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                folds: Sequence[I64], alpha: float) -> Trial:
     """Fit ``effect`` on top of ``current``: identifiable parameters, Wald pruning of its
     joint groups at alpha / groups, then the scores."""
-    cand = _candidate_specs(eng, current, effect)
+    start = vibration_start(eng, current, poses) if effect == "residual_vibration" else {}
+    cand = _candidate_specs(eng, effect, start)
     if not cand:
         return Trial(effect, None, note="no parameter applies to these data")
     keep, aliased = check_identifiable(current.ctx, current.result, cand, poses)
@@ -71,12 +76,16 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                      aliased=al)
     first = len(current.specs)
     effects = {**current.effects, effect: frozenset(s.name for s in keep)}
-    mf = eng.fit(effects, poses, current.values, current.result.theta[:eng.nreg])
-    pw = wald_groups(mf.result, first)
+    mf = eng.fit(effects, poses, {**current.values, **start},
+                 current.result.theta[:eng.nreg])
+    pw = wald_groups(mf.result, first, tested)
     sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
-    if effect in POSITIVE:  # a negative lag, friction or compliance is not that effect
+    if effect in POSITIVE:  # a negative lag, friction, compliance or mode is not that effect;
+        # nor is a mode with zeta outside (0, 1) or a frequency the sampling cannot see
+        rate = eng.traj.rate_hz
         sig -= {group_key(s) for s, v in zip(mf.specs[first:], mf.result.theta[first:],
-                                             strict=True) if v <= 0.0}
+                                             strict=True)
+                if v <= 0.0 or not plausible(s.name, float(v), rate)}
     if not sig:
         return Trial(effect, None, note="no joint group significant", aliased=al)
     if len(sig) < len(pw):
@@ -117,7 +126,7 @@ def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
 def backward_check(eng: Engine, mf: ModelFit, poses: I64, alpha: float) -> ModelFit:
     """Drop the joint groups that the final joint model no longer needs (Wald test at
     alpha / groups) and refit; drop an effect left without parameters."""
-    pw = wald_groups(mf.result, eng.nreg)
+    pw = wald_groups(mf.result, eng.nreg, tested)
     sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
     if len(sig) == len(pw):
         return mf

@@ -1,0 +1,134 @@
+"""Starting values of the residual vibration (eq. M5) by a profile search over the mode's
+frequency and damping: the nonlinear omega and zeta are gridded, the linear gain is solved at
+each grid point (against the current residual, projected off the current model's Jacobian
+columns, so the registration and the effects already found are re-fitted implicitly), and the
+best point per joint starts the Gauss-Newton fit of :class:`~zrp.gap.motion.fitting.Engine`.
+
+A joint enters the candidate only when its best gain explains more than ``screen`` times the
+residual variance per degree of freedom (an F-like ratio; the maximum over the grid is taken,
+so the screen is set far above the single-test quantile; the Wald, F and BIC tests of the
+search decide afterwards).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import NDArray
+from scipy.optimize import minimize
+
+from zrp.gap.motion.effects import MotionParam, mode_band
+from zrp.gap.motion.fitting import Engine, ModelFit
+from zrp.gap.motion.kernels import mode_response
+from zrp.gap.problem import Problem
+
+__all__ = ["ZETA_GRID", "vibration_start"]
+
+F64 = NDArray[np.float64]
+I64 = NDArray[np.int64]
+#: damping ratios tried (a lightly damped mode: well below 1)
+ZETA_GRID = (0.01, 0.03, 0.1, 0.3)
+
+
+def _explained(col: F64, r: F64, Q: F64) -> tuple[float, float, F64]:
+    """Sum of squares of r explained by ``col`` off span(Q), the gain, the projected column."""
+    col = col - Q @ (Q.T @ col)
+    cc = float(col @ col)
+    if cc <= 0.0:
+        return 0.0, 0.0, col
+    cr = float(col @ r)
+    return cr * cr / cc, -cr / cc, col
+
+
+def _refine(eng: Engine, poses: I64, k: int, c: F64, r: F64, Q: F64, w0: float, z0: float
+            ) -> tuple[float, float, float, F64]:
+    """The profile maximum near a grid point (Nelder-Mead on log omega, log zeta; each
+    evaluation solves the gain in closed form): (explained, omega, zeta, column)."""
+    traj = eng.traj
+    rows = r.size // poses.size
+
+    def column(x: F64) -> F64:
+        y = mode_response(traj.t, -traj.qdd[:, k], float(np.exp(x[0])), float(np.exp(x[1])),
+                          derivatives=False)[0]
+        return c * np.repeat(y[poses], rows)
+
+    res = minimize(lambda x: -_explained(column(x), r, Q)[0], np.log([w0, z0]),
+                   method="Nelder-Mead", options={"xatol": 1e-4, "fatol": 1e-9 * float(r @ r),
+                                                  "maxfev": 120})
+    ex, _, col = _explained(column(res.x), r, Q)
+    return ex, float(np.exp(res.x[0])), float(np.exp(res.x[1])), col
+
+
+def _joint_columns(eng: Engine, cur: ModelFit, poses: I64, joints: list[int]
+                   ) -> tuple[F64, F64, F64]:
+    """Current residual and per-joint position sensitivities, both projected off the current
+    model's Jacobian: r (3R,), C (3R, len(joints)); and Q (3R, p) the projector basis."""
+    s, n = eng.traj.q.shape
+    probes = []
+    for k in joints:
+        b = np.zeros((s, n))
+        b[:, k] = 1.0
+        probes.append(MotionParam(f"q{k + 1}.vib_probe", "1", "residual_vibration", "dq",
+                                  k + 1, 0, b, f"q{k + 1}"))
+    prob = Problem(cur.ctx, [*cur.specs, *probes], poses, eng.base_rotation)
+    theta = np.concatenate([cur.result.theta, np.zeros(len(probes))])
+    r, J = prob.residual_and_jacobian(theta)
+    p = len(cur.specs)
+    Q, _ = np.linalg.qr(J[:, :p])
+    return r - Q @ (Q.T @ r), J[:, p:], Q
+
+
+def _grid(eng: Engine, poses: I64, joints: list[int], n_omega: int
+          ) -> dict[int, dict[tuple[float, float], F64]]:
+    """Mode responses y at ``poses`` per joint and grid point; they depend on the command
+    only, so they are computed once per engine and sample set (``eng.cache``)."""
+    key = ("vibration_grid", n_omega, poses.tobytes())
+    if key not in eng.cache:
+        traj = eng.traj
+        lo, hi = mode_band(traj.rate_hz)
+        omegas = np.geomspace(lo, min(hi, 2.0 * np.pi * 100.0), n_omega)
+        eng.cache[key] = {k: {(float(w), z): mode_response(traj.t, -traj.qdd[:, k], w, z,
+                                                           derivatives=False)[0][poses]
+                              for w in omegas for z in ZETA_GRID} for k in joints}
+    return eng.cache[key]
+
+
+def vibration_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0,
+                    n_omega: int = 36) -> dict[str, float]:
+    """Start values ``q{k}.vib_gain/omega/zeta`` for the joints whose best grid point passes
+    the screen (empty when none does). Joints are taken one at a time, best first; each
+    chosen mode is projected off before the next joint is screened (a big mode on one joint
+    otherwise leaks into its neighbours' correlated columns)."""
+    traj = eng.traj
+    joints = [k for k in range(traj.n_joints)
+              if np.ptp(traj.q[:, k]) > 1e-4 and np.any(traj.qdd[:, k] != 0.0)]
+    if not joints:
+        return {}
+    r, C, Q = _joint_columns(eng, cur, poses, joints)
+    rows = r.size // poses.size
+    dof = max(r.size - Q.shape[1], 1)
+    grid = _grid(eng, poses, joints, n_omega)
+    out: dict[str, float] = {}
+    left = list(range(len(joints)))
+    while left:
+        var = float(r @ r) / dof
+        best = (0.0, -1, 0.0, 0.0)
+        for j in left:
+            for (w, z), y in grid[joints[j]].items():
+                ex = _explained(C[:, j] * np.repeat(y, rows), r, Q)[0]
+                if ex > best[0]:
+                    best = (ex, j, w, z)
+        j = best[1]
+        if j < 0 or best[0] <= screen * var:
+            break
+        ex, w, z, col = _refine(eng, poses, joints[j], C[:, j], r, Q, best[2], best[3])
+        _, g, col = _explained(col, r, Q)
+        if g <= 0.0:
+            break
+        p = f"q{joints[j] + 1}.vib_"
+        out.update({p + "gain": g, p + "omega": w, p + "zeta": z})
+        u = col / np.linalg.norm(col)
+        r = r - u * float(u @ r)
+        Q = np.column_stack([Q, u])
+        dof -= 3
+        left.remove(j)
+    return out
