@@ -9,6 +9,7 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from mjcf.gravity import joint_space_model
 from zrp.errors import InputError
 
 __all__ = ["inverse_dynamics_torques"]
@@ -35,17 +36,7 @@ def inverse_dynamics_torques(source: str | Path | mujoco.MjModel, q: ArrayLike, 
     if not (q.shape == qd.shape == qdd.shape):
         raise InputError(f"q, qd, qdd: expected equal shapes (S, n), got {q.shape}, "
                          f"{qd.shape}, {qdd.shape}")
-    if isinstance(source, mujoco.MjModel):
-        m = source
-    else:
-        try:
-            m = mujoco.MjModel.from_xml_path(str(source))
-        except Exception as exc:  # mujoco raises ValueError with its own message
-            raise InputError(f"{field} {source}: cannot load: {exc}") from exc
-    n = q.shape[1]
-    if m.nq != n or m.nv != n:
-        raise InputError(f"{field}: has {m.nq} position coordinates, but the trajectory has {n} "
-                         "joints; the MJCF must have one hinge/slide joint per model joint")
+    m = joint_space_model(source, q.shape[1], field)
     d = mujoco.MjData(m)
     saved = m.opt.disableflags
     m.opt.disableflags = saved | int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)

@@ -10,9 +10,31 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
 
-__all__ = ["gravity_torques"]
+__all__ = ["gravity_torques", "joint_space_model"]
 
 F64 = NDArray[np.float64]
+
+
+def joint_space_model(source: str | Path | mujoco.MjModel, n: int,
+                      field: str = "path") -> mujoco.MjModel:
+    """The compiled MJCF of an arm with exactly ``n`` hinge/slide joints (one per model joint,
+    in order, same zero), for torques along joint values; ``field`` names ``source`` in errors.
+
+    Raises:
+        InputError: the file does not load, or its joints do not match.
+    """
+    if isinstance(source, mujoco.MjModel):
+        m = source
+    else:
+        try:
+            m = mujoco.MjModel.from_xml_path(str(source))
+        except Exception as exc:  # mujoco raises ValueError with its own message
+            raise InputError(f"{field} {source}: cannot load: {exc}") from exc
+    if m.nq != n or m.nv != n:
+        raise InputError(f"{field} {source if isinstance(source, (str, Path)) else ''}: has "
+                         f"{m.nq} position coordinates, but the model has {n} joints; the MJCF "
+                         "must have one hinge/slide joint per model joint")
+    return m
 
 
 def gravity_torques(path: str | Path, q_pose: ArrayLike, field: str = "path") -> F64:
@@ -28,14 +50,7 @@ def gravity_torques(path: str | Path, q_pose: ArrayLike, field: str = "path") ->
         field: how error messages name ``path`` (the command line passes its option).
     """
     q_pose = np.asarray(q_pose, dtype=float)
-    try:
-        m = mujoco.MjModel.from_xml_path(str(path))
-    except Exception as exc:  # mujoco raises ValueError with its own message
-        raise InputError(f"{field} {path}: cannot load: {exc}") from exc
-    n = q_pose.shape[1]
-    if m.nq != n or m.nv != n:
-        raise InputError(f"{field} {path}: has {m.nq} position coordinates, but the model has {n} "
-                         "joints; the MJCF must have one hinge/slide joint per model joint")
+    m = joint_space_model(path, q_pose.shape[1], field)
     d = mujoco.MjData(m)
     out = np.empty(q_pose.shape)
     for i, q in enumerate(q_pose):
