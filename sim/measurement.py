@@ -60,6 +60,7 @@ __all__ = [
 F64 = NDArray[np.float64]
 APPROACHES = ("random", "order", "gravity")
 TRUTH_FORMAT = "zrp-real-robot-truth"
+TRANSFER = "simulate"
 
 
 def _num(v: object, name: str, unit: str, lo: float | None = None,
@@ -256,7 +257,10 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
             pre = q[i] - d * step
             dist = float(np.max(np.abs(pre - prev)))
             if dist > 0:
-                session.move(pre, max(0.2, 1.875 * dist / proc.speed))
+                if TRANSFER == "jump":
+                    session.jump(pre, max(0.2, 1.875 * dist / proc.speed))
+                else:
+                    session.move(pre, max(0.2, 1.875 * dist / proc.speed))
             session.set_temperature(proc.temperature(clock + session.time)[()])
             session.move(q[i], proc.approach_time)
         else:

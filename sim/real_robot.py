@@ -298,6 +298,29 @@ class Session:
         self.rate = np.zeros(self.n)
         self._apply()
 
+    def jump(self, q_to: ArrayLike, duration: float) -> None:
+        """Put the motors at rest on the targets of controller joint values ``q_to`` without
+        simulating the way there; the clock advances by ``duration`` s (whole control periods)
+        as if the move had been made. The load hinges keep their play and the integral trims
+        their values; what follows (a slow approach, then :meth:`settle`) sets the flanks and
+        trims as it does after a simulated move."""
+        dur = finite(duration, "duration", "s")
+        if dur <= 0:
+            raise InputError(f"duration: expected a time > 0 s, got {duration!r}")
+        r = self.robot
+        target = r.motor_target(np.asarray(q_to, dtype=float)) * self._q_scale
+        d = self.d
+        d.qpos[self.ids["motor_q"]] = target
+        d.qvel[:] = 0.0
+        d.qacc_warmstart[:] = 0.0
+        self.ref = target
+        self.rate = np.zeros(self.n)
+        self._apply()
+        mujoco.mj_forward(r.model, d)
+        periods = max(1, math.ceil(dur / self.period))
+        self.time += periods * self.period
+        d.time += periods * self.period
+
     def settle(self, max_time: float = 2.0, check_every: float = 0.04, tol_rad: float = 1e-7,
                speed_tol: float = 1e-5) -> float:
         """Hold the references until the motors with integral action are within ``tol_rad``

@@ -35,6 +35,7 @@ import numpy as np
 
 import zrp
 from zrp.kinematics import _kernels as K
+from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import _karrays
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -78,11 +79,12 @@ def per_call(*fns, number=20000, repeat=9) -> list[float]:
 def batched(model: zrp.Manipulator, n: int) -> None:
     q = np.random.default_rng(0).uniform(-np.pi, np.pi, (n, model.n))
     arrays = _karrays(model)
+    lim = joint_limits(model)
     out = np.empty((n, 7))
-    t_k, t_api = best(lambda: K.fk_pose_batch(q, *arrays, out),
+    t_k, t_api = best(lambda: K.fk_pose_batch(q, *arrays, lim, out),
                       lambda: zrp.end_effector_pose(model, q), repeat=7)
     jac = np.empty((n, 6, model.n))
-    t_j, t_japi = best(lambda: K.jac_batch(q, *arrays, np.empty((0, 7)), jac),
+    t_j, t_japi = best(lambda: K.jac_batch(q, *arrays, lim, np.empty((0, 7)), jac),
                        lambda: zrp.jacobian(model, q), repeat=4)
     row("batched FK, kernel (M poses/s/core)", f"{n / t_k / 1e6:.1f}", ">= 50", "-", "")
     row("batched FK, end_effector_pose (M/s)", f"{n / t_api / 1e6:.1f}", "<= 1.2x kernel",
