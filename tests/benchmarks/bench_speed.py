@@ -27,6 +27,7 @@ import os
 os.environ["NUMBA_NUM_THREADS"] = "1"  # one core: must precede the first numba import
 
 import argparse
+import sys
 import tempfile
 import time
 import timeit
@@ -34,6 +35,10 @@ import warnings
 from pathlib import Path
 
 import numpy as np
+
+# measure the checkout this script is in, not whichever copy is installed (an editable
+# install of another checkout would otherwise be imported)
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 import zrp
 from zrp.kinematics import _kernels as K
