@@ -293,11 +293,11 @@ def fk_pose_batch(q, axes, bodies, prism, lim, out):
 def _load_block(q, start, m, k, limk, qb):
     """qb[:m] = q[start:start + m, k]; returns how many are not within |x| <= limk (NaN is
     not)."""
-    bad = 0
     for i in range(m):
-        x = q[start + i, k]
-        qb[i] = x
-        bad += not abs(x) <= limk
+        qb[i] = q[start + i, k]
+    bad = 0
+    for i in range(m):  # contiguous now: a vectorised count
+        bad += not abs(qb[i]) <= limk
     return bad
 
 
