@@ -288,15 +288,45 @@ class Session:
         delta = target - start
         periods = max(1, math.ceil(dur / self.period))
         T = periods * self.period
+        # the loop of _apply + _period written out with local names (the same arithmetic:
+        # Python's overhead per control period was a quarter of the simulation's time)
+        m, d, n, sub, per = r.model, self.d, self.n, self.sub, self.period
+        ctrl, qpos, mq, gain, trim = d.ctrl, d.qpos, self.ids["motor_q"], self._gain, self.trim
+        step = mujoco.mj_step
         for i in range(1, periods + 1):
             s = i / periods
-            self.ref = start + (s**3 * (10 - 15 * s + 6 * s * s)) * delta
-            self.rate = (30 * s * s * (1 - s) ** 2 / T) * delta
-            self._apply()
-            self._period()
+            ref = start + (s**3 * (10 - 15 * s + 6 * s * s)) * delta
+            ctrl[:n] = ref + trim
+            ctrl[n:] = (30 * s * s * (1 - s) ** 2 / T) * delta
+            step(m, d, nstep=sub)
+            self.time += per
+            trim += gain * (ref - qpos[mq])
         self.ref = target
         self.rate = np.zeros(self.n)
         self._apply()
+
+    def jump(self, q_to: ArrayLike, duration: float) -> None:
+        """Put the motors at rest on the targets of controller joint values ``q_to`` without
+        simulating the way there; the clock advances by ``duration`` s (whole control periods)
+        as if the move had been made. The load hinges keep their play and the integral trims
+        their values; what follows (a slow approach, then :meth:`settle`) sets the flanks and
+        trims as it does after a simulated move."""
+        dur = finite(duration, "duration", "s")
+        if dur <= 0:
+            raise InputError(f"duration: expected a time > 0 s, got {duration!r}")
+        r = self.robot
+        target = r.motor_target(np.asarray(q_to, dtype=float)) * self._q_scale
+        d = self.d
+        d.qpos[self.ids["motor_q"]] = target
+        d.qvel[:] = 0.0
+        d.qacc_warmstart[:] = 0.0
+        self.ref = target
+        self.rate = np.zeros(self.n)
+        self._apply()
+        mujoco.mj_forward(r.model, d)
+        periods = max(1, math.ceil(dur / self.period))
+        self.time += periods * self.period
+        d.time += periods * self.period
 
     def settle(self, max_time: float = 2.0, check_every: float = 0.04, tol_rad: float = 1e-7,
                speed_tol: float = 1e-5) -> float:
@@ -307,10 +337,18 @@ class Session:
         mask = self.ids["trim"]
         speed = math.inf
         elapsed = 0.0
+        m, d, n, sub, per = self.robot.model, self.d, self.n, self.sub, self.period
+        ctrl, qpos, mq, gain, trim = d.ctrl, d.qpos, self.ids["motor_q"], self._gain, self.trim
+        ref = self.ref
+        step = mujoco.mj_step
+        err = np.zeros(n)
         while elapsed < max_time:
-            for _ in range(every):
-                err = self._period()
-                self._apply()
+            for _ in range(every):  # _period then _apply, written out (see move)
+                step(m, d, nstep=sub)
+                self.time += per
+                err = ref - qpos[mq]
+                trim += gain * err
+                ctrl[:n] = ref + trim
             elapsed += every * self.period
             speed = float(np.max(np.abs(self.d.qvel)))
             if np.max(np.abs(err[mask]), initial=0.0) < tol_rad and speed < speed_tol:

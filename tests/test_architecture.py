@@ -20,7 +20,8 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 PACKAGES = ("zrp", "mjcf", "sim")
 LAYER = {"core": 0, "mjcf": 1, "sim": 2, "cli": 3}
-CORE_THIRD_PARTY = {"numpy", "scipy", "numba", "tqdm", "tomli"}
+# threadpoolctl: BLAS thread limits for the diagnosis (zrp/blas.py)
+CORE_THIRD_PARTY = {"numpy", "scipy", "numba", "tqdm", "tomli", "threadpoolctl"}
 REPORT_ONLY = {"matplotlib", "PIL"}
 MAX_LINES = 400
 

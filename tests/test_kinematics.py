@@ -194,8 +194,9 @@ def test_blocked_batch_kernels_match_single_pose_kernels(rng):
     out = np.empty((1000, 7))
     pose = np.empty((1000, 7))
     jac = np.empty((1000, 6, 7))
-    K.fk_pose_batch(q, *arrays, out)
-    K.jac_batch(q, *arrays, pose, jac)
+    lim = np.full(7, 1e6)
+    assert K.fk_pose_batch(q, *arrays, lim, out)
+    assert K.jac_batch(q, *arrays, lim, pose, jac)
     one, j1 = np.empty(7), np.empty((6, 7))
     for i in (0, 255, 256, 999):
         K.fk_jac_one(q[i], *arrays, one, j1)

@@ -240,6 +240,27 @@ def test_gravity_approach_puts_the_backlash_on_the_gravity_flank(puma):
     assert set(np.unique(run.direction[:, 0])) == {-1.0, 1.0}
 
 
+def test_jumped_transfer_settles_where_the_simulated_move_does(puma, poses):
+    """The default procedure jumps to each pre-pose instead of stepping the move there; the
+    slow approach and the settling decide the state, so the settled tool points agree with
+    the fully simulated procedure far below the tracker noise (backlash and compliance in)."""
+    eff = HiddenEffects(backlash={1: 2e-3, 2: 1e-3}, joint_compliance={3: 2e-6},
+                        thermal_expansion=1.2e-5)
+    runs = {}
+    for mode in ("jump", "simulate"):
+        robot = RealRobot(puma, eff)
+        runs[mode] = measure(robot, poses, EXACT, np.random.default_rng(3),
+                             Procedure(transfer=mode))
+    pj = np.array(runs["jump"].truth["poses"]["points_base_noisefree"])
+    ps = np.array(runs["simulate"].truth["poses"]["points_base_noisefree"])
+    assert np.abs(pj - ps).max() < 1e-3  # mm; the tracker's noise is 0.01-0.03 mm
+    # the clock runs as if the moves had been made: same times and temperatures to a period
+    tj = runs["jump"].measurements.t
+    ts = runs["simulate"].measurements.t
+    assert np.abs(tj - ts).max() < 0.05
+    assert runs["jump"].truth["procedure"]["transfer"] == "jump"
+
+
 def test_circle_poses_follow_the_paper_circle(puma):
     q = trajectory_poses(puma, 24)
     p, _ = zrp.end_effector_pose(puma, q)
@@ -292,6 +313,8 @@ def test_bad_robot_and_procedure_options(puma):
         Procedure(approach="sideways")
     with pytest.raises(InputError, match="approach_time"):
         Procedure(approach_time=0.0)
+    with pytest.raises(InputError, match="transfer"):
+        Procedure(transfer="teleport")
     with pytest.raises(InputError, match="noise_sigma"):
         Instrument(noise_sigma=-0.01)
     with pytest.raises(InputError, match=r"q: expected finite joint values of shape \(P, 6\)"):

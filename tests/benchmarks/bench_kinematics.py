@@ -24,6 +24,7 @@ import numpy as np
 
 import zrp
 from zrp.kinematics import _kernels as K
+from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import _karrays
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
@@ -64,7 +65,8 @@ def main() -> None:
     t_api = best(lambda: zrp.end_effector_pose(model, q))
     out = np.empty((n, 7))
     arrays = _karrays(model)
-    t_kernel = best(lambda: K.fk_pose_batch(q, *arrays, out))
+    lim = joint_limits(model)
+    t_kernel = best(lambda: K.fk_pose_batch(q, *arrays, lim, out))
     t_numpy = best(lambda: zrp.forward_kinematics(model, q[:100_000]), repeat=2) * 10
     mj_rate = mujoco_loop_rate(model, q[:20_000])
     api, kern = n / t_api, n / t_kernel
@@ -78,7 +80,7 @@ def main() -> None:
 
     t_jac = best(lambda: zrp.jacobian(model, q), repeat=3)
     jac = np.empty((n, 6, 6))
-    t_jk = best(lambda: K.jac_batch(q, *arrays, np.empty((0, 7)), jac), repeat=3)
+    t_jk = best(lambda: K.jac_batch(q, *arrays, lim, np.empty((0, 7)), jac), repeat=3)
     print(f"  jacobian (allocates output)          {n / t_jac / 1e6:8.2f} M Jacobians/s")
     print(f"  compiled kernel, preallocated output {n / t_jk / 1e6:8.2f} M Jacobians/s"
           "  (target >= 5)")

@@ -10,12 +10,14 @@ figure, measured value, target, the baseline of the same run and the ratio:
 * one FK call and one Jacobian from Python; baselines: Pinocchio (``pin``)
   forwardKinematics / computeJointJacobians + getJointJacobian, MuJoCo mj_kinematics /
   mj_kinematics + mj_comPos + mj_jacBody, on the same arm (where installed);
-* Monte Carlo 1e5 robots x 360 points on one core; then on a Dask LocalCluster of 1 and of
-  2 workers (baseline: 1 worker);
+* Monte Carlo 1e5 robots x 360 points on one core (baseline: the FK kernel's rate), gathered
+  and reduced on the workers (histograms); then on a Dask LocalCluster of 1 and of 2 workers
+  (baseline: 1 worker);
 * the full diagnosis of the IRB 120 laser-tracker data in ../shared (2,946 points) and of its
-  first 999 points; baseline: the registration fit alone (skipped without ../shared);
-* the blind benchmark's simulation of a 200-pose scenario; baseline: the same poses measured
-  by forward kinematics only.
+  first 999 points; baselines: the registration fit alone, and the same diagnosis on
+  OpenBLAS's own threads (the former; zrp/blas.py) (skipped without ../shared);
+* the blind benchmark's simulation of a 200-pose scenario; baselines: the same poses measured
+  by forward kinematics only, and the former procedure (every move to a pre-pose simulated).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ import os
 os.environ["NUMBA_NUM_THREADS"] = "1"  # one core: must precede the first numba import
 
 import argparse
+import sys
 import tempfile
 import time
 import timeit
@@ -33,8 +36,13 @@ from pathlib import Path
 
 import numpy as np
 
+# measure the checkout this script is in, not whichever copy is installed (an editable
+# install of another checkout would otherwise be imported)
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
 import zrp
 from zrp.kinematics import _kernels as K
+from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import _karrays
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -75,14 +83,15 @@ def per_call(*fns, number=20000, repeat=9) -> list[float]:
     return [min(t) for t in times]
 
 
-def batched(model: zrp.Manipulator, n: int) -> None:
+def batched(model: zrp.Manipulator, n: int) -> float:
     q = np.random.default_rng(0).uniform(-np.pi, np.pi, (n, model.n))
     arrays = _karrays(model)
+    lim = joint_limits(model)
     out = np.empty((n, 7))
-    t_k, t_api = best(lambda: K.fk_pose_batch(q, *arrays, out),
+    t_k, t_api = best(lambda: K.fk_pose_batch(q, *arrays, lim, out),
                       lambda: zrp.end_effector_pose(model, q), repeat=7)
     jac = np.empty((n, 6, model.n))
-    t_j, t_japi = best(lambda: K.jac_batch(q, *arrays, np.empty((0, 7)), jac),
+    t_j, t_japi = best(lambda: K.jac_batch(q, *arrays, lim, np.empty((0, 7)), jac),
                        lambda: zrp.jacobian(model, q), repeat=4)
     row("batched FK, kernel (M poses/s/core)", f"{n / t_k / 1e6:.1f}", ">= 50", "-", "")
     row("batched FK, end_effector_pose (M/s)", f"{n / t_api / 1e6:.1f}", "<= 1.2x kernel",
@@ -91,6 +100,7 @@ def batched(model: zrp.Manipulator, n: int) -> None:
         f"FK kernel {n / t_k / 1e6:.1f} M/s", f"{t_j / t_k:.2f}x the FK time")
     row("batched Jacobian, jacobian() (M/s)", f"{n / t_japi / 1e6:.1f}", "",
         f"kernel {n / t_j / 1e6:.1f} M/s", f"{t_japi / t_j:.2f}x")
+    return n / t_k
 
 
 def pinocchio_model(model: zrp.Manipulator):
@@ -169,8 +179,8 @@ def single_calls(model: zrp.Manipulator) -> None:
         pass
 
 
-def monte_carlo(n_robots: int, workers: bool) -> None:
-    from zrp.manufacturing import Tolerances
+def monte_carlo(n_robots: int, workers: bool, fk_rate: float) -> None:
+    from zrp.manufacturing import Tolerances, monte_carlo_summary
     from zrp.manufacturing import monte_carlo as mc
 
     setup = zrp.puma_circle()
@@ -178,32 +188,42 @@ def monte_carlo(n_robots: int, workers: bool) -> None:
     q = res.q  # 360 points
     tol = Tolerances.build(setup.model, length=0.02, angle_rad=5e-5)
     mc(setup.model, q, tol, 512, seed=1)  # warm-up
-    t1 = best(lambda: mc(setup.model, q, tol, n_robots, seed=1), repeat=2)
+    t1, t_red = best(lambda: mc(setup.model, q, tol, n_robots, seed=1),
+                     lambda: monte_carlo_summary(setup.model, q, tol, n_robots, seed=1),
+                     repeat=2)
+    rate = n_robots * q.shape[0] / t1
     row(f"Monte Carlo {n_robots:.0e} x {q.shape[0]}, one core (s)", f"{t1:.2f}", "<= 0.7",
-        "-", f"{n_robots * q.shape[0] / t1 / 1e6:.1f} M poses/s")
+        f"FK kernel {fk_rate / 1e6:.1f} M poses/s", f"{rate / 1e6:.1f} M poses/s "
+        f"({rate / fk_rate:.2f}x; perturbed arms: no sparse axes)")
+    row("  the same reduced on the workers (s)", f"{t_red:.2f}", "", f"gathered {t1:.2f} s",
+        f"{t_red / t1:.2f}x")
     if not workers:
         return
     from zrp.cli.cluster import executor
 
     times: dict[int, list[float]] = {1: [], 2: []}
+    chunk = 4096  # 25 chunks of 1e5 robots: 13 + 12 on two workers (8192: 7 + 6, <= 1.86x)
     with executor(1) as e1, executor(2) as e2:
         for ex in (e1, e2):
             mc(setup.model, q, tol, 4096, seed=1, chunk=512, executor=ex)  # warm-up
         for _ in range(3):  # interleaved: both see the same load
             for w, ex in ((1, e1), (2, e2)):
                 t = time.perf_counter()
-                mc(setup.model, q, tol, n_robots, seed=1, executor=ex)
+                mc(setup.model, q, tol, n_robots, seed=1, chunk=chunk, executor=ex)
                 times[w].append(time.perf_counter() - t)
     t1, t2 = min(times[1]), min(times[2])
-    row("Monte Carlo on a Dask LocalCluster, 2 workers (s)", f"{t2:.2f}", ">= 1.8x faster",
-        f"1 worker {t1:.2f} s", f"{t1 / t2:.2f}x faster")
+    row(f"Monte Carlo on a Dask LocalCluster, 2 workers (s; chunk {chunk})", f"{t2:.2f}",
+        ">= 1.8x faster", f"1 worker {t1:.2f} s", f"{t1 / t2:.2f}x faster")
 
 
 def diagnosis() -> None:
     if not (SHARED / "measurements.csv").exists():
         row("diagnosis of the IRB 120 data", "skipped", "<= 3 s", "../shared absent", "")
         return
-    from zrp.gap import diagnose, load_measurements
+    import contextlib
+
+    from zrp.blas import blas_threads
+    from zrp.gap import diagnose, load_measurements, pipeline
     from zrp.gap.effects import Context, registration_parameters
     from zrp.gap.leastsq import fit, initial_registration
 
@@ -223,13 +243,22 @@ def diagnosis() -> None:
                 th0, rb0 = initial_registration(ctx, specs, poses)
                 return fit(ctx, specs, poses, th0, rb0)
 
+            def threaded(model=model, meas=meas):  # the former: OpenBLAS's own threads
+                pipeline.blas_threads = lambda _n: contextlib.nullcontext()
+                try:
+                    return diagnose(model, meas, seed=0)
+                finally:
+                    pipeline.blas_threads = blas_threads
+
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                t_reg, t_full = best(registration,
-                                     lambda model=model, meas=meas: diagnose(model, meas, seed=0),
-                                     repeat=2)
+                t_reg, t_full, t_thr = best(
+                    registration, lambda model=model, meas=meas: diagnose(model, meas, seed=0),
+                    threaded, repeat=2)
             row(f"diagnosis, IRB 120 {label} (s)", f"{t_full:.2f}", goal,
                 f"registration {t_reg:.3f} s", f"{t_full / t_reg:.0f}x")
+            row("  the same on OpenBLAS's own threads (s)", f"{t_thr:.2f}", "",
+                f"one BLAS thread {t_full:.2f} s", f"{t_thr / t_full:.2f}x slower")
 
 
 def simulation(poses: int) -> None:
@@ -242,8 +271,18 @@ def simulation(poses: int) -> None:
                           pair_fraction=0.0)
     scns = draw_scenarios(model, cfg)
     tool = default_tool_points(model)
+    import functools
+
+    import sim.benchmark.blind as blind
+    from sim.measurement import Procedure
+
     with tempfile.TemporaryDirectory() as tmp:
         times = [simulate_scenario(model, s, cfg, Path(tmp), Path(tmp))[2] for s in scns]
+        try:  # the former procedure, every move to a pre-pose stepped through (same run)
+            blind.Procedure = functools.partial(Procedure, transfer="simulate")
+            t_old = [simulate_scenario(model, s, cfg, Path(tmp), Path(tmp))[2] for s in scns]
+        finally:
+            blind.Procedure = Procedure
     t0 = time.perf_counter()
     for s in scns:
         q = reachable_poses(model, poses, np.random.default_rng(s.seed))
@@ -252,6 +291,8 @@ def simulation(poses: int) -> None:
     t_kin = (time.perf_counter() - t0) / len(scns)
     row(f"blind-benchmark simulation, {poses} poses (s)", f"{np.median(times):.2f}",
         "<= 1 s", f"kinematics only {t_kin * 1e3:.1f} ms", f"{np.median(times) / t_kin:.0f}x")
+    row("  the same, moves to pre-poses simulated (s)", f"{np.median(t_old):.2f}", "",
+        f"jumped {np.median(times):.2f} s", f"{np.median(t_old) / np.median(times):.2f}x slower")
 
 
 def main() -> None:
@@ -260,9 +301,9 @@ def main() -> None:
     args = ap.parse_args()
     print(f"issue-15 speed figures (one core for the kernels; load {os.getloadavg()[0]:.1f})")
     model = zrp.load_model("puma")
-    batched(model, 200_000 if args.quick else 1_000_000)
+    fk_rate = batched(model, 200_000 if args.quick else 1_000_000)
     single_calls(model)
-    monte_carlo(10_000 if args.quick else 100_000, workers=not args.quick)
+    monte_carlo(10_000 if args.quick else 100_000, workers=not args.quick, fk_rate=fk_rate)
     diagnosis()
     simulation(50 if args.quick else 200)
     print(f"(load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")

@@ -283,15 +283,25 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
     accepted_cols = list(range(nb))
     keep: list[ParamSpec] = []
     report: list[Aliased] = []
+    # every candidate projected off the base span at once (two passes, one matrix product each
+    # instead of one matrix-vector product per candidate), then, in order, off the candidates
+    # accepted before it: the same projection onto span(base, accepted)
+    C = J[:, nb:] / np.where(norms[nb:] > 0, norms[nb:], 1.0)
+    P = C - Q @ (Q.T @ C)
+    P = P - Q @ (Q.T @ P)
+    Qa = np.empty((J.shape[0], len(candidates)))  # the accepted candidates' directions
+    na = 0
     for i, spec in enumerate(candidates):
-        col = J[:, nb + i]
         nrm = norms[nb + i]
         if nrm <= 1e-12 * max(norms.max(), 1.0):
             report.append(Aliased(spec.name, spec.effect, (), 0.0, True))
             continue
-        c = col / nrm
-        rr = c - Q @ (Q.T @ c)
-        rr = rr - Q @ (Q.T @ rr)
+        c = C[:, i]
+        rr = P[:, i]
+        if na:
+            qa = Qa[:, :na]
+            rr = rr - qa @ (qa.T @ rr)
+            rr = rr - qa @ (qa.T @ rr)
         frac = float(np.linalg.norm(rr))
         if frac < WEAK_TOL:
             acc = J[:, accepted_cols] / np.where(norms[accepted_cols] > 0,
@@ -305,7 +315,8 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
                 continue
         keep.append(spec)
         accepted_cols.append(nb + i)
-        Q = np.column_stack([Q, rr / frac])
+        Qa[:, na] = rr / frac
+        na += 1
     return keep, report
 
 

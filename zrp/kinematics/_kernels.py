@@ -220,8 +220,12 @@ def _turn_block(e0, e1, e2, e3, qb, m, code, ux, uy, uz):
 
 
 @njit(cache=True, fastmath=_FM)
-def fk_pose_batch(q, axes, bodies, prism, out):
-    """Batched :func:`fk_pose_one`: q (N, n) -> out (N, 7).
+def fk_pose_batch(q, axes, bodies, prism, lim, out):
+    """Batched :func:`fk_pose_one`: q (N, n) -> out (N, 7); returns True when every
+    |q[:, k]| <= lim[k] (finite), False otherwise (out is then not to be used).
+
+    The range check rides on the copy of each joint's values into the block (no separate
+    pass over q, no early exit: it vectorises).
 
     Works on blocks of poses held as structure-of-arrays so that every inner loop runs over
     poses with no branches and vectorises (SIMD); the arithmetic is that of fk_pose_one, with
@@ -245,6 +249,7 @@ def fk_pose_batch(q, axes, bodies, prism, out):
     py = np.empty(_BLOCK)
     pz = np.empty(_BLOCK)
     qb = np.empty(_BLOCK)  # joint k's values, contiguous (a strided read stops SIMD)
+    bad = 0
     for start in range(0, N, _BLOCK):
         m = min(_BLOCK, N - start)
         e0[:m] = 1.0
@@ -258,8 +263,7 @@ def fk_pose_batch(q, axes, bodies, prism, out):
             if k > 0:
                 _body_block(e0, e1, e2, e3, px, py, pz, m, bcode[k], bodies[k, 0],
                             bodies[k, 1], bodies[k, 2])
-            for i in range(m):
-                qb[i] = q[start + i, k]
+            bad += _load_block(q, start, m, k, lim[k], qb)
             if prism[k]:
                 for i in range(m):
                     d = qb[i]
@@ -282,6 +286,19 @@ def fk_pose_batch(q, axes, bodies, prism, out):
             out[j, 4] = e1[i]
             out[j, 5] = e2[i]
             out[j, 6] = e3[i]
+    return bad == 0
+
+
+@njit(inline="always")
+def _load_block(q, start, m, k, limk, qb):
+    """qb[:m] = q[start:start + m, k]; returns how many are not within |x| <= limk (NaN is
+    not)."""
+    for i in range(m):
+        qb[i] = q[start + i, k]
+    bad = 0
+    for i in range(m):  # contiguous now: a vectorised count
+        bad += not abs(qb[i]) <= limk
+    return bad
 
 
 @njit(inline="always")
@@ -354,9 +371,9 @@ def _jac_column(prismatic, wx, wy, wz, rx, ry, rz, col):
 
 
 @njit(cache=True, fastmath=_FM)
-def jac_batch(q, axes, bodies, prism, pose, jac):
+def jac_batch(q, axes, bodies, prism, lim, pose, jac):
     """Batched :func:`fk_jac_one`: q (N, n) -> pose (N, 7) (or shape (0, 7) to skip), jac
-    (N, 6, n).
+    (N, 6, n); returns True when every |q[:, k]| <= lim[k] (as :func:`fk_pose_batch`).
 
     Blocked structure-of-arrays like :func:`fk_pose_batch`, so the loops over poses vectorise.
     """
@@ -378,6 +395,7 @@ def jac_batch(q, axes, bodies, prism, pose, jac):
     w = np.empty((n, 3, _BLOCK))  # current axes u_k
     o = np.empty((n, 3, _BLOCK))  # current joint points p_k
     qb = np.empty(_BLOCK)  # joint k's values, contiguous (a strided read stops SIMD)
+    bad = 0
     for start in range(0, N, _BLOCK):
         m = min(_BLOCK, N - start)
         e0[:m] = 1.0
@@ -395,8 +413,7 @@ def jac_batch(q, axes, bodies, prism, pose, jac):
             ux = axes[k, 0]
             uy = axes[k, 1]
             uz = axes[k, 2]
-            for i in range(m):
-                qb[i] = q[start + i, k]
+            bad += _load_block(q, start, m, k, lim[k], qb)
             for i in range(m):
                 w[k, 0, i], w[k, 1, i], w[k, 2, i] = rotate(e0[i], e1[i], e2[i], e3[i], ux, uy,
                                                             uz)
@@ -426,6 +443,7 @@ def jac_batch(q, axes, bodies, prism, pose, jac):
             for i in range(m):
                 _jac_column(pk, w[k, 0, i], w[k, 1, i], w[k, 2, i], px[i] - o[k, 0, i],
                             py[i] - o[k, 1, i], pz[i] - o[k, 2, i], jac[start + i, :, k])
+    return bad == 0
 
 
 # ---- one pose from Python: one packed model array ---------------------------------------------

@@ -2,8 +2,9 @@
 pose deviations along a trajectory (eqs 15-17, :mod:`.deviation`), the parameter vector and its
 identification Jacobian (:mod:`.sensitivity`), one-at-a-time studies (:mod:`.study`), and the
 tolerance analysis: tolerances and random draws (:mod:`.tolerance`), the nonlinear Monte Carlo
-(:mod:`.population`), the first-order budget (:mod:`.budget`), allocation
-(:mod:`.allocation`) and its figure (:mod:`.plots`). See README.md in this folder.
+(:mod:`.population`; reduced on the workers for any size: :mod:`.reduction`), the first-order
+budget (:mod:`.budget`), allocation (:mod:`.allocation`) and its figure (:mod:`.plots`). See
+README.md in this folder.
 """
 
 from zrp.manufacturing.allocation import Allocation as Allocation
@@ -22,6 +23,7 @@ from zrp.manufacturing.deviation import delta_r_eq15 as delta_r_eq15
 from zrp.manufacturing.deviation import delta_r_literal as delta_r_literal
 from zrp.manufacturing.deviation import pose_deviation as pose_deviation
 from zrp.manufacturing.deviation import trajectory_deviation as trajectory_deviation
+from zrp.manufacturing.histogram import Histogram as Histogram
 from zrp.manufacturing.perturb import PAPER_SIGN_ZERO as PAPER_SIGN_ZERO
 from zrp.manufacturing.perturb import Perturbation as Perturbation
 from zrp.manufacturing.perturb import SignZero as SignZero
@@ -37,6 +39,8 @@ from zrp.manufacturing.population import chunk_tasks as chunk_tasks
 from zrp.manufacturing.population import first_order_max as first_order_max
 from zrp.manufacturing.population import gather_chunks as gather_chunks
 from zrp.manufacturing.population import monte_carlo as monte_carlo
+from zrp.manufacturing.reduction import MonteCarloSummary as MonteCarloSummary
+from zrp.manufacturing.reduction import monte_carlo_summary as monte_carlo_summary
 from zrp.manufacturing.sensitivity import ParameterSpace as ParameterSpace
 from zrp.manufacturing.sensitivity import apply_parameters as apply_parameters
 from zrp.manufacturing.sensitivity import axis_tangents as axis_tangents
@@ -69,9 +73,11 @@ __all__ = [
     "ChunkTask",
     "Contribution",
     "Deviation",
+    "Histogram",
     "JointPath",
     "Linearity",
     "MonteCarloResult",
+    "MonteCarloSummary",
     "ParameterSpace",
     "Perturbation",
     "SignZero",
@@ -94,6 +100,7 @@ __all__ = [
     "histogram_png",
     "load_joint_csv",
     "monte_carlo",
+    "monte_carlo_summary",
     "one_at_a_time",
     "parameter_jacobian",
     "parameter_label",

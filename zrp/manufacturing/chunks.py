@@ -25,6 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
+from zrp.manufacturing.histogram import Histogram
 from zrp.manufacturing.maxima import first_order_max, nonlinear_maxima
 from zrp.manufacturing.sensitivity import parameter_jacobian
 from zrp.manufacturing.tolerance import Tolerances, draw_parameters
@@ -54,6 +55,9 @@ class ChunkTask:
         dx: parameter steps drawn by the caller, shape (size, P), or None.
         first_order: also the first-order maxima (the worker computes the identification
             Jacobian, ~30 ms, rather than receive its T x 6 x P x 8 bytes with every chunk).
+        edges: bin edges (delta_p, angle) to reduce the chunk on the worker to two
+            :class:`~zrp.manufacturing.histogram.Histogram` (a few KB whatever its size)
+            instead of returning per-robot maxima; None returns the maxima.
     """
 
     index: int
@@ -66,10 +70,13 @@ class ChunkTask:
     seed: int | None = None
     dx: F64 | None = None
     first_order: bool = False
+    edges: tuple[F64, F64] | None = None
 
     def __post_init__(self) -> None:
         if (self.seed is None) == (self.dx is None):
             raise InputError("ChunkTask: give exactly one of seed and dx")
+        if self.edges is not None and self.first_order:
+            raise InputError("ChunkTask: first_order needs the per-robot maxima (edges=None)")
         if self.dx is not None and self.dx.shape[0] != self.size:
             raise InputError(f"ChunkTask.dx: expected {self.size} rows, got {self.dx.shape[0]}")
 
@@ -84,15 +91,17 @@ class ChunkTask:
 
 @dataclass(frozen=True, eq=False)
 class ChunkResult:
-    """Per-robot maxima of one chunk, each shape (size,); first-order ones or None;
-    ``elapsed_s``: wall time of the nonlinear kernel on the worker."""
+    """Per-robot maxima of one chunk, each shape (size,) (None when reduced on the worker);
+    first-order ones or None; ``elapsed_s``: wall time of the nonlinear kernel on the worker;
+    ``histograms``: (delta_p, angle) histograms when the task gave ``edges``, else None."""
 
     index: int
-    max_delta_p: F64
-    max_angle_rad: F64
+    max_delta_p: F64 | None
+    max_angle_rad: F64 | None
     first_order_delta_p: F64 | None
     first_order_angle_rad: F64 | None
     elapsed_s: float
+    histograms: tuple[Histogram, Histogram] | None = None
 
 
 _JAC_CACHE: dict[bytes, F64] = {}
@@ -118,6 +127,9 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
     t0 = time.perf_counter()
     dp, ang = nonlinear_maxima(task.model, task.arrays, dx, task.tolerances.joint_offsets)
     elapsed = time.perf_counter() - t0
+    if task.edges is not None:  # reduce here: only the histograms travel back
+        return ChunkResult(task.index, None, None, None, None, elapsed,
+                           (Histogram.of(dp, task.edges[0]), Histogram.of(ang, task.edges[1])))
     fo_p = fo_r = None
     if task.first_order:
         fo_p, fo_r = first_order_max(_jacobian(task), dx)

@@ -40,9 +40,10 @@ def nonlinear_maxima(model: Manipulator, arrays: tuple[F64, F64, F64, F64, F64],
     n_r = dx.shape[0]
     out_dp = np.empty(n_r)
     out_s = np.empty(n_r)
-    MK.mc_max_deviation(ch, sh, q, np.ascontiguousarray(axes), np.ascontiguousarray(bodies),
-                        np.array(model.prismatic, dtype=np.bool_), np.ascontiguousarray(off),
-                        bool(joint_offsets), pd, ed, out_dp, out_s)
+    tr = np.ascontiguousarray  # the kernel reads the path joint-major: (n, T), (3, T), (4, T)
+    MK.mc_max_deviation(tr(ch.T), tr(sh.T), tr(q.T), tr(axes), tr(bodies),
+                        np.array(model.prismatic, dtype=np.bool_), tr(off),
+                        bool(joint_offsets), tr(pd.T), tr(ed.T), out_dp, out_s)
     return out_dp, 2.0 * np.arcsin(np.minimum(out_s, 1.0))
 
 

@@ -144,9 +144,11 @@ def _seed_or_rng(rng: np.random.Generator | None, seed: int | None) -> None:
 def chunk_tasks(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robots: int, *,
                 rng: np.random.Generator | None = None, seed: int | None = None,
                 distribution: str = "uniform", chunk: int = 8192,
-                first_order: bool = False) -> list[ChunkTask]:
+                first_order: bool = False,
+                edges: tuple[F64, F64] | None = None) -> list[ChunkTask]:
     """The chunks of :func:`monte_carlo` (same arguments), for an application that maps
-    :func:`~zrp.manufacturing.chunks.run_chunk` itself (checkpointing, its own scheduler)."""
+    :func:`~zrp.manufacturing.chunks.run_chunk` itself (checkpointing, its own scheduler);
+    ``edges``: reduce each chunk on its worker (:mod:`zrp.manufacturing.reduction`)."""
     check_distribution(distribution)
     n_robots = positive_int(n_robots, "n_robots")
     chunk = positive_int(chunk, "chunk")
@@ -158,7 +160,8 @@ def chunk_tasks(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robo
         m = min(chunk, n_robots - start)
         dx = None if rng is None else draw_parameters(tolerances, m, distribution, rng)
         tasks.append(ChunkTask(idx, start, m, model, arrays, tolerances, distribution,
-                               None if seed is None else int(seed), dx, bool(first_order)))
+                               None if seed is None else int(seed), dx, bool(first_order),
+                               edges))
     return tasks
 
 
@@ -170,6 +173,9 @@ def gather_chunks(model: Manipulator, tasks: list[ChunkTask], results: list[Chun
     if missing:
         raise InputError(f"results: chunks {missing[:5]} are missing")
     ordered = [by_index[t.index] for t in tasks]
+    if any(r.max_delta_p is None for r in ordered):
+        raise InputError("results: the chunks were reduced on the workers (edges given); "
+                         "merge their histograms (zrp.manufacturing.reduction)")
     cat = np.concatenate
     first = tasks[0].first_order
     return MonteCarloResult(

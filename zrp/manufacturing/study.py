@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError, ModelFileError, ZRPWarning
 from zrp.kinematics import _kernels as K
+from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import check_q, end_effector_pose
 from zrp.kinematics.ik import IKResult
 from zrp.manufacturing.perturb import (
@@ -373,12 +374,13 @@ def one_at_a_time(model: Manipulator, path: JointPath,
     vec = np.empty(shape)
     out = np.empty((t_n, 7))
     prism = np.array(model.prismatic, dtype=np.bool_)
+    lim = joint_limits(model)
     for i, nm in enumerate(names):
         for j, xi in enumerate(xis):
             pert = Perturbation({nm: xi}, sign_zero_links, sign_zero_axes)
             axes, bodies = pert.arrays(model)
             K.fk_pose_batch(q, np.ascontiguousarray(axes), np.ascontiguousarray(bodies), prism,
-                            out)
+                            lim, out)  # q checked above
             dp[i, j] = np.linalg.norm(out[:, :3] - p_d, axis=-1)  # eq (17)
             e_err = er_multiply(out[:, 3:], e_d_conj)
             vec[i, j] = np.linalg.norm(e_err[:, 1:], axis=-1)

@@ -1,0 +1,145 @@
+"""Monte Carlo of any size: each chunk is reduced on its worker to two fixed-bin histograms
+(max delta_p and max error angle per robot), merged here as they arrive.
+
+:func:`~zrp.manufacturing.population.monte_carlo` gathers every robot's maxima (16 bytes a
+robot: 1.6 GB for 1e8 robots, 16 GB for 1e9, more than a client holds). :func:`monte_carlo_summary`
+returns the same distribution as a :class:`MonteCarloSummary`: whatever the number of robots
+in a chunk, it sends back two histograms of ~33 KB each (counts and edges), and the client keeps
+one merged pair. That is a reduction once a chunk holds more than ~4,000 robots (16 bytes
+each): use large chunks for large runs (131,072 robots: 2 MB of maxima -> 66 KB). The edges
+are fixed before the run from the first-order worst case of the tolerance box
+(:func:`~zrp.manufacturing.budget.worst_case_bound`, B = 2048 geometric bins from 1e-4 to 10
+times it, i.e. a relative bin width of 0.56 %; robots outside land in an underflow or overflow
+bin, bracketed by the exact minimum or maximum); the count, the extremes, the mean and the
+standard deviation are exact, a percentile is known to its bin (:meth:`Histogram.percentile`).
+Same seed and chunk size as :func:`monte_carlo`: the same robots, so every percentile of the
+full result lies in the bracket the summary gives (tested).
+"""
+
+from __future__ import annotations
+
+from concurrent.futures import Executor
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+
+from zrp.errors import InputError
+from zrp.manufacturing._checks import check_percentile
+from zrp.manufacturing.budget import worst_case_bound
+from zrp.manufacturing.chunks import ChunkResult, run_chunk
+from zrp.manufacturing.histogram import Histogram, geometric_edges
+from zrp.manufacturing.population import DEFAULT_PERCENTILES, chunk_tasks
+from zrp.manufacturing.sensitivity import parameter_jacobian
+from zrp.manufacturing.tolerance import Tolerances
+from zrp.model.manipulator import Manipulator
+from zrp.tasks import map_tasks
+
+__all__ = ["BINS", "MonteCarloSummary", "histogram_edges", "monte_carlo_summary"]
+
+F64 = NDArray[np.float64]
+#: Bins per histogram and their span relative to the first-order worst case.
+BINS = 2048
+SPAN = (1e-4, 1e1)
+
+
+def histogram_edges(model: Manipulator, q: ArrayLike, tolerances: Tolerances,
+                    bins: int = BINS) -> tuple[F64, F64]:
+    """Edges for max delta_p (length unit) and max angle (rad), each shape (bins + 1,):
+    geometric over SPAN times the first-order worst case along q (shape (T, n))."""
+    jac = parameter_jacobian(model, q, joint_offsets=tolerances.joint_offsets)
+    wc_p, wc_r = worst_case_bound(jac, tolerances.values)
+    out = []
+    for wc in (float(np.max(wc_p)), float(np.max(wc_r))):
+        ref = wc if wc > 0 else 1e-12  # zero tolerances: every robot is in the underflow bin
+        out.append(geometric_edges(SPAN[0] * ref, SPAN[1] * ref, bins))
+    return out[0], out[1]
+
+
+@dataclass(frozen=True, eq=False)
+class MonteCarloSummary:
+    """The distribution of the per-robot maxima of a reduced Monte Carlo.
+
+    Attributes:
+        delta_p: histogram of max_t delta_p (length unit).
+        angle_rad: histogram of max_t theta_eps (rad).
+        tolerances, distribution, n_points, elapsed_s, unit, percentiles: as in
+            :class:`~zrp.manufacturing.population.MonteCarloResult`.
+    """
+
+    delta_p: Histogram
+    angle_rad: Histogram
+    tolerances: Tolerances
+    distribution: str
+    n_points: int
+    elapsed_s: float
+    unit: str = "mm"
+    percentiles: tuple[float, ...] = field(default=DEFAULT_PERCENTILES)
+
+    def __post_init__(self) -> None:
+        if self.delta_p.total != self.angle_rad.total:
+            raise InputError("MonteCarloSummary: delta_p and angle_rad count different robots")
+        for pct in self.percentiles:
+            check_percentile(pct, "percentiles")
+
+    @property
+    def n_robots(self) -> int:
+        return self.delta_p.total
+
+    def percentile(self, pct: float) -> tuple[float, float]:
+        """(delta_p, angle_rad) percentile estimates (each within its bin's bracket)."""
+        return self.delta_p.percentile(pct)[0], self.angle_rad.percentile(pct)[0]
+
+    def summary(self) -> dict[str, Any]:
+        u = self.unit
+        out: dict[str, Any] = {
+            "n_robots": self.n_robots, "n_points": self.n_points,
+            "distribution": self.distribution, "elapsed_s": self.elapsed_s,
+            "reduced_on_workers": True,
+            "relative_bin_width": self.delta_p.relative_width,
+            f"max_delta_p_{u}": {"max": self.delta_p.maximum, "mean": self.delta_p.mean},
+            "max_angle_rad": {"max": self.angle_rad.maximum, "mean": self.angle_rad.mean},
+        }
+        for pct in self.percentiles:
+            key = f"p{pct:g}"
+            for name, h in ((f"max_delta_p_{u}", self.delta_p), ("max_angle_rad", self.angle_rad)):
+                est, lo, hi = h.percentile(pct)
+                out[name][key] = est
+                out[name][f"{key}_bracket"] = [lo, hi]
+        return out
+
+
+def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances,
+                        n_robots: int, *, seed: int | None = None,
+                        rng: np.random.Generator | None = None,
+                        distribution: str = "uniform", chunk: int = 8192,
+                        progress: bool = False,
+                        percentiles: tuple[float, ...] = DEFAULT_PERCENTILES,
+                        executor: Executor | Any | None = None) -> MonteCarloSummary:
+    """:func:`~zrp.manufacturing.population.monte_carlo` reduced on the workers (same
+    arguments but ``first_order``): each chunk returns two histograms, merged as they arrive,
+    so the memory does not grow with ``n_robots`` (give ``seed`` for very large runs: with
+    ``rng`` the draws are made here and shipped)."""
+    for pct in percentiles:
+        check_percentile(pct, "percentiles")
+    edges = histogram_edges(model, q, tolerances)
+    tasks = chunk_tasks(model, q, tolerances, n_robots, rng=rng, seed=seed,
+                        distribution=distribution, chunk=chunk, edges=edges)
+    from tqdm import tqdm
+
+    hp = Histogram.of(np.empty(0), edges[0])
+    ha = Histogram.of(np.empty(0), edges[1])
+    elapsed = 0.0
+    with tqdm(total=n_robots, disable=not progress, unit="robot", desc="Monte Carlo") as bar:
+        for i, res in map_tasks(run_chunk, tasks, executor):
+            assert isinstance(res, ChunkResult) and res.histograms is not None
+            hp = hp.merge(res.histograms[0])
+            ha = ha.merge(res.histograms[1])
+            elapsed += res.elapsed_s
+            bar.update(tasks[i].size)
+    return MonteCarloSummary(hp, ha, tasks[0].tolerances, distribution,
+                             int(tasks[0].arrays[0].shape[0]), elapsed, model.length_unit,
+                             tuple(percentiles))
+
+
