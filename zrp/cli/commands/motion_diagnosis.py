@@ -53,17 +53,19 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          "overwrite": "--force"})
 
 
-def _torque(args: argparse.Namespace, model: object, traj: object) -> object:
+def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[object, object]:
+    """The inverse-dynamics torques and the mode terms (eq. M6) from the MJCF, or Nones."""
     if args.mjcf and args.inertia:
         raise InputError("--mjcf and --inertia: give one of them")
     if not (args.mjcf or args.inertia):
-        return None
+        return None, None
     # mjcf loads MuJoCo: only when torques are asked for.
-    from mjcf import MJCFOptions, build, inverse_dynamics_torques
+    from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
 
     src = args.mjcf or build(model, MJCFOptions(inertia=args.inertia)).model  # type: ignore[arg-type]
-    return inverse_dynamics_torques(src, traj.q, traj.qd, traj.qdd,  # type: ignore[attr-defined]
-                                    field="--mjcf")
+    qs = (traj.q, traj.qd, traj.qdd)  # type: ignore[attr-defined]
+    return (inverse_dynamics_torques(src, *qs, field="--mjcf"),
+            mode_terms(src, *qs, field="--mjcf"))
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -71,9 +73,10 @@ def _run(args: argparse.Namespace) -> int:
     if args.video:
         check_writable([args.video], args.force)  # before the work
     traj = load_trajectory(args.data, model, deg=args.deg, frame=args.frame)
-    tau = _torque(args, model, traj)
+    tau, terms = _torque(args, model, traj)
     with OutputDir(Path(args.out), overwrite=args.force, names=OUTPUT_FILES) as folder:
-        diag = diagnose_motion(model, traj, torque=tau, effects=args.effects, seed=args.seed,
+        diag = diagnose_motion(model, traj, torque=tau, mode_terms=terms, effects=args.effects,
+                               seed=args.seed,
                                n_segments=args.segments, noise_sigma=args.noise)
         doc = diag.to_dict()
         folder.write_text("diagnosis_motion.json", dumps(doc))

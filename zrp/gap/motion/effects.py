@@ -50,7 +50,7 @@ from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.kernels import first_order_lag, mode_response, play
 
 __all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
-           "limit_step", "linearise", "mode_band", "plausible", "tested"]
+           "joint_mode", "limit_step", "linearise", "mode_band", "plausible", "tested"]
 
 F64 = NDArray[np.float64]
 MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
@@ -168,9 +168,21 @@ def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | Non
     return out
 
 
-def _vibration(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+def joint_mode(traj: Trajectory, k: int, omega: float, zeta: float, terms: F64 | None,
+               derivatives: bool = True) -> tuple[F64, F64, F64]:
+    """The mode of 0-based joint ``k`` driven by its commanded acceleration (eq. M5), with
+    the arm's own stiffness and damping along the path when ``terms`` (S, n, 2) are given
+    (eq. M6): y, dy/domega, dy/dzeta, shape (S,) each (``kernels.mode_response``)."""
+    if terms is None:
+        return mode_response(traj.t, -traj.qdd[:, k], omega, zeta, derivatives)
+    return mode_response(traj.t, -traj.qdd[:, k], omega, zeta, derivatives,
+                         terms[:, k, 0], terms[:, k, 1])
+
+
+def _vibration(traj: Trajectory, values: Mapping[str, float], terms: F64 | None = None
+               ) -> list[Column]:
     """Per moving joint: gain (d = g y, D = y), omega and zeta (d = 0, D = g dy/dparameter),
-    so that :func:`linearise` gives the Gauss-Newton step of the exact model (eq. M5)."""
+    so that :func:`linearise` gives the Gauss-Newton step of the exact model (eq. M5, M6)."""
     s, n = traj.q.shape
     lo, hi = mode_band(traj.rate_hz)
     out = []
@@ -181,7 +193,7 @@ def _vibration(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
         # a wide box (the search rejects a final estimate outside the plausible one)
         w = float(np.clip(values.get(p + "omega", VIB_START[0]), 0.5 * lo, 2.0 * hi))
         z = float(np.clip(values.get(p + "zeta", VIB_START[1]), 1e-4, 2.0))
-        y, dw, dz = mode_response(traj.t, -traj.qdd[:, k], w, z)
+        y, dw, dz = joint_mode(traj, k, w, z, terms)
         zero = np.zeros((s, n))
         out += [Column(p + "gain", "1", "residual_vibration", k + 1, g,
                        _one_joint(s, n, k, g * y), _one_joint(s, n, k, y)),
@@ -227,12 +239,14 @@ def tested(spec: ParamSpec) -> bool:
 
 
 def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
-                   torque: F64 | None = None) -> list[Column]:
+                   torque: F64 | None = None, terms: F64 | None = None) -> list[Column]:
     """All parameters of one motion effect evaluated at ``values`` (missing names: 0).
 
     Args:
         torque: inverse-dynamics torque per sample and joint, N m, shape (S, n), or None
             (then ``dynamic_compliance`` has no parameters).
+        terms: the arm's own stiffness (1/s^2) and damping (1/s) per unit inertia, shape
+            (S, n, 2) (``mjcf.mode_terms``, eq. M6), or None (the mode alone, eq. M5).
     """
     if effect == "sync_delay":
         return _sync(traj, values)
@@ -243,7 +257,7 @@ def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
     if effect == "dynamic_compliance":
         return _compliance(traj, values, torque)
     if effect == "residual_vibration":
-        return _vibration(traj, values)
+        return _vibration(traj, values, terms)
     raise InputError(f"effect: {effect!r} is not a motion effect; valid: "
                      f"{', '.join(MOTION_EFFECTS)}")
 

@@ -55,14 +55,18 @@ class Engine:
         model: the nominal model.
         traj: the trajectory measurements.
         torque: inverse-dynamics torques (S, n), N m, or None.
+        terms: the arm's own stiffness and damping per unit inertia (S, n, 2) for the
+            residual vibration (eq. M6), or None.
         reg_specs: registration parameters; base_rotation: R_b0 (3, 3).
     """
 
     def __init__(self, model: Manipulator, traj: Trajectory, torque: F64 | None,
-                 reg_specs: Sequence[ParamSpec], base_rotation: F64) -> None:
+                 reg_specs: Sequence[ParamSpec], base_rotation: F64,
+                 terms: F64 | None = None) -> None:
         self.model = model
         self.traj = traj
         self.torque = torque
+        self.terms = terms
         self.meas = traj.measurements
         self.base_ctx = Context(model, self.meas)
         self.reg_specs = tuple(reg_specs)
@@ -84,7 +88,8 @@ class Engine:
                 sp, _ = effect_parameters(self.base_ctx, e)
                 static += [s for s in sp if keep is None or s.name in keep]
                 continue
-            cols += [c for c in effect_columns(self.traj, e, values, self.torque)
+            cols += [c for c in effect_columns(self.traj, e, values, self.torque,
+                                                     self.terms)
                      if keep is None or c.name in keep]
         shift, mspecs = linearise(cols)
         ctx = MotionContext(self.model, self.meas, shift=shift)
