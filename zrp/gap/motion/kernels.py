@@ -151,7 +151,19 @@ def _mode_tv(group: NDArray[np.int64], phi: F64, g0: F64, g1: F64, f: F64, z0: F
             for j in range(q):
                 lhs[r, 2 * j] += g1[k, r, j] * stiff[i + 1]
                 lhs[r, 2 * j + 1] += g1[k, r, j] * damp[i + 1]
-        z[i + 1] = np.linalg.solve(lhs, rhs)
+        # Gaussian elimination without pivoting: lhs = I + G1 P is within a few 1e-3 of I
+        for c in range(m):
+            for r in range(c + 1, m):
+                x = lhs[r, c] / lhs[c, c]
+                if x != 0.0:
+                    for cc in range(c, m):
+                        lhs[r, cc] -= x * lhs[c, cc]
+                    rhs[r] -= x * rhs[c]
+        for r in range(m - 1, -1, -1):
+            acc = rhs[r]
+            for c in range(r + 1, m):
+                acc -= lhs[r, c] * z[i + 1, c]
+            z[i + 1, r] = acc / lhs[r, r]
     return z
 
 
