@@ -22,13 +22,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "diagnose-motion", help="sim-to-real gap diagnosis along a measured trajectory",
         description="Register a time-stamped trajectory measurement (t, q1..qn, x, y, z; "
         "optional point, tq), then find which motion effect (sync delay, servo lag, friction "
-        "at reversals, compliance under the dynamic torque) explains the gap, where along the "
-        "path it lies and how far it shrinks on withheld time segments (zrp/gap/README.md).")
+        "at reversals, compliance under the dynamic torque, residual vibration) explains the "
+        "gap, where along the path it lies and how far it shrinks on withheld time segments (zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml", help="model file or built-in name")
     p.add_argument("--data", required=True, metavar="D.csv", help="trajectory CSV")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
     p.add_argument("--mjcf", metavar="M.xml", help="MJCF with the inertias (inverse-dynamics "
-                   "torques for dynamic_compliance; one hinge/slide joint per model joint)")
+                   "torques for dynamic_compliance, the arm's own stiffness and damping for "
+                   "residual_vibration; one hinge/slide joint per model joint)")
     p.add_argument("--inertia", choices=("puma560", "rods"),
                    help="instead of --mjcf: build the nominal MJCF with these inertias")
     p.add_argument("--frame", choices=("instrument", "base"), default="instrument")
