@@ -23,7 +23,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         description="Register a time-stamped trajectory measurement (t, q1..qn, x, y, z; "
         "optional point, tq), then find which motion effect (sync delay, servo lag, friction "
         "at reversals, compliance under the dynamic torque, residual vibration) explains the "
-        "gap, where along the path it lies and how far it shrinks on withheld time segments (zrp/gap/README.md).")
+        "gap, where along the path it lies and how far it shrinks on withheld time segments "
+        "(zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml", help="model file or built-in name")
     p.add_argument("--data", required=True, metavar="D.csv", help="trajectory CSV")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
