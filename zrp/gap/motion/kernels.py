@@ -21,6 +21,7 @@ discrete model (so the analytic Jacobian equals the finite difference of the sam
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numba
@@ -204,27 +205,18 @@ def mode_response(t: F64, f: F64, omega: float, zeta: float, derivatives: bool =
     t = np.ascontiguousarray(t, dtype=float)
     f = np.ascontiguousarray(f, dtype=float)
     m = 6 if derivatives else 2
-    a = _system(float(omega), float(zeta))[:m, :m]
     h = np.diff(t)
     hs, group = np.unique(np.round(h, 12), return_inverse=True)
     if hs.size > 64:  # irregular stamps: one discretisation per step
         hs, group = h, np.arange(h.size)
+        phi, g0, g1 = _discretise(_system(float(omega), float(zeta))[:m, :m], hs)
+    else:  # the profile grid repeats (omega, zeta) for every joint: cached
+        phi, g0, g1 = _discretised(float(omega), float(zeta), tuple(hs.tolist()), m)
     if stiffness is not None or damping is not None:
         sb = [np.zeros(f.size) if v is None else np.ascontiguousarray(v, dtype=float)
               for v in (stiffness, damping)]
-        return _varying(a, hs, group, f, float(omega), sb[0], sb[1], derivatives)
-    phi = np.empty((hs.size, m, m))
-    g0 = np.empty((hs.size, m))
-    g1 = np.empty((hs.size, m))
-    big = np.zeros((m + 2, m + 2))
-    for i, hi in enumerate(hs):
-        big[:m, :m] = a * hi
-        big[1, m] = hi  # input f enters y''
-        big[m, m + 1] = 1.0  # f(t) = f_i + (f_{i+1} - f_i) s / h
-        e = expm(big)
-        phi[i] = e[:m, :m]
-        g0[i] = e[:m, m] - e[:m, m + 1]
-        g1[i] = e[:m, m + 1]
+        return _varying(phi, g0, g1, group, f, float(omega), sb[0], sb[1], derivatives)
+    g0, g1 = np.ascontiguousarray(g0[:, :, 0]), np.ascontiguousarray(g1[:, :, 0])
     w2 = omega * omega
     z0 = np.array([f[0] / w2, 0.0, -2.0 * f[0] / (w2 * omega), 0.0, 0.0, 0.0])[:m]
     z = _mode(group.astype(np.int64).ravel(), phi, g0, g1, f, z0)
@@ -234,12 +226,20 @@ def mode_response(t: F64, f: F64, omega: float, zeta: float, derivatives: bool =
     return z[:, 0], z[:, 2], z[:, 4]
 
 
-def _varying(a: F64, hs: F64, group: NDArray[np.intp], f: F64, omega: float, stiff: F64,
-             damp: F64, derivatives: bool) -> tuple[F64, F64, F64]:
-    """:func:`mode_response` with the time-varying stiffness and damping (eq. M6)."""
-    if stiff.shape != f.shape or damp.shape != f.shape:
-        raise ValueError(f"stiffness, damping: expected shape {f.shape}, got {stiff.shape}, "
-                         f"{damp.shape}")
+@functools.lru_cache(maxsize=512)
+def _discretised(omega: float, zeta: float, hs: tuple[float, ...], m: int
+                 ) -> tuple[F64, F64, F64]:
+    """:func:`_discretise` of the mode (omega, zeta) for the step sizes ``hs``, cached."""
+    out = _discretise(_system(omega, zeta)[:m, :m], np.array(hs))
+    for x in out:
+        x.setflags(write=False)
+    return out
+
+
+def _discretise(a: F64, hs: F64) -> tuple[F64, F64, F64]:
+    """The first-order-hold discretisation of z' = a z + E w(t), w linear between samples
+    and entering the velocity rows 1, 3, 5 (E), per step size: phi (H, m, m) and G0, G1
+    (H, m, m/2) with z+ = phi z + G0 w + G1 w+ (``scipy.linalg.expm`` of the block matrix)."""
     m = a.shape[0]
     q = m // 2
     phi = np.empty((hs.size, m, m))
@@ -255,6 +255,16 @@ def _varying(a: F64, hs: F64, group: NDArray[np.intp], f: F64, omega: float, sti
         phi[i] = e[:m, :m]
         g0[i] = e[:m, m:m + q] - e[:m, m + q:]
         g1[i] = e[:m, m + q:]
+    return phi, g0, g1
+
+
+def _varying(phi: F64, g0: F64, g1: F64, group: NDArray[np.intp], f: F64, omega: float,
+             stiff: F64, damp: F64, derivatives: bool) -> tuple[F64, F64, F64]:
+    """:func:`mode_response` with the time-varying stiffness and damping (eq. M6)."""
+    if stiff.shape != f.shape or damp.shape != f.shape:
+        raise ValueError(f"stiffness, damping: expected shape {f.shape}, got {stiff.shape}, "
+                         f"{damp.shape}")
+    m = phi.shape[1]
     k = omega * omega + stiff[0]
     z0 = np.array([f[0] / k, 0.0, -2.0 * omega * f[0] / (k * k), 0.0, 0.0, 0.0])[:m]
     z = _mode_tv(group.astype(np.int64).ravel(), phi, g0, g1, f, z0, stiff, damp)
