@@ -26,6 +26,12 @@ effect                  parameter (per joint k)        unit  d(t; theta)
                                                              each stop (g = 1 for a single link)
 ======================= ============================== ===== =====================================
 
+With the arm's own stiffness s_k(t) and damping b_k(t) per unit inertia (``terms``, from the
+MJCF by ``mjcf.mode_terms``) the mode is y'' + (2 zeta omega + b_k) y' + (omega^2 + s_k) y =
+f (eq. M6); with a sync delay or a servo lag on the joint in the model, it is driven through
+them, f = -L_tau[u_k''(t - delta)] (eq. M7), and its derivatives in delta and tau join those
+parameters' columns (:attr:`Column.via`, merged by :func:`linearise`).
+
 The nonlinear ones (delay, lag, play, the mode's omega and zeta) are linearised at the current
 estimate theta0: q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the
 *shift*) goes into the joint values of :class:`MotionContext` and D into a ``dq`` basis, so the
