@@ -80,8 +80,9 @@ def mode_terms(source: str | Path | mujoco.MjModel, q: ArrayLike, qd: ArrayLike,
             d.qacc[:] = qdd[i]
             mujoco.mjd_inverseFD(m, d, 1e-6, False, dq, dv, da, None, None, None, None)
             mkk = np.diag(da)
-            out[i, :, 0] = np.diag(dq) / mkk
-            out[i, :, 1] = np.diag(dv) / mkk
+            ok = mkk > 0.0  # a joint that moves no mass has no mode: its terms stay 0
+            out[i, :, 0] = np.divide(np.diag(dq), mkk, out=np.zeros(nv), where=ok)
+            out[i, :, 1] = np.divide(np.diag(dv), mkk, out=np.zeros(nv), where=ok)
     finally:
         m.opt.disableflags = saved
     return out
