@@ -7,7 +7,7 @@
 
 from mjcf import _env  # noqa: F401 (checks MUJOCO_GL before any module imports mujoco)
 from mjcf.builder import BuiltArm, MJCFOptions, build, build_spec
-from mjcf.dynamics import inverse_dynamics_torques
+from mjcf.dynamics import inverse_dynamics_torques, mode_terms
 from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
 from mjcf.gravity import gravity_torques
 from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
@@ -33,6 +33,7 @@ __all__ = [
     "manipulator_from_mujoco",
     "metres_per_unit",
     "mjcf_xml",
+    "mode_terms",
     "puma560_inertias",
     "rod_inertias",
     "save_mjcf",

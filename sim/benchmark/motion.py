@@ -28,7 +28,7 @@ import numpy as np
 from tqdm.auto import tqdm
 
 from mjcf import MJCFOptions, build
-from mjcf.dynamics import inverse_dynamics_torques
+from mjcf.dynamics import inverse_dynamics_torques, mode_terms
 from sim.measurement import random_instrument
 from sim.motion_measure import named_command
 from sim.motion_robot import MOTION_HIDDEN, MotionEffects, execute_trajectory
@@ -152,8 +152,9 @@ def _run_one(model: Manipulator, scn: MotionScenario, work: Path, arm_model: Any
     t1 = time.perf_counter()
     traj = load_trajectory(csv_path, model)
     tau = inverse_dynamics_torques(arm_model, traj.q, traj.qd, traj.qdd)
+    terms = mode_terms(arm_model, traj.q, traj.qd, traj.qdd)
     # the thorough setting: a denser search and every fitting sample in the final fit
-    diag = diagnose_motion(model, traj, torque=tau, seed=scn.seed % 1000,
+    diag = diagnose_motion(model, traj, torque=tau, mode_terms=terms, seed=scn.seed % 1000,
                            max_search_samples=4000, max_fit_samples=10**9)
     diag_s = time.perf_counter() - t1
     truth = _load_truth(truth_path)

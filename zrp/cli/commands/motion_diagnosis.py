@@ -22,13 +22,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         "diagnose-motion", help="sim-to-real gap diagnosis along a measured trajectory",
         description="Register a time-stamped trajectory measurement (t, q1..qn, x, y, z; "
         "optional point, tq), then find which motion effect (sync delay, servo lag, friction "
-        "at reversals, compliance under the dynamic torque) explains the gap, where along the "
-        "path it lies and how far it shrinks on withheld time segments (zrp/gap/README.md).")
+        "at reversals, compliance under the dynamic torque, residual vibration) explains the "
+        "gap, where along the path it lies and how far it shrinks on withheld time segments "
+        "(zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml", help="model file or built-in name")
     p.add_argument("--data", required=True, metavar="D.csv", help="trajectory CSV")
     p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
     p.add_argument("--mjcf", metavar="M.xml", help="MJCF with the inertias (inverse-dynamics "
-                   "torques for dynamic_compliance; one hinge/slide joint per model joint)")
+                   "torques for dynamic_compliance, the arm's own stiffness and damping for "
+                   "residual_vibration; one hinge/slide joint per model joint)")
     p.add_argument("--inertia", choices=("puma560", "rods"),
                    help="instead of --mjcf: build the nominal MJCF with these inertias")
     p.add_argument("--frame", choices=("instrument", "base"), default="instrument")
@@ -53,17 +55,19 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          "overwrite": "--force"})
 
 
-def _torque(args: argparse.Namespace, model: object, traj: object) -> object:
+def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[object, object]:
+    """The inverse-dynamics torques and the mode terms (eq. M6) from the MJCF, or Nones."""
     if args.mjcf and args.inertia:
         raise InputError("--mjcf and --inertia: give one of them")
     if not (args.mjcf or args.inertia):
-        return None
+        return None, None
     # mjcf loads MuJoCo: only when torques are asked for.
-    from mjcf import MJCFOptions, build, inverse_dynamics_torques
+    from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
 
     src = args.mjcf or build(model, MJCFOptions(inertia=args.inertia)).model  # type: ignore[arg-type]
-    return inverse_dynamics_torques(src, traj.q, traj.qd, traj.qdd,  # type: ignore[attr-defined]
-                                    field="--mjcf")
+    qs = (traj.q, traj.qd, traj.qdd)  # type: ignore[attr-defined]
+    return (inverse_dynamics_torques(src, *qs, field="--mjcf"),
+            mode_terms(src, *qs, field="--mjcf"))
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -71,9 +75,10 @@ def _run(args: argparse.Namespace) -> int:
     if args.video:
         check_writable([args.video], args.force)  # before the work
     traj = load_trajectory(args.data, model, deg=args.deg, frame=args.frame)
-    tau = _torque(args, model, traj)
+    tau, terms = _torque(args, model, traj)
     with OutputDir(Path(args.out), overwrite=args.force, names=OUTPUT_FILES) as folder:
-        diag = diagnose_motion(model, traj, torque=tau, effects=args.effects, seed=args.seed,
+        diag = diagnose_motion(model, traj, torque=tau, mode_terms=terms, effects=args.effects,
+                               seed=args.seed,
                                n_segments=args.segments, noise_sigma=args.noise)
         doc = diag.to_dict()
         folder.write_text("diagnosis_motion.json", dumps(doc))

@@ -26,6 +26,12 @@ effect                  parameter (per joint k)        unit  d(t; theta)
                                                              each stop (g = 1 for a single link)
 ======================= ============================== ===== =====================================
 
+With the arm's own stiffness s_k(t) and damping b_k(t) per unit inertia (``terms``, from the
+MJCF by ``mjcf.mode_terms``) the mode is y'' + (2 zeta omega + b_k) y' + (omega^2 + s_k) y =
+f (eq. M6); with a sync delay or a servo lag on the joint in the model, it is driven through
+them, f = -L_tau[u_k''(t - delta)] (eq. M7), and its derivatives in delta and tau join those
+parameters' columns (:attr:`Column.via`, merged by :func:`linearise`).
+
 The nonlinear ones (delay, lag, play, the mode's omega and zeta) are linearised at the current
 estimate theta0: q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the
 *shift*) goes into the joint values of :class:`MotionContext` and D into a ``dq`` basis, so the
@@ -50,7 +56,7 @@ from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.kernels import first_order_lag, mode_response, play
 
 __all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
-           "limit_step", "linearise", "mode_band", "plausible", "tested"]
+           "joint_mode", "limit_step", "linearise", "mode_band", "plausible", "tested"]
 
 F64 = NDArray[np.float64]
 MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
@@ -99,6 +105,8 @@ class Column:
         value: the value at which d and D are evaluated.
         d: the joint deviation d(theta), shape (S, n).
         D: its derivative, shape (S, n).
+        via: for a coupling column (eq. M7), the parameter through which ``name`` acts
+            here (the mode's gain); "" for the parameter's own column.
     """
 
     name: str
@@ -108,6 +116,7 @@ class Column:
     value: float
     d: F64
     D: F64
+    via: str = ""
 
 
 def _one_joint(s: int, n: int, k: int, col: F64) -> F64:
@@ -168,11 +177,46 @@ def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | Non
     return out
 
 
-def _vibration(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+def _drive(traj: Trajectory, k: int, delay: float | None, lag: float | None
+           ) -> tuple[F64, F64, F64]:
+    """The mode's forcing f = -L_tau[u_k''(t - delta)] (eq. M5 through the sync delay and the
+    joint's servo lag, which act before the transmission: eq. M7) and df/ddelta, df/dtau
+    (None: that effect is not in the model; its derivative is then zero)."""
+    zero = np.zeros(traj.n_samples)
+    if delay is None:
+        a, a3 = traj.qdd[:, k], zero
+    else:
+        ts = traj.t - delay
+        a, a3 = traj.spline(ts, 2)[:, k], traj.spline(ts, 3)[:, k]
+    da = zero
+    if lag is not None:
+        a, da = first_order_lag(traj.t, a, lag)
+        a3 = first_order_lag(traj.t, a3, lag)[0] if delay is not None else zero
+    return -a, a3, -da
+
+
+def joint_mode(traj: Trajectory, k: int, omega: float, zeta: float, terms: F64 | None,
+               derivatives: bool = True, forcing: F64 | None = None) -> tuple[F64, F64, F64]:
+    """The mode of 0-based joint ``k`` driven by ``forcing`` (default: its negated commanded
+    acceleration, eq. M5), with the arm's own stiffness and damping along the path when
+    ``terms`` (S, n, 2) are given (eq. M6): y, dy/domega, dy/dzeta, shape (S,) each
+    (``kernels.mode_response``)."""
+    f = -traj.qdd[:, k] if forcing is None else forcing
+    if terms is None:
+        return mode_response(traj.t, f, omega, zeta, derivatives)
+    return mode_response(traj.t, f, omega, zeta, derivatives, terms[:, k, 0], terms[:, k, 1])
+
+
+def _vibration(traj: Trajectory, values: Mapping[str, float], terms: F64 | None = None,
+               couple: Mapping[str, float] | None = None) -> list[Column]:
     """Per moving joint: gain (d = g y, D = y), omega and zeta (d = 0, D = g dy/dparameter),
-    so that :func:`linearise` gives the Gauss-Newton step of the exact model (eq. M5)."""
+    so that :func:`linearise` gives the Gauss-Newton step of the exact model (eq. M5, M6).
+    With ``couple`` (``sync.delay``, ``q{k}.lag`` of the effects in the model) the mode is
+    driven through them (eq. M7) and columns named after them carry g dy/ddelta, g dy/dtau
+    (``via`` the joint's gain: :func:`linearise` adds them to those parameters' columns)."""
     s, n = traj.q.shape
     lo, hi = mode_band(traj.rate_hz)
+    couple = dict(couple or {})
     out = []
     for k in _moving(traj):
         p = f"q{k + 1}.vib_"
@@ -181,7 +225,9 @@ def _vibration(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
         # a wide box (the search rejects a final estimate outside the plausible one)
         w = float(np.clip(values.get(p + "omega", VIB_START[0]), 0.5 * lo, 2.0 * hi))
         z = float(np.clip(values.get(p + "zeta", VIB_START[1]), 1e-4, 2.0))
-        y, dw, dz = mode_response(traj.t, -traj.qdd[:, k], w, z)
+        delay, lag = couple.get("sync.delay"), couple.get(f"q{k + 1}.lag")
+        f, f_delay, f_lag = _drive(traj, k, delay, lag)
+        y, dw, dz = joint_mode(traj, k, w, z, terms, forcing=f)
         zero = np.zeros((s, n))
         out += [Column(p + "gain", "1", "residual_vibration", k + 1, g,
                        _one_joint(s, n, k, g * y), _one_joint(s, n, k, y)),
@@ -189,6 +235,12 @@ def _vibration(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
                        _one_joint(s, n, k, g * dw)),
                 Column(p + "zeta", "1", "residual_vibration", k + 1, z, zero,
                        _one_joint(s, n, k, g * dz))]
+        for name, df, eff, j in (("sync.delay", f_delay, "sync_delay", 0),
+                                 (f"q{k + 1}.lag", f_lag, "servo_lag", k + 1)):
+            if name in couple:
+                dy = joint_mode(traj, k, w, z, terms, derivatives=False, forcing=df)[0]
+                out.append(Column(name, "s", eff, j, couple[name], zero,
+                                  _one_joint(s, n, k, g * dy), via=p + "gain"))
     return out
 
 
@@ -227,12 +279,17 @@ def tested(spec: ParamSpec) -> bool:
 
 
 def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
-                   torque: F64 | None = None) -> list[Column]:
+                   torque: F64 | None = None, terms: F64 | None = None,
+                   couple: Mapping[str, float] | None = None) -> list[Column]:
     """All parameters of one motion effect evaluated at ``values`` (missing names: 0).
 
     Args:
         torque: inverse-dynamics torque per sample and joint, N m, shape (S, n), or None
             (then ``dynamic_compliance`` has no parameters).
+        terms: the arm's own stiffness (1/s^2) and damping (1/s) per unit inertia, shape
+            (S, n, 2) (``mjcf.mode_terms``, eq. M6), or None (the mode alone, eq. M5).
+        couple: for ``residual_vibration``, the sync delay and servo lags in the model that
+            act before the transmission (eq. M7); None: none.
     """
     if effect == "sync_delay":
         return _sync(traj, values)
@@ -243,17 +300,27 @@ def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
     if effect == "dynamic_compliance":
         return _compliance(traj, values, torque)
     if effect == "residual_vibration":
-        return _vibration(traj, values)
+        return _vibration(traj, values, terms, couple)
     raise InputError(f"effect: {effect!r} is not a motion effect; valid: "
                      f"{', '.join(MOTION_EFFECTS)}")
 
 
 def linearise(cols: list[Column]) -> tuple[F64 | None, list[MotionParam]]:
     """The shift sum_c [d_c - D_c theta_c] (S, n) (None when zero) and the ``dq`` specs with
-    basis D_c, so that q' = commanded + shift + sum_c D_c theta_c."""
+    basis D_c, so that q' = commanded + shift + sum_c D_c theta_c. Columns of the same name
+    (a parameter's own and its coupling columns, eq. M7) are one parameter: d and D add."""
+    merged: dict[str, Column] = {}
+    for c in cols:
+        o = merged.get(c.name)
+        if o is None:
+            merged[c.name] = c
+        else:
+            own = c if not c.via else o
+            merged[c.name] = Column(c.name, own.unit, own.effect, own.joint, own.value,
+                                    o.d + c.d, o.D + c.D)
     shift = None
     specs = []
-    for c in cols:
+    for c in merged.values():
         part = c.d - c.D * c.value
         if np.any(part != 0.0):
             shift = part if shift is None else shift + part

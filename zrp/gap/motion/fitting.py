@@ -48,6 +48,19 @@ class ModelFit:
         return self.result.specs
 
 
+def _couplings(traj: Trajectory, effects: Mapping[str, frozenset[str] | None],
+               values: Mapping[str, float]) -> dict[str, float]:
+    """The sync delay and servo lags of the model that drive a mode through them (eq. M7):
+    name -> current value, for the parameters the model keeps."""
+    out = {}
+    names = ["sync.delay"] + [f"q{k + 1}.lag" for k in range(traj.n_joints)]
+    for e, name in zip(["sync_delay"] + ["servo_lag"] * traj.n_joints, names, strict=True):
+        keep = effects.get(e, frozenset())
+        if e in effects and (keep is None or name in keep):
+            out[name] = float(values.get(name, 0.0))
+    return out
+
+
 class Engine:
     """The data and registration shared by all fits of one diagnosis.
 
@@ -55,14 +68,18 @@ class Engine:
         model: the nominal model.
         traj: the trajectory measurements.
         torque: inverse-dynamics torques (S, n), N m, or None.
+        terms: the arm's own stiffness and damping per unit inertia (S, n, 2) for the
+            residual vibration (eq. M6), or None.
         reg_specs: registration parameters; base_rotation: R_b0 (3, 3).
     """
 
     def __init__(self, model: Manipulator, traj: Trajectory, torque: F64 | None,
-                 reg_specs: Sequence[ParamSpec], base_rotation: F64) -> None:
+                 reg_specs: Sequence[ParamSpec], base_rotation: F64,
+                 terms: F64 | None = None) -> None:
         self.model = model
         self.traj = traj
         self.torque = torque
+        self.terms = terms
         self.meas = traj.measurements
         self.base_ctx = Context(model, self.meas)
         self.reg_specs = tuple(reg_specs)
@@ -79,13 +96,15 @@ class Engine:
         """The context (shifted joints) and the effect specs linearised at ``values``."""
         cols = []
         static: list[ParamSpec] = []
+        couple = _couplings(self.traj, effects, values)
         for e, keep in effects.items():
             if e in EFFECTS:
                 sp, _ = effect_parameters(self.base_ctx, e)
                 static += [s for s in sp if keep is None or s.name in keep]
                 continue
-            cols += [c for c in effect_columns(self.traj, e, values, self.torque)
-                     if keep is None or c.name in keep]
+            cols += [c for c in effect_columns(self.traj, e, values, self.torque,
+                                               self.terms, couple)
+                     if keep is None or (c.via or c.name) in keep]
         shift, mspecs = linearise(cols)
         ctx = MotionContext(self.model, self.meas, shift=shift)
         return ctx, [*mspecs, *static]

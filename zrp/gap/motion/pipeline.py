@@ -53,6 +53,17 @@ def _check(model: Manipulator, traj: Trajectory, torque: ArrayLike | None,
     return tau
 
 
+def _check_terms(traj: Trajectory, terms: ArrayLike | None) -> F64 | None:
+    if terms is None:
+        return None
+    a = np.asarray(terms, dtype=float)
+    if a.shape != (*traj.q.shape, 2) or not np.all(np.isfinite(a)):
+        raise InputError(f"mode_terms: expected finite values of shape "
+                         f"{(*traj.q.shape, 2)} (stiffness 1/s^2, damping 1/s per unit "
+                         f"inertia, mjcf.mode_terms), got {a.shape}")
+    return a
+
+
 def _registration(ctx: Context, poses: I64) -> tuple[list, F64, F64]:
     """Registration parameters these samples can identify (Gram-Schmidt on the normalised
     Jacobian columns, as :func:`zrp.gap.leastsq.check_identifiable`), starting values, R_b0."""
@@ -100,7 +111,7 @@ def _phase_table(traj: Trajectory, before: F64, after: F64, withheld: I64) -> tu
 
 
 def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
-                    torque: ArrayLike | None = None,
+                    torque: ArrayLike | None = None, mode_terms: ArrayLike | None = None,
                     effects: Sequence[str] = MOTION_EFFECTS,
                     rng: np.random.Generator | None = None, seed: int = 0,
                     withheld_fraction: float = 0.25, n_segments: int = 20, folds: int = 5,
@@ -114,6 +125,10 @@ def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
         trajectory: the time-stamped measurements.
         torque: inverse-dynamics torque per sample and joint (N m), shape (S, n), from the
             MJCF inertias (``mjcf.inverse_dynamics_torques``); enables ``dynamic_compliance``.
+        mode_terms: the arm's own stiffness (1/s^2) and damping (1/s) of each joint per unit
+            inertia along the commanded path, shape (S, n, 2), from the MJCF
+            (``mjcf.mode_terms``); the residual vibration's mode then carries them (eq. M6:
+            gravity's stiffness and the velocity coupling change the mode along the path).
         effects: candidates (motion effects, static ones allowed too).
         rng: seeded generator of the segment split (default: from ``seed``).
         withheld_fraction, n_segments, folds: the split by time segments.
@@ -128,13 +143,14 @@ def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
     """
     clock = {"start": time.perf_counter()}
     tau = _check(model, trajectory, torque, effects)
+    terms = _check_terms(trajectory, mode_terms)
     rng = np.random.default_rng(seed) if rng is None else rng
     split = split_segments(trajectory, rng, n_segments, withheld_fraction, folds)
     search = _decimate(split.fitting, max_search_samples)
     sfolds = [np.intersect1d(f, search) for f in split.folds]
     ctx = Context(model, trajectory.measurements)
     reg_specs, reg0, rb0 = _registration(ctx, search)
-    eng = Engine(model, trajectory, tau, reg_specs, rb0)
+    eng = Engine(model, trajectory, tau, reg_specs, rb0, terms)
     start = eng.fit({}, search, reg_theta=reg0)
     clock["register"] = time.perf_counter()
     final, trace = greedy(eng, start, list(effects), search, sfolds, alpha, 0.01, max_steps)
@@ -177,7 +193,8 @@ def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
          "n_samples": trajectory.n_samples, "rate_hz": trajectory.rate_hz,
          "duration_s": trajectory.duration, "search_samples": int(search.size),
          "fit_samples": int(fitting.size),
-         "torque": tau is not None, "point_labels": list(trajectory.point_labels)},
+         "torque": tau is not None, "mode_terms": terms is not None,
+         "point_labels": list(trajectory.point_labels)},
         Metrics.of(r_before[split.withheld].ravel()), tuple(steps),
         Metrics.of(r_after[split.withheld].ravel()), _estimates(eng, final_all), sigma,
         method, _phase_table(trajectory, e_before, e_after, split.withheld),

@@ -16,9 +16,8 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize
 
-from zrp.gap.motion.effects import MotionParam, mode_band
+from zrp.gap.motion.effects import MotionParam, joint_mode, mode_band
 from zrp.gap.motion.fitting import Engine, ModelFit
-from zrp.gap.motion.kernels import mode_response
 from zrp.gap.problem import Problem
 
 __all__ = ["ZETA_GRID", "vibration_start"]
@@ -47,8 +46,8 @@ def _refine(eng: Engine, poses: I64, k: int, c: F64, r: F64, Q: F64, w0: float, 
     rows = r.size // poses.size
 
     def column(x: F64) -> F64:
-        y = mode_response(traj.t, -traj.qdd[:, k], float(np.exp(x[0])), float(np.exp(x[1])),
-                          derivatives=False)[0]
+        y = joint_mode(traj, k, float(np.exp(x[0])), float(np.exp(x[1])), eng.terms,
+                       derivatives=False)[0]
         return c * np.repeat(y[poses], rows)
 
     res = minimize(lambda x: -_explained(column(x), r, Q)[0], np.log([w0, z0]),
@@ -86,8 +85,8 @@ def _grid(eng: Engine, poses: I64, joints: list[int], n_omega: int
         traj = eng.traj
         lo, hi = mode_band(traj.rate_hz)
         omegas = np.geomspace(lo, min(hi, 2.0 * np.pi * 100.0), n_omega)
-        eng.cache[key] = {k: {(float(w), z): mode_response(traj.t, -traj.qdd[:, k], w, z,
-                                                           derivatives=False)[0][poses]
+        eng.cache[key] = {k: {(float(w), z): joint_mode(traj, k, w, z, eng.terms,
+                                                        derivatives=False)[0][poses]
                               for w in omegas for z in ZETA_GRID} for k in joints}
     return eng.cache[key]
 

@@ -55,7 +55,7 @@ class Trial:
 def _candidate_specs(eng: Engine, effect: str, start: dict[str, float]) -> list:
     if effect in EFFECTS:
         return effect_parameters(eng.base_ctx, effect)[0]
-    specs = linearise(effect_columns(eng.traj, effect, start, eng.torque))[1]
+    specs = linearise(effect_columns(eng.traj, effect, start, eng.torque, eng.terms))[1]
     if effect == "residual_vibration":  # only the joints the profile search found a mode on
         specs = [s for s in specs if s.name in start]
     return specs
