@@ -28,6 +28,7 @@ from numpy.typing import NDArray
 
 from zrp.gap.baseline import GeometricBaseline
 from zrp.gap.effects import Context
+from zrp.gap.fallback import FinalChoice
 from zrp.gap.leastsq import FitResult
 from zrp.gap.registration import Registration
 from zrp.gap.uncertainty import Correlations
@@ -175,6 +176,8 @@ class Assessment:
         remainder: the evidence on what remains.
         resolution: numerical resolution of the fits (length unit): below it nothing is
             resolved.
+        choice: which model is final - the search's, or the geometric calibration when the
+            search's is worse on the withheld poses (:mod:`zrp.gap.fallback`).
     """
 
     baseline: GeometricBaseline
@@ -185,6 +188,7 @@ class Assessment:
     unexcited: tuple[int, ...]
     remainder: Remainder
     resolution: float
+    choice: FinalChoice | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {"geometric_baseline": self.baseline.to_dict(),
@@ -192,4 +196,5 @@ class Assessment:
                 "correlation": self.correlations.to_dict(),
                 "implausible": list(self.implausible),
                 "unexcited_joints": list(self.unexcited),
-                "remainder": self.remainder.to_dict(), "resolution": self.resolution}
+                "remainder": self.remainder.to_dict(), "resolution": self.resolution,
+                "final_model": None if self.choice is None else self.choice.to_dict()}

@@ -90,9 +90,12 @@ def _shrink(diag: Diagnosis) -> list[str]:
         L.append(f"| {i} | {st.effect} | {_joints(st.joints)} | {w.rms:.4g} | {w.p95:.4g} | "
                  f"{w.max:.4g} | {st.cv_rms:.4g} | {st.p_value:.2g} | {st.bic_delta:.1f} |")
     fin = diag.final
-    L.append(f"| final | final model after pruning: {final_effects_text(diag) or 'none'} | | "
-             f"{fin.rms:.4g} | {fin.p95:.4g} | {fin.max:.4g} | | | |")
     a = diag.assessment
+    fell_back = a is not None and a.choice is not None and a.choice.fell_back
+    what = ("the geometric calibration (the search's model was worse on withheld poses)"
+            if fell_back else "final model after pruning")
+    L.append(f"| final | {what}: {final_effects_text(diag) or 'none'} | | "
+             f"{fin.rms:.4g} | {fin.p95:.4g} | {fin.max:.4g} | | | |")
     if a is not None:
         b = a.baseline
         L.append(f"| baseline | complete geometric calibration ({b.n_parameters} parameters) "

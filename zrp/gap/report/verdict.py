@@ -69,6 +69,11 @@ def final_effects_text(diag: Diagnosis) -> str:
 
 def _effects_found(diag: Diagnosis) -> list[str]:
     steps = diag.steps
+    choice = None if diag.assessment is None else diag.assessment.choice
+    if choice is not None and choice.fell_back:
+        found = ", ".join(s.effect for s in steps) or "no effect"
+        return [f"The search found {found}. {choice.note(diag.length_unit)}",
+                f"Final model: {final_effects_text(diag)}."]
     if not steps:
         return ["No effect in the library improves the model significantly (none)."]
     parts = [f"Final model (after pruning): {final_effects_text(diag)}."]
