@@ -22,7 +22,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.arguments import check_instance, check_int, check_seed
 from zrp.errors import InputError
-from zrp.gap.assessment import Assessment, remainder_evidence
+from zrp.gap.assessment import Assessment, compliance_units, remainder_evidence
 from zrp.gap.baseline import GeometricBaseline, geometric_baseline
 from zrp.gap.checks import (
     check_gravity_torque,
@@ -270,4 +270,5 @@ def _assess(ctx: Context, baseline: GeometricBaseline, choice: FinalChoice, fina
     names = tuple(sp.name for sp in final.specs)
     frame = registration_of(final, se, cov, ctx.meas.point_labels, ctx.model.length_unit)
     return Assessment(baseline, frame, correlations(names, cov), se, implausible, unexcited,
-                      remainder_evidence(ctx, final, where_final), resolution, choice)
+                      remainder_evidence(ctx, final, where_final), resolution, choice,
+                      compliance_units(ctx))

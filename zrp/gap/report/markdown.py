@@ -133,10 +133,11 @@ def _parameters(diag: Diagnosis) -> list[str]:
     flags = diag.assessment.implausible if diag.assessment is not None else ()
     L = ["## Identified parameters (final model, robust 95 % intervals)\n",
          "Estimated jointly in the final model (the per-step values in diagnosis.json were "
-         "each estimated before the later effects were added). Intervals: the larger of the "
-         "pose-clustered sandwich and the normal-theory standard error, so they hold when a "
-         "gap remains. Backlash is the full play; compliance is in rad/(N m) with MJCF "
-         "torques (lumped masses without: rad per length unit of moment arm x kg).\n"]
+         "each estimated before the later effects were added). Intervals: the largest of the "
+         "pose-clustered jackknife, the sandwich and the normal-theory standard error, so "
+         "they hold when a gap remains. Backlash is the full play. "
+         + ("" if diag.assessment is None or diag.assessment.compliance is None else
+            "Compliance: " + diag.assessment.compliance["note"] + ".") + "\n"]
     by_eff: dict[str, list[ParameterEstimate]] = {}
     for p in diag.final_parameters:
         by_eff.setdefault(p.effect, []).append(p)
@@ -304,10 +305,11 @@ METHOD = ("See zrp/gap/README.md. Registration (base_frame, tool_offset) first; 
           "candidates are ranked by cross-validated RMS and added greedily while an F test, "
           "BIC and the CV RMS agree that they help; a backward pass drops what the final "
           "model no longer needs. Final intervals are robust 95 % intervals (pose-clustered "
-          "sandwich covariance, never narrower than the normal-theory ones); per-step "
-          "intervals in diagnosis.json are normal-theory. A complete geometric calibration "
-          "(QR-reduced base set of joint offsets, body vectors and axis tilts) is always "
-          "fitted beside the chosen effects.")
+          "jackknife covariance, never narrower than the sandwich or the normal-theory "
+          "ones); per-step intervals in diagnosis.json are normal-theory. A complete "
+          "geometric calibration (QR-reduced base set of joint offsets, body vectors and axis "
+          "tilts) is always fitted beside the chosen effects, and it is the final model when "
+          "the effects found do not beat it on the withheld poses.")
 
 
 def report_markdown(diag: Diagnosis) -> str:

@@ -111,6 +111,10 @@ def _trust(diag: Diagnosis) -> list[str]:
         names = ", ".join(m.split(" = ")[0] for m in a.implausible)
         parts.append(f"Physically implausible values (do not use them as physical "
                      f"properties): {names}.")
+    if (a.compliance is not None and not a.compliance["in_rad_per_newton_metre"]
+            and "joint_compliance" in diag.final_joints):
+        parts.append(f"Joint compliance is given as compliance x lumped weight in "
+                     f"{a.compliance['unit']}, not in rad/(N m): no MJCF supplied the masses.")
     if a.unexcited:
         parts.append(f"These data leave joint(s) {_ranges(a.unexcited)} unidentifiable for "
                      "scale, cyclic error and backlash (they barely move).")
