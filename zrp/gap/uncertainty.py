@@ -36,6 +36,7 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+from scipy import special
 
 from zrp.errors import InputError
 from zrp.gap.effects import Context
@@ -50,6 +51,7 @@ __all__ = [
     "plausibility",
     "robust_covariance",
     "robust_stderr",
+    "simultaneous_z",
 ]
 
 F64 = NDArray[np.float64]
@@ -220,3 +222,14 @@ def plausibility(name: str, effect: str, value: float, stderr: float, unit: str)
         return (f"{name} = {value:.3g} {unit} exceeds the typical range of an industrial arm "
                 f"(|value| <= {lim:g} {unit}); check the model or the data")
     return None
+
+
+def simultaneous_z(k: int, level: float = 0.95) -> float:
+    """Half-width in standard errors of intervals that hold for all ``k`` parameters of an
+    effect at once with probability ``level`` (Sidak: each at level**(1/k), exact for
+    independent estimates and conservative for correlated ones, Sidak 1967):
+    z = Phi^-1(1 - (1 - level**(1/k)) / 2). k = 1 gives 1.96; k = 4, 2.49."""
+    if k < 1:
+        raise InputError(f"simultaneous_z: k must be >= 1, got {k}")
+    each = level ** (1.0 / k)
+    return float(special.ndtri(1.0 - (1.0 - each) / 2.0))

@@ -39,11 +39,16 @@ def _joints(joints: Sequence[int]) -> str:
 
 def _parameter_table(params: Sequence[ParameterEstimate], *, flags: Sequence[str] = ()
                      ) -> list[str]:
-    out = ["| parameter | value | 95 % interval | plausible |", "|---|---|---|---|"]
+    joint = any(p.ci95_effect is not None for p in params)
+    out = (["| parameter | value | 95 % interval | 95 % for the whole effect | plausible |",
+            "|---|---|---|---|---|"] if joint else
+           ["| parameter | value | 95 % interval | plausible |", "|---|---|---|---|"])
     for p in params:
         v, ci = value_ci(p.value, *p.ci95, p.unit)
         bad = any(f.startswith(p.name + " = ") for f in flags)
-        out.append(f"| {p.name} | {v} | {ci} | {'NO' if bad else 'yes'} |")
+        both = "" if not joint else (
+            f"{value_ci(p.value, *p.ci95_effect, p.unit)[1]} | " if p.ci95_effect else "| ")
+        out.append(f"| {p.name} | {v} | {ci} | {both}{'NO' if bad else 'yes'} |")
     return out
 
 
@@ -135,7 +140,8 @@ def _parameters(diag: Diagnosis) -> list[str]:
          "Estimated jointly in the final model (the per-step values in diagnosis.json were "
          "each estimated before the later effects were added). Intervals: the largest of the "
          "pose-clustered jackknife, the sandwich and the normal-theory standard error, so "
-         "they hold when a gap remains. Backlash is the full play. "
+         "they hold when a gap remains; \"for the whole effect\": simultaneous intervals that "
+         "hold for all parameters of the effect at once (Sidak). Backlash is the full play. "
          + ("" if diag.assessment is None or diag.assessment.compliance is None else
             "Compliance: " + diag.assessment.compliance["note"] + ".") + "\n"]
     by_eff: dict[str, list[ParameterEstimate]] = {}
