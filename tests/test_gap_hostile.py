@@ -64,13 +64,14 @@ def test_falls_back_to_the_geometric_calibration_when_the_effects_do_not_beat_it
     assert d.final.rms == a.baseline.withheld.rms < 1.5 * d.noise_floor.rms
     _not_worse_than_baseline(d)
     assert set(d.final_joints) <= {"joint_offset", "link_length", "axis_misalignment"}
-    assert "do not beat a complete geometric calibration" in d.verdict
+    assert "does not beat a complete geometric calibration" in d.verdict
+    assert not a.choice.within_noise and "a clear difference" in d.verdict
     assert "Final model: " in d.verdict
     write_outputs(d, tmp_path)  # with the figures: they draw the fallback model
     md = (tmp_path / "report.md").read_text(encoding="utf-8")
     assert "| final | the geometric calibration (the search's model was worse" in md
     assert (tmp_path / "residual_map.png").stat().st_size > 0
-    assert "do not beat a complete geometric calibration" in (
+    assert "does not beat a complete geometric calibration" in (
         tmp_path / "report.html").read_text(encoding="utf-8")
     doc = json.loads((tmp_path / "diagnosis.json").read_text(encoding="utf-8"))
     assert doc["final_model"]["fell_back"] is True

@@ -151,7 +151,12 @@ def test_no_effect_gives_none():
     d = diagnose(model, meas, seed=0)
     assert d.effects == ("none",)
     assert d.unexplained is False
-    assert d.final.rms == d.nominal.rms
+    # the final model is registration only, or the complete geometric calibration when that is
+    # (here by chance, within the noise) lower on the withheld poses (zrp/gap/fallback.py)
+    ch = d.assessment.choice
+    assert d.final.rms == min(d.nominal.rms, d.assessment.baseline.withheld.rms)
+    if ch.fell_back:
+        assert ch.within_noise and "within the noise" in d.verdict
     assert "at the noise floor" in d.verdict
 
 

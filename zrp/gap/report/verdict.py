@@ -71,8 +71,9 @@ def _effects_found(diag: Diagnosis) -> list[str]:
     steps = diag.steps
     choice = None if diag.assessment is None else diag.assessment.choice
     if choice is not None and choice.fell_back:
-        found = ", ".join(s.effect for s in steps) or "no effect"
-        return [f"The search found {found}. {choice.note(diag.length_unit)}",
+        found = (f"The search found {', '.join(s.effect for s in steps)}." if steps else
+                 "No effect in the library improves the model significantly (none).")
+        return [found, choice.note(diag.length_unit),
                 f"Final model: {final_effects_text(diag)}."]
     if not steps:
         return ["No effect in the library improves the model significantly (none)."]
