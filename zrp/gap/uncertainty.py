@@ -152,9 +152,11 @@ def interval_covariance(ctx: Context, result: FitResult) -> F64:
         jk = robust_covariance(ctx, result)  # a pose of leverage 1: the sandwich instead
     sd = np.sqrt(np.clip(np.diag(jk), 0.0, None))
     se = np.maximum.reduce([sd, robust_stderr(ctx, result), result.stderr])
-    with np.errstate(invalid="ignore", divide="ignore"):
-        scale = np.where(sd > 0, se / sd, 1.0)
-    return jk * np.outer(scale, scale)
+    fin = np.isfinite(sd) & np.isfinite(se) & (sd > 0)
+    scale = np.where(fin, se / np.where(fin, sd, 1.0), 1.0)
+    cov = jk * np.outer(scale, scale)
+    cov[np.diag_indices_from(cov)] = se * se  # exactly se^2 (inf where not identified)
+    return cov
 
 
 def robust_stderr(ctx: Context, result: FitResult) -> F64:
