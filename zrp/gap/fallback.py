@@ -23,7 +23,7 @@ difference is within the noise).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -53,12 +53,14 @@ class FinalChoice:
         baseline_rms: withheld RMS of the complete geometric calibration (length unit).
         z: paired z of the withheld squared-error difference, search minus baseline (see the
             module docstring; positive: the baseline is better).
+        search_fit: the search's model (in-process only; the final one unless it fell back).
     """
 
     source: str
     search_rms: float
     baseline_rms: float
     z: float = 0.0
+    search_fit: FitResult | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         if self.source not in SOURCES:
@@ -127,5 +129,5 @@ def choose_final(ctx: Context, search_fit: FitResult, baseline: GeometricBaselin
     r_base = Problem(ctx, b.specs, withheld, b.base_rotation).residual(b.theta)
     z = _paired_z(ctx, withheld, r_search, r_base)
     if s_rms <= b_rms:
-        return search_fit, r_search, FinalChoice("search", s_rms, b_rms, z)
-    return b, r_base, FinalChoice("geometric_baseline", s_rms, b_rms, z)
+        return search_fit, r_search, FinalChoice("search", s_rms, b_rms, z, search_fit)
+    return b, r_base, FinalChoice("geometric_baseline", s_rms, b_rms, z, search_fit)

@@ -79,7 +79,8 @@ def _header(diag: Diagnosis) -> list[str]:
             f"Data: {diag.context.meas.source}: {s['n_poses']} poses, {s['n_points']} measured "
             f"points ({', '.join(s['point_labels'])}), frame `{s['frame']}`. Fitting set "
             f"{len(diag.fitting_poses)} poses, withheld set {len(diag.withheld_poses)} poses "
-            f"(never used for fitting or selection), {s['folds']} cross-validation folds.\n"]
+            "(never used for fitting; only to choose between the search's model and the "
+            f"geometric calibration), {s['folds']} cross-validation folds.\n"]
 
 
 def _shrink(diag: Diagnosis) -> list[str]:
