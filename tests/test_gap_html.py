@@ -57,6 +57,7 @@ def _check_page(out: Path, verdict: str, tmp: Path) -> None:
     text = page.read_text(encoding="utf-8")
     # self-contained: every image and link is embedded or in-page
     refs = re.findall(r'(?:src|href)="([^"]*)"', text)
+    assert "Content-Security-Policy" in text  # and the CSP forbids any network access
     assert refs and all(r.startswith(("data:", "#")) for r in refs), [
         r[:40] for r in refs if not r.startswith(("data:", "#"))]
     console, img, dom = _browse(page, tmp)
@@ -80,6 +81,38 @@ def test_the_checks_can_fail(tmp_path):
     assert not _verdict_shown(img)
 
 
+#: appended to a copy of the page: a wheel turn over the first figure, then a drag; the
+#: figure's state (data-scale, data-tx, data-ty) is read back from the dumped DOM.
+_GESTURES = """<script>(function(){var box=document.querySelector('.pz');
+var r=box.getBoundingClientRect(),cx=r.left+r.width/2,cy=r.top+r.height/2;
+box.dispatchEvent(new WheelEvent('wheel',{deltaY:-500,clientX:cx,clientY:cy,bubbles:true,
+cancelable:true}));document.body.dataset.afterWheel=box.dataset.scale+','+box.dataset.tx;
+var o={clientX:cx,clientY:cy,bubbles:true,pointerId:1};
+box.dispatchEvent(new PointerEvent('pointerdown',o));
+box.dispatchEvent(new PointerEvent('pointermove',Object.assign({},o,{clientX:cx+40,
+clientY:cy+25})));box.dispatchEvent(new PointerEvent('pointerup',o));
+document.body.dataset.afterDrag=box.dataset.tx+','+box.dataset.ty;
+box.dispatchEvent(new MouseEvent('dblclick',{bubbles:true}));
+document.body.dataset.afterReset=box.dataset.scale;})();</script>"""
+
+
+def _check_zoom(out: Path, tmp: Path) -> None:
+    """Every figure is a pan/zoom box; a wheel turn zooms it about the pointer, a drag pans
+    it, a double click restores it."""
+    text = (out / "report.html").read_text(encoding="utf-8")
+    assert text.count('class="pz"') == text.count("<figure") == 5
+    probe = tmp / "probe.html"
+    probe.write_text(text.replace("</body>", _GESTURES + "</body>"), encoding="utf-8")
+    console, _, dom = _browse(probe, tmp)
+    assert console == [], console
+    body = re.search(r"<body([^>]*)>", dom).group(1)
+    scale, tx = map(float, re.search(r'data-after-wheel="([^"]+)"', body).group(1).split(","))
+    assert scale == pytest.approx(np.exp(500 * 0.0015), rel=1e-3) and tx < 0
+    dx, dy = map(float, re.search(r'data-after-drag="([^"]+)"', body).group(1).split(","))
+    assert dx == pytest.approx(tx + 40, abs=0.2) and dy < 0
+    assert float(re.search(r'data-after-reset="([^"]+)"', body).group(1)) == 1.0
+
+
 @needs_browser
 def test_report_html_synthetic(tmp_path):
     model = zrp.load_model("puma")
@@ -89,6 +122,7 @@ def test_report_html_synthetic(tmp_path):
     d = diagnose(model, meas, seed=0)
     write_outputs(d, tmp_path / "out")
     _check_page(tmp_path / "out", d.verdict, tmp_path)
+    _check_zoom(tmp_path / "out", tmp_path)
 
 
 @needs_browser

@@ -151,7 +151,12 @@ def test_no_effect_gives_none():
     d = diagnose(model, meas, seed=0)
     assert d.effects == ("none",)
     assert d.unexplained is False
-    assert d.final.rms == d.nominal.rms
+    # the final model is registration only, or the complete geometric calibration when that is
+    # (here by chance, within the noise) lower on the withheld poses (zrp/gap/fallback.py)
+    ch = d.assessment.choice
+    assert d.final.rms == min(d.nominal.rms, d.assessment.baseline.withheld.rms)
+    if ch.fell_back:
+        assert ch.within_noise and "within the noise" in d.verdict
     assert "at the noise floor" in d.verdict
 
 
@@ -170,7 +175,9 @@ def test_gap_outside_the_library_is_reported_unexplained():
 
 
 def test_withheld_poses_never_influence_fitting_or_selection():
-    """Corrupting the withheld measurements changes the withheld errors and nothing else."""
+    """Corrupting the withheld measurements changes the withheld errors and nothing else but
+    the one choice they are for (zrp/gap/fallback.py): between the search's model and the
+    complete geometric calibration, both fitted without them and unchanged here."""
     injection, _, _ = SINGLE["joint_offset"]
     model, meas = _measure("puma", injection, seed=5, poses=120)
     with warnings.catch_warnings():
@@ -182,7 +189,13 @@ def test_withheld_poses_never_influence_fitting_or_selection():
         d2 = diagnose(model, Measurements.from_arrays(meas.pose, meas.q, xyz, point=meas.point),
                       seed=3)
     assert d1.effects == d2.effects
-    np.testing.assert_allclose(d1.final_fit.theta, d2.final_fit.theta, rtol=0, atol=1e-12)
+    c1, c2 = d1.assessment.choice, d2.assessment.choice
+    np.testing.assert_allclose(c1.search_fit.theta, c2.search_fit.theta, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(d1.assessment.baseline.fit.theta,
+                               d2.assessment.baseline.fit.theta, rtol=0, atol=1e-12)
+    for d, c in ((d1, c1), (d2, c2)):  # the final model is one of the two
+        ref = d.assessment.baseline.fit if c.fell_back else c.search_fit
+        np.testing.assert_array_equal(d.final_fit.theta, ref.theta)
     assert d1.split == d2.split
     assert d2.final.rms > 3 * d1.final.rms
 

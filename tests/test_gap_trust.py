@@ -189,7 +189,7 @@ def test_single_reflector_says_no_noise_floor():
     d = _quiet(PUMA, m, seed=0)
     assert d.noise_floor.rms is None and d.unexplained is None
     assert "No noise floor can be estimated" in d.verdict
-    assert d.final.rms <= d.assessment.baseline.withheld.rms * 1.02
+    assert d.final.rms <= d.assessment.baseline.withheld.rms  # by construction (fallback.py)
 
 
 SEVEN = """name = "7-axis test arm"

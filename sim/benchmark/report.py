@@ -63,8 +63,10 @@ def render_text(result: BenchmarkResult) -> str:
                            r["median_shrink"], r.get("both_found", "")] for r in rows]))
     out += ["", "95 % interval coverage of the true values (final parameters of the hidden "
             "effect, 0 where not injected; sim/benchmark/coverage.py):", "",
-            _md_table(["group", "parameters covered", "scenarios with all covered"],
-                      [[r["group"], r["ci95_parameters"], r["ci95_scenarios"]] for r in rows])]
+            _md_table(["group", "parameters covered", "scenarios with all covered",
+                       "same, simultaneous 95 % intervals of the effect"],
+                      [[r["group"], r["ci95_parameters"], r["ci95_scenarios"],
+                        r.get("ci95_effect_scenarios", "-")] for r in rows])]
     conf = confusion_matrix(result)
     cols = sorted({c for r in conf.values() for c in r})
     out += ["", "## Confusion matrix (single effect and none; row: hidden, column: named first)",

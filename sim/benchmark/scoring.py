@@ -257,8 +257,10 @@ def score(model: Manipulator, truth: dict[str, Any], diagnosis: dict[str, Any],
                         else ""))
     note = "; ".join(notes)
     covered, compared, misses = interval_coverage(eff, hidden, diagnosis)
+    eff_cov, eff_cmp, _ = interval_coverage(eff, hidden, diagnosis, "ci95_effect")
     values = {"success": bool(top_correct and joints_ok and ratio <= config.ratio_target),
-              "ci_covered": covered, "ci_compared": compared, "ci_misses": misses}
+              "ci_covered": covered, "ci_compared": compared, "ci_misses": misses,
+              "ci_effect_all": bool(eff_cmp and eff_cov == eff_cmp)}
     return ScenarioScore(int(scn.get("index", -1)), str(scn.get("kind", "")), hidden, hj, snr,
                          expected, found, found_joints, bool(top_correct), tied,
                          bool(joints_ok),

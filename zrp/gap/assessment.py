@@ -28,13 +28,15 @@ from numpy.typing import NDArray
 
 from zrp.gap.baseline import GeometricBaseline
 from zrp.gap.effects import Context
+from zrp.gap.fallback import FinalChoice
 from zrp.gap.leastsq import FitResult
 from zrp.gap.registration import Registration
 from zrp.gap.uncertainty import Correlations
 from zrp.gap.where import WhereAnalysis
 from zrp.units import metres_per_unit
 
-__all__ = ["TYPICAL_REPEATABILITY_MM", "Assessment", "Remainder", "remainder_evidence"]
+__all__ = ["TYPICAL_REPEATABILITY_MM", "Assessment", "Remainder", "compliance_units",
+           "remainder_evidence"]
 
 F64 = NDArray[np.float64]
 #: upper end of the specified pose repeatability (ISO 9283) of industrial arms up to ~50 kg
@@ -161,6 +163,24 @@ def remainder_evidence(ctx: Context, fit: FitResult, where: WhereAnalysis) -> Re
                      jr, bool(rms > spec))
 
 
+def compliance_units(ctx: Context) -> dict[str, Any]:
+    """In which unit ``joint_compliance`` is given, and why: rad/(N m) needs the masses of an
+    MJCF (gravity torques); without one the lumped weights compliance x weight are identified
+    in rad per length unit, and the masses cannot be separated from the compliance."""
+    u = ctx.model.length_unit
+    if ctx.gravity_torque is not None:
+        return {"model": "mjcf", "unit": "rad/(N m)", "payload_unit": "rad/kg",
+                "in_rad_per_newton_metre": True,
+                "note": "compliances q{k}.compliance in rad/(N m) (prismatic joints: length "
+                        "unit/(N m)) on the MJCF's gravity torques"}
+    return {"model": "lumped_masses", "unit": f"rad/{u}", "payload_unit": f"rad/({u} kg)",
+            "in_rad_per_newton_metre": False,
+            "note": f"no MJCF supplied the masses, so compliance cannot be given in rad/(N m): "
+                    f"each q{{k}}.w_{{p}} is the compliance times the weight of an unknown "
+                    f"mass lumped at point p, in rad/{u} of moment arm (q{{k}}.w_load: per kg "
+                    f"of the load column, rad/({u} kg)); give the MJCF (--mjcf) for rad/(N m)"}
+
+
 @dataclass(frozen=True, eq=False)
 class Assessment:
     """How far to trust the final model (see the module docstring).
@@ -175,6 +195,9 @@ class Assessment:
         remainder: the evidence on what remains.
         resolution: numerical resolution of the fits (length unit): below it nothing is
             resolved.
+        compliance: the unit of ``joint_compliance`` and why (:func:`compliance_units`).
+        choice: which model is final - the search's, or the geometric calibration when the
+            search's is worse on the withheld poses (:mod:`zrp.gap.fallback`).
     """
 
     baseline: GeometricBaseline
@@ -185,6 +208,8 @@ class Assessment:
     unexcited: tuple[int, ...]
     remainder: Remainder
     resolution: float
+    choice: FinalChoice | None = None
+    compliance: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {"geometric_baseline": self.baseline.to_dict(),
@@ -192,4 +217,6 @@ class Assessment:
                 "correlation": self.correlations.to_dict(),
                 "implausible": list(self.implausible),
                 "unexcited_joints": list(self.unexcited),
-                "remainder": self.remainder.to_dict(), "resolution": self.resolution}
+                "remainder": self.remainder.to_dict(), "resolution": self.resolution,
+                "final_model": None if self.choice is None else self.choice.to_dict(),
+                "compliance_units": self.compliance}

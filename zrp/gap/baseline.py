@@ -11,7 +11,7 @@ withheld poses?".
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -42,6 +42,9 @@ class GeometricBaseline:
         n_non_geometric: their parameters identifiable on top of the base set.
         combined: withheld errors of geometric + non-geometric, or None when the final model
             has no non-geometric effect.
+        fit: the geometric calibration's fit (registration + base set; the final model when
+            the search's model does not beat it on the withheld poses, see
+            :mod:`zrp.gap.fallback`).
     """
 
     n_parameters: int
@@ -51,6 +54,7 @@ class GeometricBaseline:
     non_geometric: tuple[str, ...]
     n_non_geometric: int
     combined: Metrics | None
+    fit: FitResult | None = field(default=None, compare=False, repr=False)
 
     @property
     def increment(self) -> float | None:
@@ -99,4 +103,4 @@ def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
         both, n_ng, _ = _on_top(ctx, base, non_geo, fitting, rb0)
         combined = _withheld(ctx, both, withheld)
     return GeometricBaseline(n_geo, n_drop, _withheld(ctx, base, withheld),
-                             cv_rms(ctx, base, folds), effects, n_ng, combined)
+                             cv_rms(ctx, base, folds), effects, n_ng, combined, base)

@@ -23,8 +23,8 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.arguments import check_instance, check_int, check_seed
 from zrp.blas import blas_threads
 from zrp.errors import InputError
-from zrp.gap.assessment import Assessment, remainder_evidence
-from zrp.gap.baseline import geometric_baseline
+from zrp.gap.assessment import Assessment, compliance_units, remainder_evidence
+from zrp.gap.baseline import GeometricBaseline, geometric_baseline
 from zrp.gap.checks import (
     check_gravity_torque,
     check_points,
@@ -41,6 +41,7 @@ from zrp.gap.effects import (
     registration_parameters,
 )
 from zrp.gap.excitation import excited_only
+from zrp.gap.fallback import FinalChoice, choose_final
 from zrp.gap.identifiability import ReferencePoses, registration_identifiable, survey
 from zrp.gap.leastsq import FitResult, fit, initial_registration
 from zrp.gap.metrics import Metrics
@@ -58,7 +59,7 @@ from zrp.gap.results import (
 from zrp.gap.search import SearchSettings, greedy_search, withheld_residual
 from zrp.gap.split import split_poses
 from zrp.gap.subsample import MAX_POINTS, subsample_poses
-from zrp.gap.uncertainty import correlations, plausibility, robust_covariance
+from zrp.gap.uncertainty import correlations, interval_covariance, plausibility
 from zrp.gap.where import WhereAnalysis, where_analysis
 from zrp.model.manipulator import Manipulator
 
@@ -231,33 +232,33 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
                           {e: excited_only(ctx, v) for e, v in specs_of.items()}, SearchSettings(
         prep.fitting, prep.withheld, prep.folds, regd.rb0, opts.alpha, opts.min_gain,
         opts.max_steps, opts.progress, resolution))
-    after = withheld_residual(ctx, found.final_fit, prep.withheld)
+    baseline = geometric_baseline(ctx, reg, found.final_fit, prep.fitting, prep.withheld,
+                                  prep.folds, regd.rb0)
+    final_fit, after, choice = choose_final(ctx, found.final_fit, baseline, prep.withheld)
+    if choice.fell_back:
+        warnings.warn(choice.note(model.length_unit), GapWarning, stacklevel=2)
     final = Metrics.of(after)
     unexplained = (None if floor.rms is None
                    else bool(final.rms > UNEXPLAINED_RATIO * max(floor.rms, resolution)))
+    changed = bool(found.steps) or choice.fell_back
     where = Where(where_nominal, identifiability, found.backlash, found.last_candidates,
-                  found.pruned, where_analysis(ctx, found.final_fit) if found.steps else None)
-    assessment = _assess(ctx, prep, regd, found.final_fit,
+                  found.pruned, where_analysis(ctx, final_fit) if changed else None)
+    assessment = _assess(ctx, baseline, choice, final_fit, len(reg.specs),
                          where.after_final_model or where_nominal, resolution)
     return Diagnosis(model.name, model.length_unit, Metrics.of(regd.withheld_residual),
                      regd.fitting, parameter_estimates(reg, 0), found.steps, final, floor,
                      unexplained, _split_ids(meas, prep, opts), where, found.aliased, (), reg,
-                     found.final_fit, regd.withheld_residual, after, ctx, prep.fitting,
+                     final_fit, regd.withheld_residual, after, ctx, prep.fitting,
                      prep.withheld, _settings(ctx, opts), assessment)
 
 
-def _assess(ctx: Context, prep: _Prepared, regd: _Registered, final: FitResult,
-            where_final: WhereAnalysis, resolution: float) -> Assessment:
-    """The geometric baseline, robust intervals, correlations, plausibility, the full
-    registration and the evidence on what remains (warns on implausible values and on joints
-    the data do not excite)."""
-    cov = robust_covariance(ctx, final)
-    rob = np.sqrt(np.clip(np.diag(cov), 0.0, None))
-    se = np.maximum(rob, final.stderr)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        scale = np.where(rob > 0, se / rob, 1.0)
-    cov = cov * np.outer(scale, scale)  # the correlations of the robust one, diag se^2
-    nreg = len(regd.fit.specs)
+def _assess(ctx: Context, baseline: GeometricBaseline, choice: FinalChoice, final: FitResult,
+            nreg: int, where_final: WhereAnalysis, resolution: float) -> Assessment:
+    """Robust intervals, correlations, plausibility, the full registration and the evidence
+    on what remains, beside the geometric baseline and the choice of the final model (warns on
+    implausible values and on joints the data do not excite)."""
+    cov = interval_covariance(ctx, final)  # jackknife over poses, at least the sandwich
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))
     implausible = tuple(m for i, sp in enumerate(final.specs) if i >= nreg and (
         m := plausibility(sp.name, sp.effect, float(final.theta[i]), float(se[i]), sp.unit)))
     for m in implausible:
@@ -270,7 +271,6 @@ def _assess(ctx: Context, prep: _Prepared, regd: _Registered, final: FitResult,
                       "is placed on them)", GapWarning, stacklevel=2)
     names = tuple(sp.name for sp in final.specs)
     frame = registration_of(final, se, cov, ctx.meas.point_labels, ctx.model.length_unit)
-    baseline = geometric_baseline(ctx, regd.fit, final, prep.fitting, prep.withheld,
-                                  prep.folds, regd.rb0)
     return Assessment(baseline, frame, correlations(names, cov), se, implausible, unexcited,
-                      remainder_evidence(ctx, final, where_final), resolution)
+                      remainder_evidence(ctx, final, where_final), resolution, choice,
+                      compliance_units(ctx))

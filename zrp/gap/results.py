@@ -21,6 +21,7 @@ from zrp.gap.assessment import Assessment
 from zrp.gap.effects import EFFECTS, Context
 from zrp.gap.leastsq import Aliased, FitResult
 from zrp.gap.metrics import Metrics, NoiseFloor
+from zrp.gap.uncertainty import simultaneous_z
 from zrp.gap.where import WhereAnalysis
 
 __all__ = [
@@ -53,7 +54,9 @@ class GapWarning(ZRPWarning):
 
 @dataclass(frozen=True)
 class ParameterEstimate:
-    """An identified parameter with its 95 % confidence interval (normal approximation)."""
+    """An identified parameter with its 95 % confidence interval (normal approximation) and,
+    for the final model, ``ci95_effect``: the simultaneous 95 % interval that holds for all
+    parameters of its effect at once (:func:`~zrp.gap.uncertainty.simultaneous_z`)."""
 
     name: str
     effect: str
@@ -62,6 +65,7 @@ class ParameterEstimate:
     value: float
     stderr: float
     ci95: tuple[float, float]
+    ci95_effect: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         if not math.isfinite(self.value):
@@ -72,21 +76,32 @@ class ParameterEstimate:
     def to_dict(self) -> dict[str, Any]:
         return {"name": self.name, "effect": self.effect, "joint": self.joint,
                 "unit": self.unit, "value": self.value, "stderr": self.stderr,
-                "ci95": list(self.ci95)}
+                "ci95": list(self.ci95),
+                **({} if self.ci95_effect is None else {"ci95_effect": list(self.ci95_effect)})}
 
 
 def parameter_estimates(result: FitResult, first: int, last: int | None = None,
-                        stderr: F64 | None = None) -> tuple[ParameterEstimate, ...]:
+                        stderr: F64 | None = None, simultaneous: bool = False
+                        ) -> tuple[ParameterEstimate, ...]:
     """The parameters ``first`` .. ``last`` (default: all after ``first``) of a fit, with
-    their 95 % intervals (from ``stderr``, shape (p,), default the normal-theory ones)."""
+    their 95 % intervals (from ``stderr``, shape (p,), default the normal-theory ones) and,
+    with ``simultaneous``, the per-effect simultaneous ones over these parameters."""
     se = result.stderr if stderr is None else stderr
+    idx = range(first, len(result.specs) if last is None else last)
+    k_of: dict[str, int] = {}
+    for i in idx:
+        k_of[result.specs[i].effect] = k_of.get(result.specs[i].effect, 0) + 1
     out = []
-    for i in range(first, len(result.specs) if last is None else last):
+    for i in idx:
         s = result.specs[i]
         v = float(result.theta[i])
         h = Z95 * float(se[i])
+        joint = None
+        if simultaneous:
+            hj = simultaneous_z(k_of[s.effect]) * float(se[i])
+            joint = (v - hj, v + hj)
         out.append(ParameterEstimate(s.name, s.effect, s.joint, s.unit, v, float(se[i]),
-                                     (v - h, v + h)))
+                                     (v - h, v + h), joint))
     return tuple(out)
 
 
@@ -373,7 +388,8 @@ class Diagnosis:
         pass), with robust 95 % intervals (:mod:`zrp.gap.uncertainty`). The per-step values
         are each estimated without the effects added later, so these are the ones to use."""
         se = None if self.assessment is None else self.assessment.stderr
-        return parameter_estimates(self.final_fit, len(self.registration), stderr=se)
+        return parameter_estimates(self.final_fit, len(self.registration), stderr=se,
+                                   simultaneous=True)
 
     @property
     def final_joints(self) -> dict[str, tuple[int, ...]]:

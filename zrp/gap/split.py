@@ -1,7 +1,8 @@
 """The seeded split of the poses into fitting and withheld sets and cross-validation folds.
 
 Poses with identical joint values (repeats) always stay on the same side. The withheld poses
-are never used for fitting or selection; they only judge the final model.
+are never used for fitting; they judge the final model, and choose it only between the search's
+model and the complete geometric calibration (:mod:`zrp.gap.fallback`).
 """
 
 from __future__ import annotations

@@ -1,7 +1,14 @@
-"""report.html: one self-contained page (no network, no script), rendered from the same text
-as report.md so the two can never disagree, with the figures embedded as SVG (vector: they
-stay sharp at any browser zoom) and a click on any figure opening it full-window (a CSS
-``:target`` overlay; "close" or the browser's back button closes it).
+"""report.html: one self-contained page (no network: a Content-Security-Policy allows only
+inline styles, one inline script and data: images), rendered from the same text as report.md
+so the two can never disagree, with the figures embedded as SVG (vector: they stay sharp at
+any zoom).
+
+Every figure pans and zooms in place (a small inline script, :data:`_SCRIPT`): the mouse wheel
+zooms about the pointer (1x to 40x), dragging pans, a double click or "reset" returns to the
+whole figure, and "+" / "-" zoom about the centre (keyboard or touchpad without a wheel).
+"full window" opens a figure over the whole window (a CSS ``:target`` overlay; "close" or the
+browser's back button closes it), where it pans and zooms the same way. Without script the
+figures are still shown whole.
 
 Only the small subset of Markdown that :func:`~zrp.gap.report.markdown.report_markdown`
 writes is translated: headings, paragraphs, ``- `` lists, pipe tables, ``**bold**``,
@@ -27,14 +34,48 @@ table{border-collapse:collapse;margin:.6em 0;font-size:.9em}
 td,th{border:1px solid #ccc;padding:.25em .5em;text-align:left;vertical-align:top}
 th{background:#f0f0f0}tr:nth-child(even) td{background:#fafafa}
 code{background:#f2f2f2;padding:0 .2em}
-figure{margin:1em 0}figure img{max-width:100%;cursor:zoom-in;border:1px solid #ddd}
-figcaption{font-size:.85em;color:#555}
+figure{margin:1em 0}figcaption{font-size:.85em;color:#555}
+.pz{overflow:hidden;border:1px solid #ddd;cursor:grab;touch-action:none;background:#fff;
+display:inline-block;max-width:100%;line-height:0}
+.pz img{display:block;max-width:100%;transform-origin:0 0;user-select:none;
+-webkit-user-drag:none}
+.tools{font-size:.85em;margin:.2em 0}.tools button,.tools a{margin-right:.4em}
 figure:target{position:fixed;inset:0;margin:0;background:rgba(0,0,0,.85);z-index:10;
 display:flex;flex-direction:column;align-items:center;justify-content:center}
-figure:target img{max-width:98vw;max-height:92vh;background:#fff;cursor:default}
-figure .close{display:none}figure:target .close{display:block;color:#fff;font-size:1.2em}
-figure:target figcaption{color:#eee}
+figure:target .pz img{max-width:98vw;max-height:88vh}
+figure .close{display:none}figure:target .close{display:inline;color:#fff}
+figure:target .full{display:none}figure:target figcaption{color:#eee}
 """
+
+#: pan and zoom of every ``.pz`` box (see the module docstring); the state is mirrored into
+#: the box's data-scale / data-tx / data-ty attributes (read by the browser test).
+_SCRIPT = """(function(){
+document.querySelectorAll('figure').forEach(function(fig){
+var box=fig.querySelector('.pz'),img=box.querySelector('img'),s=1,x=0,y=0,drag=null;
+function apply(){img.style.transform='translate('+x+'px,'+y+'px) scale('+s+')';
+box.dataset.scale=s.toFixed(4);box.dataset.tx=x.toFixed(1);box.dataset.ty=y.toFixed(1);}
+function zoom(f,cx,cy){var n=Math.min(40,Math.max(1,s*f));f=n/s;x=cx-(cx-x)*f;
+y=cy-(cy-y)*f;s=n;if(s===1){x=0;y=0;}apply();}
+function centre(f){var r=box.getBoundingClientRect();zoom(f,r.width/2,r.height/2);}
+box.addEventListener('wheel',function(e){e.preventDefault();
+var r=box.getBoundingClientRect();zoom(Math.exp(-e.deltaY*0.0015),e.clientX-r.left,
+e.clientY-r.top);},{passive:false});
+box.addEventListener('pointerdown',function(e){drag={x:e.clientX-x,y:e.clientY-y};
+box.style.cursor='grabbing';});
+box.addEventListener('pointermove',function(e){if(!drag||s===1)return;
+x=e.clientX-drag.x;y=e.clientY-drag.y;apply();});
+function up(){drag=null;box.style.cursor='';}
+box.addEventListener('pointerup',up);box.addEventListener('pointerleave',up);
+box.addEventListener('pointercancel',up);
+box.addEventListener('dblclick',function(){s=1;x=0;y=0;apply();});
+fig.querySelector('.zin').addEventListener('click',function(){centre(1.5);});
+fig.querySelector('.zout').addEventListener('click',function(){centre(1/1.5);});
+fig.querySelector('.zreset').addEventListener('click',function(){s=1;x=0;y=0;apply();});
+apply();});})();"""
+
+#: no network: only inline style, the inline script and data: images.
+_CSP = ("default-src 'none'; img-src data:; style-src 'unsafe-inline'; "
+        "script-src 'unsafe-inline'")
 
 
 def _inline(text: str) -> str:
@@ -58,9 +99,14 @@ def _figure(alt: str, name: str, svgs: Mapping[str, bytes]) -> str:
         return ""
     src = "data:image/svg+xml;base64," + base64.b64encode(svg).decode("ascii")
     fid = "zoom-" + re.sub(r"[^a-z0-9]+", "-", name.lower())
-    return (f'<figure id="{fid}"><a class="close" href="#_">close x</a><a href="#{fid}">'
-            f'<img src="{src}" alt="{html.escape(alt)}"></a><figcaption>{html.escape(alt)} '
-            f"(click to enlarge; {html.escape(name)} beside this file)</figcaption></figure>")
+    return (f'<figure id="{fid}"><div class="tools"><button type="button" class="zin" '
+            'title="zoom in">+</button><button type="button" class="zout" title="zoom out">'
+            '-</button><button type="button" class="zreset">reset</button>'
+            f'<a class="full" href="#{fid}">full window</a><a class="close" href="#_">'
+            f'close x</a></div><div class="pz"><img src="{src}" alt="{html.escape(alt)}" '
+            f'draggable="false"></div><figcaption>{html.escape(alt)} (wheel: zoom, drag: pan, '
+            f"double click: whole figure; {html.escape(name)} beside this file)</figcaption>"
+            "</figure>")
 
 
 def _blocks(md: str, svgs: Mapping[str, bytes]) -> list[str]:
@@ -121,6 +167,7 @@ def report_html(markdown: str, svgs: Mapping[str, bytes], title: str) -> str:
     body = "\n".join(_blocks(markdown, svgs))
     return ("<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">"
             "<meta name=\"viewport\" content=\"width=device-width, initial-scale=1\">"
+            f"<meta http-equiv=\"Content-Security-Policy\" content=\"{_CSP}\">"
             "<link rel=\"icon\" href=\"data:,\">"
             f"<title>{html.escape(title)}</title><style>{_CSS}</style></head>"
-            f"<body>\n{body}\n</body></html>\n")
+            f"<body>\n{body}\n<script>{_SCRIPT}</script>\n</body></html>\n")

@@ -39,11 +39,16 @@ def _joints(joints: Sequence[int]) -> str:
 
 def _parameter_table(params: Sequence[ParameterEstimate], *, flags: Sequence[str] = ()
                      ) -> list[str]:
-    out = ["| parameter | value | 95 % interval | plausible |", "|---|---|---|---|"]
+    joint = any(p.ci95_effect is not None for p in params)
+    out = (["| parameter | value | 95 % interval | 95 % for the whole effect | plausible |",
+            "|---|---|---|---|---|"] if joint else
+           ["| parameter | value | 95 % interval | plausible |", "|---|---|---|---|"])
     for p in params:
         v, ci = value_ci(p.value, *p.ci95, p.unit)
         bad = any(f.startswith(p.name + " = ") for f in flags)
-        out.append(f"| {p.name} | {v} | {ci} | {'NO' if bad else 'yes'} |")
+        both = "" if not joint else (
+            f"{value_ci(p.value, *p.ci95_effect, p.unit)[1]} | " if p.ci95_effect else "| ")
+        out.append(f"| {p.name} | {v} | {ci} | {both}{'NO' if bad else 'yes'} |")
     return out
 
 
@@ -74,7 +79,8 @@ def _header(diag: Diagnosis) -> list[str]:
             f"Data: {diag.context.meas.source}: {s['n_poses']} poses, {s['n_points']} measured "
             f"points ({', '.join(s['point_labels'])}), frame `{s['frame']}`. Fitting set "
             f"{len(diag.fitting_poses)} poses, withheld set {len(diag.withheld_poses)} poses "
-            f"(never used for fitting or selection), {s['folds']} cross-validation folds.\n"]
+            "(never used for fitting; only to choose between the search's model and the "
+            f"geometric calibration), {s['folds']} cross-validation folds.\n"]
 
 
 def _shrink(diag: Diagnosis) -> list[str]:
@@ -90,9 +96,12 @@ def _shrink(diag: Diagnosis) -> list[str]:
         L.append(f"| {i} | {st.effect} | {_joints(st.joints)} | {w.rms:.4g} | {w.p95:.4g} | "
                  f"{w.max:.4g} | {st.cv_rms:.4g} | {st.p_value:.2g} | {st.bic_delta:.1f} |")
     fin = diag.final
-    L.append(f"| final | final model after pruning: {final_effects_text(diag) or 'none'} | | "
-             f"{fin.rms:.4g} | {fin.p95:.4g} | {fin.max:.4g} | | | |")
     a = diag.assessment
+    fell_back = a is not None and a.choice is not None and a.choice.fell_back
+    what = ("the geometric calibration (the search's model was worse on withheld poses)"
+            if fell_back else "final model after pruning")
+    L.append(f"| final | {what}: {final_effects_text(diag) or 'none'} | | "
+             f"{fin.rms:.4g} | {fin.p95:.4g} | {fin.max:.4g} | | | |")
     if a is not None:
         b = a.baseline
         L.append(f"| baseline | complete geometric calibration ({b.n_parameters} parameters) "
@@ -130,10 +139,12 @@ def _parameters(diag: Diagnosis) -> list[str]:
     flags = diag.assessment.implausible if diag.assessment is not None else ()
     L = ["## Identified parameters (final model, robust 95 % intervals)\n",
          "Estimated jointly in the final model (the per-step values in diagnosis.json were "
-         "each estimated before the later effects were added). Intervals: the larger of the "
-         "pose-clustered sandwich and the normal-theory standard error, so they hold when a "
-         "gap remains. Backlash is the full play; compliance is in rad/(N m) with MJCF "
-         "torques (lumped masses without: rad per length unit of moment arm x kg).\n"]
+         "each estimated before the later effects were added). Intervals: the largest of the "
+         "pose-clustered jackknife, the sandwich and the normal-theory standard error, so "
+         "they hold when a gap remains; \"for the whole effect\": simultaneous intervals that "
+         "hold for all parameters of the effect at once (Sidak). Backlash is the full play. "
+         + ("" if diag.assessment is None or diag.assessment.compliance is None else
+            "Compliance: " + diag.assessment.compliance["note"] + ".") + "\n"]
     by_eff: dict[str, list[ParameterEstimate]] = {}
     for p in diag.final_parameters:
         by_eff.setdefault(p.effect, []).append(p)
@@ -301,10 +312,11 @@ METHOD = ("See zrp/gap/README.md. Registration (base_frame, tool_offset) first; 
           "candidates are ranked by cross-validated RMS and added greedily while an F test, "
           "BIC and the CV RMS agree that they help; a backward pass drops what the final "
           "model no longer needs. Final intervals are robust 95 % intervals (pose-clustered "
-          "sandwich covariance, never narrower than the normal-theory ones); per-step "
-          "intervals in diagnosis.json are normal-theory. A complete geometric calibration "
-          "(QR-reduced base set of joint offsets, body vectors and axis tilts) is always "
-          "fitted beside the chosen effects.")
+          "jackknife covariance, never narrower than the sandwich or the normal-theory "
+          "ones); per-step intervals in diagnosis.json are normal-theory. A complete "
+          "geometric calibration (QR-reduced base set of joint offsets, body vectors and axis "
+          "tilts) is always fitted beside the chosen effects, and it is the final model when "
+          "the effects found do not beat it on the withheld poses.")
 
 
 def report_markdown(diag: Diagnosis) -> str:

@@ -69,6 +69,12 @@ def final_effects_text(diag: Diagnosis) -> str:
 
 def _effects_found(diag: Diagnosis) -> list[str]:
     steps = diag.steps
+    choice = None if diag.assessment is None else diag.assessment.choice
+    if choice is not None and choice.fell_back:
+        found = (f"The search found {', '.join(s.effect for s in steps)}." if steps else
+                 "No effect in the library improves the model significantly (none).")
+        return [found, choice.note(diag.length_unit),
+                f"Final model: {final_effects_text(diag)}."]
     if not steps:
         return ["No effect in the library improves the model significantly (none)."]
     parts = [f"Final model (after pruning): {final_effects_text(diag)}."]
@@ -106,6 +112,10 @@ def _trust(diag: Diagnosis) -> list[str]:
         names = ", ".join(m.split(" = ")[0] for m in a.implausible)
         parts.append(f"Physically implausible values (do not use them as physical "
                      f"properties): {names}.")
+    if (a.compliance is not None and not a.compliance["in_rad_per_newton_metre"]
+            and "joint_compliance" in diag.final_joints):
+        parts.append(f"Joint compliance is given as compliance x lumped weight in "
+                     f"{a.compliance['unit']}, not in rad/(N m): no MJCF supplied the masses.")
     if a.unexcited:
         parts.append(f"These data leave joint(s) {_ranges(a.unexcited)} unidentifiable for "
                      "scale, cyclic error and backlash (they barely move).")
