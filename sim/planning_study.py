@@ -46,7 +46,7 @@ from zrp.gap import EFFECTS, Measurements, diagnose
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["DesignScore", "PLANNED_EFFECTS", "design_rows", "run_k_study", "study_scenario"]
+__all__ = ["PLANNED_EFFECTS", "DesignScore", "design_rows", "run_k_study", "study_scenario"]
 
 F64 = NDArray[np.float64]
 #: What the plan makes identifiable: every candidate effect the poses can excite.
