@@ -248,6 +248,18 @@ class CalibratedRobot:
         y = pos + rn @ self.tool_offset(point)
         return self.to_frame(y, frame)
 
+    def predict_rotation(self, q: ArrayLike, cond: PoseConditions | None = None,
+                         frame: str = "instrument") -> F64:
+        """Predicted hand rotation R'_n(x) when q (P, n) is commanded, shape (P, 3, 3), in the
+        instrument frame (R_b R'_n) or ``frame="base"``."""
+        x = self.actual_joint_values(q, cond or PoseConditions())
+        _, rn, _, _ = chain(self.model, x)
+        if frame == "base":
+            return rn
+        if frame != "instrument":
+            raise InputError(f"frame: expected 'instrument' or 'base', got {frame!r}")
+        return np.asarray(self.base_rotation) @ rn
+
     def tool_offset(self, point: str | None) -> F64:
         """t'_j of the tool point ``point`` (zeros for None), shape (3,)."""
         if point is None:
