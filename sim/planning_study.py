@@ -46,7 +46,16 @@ from zrp.gap import EFFECTS, Measurements, diagnose
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["PLANNED_EFFECTS", "DesignScore", "design_rows", "run_k_study", "study_scenario"]
+__all__ = [
+    "PLANNED_EFFECTS",
+    "DesignScore",
+    "design_rows",
+    "render_k_study",
+    "run_k_study",
+    "score_from_row",
+    "smallest_matching_k",
+    "study_scenario",
+]
 
 F64 = NDArray[np.float64]
 #: What the plan makes identifiable: every candidate effect the poses can excite.
@@ -251,3 +260,65 @@ def design_rows(scores: list[DesignScore]) -> list[dict[str, Any]]:
                      "std_ratio_median": float(np.median(med)) if med else float("nan"),
                      "std_ratio_worst": float(np.median(worst)) if worst else float("nan")})
     return rows
+
+
+def smallest_matching_k(scores: list[DesignScore]) -> int | None:
+    """The smallest K whose planned design succeeds in at least as many scenarios as the
+    random design (same scenarios), and from which every larger K does too; None if none."""
+    rows = design_rows(scores)
+    ref = next((r for r in rows if r["design"] == "random"), None)
+    if ref is None:
+        return None
+    planned = [r for r in rows if r["design"] == "planned"]
+    best = None
+    for r in reversed(planned):
+        if r["success"] < ref["success"]:
+            break
+        best = r["poses"]
+    return best
+
+
+def render_k_study(scores: list[DesignScore], ratio_target: float = 1.5) -> str:
+    """Markdown: the per-design table, the smallest matching K, the scenarios where a design
+    failed."""
+    rows = design_rows(scores)
+    n_scn = len({s.scenario for s in scores})
+    out = ["# K planned poses against 200 random ones (blind benchmark scenarios)", "",
+           f"{n_scn} scenarios. Success: the right effect named first, its joints located, and "
+           f"the calibrated robot's RMS on the common validation poses <= {ratio_target:g}x "
+           "the tracker noise. std ratio: predicted standard deviation of each planned "
+           "parameter over the random design's (same scenario), median over parameters "
+           "(and worst parameter), then median over scenarios.", "",
+           "| design | poses | success | right effect | joints | validation RMS / noise "
+           "(median, max) | <= target | std ratio median | std ratio worst |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        n = r["scenarios"]
+        out.append(f"| {r['design']} | {r['poses']} | {r['success']}/{n} | "
+                   f"{r['top_correct']}/{n} | {r['joints_correct']}/{n} | "
+                   f"{r['ratio_median']:.2f}, {r['ratio_max']:.2f} | {r['within_target']}/{n} | "
+                   f"{r['std_ratio_median']:.2f} | {r['std_ratio_worst']:.2f} |")
+    k = smallest_matching_k(scores)
+    out += ["", "Smallest K that succeeds in as many scenarios as the random design (and every "
+            f"larger K too): {k if k is not None else 'none of those tried'}."]
+    bad = [s for s in scores if not s.success]
+    if bad:
+        out += ["", "Designs that did not succeed:", "",
+                "| scenario | hidden | design | poses | expected | found | ratio |",
+                "|---|---|---|---|---|---|---|"]
+        out += [f"| {s.scenario} | {', '.join(s.hidden) or 'none'} | {s.design} | {s.poses} | "
+                f"{', '.join(s.expected)} | {', '.join(s.found)} | {s.ratio:.2f} |"
+                for s in bad]
+    return "\n".join(out) + "\n"
+
+
+def score_from_row(d: dict[str, Any]) -> DesignScore:
+    """The inverse of :meth:`DesignScore.row` plus its ``std`` (JSON files of a run)."""
+    def tup(v: str) -> tuple[str, ...]:
+        return tuple(x for x in str(v).split(", ") if x)
+    return DesignScore(int(d["scenario"]), () if d["hidden"] == "none" else tup(d["hidden"]),
+                       str(d["design"]), int(d["poses"]), tup(d["expected"]), tup(d["found"]),
+                       bool(d["top_correct"]), bool(d["joints_correct"]), float(d["noise_rms"]),
+                       float(d["validation_rms"]), float(d["ratio"]), bool(d["success"]),
+                       {k: float(v) for k, v in d.get("std", {}).items()},
+                       float(d["temp_span"]))

@@ -49,7 +49,7 @@ def test_backlash_is_half_the_side_and_unknown_terms_are_refused():
     ctx = _context(True, None)
     b = term_basis(Term("q2.backlash", "backlash", 2, "rad", 8e-4), ctx)
     np.testing.assert_array_equal(b, -0.5 * ctx.meas.approach_direction()[:, 1])
-    with pytest.raises(InputError, match="q2.sin9"):
+    with pytest.raises(InputError, match=r"q2\.sin9"):
         term_basis(Term("q2.sin9", "cyclic_error", 2, "rad", 1e-4), ctx)
     with pytest.raises(InputError, match="gravity torque"):
         term_basis(Term("q2.compliance", "joint_compliance", 2, "rad/(N m)", 1e-5),
