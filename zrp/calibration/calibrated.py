@@ -31,6 +31,7 @@ from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
 from zrp.gap.data import Measurements
 from zrp.gap.effects import Context
+from zrp.gap.leastsq import FitResult
 from zrp.gap.problem import Problem
 from zrp.gap.results import Diagnosis
 from zrp.model.manipulator import Manipulator
@@ -168,12 +169,15 @@ class CalibratedRobot:
 
     # ---- from a diagnosis -----------------------------------------------------------------
     @classmethod
-    def from_diagnosis(cls, diag: Diagnosis, registration_only: bool = False
-                       ) -> CalibratedRobot:
+    def from_diagnosis(cls, diag: Diagnosis, registration_only: bool = False,
+                       fit: FitResult | None = None) -> CalibratedRobot:
         """The calibrated robot of the final model of ``diag`` (its jointly estimated
         parameters, registration included); with ``registration_only``, the nominal model
-        with the registration alone (base frame and tool points: the usual baseline)."""
-        fit = diag.nominal_fit if registration_only else diag.final_fit
+        with the registration alone (base frame and tool points: the usual baseline); with
+        ``fit``, another estimate of the final model's parameters (e.g. the full-pose refit
+        of :func:`zrp.calibration.fullpose.full_pose_calibration`)."""
+        if fit is None:
+            fit = diag.nominal_fit if registration_only else diag.final_fit
         ctx = diag.context
         prob = Problem(ctx, fit.specs, diag.fitting_poses[:1], fit.base_rotation)
         theta = fit.theta

@@ -274,11 +274,13 @@ class Measurements:
         q = np.degrees(self.q) if deg else self.q
         cols = ["pose", "point", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z"]
         extra = [c for c in OPTIONAL_SCALARS if getattr(self, c) is not None]
+        quat = ["qw", "qx", "qy", "qz"] if self.quat is not None else []
         buf = io.StringIO()
         w = csv.writer(buf)
-        w.writerow(cols + extra)
+        w.writerow(cols + extra + quat)
         for i in range(self.n_rows):
             w.writerow([self.pose[i], self.point[i], *(repr(float(v)) for v in q[i]),
                         *(repr(float(v)) for v in self.xyz[i]),
-                        *(repr(float(getattr(self, c)[i])) for c in extra)])
+                        *(repr(float(getattr(self, c)[i])) for c in extra),
+                        *([] if self.quat is None else (repr(float(v)) for v in self.quat[i]))])
         return write_text(path, buf.getvalue(), overwrite=overwrite)
