@@ -157,9 +157,12 @@ def _score_design(model: Manipulator, scn: Scenario, design: str, meas: Measurem
 
 def study_scenario(model: Manipulator, scn: Scenario, config: BenchmarkConfig,
                    ks: tuple[int, ...], *, random_poses: int = 200, validation: int = 100,
-                   candidates: int = 1000, xml: Path) -> list[DesignScore]:
-    """All designs of one scenario (module doc): ``random_poses`` random, then K planned
-    for each K in ``ks``; every design measured on the same robot with the same tracker."""
+                   candidates: int = 1000, xml: Path, random_ks: tuple[int, ...] = ()
+                   ) -> list[DesignScore]:
+    """All designs of one scenario (module doc): ``random_poses`` random (0: none), then K
+    planned for each K in ``ks``, then K random for each K in ``random_ks`` (controls: does
+    planning matter?); every design measured on the same robot with the same tracker and
+    judged on the same validation poses."""
     rng = np.random.default_rng(scn.seed)
     inst = random_instrument(model, rng, scn.noise_sigma)   # the benchmark's first draws
     robot = RealRobot(model, scn.effects)
@@ -184,10 +187,11 @@ def study_scenario(model: Manipulator, scn: Scenario, config: BenchmarkConfig,
         return dict(zip(names, std.tolist(), strict=True))
 
     out = []
-    q = reachable_poses(model, random_poses, rng)
-    run = measure(robot, q, inst, rng, grav)
-    out.append(_score_design(model, scn, "random", run.measurements, val, xml, config,
-                             stds(q, run.measurements.per_pose("direction"))))
+    if random_poses:
+        q = reachable_poses(model, random_poses, rng)
+        run = measure(robot, q, inst, rng, grav)
+        out.append(_score_design(model, scn, "random", run.measurements, val, xml, config,
+                                 stds(q, run.measurements.per_pose("direction"))))
     floor = -0.8 * model.reach
     for k in ks:
         prng = np.random.default_rng([scn.seed, 3, k])
@@ -201,17 +205,24 @@ def study_scenario(model: Manipulator, scn: Scenario, config: BenchmarkConfig,
                       directions=plan.direction)
         out.append(_score_design(model, scn, "planned", run.measurements, val, xml, config,
                                  stds(plan.q, plan.direction)))
+    for k in random_ks:
+        rrng = np.random.default_rng([scn.seed, 4, k])
+        q = reachable_poses(model, k, rrng)
+        run = measure(robot, q, inst, rrng, grav)
+        out.append(_score_design(model, scn, "random", run.measurements, val, xml, config,
+                                 stds(q, run.measurements.per_pose("direction"))))
     return out
 
 
 def run_k_study(model: Manipulator, config: BenchmarkConfig, ks: tuple[int, ...] = (
         20, 30, 40, 50, 75), *, random_poses: int = 200, validation: int = 100,
         candidates: int = 1000, scenarios: tuple[int, ...] | None = None,
-        progress: bool = False) -> list[DesignScore]:
+        progress: bool = False, random_ks: tuple[int, ...] = ()) -> list[DesignScore]:
     """:func:`study_scenario` over the blind benchmark's scenarios of ``config`` (all, or
     the indices ``scenarios``)."""
-    if not ks or any(int(k) < 2 for k in ks):
-        raise InputError(f"ks: expected pose counts >= 2, got {ks!r}")
+    if any(int(k) < 2 for k in (*ks, *random_ks)):
+        raise InputError(f"ks, random_ks: expected pose counts >= 2, got {ks!r}, "
+                         f"{random_ks!r}")
     scns = draw_scenarios(model, config)
     if scenarios is not None:
         scns = [s for s in scns if s.index in set(scenarios)]
@@ -220,7 +231,8 @@ def run_k_study(model: Manipulator, config: BenchmarkConfig, ks: tuple[int, ...]
         xml = _nominal_mjcf(model, Path(tmp) / "nominal.xml")
         for scn in scns:
             rows = study_scenario(model, scn, config, ks, random_poses=random_poses,
-                                  validation=validation, candidates=candidates, xml=xml)
+                                  validation=validation, candidates=candidates, xml=xml,
+                                  random_ks=random_ks)
             out += rows
             if progress:
                 for r in rows:
@@ -234,8 +246,14 @@ def design_rows(scores: list[DesignScore]) -> list[dict[str, Any]]:
     """Per design (random N, planned K): scenarios, successes, right effect, joints, median
     and worst validation ratio, and the median over scenarios of the median / worst
     parameter std over the random design's (same scenario)."""
-    ref = {s.scenario: s for s in scores if s.design == "random"}
-    keys = sorted({(s.design, s.poses) for s in scores}, key=lambda k: (k[0] != "random", k[1]))
+    ref: dict[int, DesignScore] = {}
+    for s in scores:                 # the reference: each scenario's largest random design
+        if s.design == "random" and (s.scenario not in ref or s.poses > ref[s.scenario].poses):
+            ref[s.scenario] = s
+    top = max((s.poses for s in ref.values()), default=0)
+    keys = sorted({(s.design, s.poses) for s in scores},   # reference, planned, controls
+                  key=lambda k: (0 if k == ("random", top) else 1 if k[0] == "planned" else 2,
+                                 k[1]))
     rows = []
     for design, poses in keys:
         sel = [s for s in scores if (s.design, s.poses) == (design, poses)]
@@ -266,9 +284,10 @@ def smallest_matching_k(scores: list[DesignScore]) -> int | None:
     """The smallest K whose planned design succeeds in at least as many scenarios as the
     random design (same scenarios), and from which every larger K does too; None if none."""
     rows = design_rows(scores)
-    ref = next((r for r in rows if r["design"] == "random"), None)
-    if ref is None:
+    randoms = [r for r in rows if r["design"] == "random"]
+    if not randoms:
         return None
+    ref = max(randoms, key=lambda r: r["poses"])
     planned = [r for r in rows if r["design"] == "planned"]
     best = None
     for r in reversed(planned):

@@ -32,6 +32,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", default="puma", metavar="M.toml", help="model (default puma)")
     p.add_argument("--ks", type=whole(2, 100_000), nargs="+", default=[20, 30, 40, 50, 75],
                    metavar="K", help="planned pose counts (default 20 30 40 50 75)")
+    p.add_argument("--random-ks", type=whole(2, 100_000), nargs="+", default=[], metavar="K",
+                   help="also K random poses for each K (controls: does planning matter?)")
     p.add_argument("--random-poses", type=whole(8, 100_000), default=200, metavar="N",
                    help="random poses of the reference design (default 200)")
     p.add_argument("--validation", type=whole(8, 100_000), default=100, metavar="N",
@@ -61,7 +63,7 @@ def _run(args: argparse.Namespace) -> int:
         scores = run_k_study(model, cfg, tuple(args.ks), random_poses=args.random_poses,
                              validation=args.validation, candidates=args.candidates,
                              scenarios=tuple(args.only) if args.only else None,
-                             progress=not args.json)
+                             progress=not args.json, random_ks=tuple(args.random_ks))
         text = render_k_study(scores, cfg.ratio_target)
         folder.write_text("summary.md", text)
         doc = {"rows": design_rows(scores), "designs": [{**s.row(), "std": s.std}
