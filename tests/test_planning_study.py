@@ -69,3 +69,18 @@ def test_plan_benchmark_command_end_to_end(tmp_path, capsys):
     assert "| planned | 20 |" in (out / "summary.md").read_text()
     assert main(["plan-benchmark", "--scenarios", "2", "--only", "5", "--out",
                  str(tmp_path / "x")]) == 2
+
+
+def test_measure_refuses_directions_it_cannot_follow():
+    from sim.measurement import Instrument, Procedure, measure
+    from sim.real_robot import RealRobot
+
+    robot = RealRobot(PUMA)
+    q = np.zeros((3, 6))
+    rng = np.random.default_rng(0)
+    with pytest.raises(InputError, match="directions"):
+        measure(robot, q, Instrument(), rng, Procedure(approach="gravity"),
+                directions=np.ones((3, 6)))
+    with pytest.raises(InputError, match="directions"):
+        measure(robot, q, Instrument(), rng, Procedure(approach="random"),
+                directions=np.zeros((3, 6)))

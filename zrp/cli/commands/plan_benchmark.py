@@ -50,6 +50,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo and the diagnosis: only when this command runs
     from sim.benchmark import BenchmarkConfig
+
     # (the same reason: MuJoCo is loaded only when this command runs)
     from sim.planning_study import design_rows, render_k_study, run_k_study
 
