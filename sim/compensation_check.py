@@ -31,17 +31,21 @@ from numpy.typing import NDArray
 
 from mjcf import MJCFOptions, build, save_mjcf
 from mjcf.gravity import gravity_torques
-from sim.benchmark.scenarios import BenchmarkConfig, draw_scenarios
 from sim.effects import HiddenEffects
-from sim.measurement import Instrument, Procedure, measure, trajectory_poses
+from sim.measurement import (
+    Instrument,
+    Procedure,
+    _nominal_static_torque,
+    measure,
+    trajectory_poses,
+)
 from sim.real_robot import RealRobot
 from zrp.calibration import CalibratedRobot, Compensation, PoseConditions, compensate
-from zrp.errors import InputError
 from zrp.gap import Diagnosis, Measurements, diagnose
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["CompensationCheck", "compensation_scenarios", "run_compensation_check"]
+__all__ = ["CompensationCheck", "compensate_and_measure", "run_compensation_check"]
 
 F64 = NDArray[np.float64]
 
@@ -132,47 +136,56 @@ def run_compensation_check(model: Manipulator, effects: HiddenEffects, *, poses:
             warnings.simplefilter("ignore")
             diag = diagnose(model, meas, gravity_torque=gravity_torques(xml, meas.q_pose),
                             rng=np.random.default_rng(seed))
-        cal = CalibratedRobot.from_diagnosis(diag)
-        baseline = CalibratedRobot.from_diagnosis(diag, registration_only=True)
-        q_prog, labels = _targets(model, rng, n_random, n_circle)
-        load = np.full(len(q_prog), effects.payload)
-        target = baseline.predict(q_prog, "smr1")
+        return compensate_and_measure(robot, inst, diag, xml, rng, n_random=n_random,
+                                      n_circle=n_circle)
+
+
+def compensate_and_measure(robot: RealRobot, instrument: Instrument, diag: Diagnosis,
+                           mjcf_path: str | Path | None, rng: np.random.Generator, *,
+                           n_random: int = 40, n_circle: int = 24, chosen_side: bool = False
+                           ) -> CompensationCheck:
+    """Steps 3-4 of the module doc for a diagnosis of ``robot`` measured with ``instrument``.
+
+    The program is commanded first as it is ("before"); its logged temperatures are the
+    conditions the compensated commands are computed for (thermal expansion), as when a
+    program that runs repeatedly is compensated. With ``chosen_side`` every target is
+    approached from a chosen side (the gravity-loaded joints lifting, the others from below:
+    ``approach="random"`` with those directions) and the compensation knows it; otherwise the
+    moves go straight from target to target and the directions come from the order.
+    """
+    model = robot.nominal
+    cal = CalibratedRobot.from_diagnosis(diag)
+    baseline = CalibratedRobot.from_diagnosis(diag, registration_only=True)
+    q_prog, labels = _targets(model, rng, n_random, n_circle)
+    target = baseline.predict(q_prog, "smr1")
+    dirs = _chosen_side(robot, q_prog) if chosen_side else None
+    proc = Procedure(approach="random" if chosen_side else "order")
+    before = measure(robot, q_prog, instrument, rng, proc, directions=dirs).measurements
+    sel = np.asarray(before.point) == "smr1"
+    temp = None if before.temp is None else before.temp[sel]
+    cond = PoseConditions(direction=dirs, temp=temp,
+                          load=np.full(len(q_prog), robot.effects.payload))
+
+    def tau(q: F64) -> F64:
+        return gravity_torques(mjcf_path, q)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
         comp = compensate(cal, target, q_prog, point="smr1", frame="instrument",
-                          conditions=_conditions(load),
-                          gravity_torque=lambda q: gravity_torques(xml, q))
-    before = measure(robot, q_prog, inst, rng, proc).measurements
-    after = measure(robot, comp.q_command, inst, rng, proc).measurements
+                          conditions=cond, gravity_torque=None if mjcf_path is None else tau)
+    after = measure(robot, comp.q_command, instrument, rng, proc,
+                    directions=dirs).measurements
     return CompensationCheck(diag, comp, _error(before, target), _error(after, target),
-                             float(np.sqrt(3.0) * inst.noise_sigma), labels)
+                             float(np.sqrt(3.0) * instrument.noise_sigma), labels)
 
 
-def _conditions(load: F64) -> PoseConditions:
-    return PoseConditions(load=load)
+def _chosen_side(robot: RealRobot, q: F64) -> F64:
+    """Approach directions: lifting where the nominal arm carries a gravity torque, +1
+    elsewhere (the benchmark procedure's rule without its random side)."""
+    lift = _nominal_static_torque(robot, q)
+    return np.where(np.abs(lift) > 1e-3, np.sign(lift), 1.0)
 
 
 def _error(meas: Measurements, target: F64) -> F64:
     sel = np.asarray(meas.point) == "smr1"
     return np.linalg.norm(meas.xyz[sel] - target, axis=1)
-
-
-def compensation_scenarios(model: Manipulator, config: BenchmarkConfig, *, poses: int = 200,
-                           n_random: int = 40, n_circle: int = 24) -> list[dict[str, object]]:
-    """The "compensated" column of the blind benchmark: :func:`run_compensation_check` on each
-    scenario the benchmark draws (``config``: its seed, effects, noise; the scenario's own
-    seed), one row per scenario: hidden effects, effects found, measured RMS before and after
-    compensation and after / pure-noise RMS. Thermal expansion is not compensated (the
-    targets' future temperatures are not known when the commands are computed)."""
-    rows: list[dict[str, object]] = []
-    for scn in draw_scenarios(model, config):
-        row: dict[str, object] = {"index": scn.index, "hidden": ", ".join(scn.labels) or "none",
-                                  "payload_kg": scn.effects.payload}
-        try:
-            r = run_compensation_check(model, scn.effects, poses=poses, n_random=n_random,
-                                       n_circle=n_circle, noise_sigma=scn.noise_sigma,
-                                       seed=scn.seed % (2 ** 32))
-        except InputError as exc:  # the diagnosis or compensation refused: report it
-            row["error"] = str(exc)
-        else:
-            row.update(r.summary())
-        rows.append(row)
-    return rows

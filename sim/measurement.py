@@ -224,7 +224,8 @@ class MeasurementRun:
 
 
 def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.random.Generator,
-            procedure: Procedure | None = None, *, progress: bool = False) -> MeasurementRun:
+            procedure: Procedure | None = None, *, progress: bool = False,
+            directions: ArrayLike | None = None) -> MeasurementRun:
     """Measure the real robot at commanded poses ``q`` (rad, shape (P, n), in order).
 
     Args:
@@ -234,6 +235,8 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
         rng: approach directions, temperature-sensor noise and tracker noise are drawn from it.
         procedure: approach, speeds, timing, temperature.
         progress: tqdm bar over the poses.
+        directions: planned approach direction per pose and joint (-1/+1), shape (P, n), used
+            instead of the drawn ones with ``approach="random"`` (e.g. ``zrp plan``'s).
     """
     proc = procedure or Procedure()
     if not isinstance(robot, RealRobot):
@@ -246,6 +249,11 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
     P = q.shape[0]
     M = len(robot.tool_points)
     step = proc.approach_step
+    dirs_plan = None if directions is None else np.asarray(directions, dtype=float)
+    if dirs_plan is not None and (dirs_plan.shape != q.shape or proc.approach != "random"
+                                  or not np.all(np.abs(dirs_plan) == 1.0)):
+        raise InputError(f"directions: expected -1/+1 of shape {q.shape} with "
+                         f"approach='random', got shape {dirs_plan.shape}")
     lift = (_nominal_static_torque(robot, q) if proc.approach == "gravity" else None)
     session = robot.session(q[0] - step, proc.temperature(0.0)[()])
     session.settle(max_time=proc.settle_time)
@@ -262,7 +270,7 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
     motor_err = np.empty(P)
     for i in tqdm(range(P), desc="measure", unit="pose", disable=not progress, leave=False):
         if proc.approach in ("random", "gravity"):
-            d = rng.choice([-1.0, 1.0], size=n)
+            d = rng.choice([-1.0, 1.0], size=n) if directions is None else dirs_plan[i]
             if lift is not None:
                 d = np.where(np.abs(lift[i]) > 1e-3, np.sign(lift[i]), d)
             pre = q[i] - d * step

@@ -49,3 +49,37 @@ def test_needs_repeats():
     meas = synthesize(PUMA, uniform_joint_values(PUMA, 20, rng), INJ, rng=rng)
     with pytest.raises(InputError, match="min_repeats"):
         pose_accuracy(meas, _model_robot(), "s1")
+
+
+def test_orientation_ap_rp():
+    """AP_abc: the rotation between the model's and the injected robot's hand frames (here
+    a joint-2 offset), from zrp.forward_kinematics; RP_abc: 3 sigma for Gaussian noise."""
+    from scipy.spatial.transform import Rotation
+
+    from zrp.gap import Measurements
+
+    rng = np.random.default_rng(4)
+    q0 = uniform_joint_values(PUMA, 8, rng)
+    q = np.tile(q0, (30, 1))
+    rb = matrix_from_rotvec([0.02, -0.01, 0.8])
+    rt = Rotation.from_rotvec([0.1, 0.2, -0.3]).as_matrix()
+    true = zrp.forward_kinematics(PUMA, q + np.array([0, 1e-3, 0, 0, 0, 0]))
+    sig_o = 1e-4
+    noise = Rotation.from_rotvec(rng.normal(scale=sig_o, size=(len(q), 3))).as_matrix()
+    quat = Rotation.from_matrix(noise @ rb @ true.rotation @ rt).as_quat()[:, [3, 0, 1, 2]]
+    xyz = (true.position + true.rotation @ TOOLS[0]) @ rb.T + np.array([1500.0, -300.0, 200.0])
+    meas = Measurements.from_arrays(np.arange(len(q)), q, xyz, point=["s1"] * len(q),
+                                    quat=quat)
+    acc = pose_accuracy(meas, _model_robot(), "s1", probe_rotation=rt)
+    nom = zrp.forward_kinematics(PUMA, acc.q)        # acc.q: the repeated poses, its order
+    t8 = zrp.forward_kinematics(PUMA, acc.q + np.array([0, 1e-3, 0, 0, 0, 0]))
+    want = Rotation.from_matrix(np.swapaxes(nom.rotation @ rt, 1, 2)
+                                @ t8.rotation @ rt).as_rotvec()
+    np.testing.assert_allclose(acc.ap_abc, want, atol=4 * sig_o / np.sqrt(30))
+    assert np.abs(want).max() > 5e-4                  # the offset shows in the angles
+    np.testing.assert_allclose(np.median(acc.rp_abc), 3 * sig_o, rtol=0.2)
+    assert "ap_abc_rad" in acc.to_dict()
+    no_quat = pose_accuracy(Measurements.from_arrays(np.arange(len(q)), q, xyz,
+                                                     point=["s1"] * len(q)),
+                            _model_robot(), "s1")
+    assert no_quat.ap_abc is None and "ap_abc_rad" not in no_quat.to_dict()

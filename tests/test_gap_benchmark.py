@@ -46,7 +46,7 @@ def test_truth_never_reaches_the_diagnosis(puma, tmp_path, monkeypatch):
     opens no truth file, and gives the same answer when the truth files are gone."""
     global _OPENED
     calls = []
-    real = gb.diagnose_blind
+    real = gb.blind.diagnose_blind_result      # what the runner calls (diagnose_blind's core)
 
     def spy(csv_path, model, **kw):
         global _OPENED
@@ -58,7 +58,7 @@ def test_truth_never_reaches_the_diagnosis(puma, tmp_path, monkeypatch):
             calls[-1] = (*calls[-1], list(_OPENED))
             _OPENED = None
 
-    monkeypatch.setattr(gb.runner, "diagnose_blind", spy)
+    monkeypatch.setattr(gb.runner, "diagnose_blind_result", spy)
     cfg = BenchmarkConfig(scenarios=2, seed=5, **SMALL)
     res = run_benchmark(puma, cfg, tmp_path, progress=False)
     assert len(calls) == 2 and len(res.scores) == 2
@@ -82,10 +82,10 @@ def test_truth_never_reaches_the_diagnosis(puma, tmp_path, monkeypatch):
     assert "motor" not in xml and "payload" not in xml
     # same answer without the truth files
     first_csv = calls[0][0]
-    before = real(first_csv, puma, mjcf_path=calls[0][2]["mjcf_path"], seed=0)
+    before = gb.diagnose_blind(first_csv, puma, mjcf_path=calls[0][2]["mjcf_path"], seed=0)
     for f in (tmp_path / "truth").iterdir():
         f.unlink()
-    after = real(first_csv, puma, mjcf_path=calls[0][2]["mjcf_path"], seed=0)
+    after = gb.diagnose_blind(first_csv, puma, mjcf_path=calls[0][2]["mjcf_path"], seed=0)
     assert json.dumps(before, sort_keys=True, default=str) == \
         json.dumps(after, sort_keys=True, default=str)
 

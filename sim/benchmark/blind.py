@@ -26,11 +26,11 @@ from sim.measurement import (
     write_truth,
 )
 from sim.real_robot import RealRobot
-from zrp.gap import diagnose, load_measurements
+from zrp.gap import Diagnosis, diagnose, load_measurements
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["diagnose_blind", "simulate_scenario"]
+__all__ = ["diagnose_blind", "diagnose_blind_result", "simulate_scenario"]
 
 
 def simulate_scenario(model: Manipulator, scenario: Scenario, config: BenchmarkConfig,
@@ -60,9 +60,15 @@ def diagnose_blind(csv_path: str | Path, model: Manipulator, *, mjcf_path: str |
     nominal model and the nominal MJCF - nothing about the scenario. Warnings of the diagnosis
     are kept in the returned document, not printed.
     """
+    return diagnose_blind_result(csv_path, model, mjcf_path=mjcf_path, seed=seed).to_dict()
+
+
+def diagnose_blind_result(csv_path: str | Path, model: Manipulator, *,
+                          mjcf_path: str | Path | None, seed: int = 0) -> Diagnosis:
+    """:func:`diagnose_blind`, returning the :class:`zrp.gap.Diagnosis` itself (the
+    compensated column takes the calibrated robot out of it)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         meas = load_measurements(csv_path, model)
         tau = None if mjcf_path is None else gravity_torques(mjcf_path, meas.q_pose)
-        diag = diagnose(model, meas, gravity_torque=tau, seed=seed)
-    return diag.to_dict()
+        return diagnose(model, meas, gravity_torque=tau, seed=seed)

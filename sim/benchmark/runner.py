@@ -22,7 +22,8 @@ from typing import Any
 from tqdm.auto import tqdm
 
 from mjcf import MJCFOptions, build, save_mjcf
-from sim.benchmark.blind import diagnose_blind, simulate_scenario
+from sim.benchmark.blind import diagnose_blind_result, simulate_scenario
+from sim.benchmark.compensated import compensated_column
 from sim.benchmark.results import BenchmarkResult
 from sim.benchmark.scenarios import BenchmarkConfig, Scenario, draw_scenarios
 from sim.benchmark.scoring import ScenarioScore, score
@@ -61,8 +62,11 @@ def run_scenario(task: ScenarioTask) -> ScenarioScore:
     csv_path, truth_path, sim_s = simulate_scenario(model, scn, config, work / "measurements",
                                                     work / "truth")
     t1 = time.perf_counter()
+    result = None
     try:
-        diag = diagnose_blind(csv_path, model, mjcf_path=task.mjcf_path, seed=scn.index)
+        result = diagnose_blind_result(csv_path, model, mjcf_path=task.mjcf_path,
+                                       seed=scn.index)
+        diag = result.to_dict()
     except InputError as exc:  # the diagnosis refused the data: report, do not crash
         diag = {"steps": [], "nominal": {"rms": math.nan}, "final": {"rms": math.nan},
                 "unexplained": None, "error": str(exc)}
@@ -72,7 +76,12 @@ def run_scenario(task: ScenarioTask) -> ScenarioScore:
     # only now, after the diagnosis has answered, is the truth read
     truth = json.loads(truth_path.read_text(encoding="utf-8"))
     sc = score(model, truth, diag, config)
-    return ScenarioScore(**{**sc.__dict__, "sim_s": sim_s, "diag_s": diag_s})
+    values = dict(sc.values)
+    if config.compensate and result is not None:
+        values.update(compensated_column(model, scn, truth, result, task.mjcf_path,
+                                         config.compensate))
+    return ScenarioScore(**{**sc.__dict__, "sim_s": sim_s, "diag_s": diag_s,
+                            "values": values})
 
 
 _TUPLES = {"hidden", "expected", "found", "tied"}

@@ -54,6 +54,9 @@ class BenchmarkConfig:
         excitation_threshold: an effect counts as visible when its registered signature RMS
             is at least this multiple of the noise RMS.
         ratio_target: withheld RMS after correction / noise RMS regarded as success.
+        compensate: fresh random targets (plus half as many circle points for a 6-joint arm)
+            compensated with each scenario's diagnosis, commanded and measured (the
+            "compensated" column, :mod:`sim.benchmark.compensated`); 0: no column.
     """
 
     scenarios: int = 50
@@ -69,9 +72,10 @@ class BenchmarkConfig:
     use_mjcf: bool = True
     excitation_threshold: float = 1.0
     ratio_target: float = 1.5
+    compensate: int = 0
 
     def __post_init__(self) -> None:
-        for name, lo in (("scenarios", 1), ("poses", 16)):
+        for name, lo in (("scenarios", 1), ("poses", 16), ("compensate", 0)):
             v = getattr(self, name)
             if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo:
                 raise InputError(f"{name}: expected an integer >= {lo}, got {v!r}")

@@ -31,6 +31,7 @@ from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
 from zrp.gap.data import Measurements
 from zrp.gap.effects import Context
+from zrp.gap.leastsq import FitResult
 from zrp.gap.problem import Problem
 from zrp.gap.results import Diagnosis
 from zrp.model.manipulator import Manipulator
@@ -168,12 +169,15 @@ class CalibratedRobot:
 
     # ---- from a diagnosis -----------------------------------------------------------------
     @classmethod
-    def from_diagnosis(cls, diag: Diagnosis, registration_only: bool = False
-                       ) -> CalibratedRobot:
+    def from_diagnosis(cls, diag: Diagnosis, registration_only: bool = False,
+                       fit: FitResult | None = None) -> CalibratedRobot:
         """The calibrated robot of the final model of ``diag`` (its jointly estimated
         parameters, registration included); with ``registration_only``, the nominal model
-        with the registration alone (base frame and tool points: the usual baseline)."""
-        fit = diag.nominal_fit if registration_only else diag.final_fit
+        with the registration alone (base frame and tool points: the usual baseline); with
+        ``fit``, another estimate of the final model's parameters (e.g. the full-pose refit
+        of :func:`zrp.calibration.fullpose.full_pose_calibration`)."""
+        if fit is None:
+            fit = diag.nominal_fit if registration_only else diag.final_fit
         ctx = diag.context
         prob = Problem(ctx, fit.specs, diag.fitting_poses[:1], fit.base_rotation)
         theta = fit.theta
@@ -247,6 +251,18 @@ class CalibratedRobot:
         pos, rn, _, _ = chain(self.model, x, self.body_scale(len(x), cond.temp))
         y = pos + rn @ self.tool_offset(point)
         return self.to_frame(y, frame)
+
+    def predict_rotation(self, q: ArrayLike, cond: PoseConditions | None = None,
+                         frame: str = "instrument") -> F64:
+        """Predicted hand rotation R'_n(x) when q (P, n) is commanded, shape (P, 3, 3), in the
+        instrument frame (R_b R'_n) or ``frame="base"``."""
+        x = self.actual_joint_values(q, cond or PoseConditions())
+        _, rn, _, _ = chain(self.model, x)
+        if frame == "base":
+            return rn
+        if frame != "instrument":
+            raise InputError(f"frame: expected 'instrument' or 'base', got {frame!r}")
+        return np.asarray(self.base_rotation) @ rn
 
     def tool_offset(self, point: str | None) -> F64:
         """t'_j of the tool point ``point`` (zeros for None), shape (3,)."""

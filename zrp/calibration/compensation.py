@@ -17,6 +17,7 @@ re-evaluated on the solution and the solve repeated until they no longer change.
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 
@@ -24,12 +25,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.calibration.calibrated import CalibratedRobot, PoseConditions, chain
-from zrp.errors import InputError
+from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import hand_frame
 from zrp.rotations import er_from_matrix, er_to_rotvec
 
-__all__ = ["Compensation", "compensate", "compensate_program"]
+__all__ = ["Compensation", "ThermalWarning", "compensate", "compensate_program"]
 
 F64 = NDArray[np.float64]
 GravityFn = Callable[[F64], F64]
@@ -188,6 +189,10 @@ def _check_limits(q: F64, limits: ArrayLike | None, margin: float, ids: tuple[st
     return np.any((q < lim[:, 0] + margin) | (q > lim[:, 1] - margin), axis=1)
 
 
+class ThermalWarning(ZRPWarning):
+    """Thermal expansion was identified but the targets' temperature is not known."""
+
+
 def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
                orientations: ArrayLike | None = None, point: str | None = None,
                frame: str = "base", conditions: PoseConditions | None = None,
@@ -233,6 +238,11 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
         raise InputError(f"orientations: expected shape ({T}, 3, 3), got {rot.shape}")
     tg = _Targets(y, rot, cal.tool_offset(point))
     base = conditions or PoseConditions()
+    if cal.kappa != 0.0 and base.temp is None:
+        warnings.warn(f"the calibration found thermal expansion (kappa = {cal.kappa:.3g} "
+                      f"1/degC) but no temperature was given (conditions=PoseConditions("
+                      f"temp=...)): the commands are for the reference temperature "
+                      f"{cal.t_ref:.4g} degC", ThermalWarning, stacklevel=2)
     cond = _conditions(base, gravity_torque, q0)
     e0, _, _ = _errors(cal, q0, cond, tg)
     q = q0

@@ -2,22 +2,12 @@
 
 Every non-geometric parameter of the gap diagnosis is a joint correction theta B(pose) with a
 basis B that depends on the commanded joint values and the pose's conditions
-(:mod:`zrp.gap.effects`). A calibrated robot keeps the parameter values (:class:`Term`) and
-re-evaluates the bases on new poses with the diagnosis's own :class:`zrp.gap.Context`, so the
-correction of a fresh target is computed exactly as the diagnosis computed it on the
-measured poses:
-
-==========================  =============================================================
-term (``q{k}.``)            basis for joint k (per pose)
-==========================  =============================================================
-``offset`` (prismatic)      1 (revolute offsets are folded into the geometry)
-``scale``                   q_k (encoder scale: q_actual = q (1 + s))
-``sin{h}``, ``cos{h}``      sin(h q_k), cos(h q_k) (cyclic error)
-``compliance``              gravity torque tau_k (MJCF) + g load h_ee (N m)
-``compliance_payload``      g h_ee (moment arm of the tool, m) (unknown payload)
-``w_{p}``, ``w_load``       lumped-mass moment arms (length unit), load x h_ee
-``backlash``                -approach direction, or sign(tau_k) above the switching torque
-==========================  =============================================================
+(:mod:`zrp.gap.jointbases`). A calibrated robot keeps the parameter values (:class:`Term`)
+and re-evaluates the bases on new poses with the diagnosis's own :class:`zrp.gap.Context` and
+the diagnosis's own definition of each basis (:func:`zrp.gap.jointbases.joint_bases`, the
+table there), so the correction of a fresh target is computed exactly as the diagnosis
+computed it on the measured poses, and a change of a basis there changes both alike
+(revolute offsets are folded into the geometry; ``offset`` terms are prismatic joints').
 """
 
 from __future__ import annotations
@@ -30,15 +20,14 @@ from numpy.typing import NDArray
 
 from zrp.errors import InputError
 from zrp.gap.effects import Context
-from zrp.units import G_STANDARD, metres_per_unit
+from zrp.gap.jointbases import JOINT_EFFECTS, joint_bases
 
 __all__ = ["NON_GEOMETRIC", "Term", "term_basis"]
 
 F64 = NDArray[np.float64]
 
 #: effects whose parameters are joint corrections with a pose-dependent basis.
-NON_GEOMETRIC = ("joint_offset", "encoder_scale", "joint_compliance", "backlash",
-                 "cyclic_error")
+NON_GEOMETRIC = JOINT_EFFECTS
 
 
 @dataclass(frozen=True)
@@ -89,63 +78,22 @@ class Term:
                              f"({exc})") from exc
 
 
-def _harmonic(what: str) -> tuple[str, int] | None:
-    for fn in ("sin", "cos"):
-        if what.startswith(fn) and what[3:].isdigit():
-            return fn, int(what[3:])
-    return None
-
-
-def _lumped(ctx: Context, k: int, label: str) -> F64:
-    labels, h = ctx.moment_arms()
-    h = np.where(np.abs(h) > 1e-9 * ctx.model.characteristic_length, h, 0.0)
-    if label not in labels:
-        raise InputError(f"term q{k + 1}.w_{label}: no lumped mass point {label!r}; the model "
-                         f"has {labels}")
-    return h[:, k, labels.index(label)]
-
-
-def _compliance(ctx: Context, k: int, what: str) -> F64:
-    """Bases of the ``joint_compliance`` terms (as :mod:`zrp.gap.effects` builds them)."""
-    load = ctx.meas.per_pose("load")
-    to_m = metres_per_unit(ctx.model.length_unit, "model.length_unit")
-    h_ee = ctx.end_effector_arms()[:, k]
-    if what == "compliance":
-        if ctx.gravity_torque is None:
-            raise InputError(f"q{k + 1}.compliance: needs the gravity torque of every pose "
-                             "(gravity_torque=, from mjcf.gravity.gravity_torques)")
-        tau = np.array(ctx.gravity_torque[:, k], dtype=float)
-        return tau if load is None else tau + G_STANDARD * load * h_ee * to_m
-    if what == "compliance_payload":
-        return G_STANDARD * h_ee * to_m
-    if what == "w_load":
-        return np.zeros(len(h_ee)) if load is None else load * h_ee
-    return _lumped(ctx, k, what[2:])
-
-
 def term_basis(term: Term, ctx: Context) -> F64:
-    """The basis of ``term`` on the poses of ``ctx``, shape (P,) (joint ``term.joint``).
+    """The basis of ``term`` on the poses of ``ctx``, shape (P,) (joint ``term.joint``): the
+    diagnosis's own definition (:func:`zrp.gap.jointbases.joint_bases`).
 
     Raises:
         InputError: a term this library does not know, or missing pose conditions.
     """
-    k = term.joint - 1
-    q = ctx.q[:, k]
-    what = term.what
-    harm = _harmonic(what)
-    if what == "offset":
-        return np.ones(len(q))
-    if what == "scale":
-        return np.array(q, dtype=float)
-    if harm is not None:
-        fn, h = harm
-        return np.sin(h * q) if fn == "sin" else np.cos(h * q)
-    if what == "backlash":
-        # the parameter is the full play: each flank is half of it away (zrp.gap.effects)
-        return 0.5 * np.array(ctx.backlash_basis()[:, k], dtype=float)
-    if term.effect == "joint_compliance":
-        return _compliance(ctx, k, what)
-    raise InputError(f"term {term.name}: unknown joint-correction term")
+    if term.effect == "joint_compliance" and term.what == "compliance" and \
+            ctx.gravity_torque is None:
+        raise InputError(f"{term.name}: needs the gravity torque of every pose "
+                         "(gravity_torque=, from mjcf.gravity.gravity_torques)")
+    bases = joint_bases(ctx, term.effect)
+    if term.what not in bases:
+        raise InputError(f"term {term.name}: unknown joint-correction term of "
+                         f"{term.effect} (known: {', '.join(bases)})")
+    return np.array(bases[term.what][:, term.joint - 1], dtype=float)
 
 
 def joint_correction(terms: tuple[Term, ...], ctx: Context) -> F64:

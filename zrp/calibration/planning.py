@@ -36,7 +36,7 @@ from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.sampling import uniform_joint_values
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["Plan", "PlanWarning", "plan_poses"]
+__all__ = ["Plan", "PlanWarning", "design_std", "plan_poses"]
 
 F64 = NDArray[np.float64]
 ALIAS_TOL = 1e-6
@@ -152,13 +152,14 @@ def _exchange(A: F64, design: NDArray[np.int64], max_iter: int) -> NDArray[np.in
     eye = np.eye(k)
     for _ in range(max_iter):
         Mi = np.linalg.inv(np.einsum("skp,skq->pq", A[design], A[design]))
-        G = np.einsum("ckp,pq,clq->ckl", A, Mi, A)
+        G = (A @ Mi) @ A.transpose(0, 2, 1)      # (C, k, k); a 3-operand einsum is 100x slower
         gain = np.linalg.slogdet(eye + G)[1]
         gain[design] = -np.inf
         add = int(np.argmax(gain))
         trial = np.append(design, add)
         Mi = np.linalg.inv(np.einsum("skp,skq->pq", A[trial], A[trial]))
-        Gd = np.einsum("skp,pq,slq->skl", A[trial], Mi, A[trial])
+        At = A[trial]
+        Gd = (At @ Mi) @ At.transpose(0, 2, 1)
         sign, ld = np.linalg.slogdet(eye - Gd)
         loss = np.where(sign > 0, -ld, np.inf)
         drop = int(np.argmin(loss))
@@ -172,7 +173,7 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
                rng: np.random.Generator, limits: ArrayLike | None = None,
                tool_points: ArrayLike = ((0.0, 0.0, 0.0),), floor_z: float | None = None,
                noise_sigma: float = 0.02, candidates: int = 1000, max_iter: int = 300,
-               gravity_torque_fn: object = None) -> Plan:
+               gravity_torque_fn: object = None, direction_fn: object = None) -> Plan:
     """Choose ``n_poses`` poses that identify registration + ``effects`` (module doc).
 
     Args:
@@ -187,6 +188,9 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
         noise_sigma: instrument noise per coordinate (length unit) for the predicted std.
         candidates: size of the candidate set.
         gravity_torque_fn: optional q (C, n) -> MJCF gravity torques (C, n) (N m).
+        direction_fn: optional q (C, n) -> approach directions (C, n) in {-1, 0, +1} that the
+            measuring procedure imposes (e.g. lifting the gravity-loaded joints); 0 leaves the
+            joint's direction to the plan (drawn at random per candidate).
 
     Raises:
         InputError: too few poses for the parameters, invalid arguments.
@@ -196,6 +200,12 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
            else np.asarray(limits, dtype=float))
     q = _candidates(model, candidates, rng, lim, tool, floor_z)
     d = rng.choice([-1.0, 1.0], size=q.shape)
+    if direction_fn is not None:
+        imposed = np.asarray(direction_fn(q), dtype=float)  # type: ignore[operator]
+        if imposed.shape != q.shape or not np.all(np.isin(imposed, (-1.0, 0.0, 1.0))):
+            raise InputError(f"direction_fn: expected -1/0/+1 of shape {q.shape}, got "
+                             f"shape {imposed.shape}")
+        d = np.where(imposed != 0.0, imposed, d)
     tau = None if gravity_torque_fn is None else np.asarray(gravity_torque_fn(q))  # type: ignore[operator]
     specs, J = _jacobian(model, q, d, tool, effects, tau)
     keep = _identifiable(J.reshape(-1, len(specs)))
@@ -220,3 +230,35 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
     return Plan(q[order], d[order], tuple(s.name for s in specs), std,
                 tuple(s.unit for s in specs), lost,
                 _logdet(A, design) - p * np.log(n_poses), _logdet(A, start) - p * np.log(n_poses))
+
+
+def design_std(model: Manipulator, q: ArrayLike, direction: ArrayLike, effects: Sequence[str], *,
+               tool_points: ArrayLike = ((0.0, 0.0, 0.0),), noise_sigma: float = 0.02,
+               gravity_torque: ArrayLike | None = None) -> tuple[tuple[str, ...], F64]:
+    """Predicted standard deviation of registration + ``effects`` for a given design (any
+    poses, e.g. random ones, to set beside a plan): sigma sqrt(diag((J^T J)^-1)) over the
+    parameters the design separates (aliased ones left out, as in :func:`plan_poses`).
+
+    Args:
+        q: the poses, rad, shape (N, n); direction: approach directions (N, n), -1/0/+1.
+        gravity_torque: MJCF gravity torques at q (N, n), N m, or None (lumped masses).
+
+    Returns:
+        the parameter names (p,) and their standard deviations (p,) (their units).
+    """
+    qa = np.atleast_2d(np.asarray(q, dtype=float))
+    da = np.asarray(direction, dtype=float)
+    if qa.ndim != 2 or qa.shape[1] != model.n or da.shape != qa.shape:
+        raise InputError(f"q, direction: expected two arrays of shape (N, {model.n}), got "
+                         f"{qa.shape} and {da.shape}")
+    tool = np.atleast_2d(np.asarray(tool_points, dtype=float))
+    tau = None if gravity_torque is None else np.asarray(gravity_torque, dtype=float)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlanWarning)
+        specs, J = _jacobian(model, qa, da, tool, effects, tau)
+    J = J.reshape(-1, len(specs))
+    keep = _identifiable(J)
+    Jk = J[:, keep] / np.linalg.norm(J[:, keep], axis=0)
+    Mi = np.linalg.inv(Jk.T @ Jk) / np.outer(*(2 * [np.linalg.norm(J[:, keep], axis=0)]))
+    names = tuple(s.name for s, k in zip(specs, keep, strict=True) if k)
+    return names, noise_sigma * np.sqrt(np.diag(Mi))

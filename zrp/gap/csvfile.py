@@ -9,7 +9,8 @@ One row per measured point, rows in measurement order. Columns (header names, an
 * ``x``, ``y``, ``z`` (required): measured position in the model's length unit, in the
   instrument's frame (or the robot's base frame with ``frame="base"``).
 * ``qw``, ``qx``, ``qy``, ``qz`` (optional, all four): measured orientation (loaded and checked;
-  the diagnosis uses positions only and says so with a warning).
+  the diagnosis chooses effects from positions only and says so with a warning; zrp calibrate
+  and zrp.gap.fullpose use them).
 * ``t`` (s), ``temp`` (deg C), ``load`` (kg) (optional).
 * ``dir1`` .. ``dirn`` (optional, all n): the direction from which each joint approached the
   pose (-1, 0 or +1); when absent it is taken from the measurement order (see
@@ -370,8 +371,9 @@ def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: 
     _joint_units(c.q, model, deg, c.lines, src)
     _check_scalars(c.scalars, c.lines, src)
     if c.quat is not None:
-        warnings.warn(f"{src}: measured orientations (qw..qz) are loaded but the diagnosis uses "
-                      "positions only", DataWarning, stacklevel=2)
+        warnings.warn(f"{src}: measured orientations (qw..qz) are loaded; the diagnosis chooses "
+                      "the effects from the positions only (zrp calibrate refits the final "
+                      "model with the orientations)", DataWarning, stacklevel=2)
     return Measurements(c.pose, c.point, c.q, c.xyz, frame, c.scalars.get("t"),
                         c.scalars.get("temp"), c.scalars.get("load"), c.quat, c.dirs, c.lines,
                         src)

@@ -73,7 +73,8 @@ class Measurements:
         t: time, s, shape (R,), or None.
         temp: temperature, deg C, shape (R,), or None.
         load: payload, kg, shape (R,), or None.
-        quat: measured orientation (qw, qx, qy, qz), shape (R, 4), or None (not used).
+        quat: measured orientation (qw, qx, qy, qz), shape (R, 4), or None (used by
+            :mod:`zrp.gap.fullpose`; the stepwise diagnosis uses positions only).
         direction: approach direction per joint (-1, 0, +1), shape (R, n), or None.
         lines: source line number of each row (for messages), shape (R,).
         source: file name or a description, for messages.
@@ -252,11 +253,13 @@ class Measurements:
                     point: ArrayLike | None = None, frame: str = "instrument",
                     t: ArrayLike | None = None, temp: ArrayLike | None = None,
                     load: ArrayLike | None = None, direction: ArrayLike | None = None,
-                    source: str = "measurements") -> Measurements:
-        """Build from arrays (q in rad, xyz in the model's length unit); see the class doc."""
+                    source: str = "measurements", quat: ArrayLike | None = None
+                    ) -> Measurements:
+        """Build from arrays (q in rad, xyz in the model's length unit, quat scalar first);
+        see the class doc."""
         return cls(np.asarray(pose), None if point is None else np.asarray(point),
                    q, xyz, frame,  # type: ignore[arg-type]  (converted, checked on init)
-                   t, temp, load, None, direction,  # type: ignore[arg-type]
+                   t, temp, load, quat, direction,  # type: ignore[arg-type]
                    None, source)
 
     def to_csv(self, path: str | os.PathLike[str], *, deg: bool = False,
@@ -271,11 +274,13 @@ class Measurements:
         q = np.degrees(self.q) if deg else self.q
         cols = ["pose", "point", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z"]
         extra = [c for c in OPTIONAL_SCALARS if getattr(self, c) is not None]
+        quat = ["qw", "qx", "qy", "qz"] if self.quat is not None else []
         buf = io.StringIO()
         w = csv.writer(buf)
-        w.writerow(cols + extra)
+        w.writerow(cols + extra + quat)
         for i in range(self.n_rows):
             w.writerow([self.pose[i], self.point[i], *(repr(float(v)) for v in q[i]),
                         *(repr(float(v)) for v in self.xyz[i]),
-                        *(repr(float(getattr(self, c)[i])) for c in extra)])
+                        *(repr(float(getattr(self, c)[i])) for c in extra),
+                        *([] if self.quat is None else (repr(float(v)) for v in self.quat[i]))])
         return write_text(path, buf.getvalue(), overwrite=overwrite)

@@ -32,6 +32,7 @@ from numpy.typing import NDArray
 
 from zrp.errors import InputError
 from zrp.gap.data import Measurements
+from zrp.gap.jointbases import joint_bases
 from zrp.kinematics.forward import forward_kinematics
 from zrp.manufacturing.sensitivity import axis_tangents
 from zrp.model.manipulator import Manipulator
@@ -302,30 +303,31 @@ Built = tuple[list[ParamSpec], str | None]
 
 def _joint_offset(ctx: Context) -> Built:
     junit = _junits(ctx)
-    return [_dq(ctx, f"q{k + 1}.offset", junit[k], "joint_offset", k, np.ones(len(ctx.q)))
+    b = joint_bases(ctx, "joint_offset")["offset"]
+    return [_dq(ctx, f"q{k + 1}.offset", junit[k], "joint_offset", k, b[:, k])
             for k in range(ctx.n)], None
 
 
 def _encoder_scale(ctx: Context) -> Built:
-    return [_dq(ctx, f"q{k + 1}.scale", "1", "encoder_scale", k, ctx.q[:, k])
+    b = joint_bases(ctx, "encoder_scale")["scale"]
+    return [_dq(ctx, f"q{k + 1}.scale", "1", "encoder_scale", k, b[:, k])
             for k in range(ctx.n)], None
 
 
 def _cyclic_error(ctx: Context) -> Built:
-    q = ctx.q
     rev = [k for k in range(ctx.n) if not ctx.model.prismatic[k]]
     if not rev:
         return [], "no revolute joint"
-    return [_dq(ctx, f"q{k + 1}.{fn}{h}", "rad", "cyclic_error", k,
-                np.sin(h * q[:, k]) if fn == "sin" else np.cos(h * q[:, k]))
+    b = joint_bases(ctx, "cyclic_error")
+    return [_dq(ctx, f"q{k + 1}.{fn}{h}", "rad", "cyclic_error", k, b[f"{fn}{h}"][:, k])
             for k in rev for h in ctx.harmonics for fn in ("sin", "cos")], None
 
 
 def _backlash(ctx: Context) -> Built:
     """One full play b per joint (the definition of ``zrp measure``): the joint sits b/2 off
-    the centre of its play, so the basis is half the flank side."""
+    the centre of its play, so the basis is half the flank side (:mod:`zrp.gap.jointbases`)."""
     junit = _junits(ctx)
-    basis = 0.5 * ctx.backlash_basis()
+    basis = joint_bases(ctx, "backlash")["backlash"]
     specs = [_dq(ctx, f"q{k + 1}.backlash", junit[k], "backlash", k, basis[:, k])
              for k in range(ctx.n) if np.any(basis[:, k] > 0) and np.any(basis[:, k] < 0)]
     if not specs:
@@ -339,20 +341,16 @@ def _compliance_mjcf(ctx: Context) -> Built:
     for an unknown payload at the tool (it adds c_k m g h_ee: linear in c_k m)."""
     effect = "joint_compliance"
     junit = _junits(ctx)
-    load = ctx.meas.per_pose("load")
-    tau = np.array(ctx.gravity_torque, dtype=float)
-    h_ee = ctx.end_effector_arms()
-    to_m = metres_per_unit(ctx.model.length_unit, "model.length_unit")
-    if load is not None:
-        tau = tau + G_STANDARD * load[:, None] * h_ee * to_m
+    b = joint_bases(ctx, effect)
+    tau, pay = b["compliance"], b["compliance_payload"]
     specs: list[ParamSpec] = []
     for k in range(ctx.n):
         if np.ptp(tau[:, k]) > 0 or np.any(tau[:, k] != 0):
             specs.append(_dq(ctx, f"q{k + 1}.compliance", f"{junit[k]}/(N m)", effect, k,
                              tau[:, k]))
-        if np.any(h_ee[:, k] != 0.0):
+        if np.any(pay[:, k] != 0.0):
             specs.append(_dq(ctx, f"q{k + 1}.compliance_payload", f"{junit[k]}/kg", effect, k,
-                             G_STANDARD * h_ee[:, k] * to_m))
+                             pay[:, k]))
     return specs, None
 
 
@@ -362,16 +360,16 @@ def _compliance_lumped(ctx: Context) -> Built:
     effect = "joint_compliance"
     unit = ctx.model.length_unit
     load = ctx.meas.per_pose("load")
-    labels, h = ctx.moment_arms()
-    h = np.where(np.abs(h) > 1e-9 * ctx.model.characteristic_length, h, 0.0)
+    labels, _ = ctx.moment_arms()
+    h_ee = ctx.end_effector_arms()
+    b = joint_bases(ctx, effect)
     specs: list[ParamSpec] = []
     for k in range(ctx.n):
-        specs += [_dq(ctx, f"q{k + 1}.w_{lab}", f"rad/{unit}", effect, k, h[:, k, jj])
-                  for jj, lab in enumerate(labels) if np.any(h[:, k, jj] != 0.0)]
-        h_ee = ctx.end_effector_arms()
+        specs += [_dq(ctx, f"q{k + 1}.w_{lab}", f"rad/{unit}", effect, k, b[f"w_{lab}"][:, k])
+                  for lab in labels if np.any(b[f"w_{lab}"][:, k] != 0.0)]
         if load is not None and np.ptp(load) > 0 and np.any(h_ee[:, k] != 0.0):
             specs.append(_dq(ctx, f"q{k + 1}.w_load", f"rad/({unit} kg)", effect, k,
-                             load * h_ee[:, k]))
+                             b["w_load"][:, k]))
     return specs, (None if specs else "no joint carries a gravity torque")
 
 

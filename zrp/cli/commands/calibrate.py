@@ -8,9 +8,10 @@ import contextlib
 from pathlib import Path
 
 from zrp.calibration import CalibratedRobot, write_calibration
+from zrp.calibration.fullpose import FullPoseCalibration, full_pose_calibration
 from zrp.calibration.storage import calibration_document
 from zrp.cli.app import emit
-from zrp.cli.options import LENGTH, SEED, whole
+from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.gap import diagnose, load_measurements
 from zrp.gap.effects import EFFECTS
 from zrp.gap.report import OUTPUT_FILES, write_outputs
@@ -41,10 +42,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-steps", type=whole(1, 8), default=4,
                    help="most effects added (default 4)")
     p.add_argument("--noise", type=LENGTH, metavar="SIGMA", help="known noise per coordinate")
+    p.add_argument("--orientation-sigma", type=real(0.0, 1.0, open_lo=True), metavar="RAD",
+                   help="orientation noise per component when the data carry qw..qz "
+                   "(default: estimated from the residuals)")
+    p.add_argument("--no-orientation", action="store_true",
+                   help="ignore measured orientations (qw..qz): positions only")
     p.add_argument("--json", action="store_true", help="print the compensation file")
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "seed": "--seed",
                                          "effects": "--effects", "max_steps": "--max-steps",
-                                         "gravity_torque": "--mjcf"})
+                                         "gravity_torque": "--mjcf",
+                                         "orientation_sigma": "--orientation-sigma"})
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -61,6 +68,10 @@ def _run(args: argparse.Namespace) -> int:
             diag = diagnose(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, max_steps=args.max_steps, noise_sigma=args.noise)
             cal = CalibratedRobot.from_diagnosis(diag)
+            full = None
+            if meas.quat is not None and not args.no_orientation:
+                full = full_pose_calibration(diag, args.orientation_sigma)
+                cal = full.robot
             files = write_outputs(diag, out, plots=False)
             files += list(write_calibration(cal, out_dir / FILES[0], out_dir / FILES[1],
                                             overwrite=True))
@@ -71,6 +82,17 @@ def _run(args: argparse.Namespace) -> int:
         raise
     text = (f"withheld RMS {diag.nominal.rms:.4g} -> {diag.final.rms:.4g} "
             f"{model.length_unit} (effects: {', '.join(diag.effects)})\n"
+            + ("" if full is None else _full_pose_line(full, model.length_unit))
             + "\n".join(f"wrote {f}" for f in files))
     emit(args, calibration_document(cal, FILES[0]), text)
     return 0
+
+
+def _full_pose_line(full: FullPoseCalibration, unit: str) -> str:
+    s = full.summary()
+    return (f"full pose (measured orientations, noise {s['sigma_orientation_rad']:.3g} rad): "
+            f"parameter std x{s['std_ratio_median']:.2f} (median; best x"
+            f"{s['std_ratio_min']:.2g}) of the position-only fit; withheld RMS "
+            f"{s['withheld_rms_position_only']:.4g} -> {s['withheld_rms']:.4g} {unit}, "
+            f"orientation {s['withheld_orientation_rms_rad']:.3g} rad; the calibration "
+            "written is the full-pose one\n")

@@ -6,10 +6,11 @@ import argparse
 
 import numpy as np
 
+from zrp.calibration import PoseConditions, compensate_program, read_calibration
 from zrp.calibration import compensate as compensate_targets
-from zrp.calibration import compensate_program, read_calibration
 from zrp.calibration.targets import load_targets, write_commands
 from zrp.cli.app import emit
+from zrp.cli.options import real
 from zrp.errors import InputError
 from zrp.output import check_writable
 
@@ -35,9 +36,15 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "e.g. --limits=-165:165,-110:110,...")
     p.add_argument("--mjcf", metavar="M.xml", help="MJCF with inertias (needed when the "
                    "compliance was identified with MJCF torques)")
+    p.add_argument("--temp", type=real(-100.0, 500.0), metavar="DEGC",
+                   help="robot temperature when the commands run, deg C (required when the "
+                   "calibration found thermal expansion)")
+    p.add_argument("--load", type=real(0.0, 1e4), metavar="KG",
+                   help="payload when the commands run, kg (default none)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=_run, api_names={"limits": "--limits", "point": "--point",
-                                         "gravity_torque": "--mjcf"})
+                                         "gravity_torque": "--mjcf", "temp": "--temp",
+                                         "load": "--load"})
 
 
 def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
@@ -71,13 +78,20 @@ def _run(args: argparse.Namespace) -> int:
             t.name.endswith(".compliance") for t in cal.terms):
         raise InputError("--mjcf: the calibration's compliance was identified with MJCF "
                          "gravity torques; pass the MJCF")
+    if cal.kappa != 0.0 and args.temp is None:
+        raise InputError(f"--temp: the calibration found thermal expansion (kappa = "
+                         f"{cal.kappa:.3g} 1/degC, reference {cal.t_ref:.4g} degC); give the "
+                         "robot temperature at which the commands will run")
+    T = len(tg.q)
+    cond = PoseConditions(temp=None if args.temp is None else np.full(T, args.temp),
+                          load=None if args.load is None else np.full(T, args.load))
     if tg.xyz is None:
         comp = compensate_program(cal, tg.q, limits=lim, gravity_torque=grav,
-                                  target_ids=tg.ids)
+                                  target_ids=tg.ids, conditions=cond)
     else:
         comp = compensate_targets(cal, tg.xyz, tg.q, orientations=tg.rotation, point=args.point,
                           frame=args.frame, limits=lim, gravity_torque=grav,
-                          target_ids=tg.ids)
+                          target_ids=tg.ids, conditions=cond)
     path = write_commands(comp, args.out, deg=args.deg, overwrite=args.force)
     s = comp.summary()
     text = (f"{s['targets']} targets: predicted RMS error {s['rms_before']:.4g} -> "

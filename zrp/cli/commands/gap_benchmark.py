@@ -57,6 +57,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workdir", default=None, metavar="DIR",
                    help="where the measurement CSVs, truth files and diagnoses go (default "
                         "OUT/work)")
+    p.add_argument("--compensate", type=whole(0, 100_000), default=0, metavar="N",
+                   help="the compensated column: compensate N fresh random targets (plus N/2 "
+                        "circle points) with each scenario's diagnosis, command and measure "
+                        "them (default 0: no column)")
     add_cluster_options(p)
     p.add_argument("--resume", action="store_true",
                    help="keep the scores an interrupted run of the same configuration wrote "
@@ -89,7 +93,7 @@ def _run(args: argparse.Namespace) -> int:
                           none_fraction=args.none, pair_fraction=args.pairs,
                           effects=tuple(args.effects), noise=tuple(args.noise),
                           poses_from=args.poses_from, approach=args.approach,
-                          use_mjcf=not args.no_mjcf)
+                          use_mjcf=not args.no_mjcf, compensate=args.compensate)
     model = load_model(args.model)
     # the folder is locked and its files checked before the (long) run
     with OutputDir(out, overwrite=overwrite, names=output_names(not args.no_plots)) as folder:
