@@ -203,3 +203,29 @@ def test_blocked_batch_kernels_match_single_pose_kernels(rng):
         np.testing.assert_allclose(out[i], one, atol=1e-12)
         np.testing.assert_allclose(pose[i], one, atol=1e-12)
         np.testing.assert_allclose(jac[i], j1, atol=1e-12)
+
+
+def test_streamed_stores_of_a_large_batch_give_the_same_bits(rng):
+    """fk_pose_batch writes a batch of >= _STREAM_MIN poses with non-temporal stores: the same
+    bits as the ordinary stores of small batches, every row written, the range check intact."""
+    from zrp.kinematics import _kernels as K
+
+    model = random_arm(rng, 6, 0.3)
+    n = K._STREAM_MIN + 777  # streamed, with a partial last block
+    q = rng.uniform(-4, 4, (n, 6))
+    arrays = K.kernel_arrays(model.axes, model.bodies, model.prismatic)
+    lim = np.full(6, 1e6)
+    out = np.full((n, 7), np.nan)
+    assert K.fk_pose_batch(q, *arrays, lim, out)
+    parts = np.full((n, 7), np.nan)
+    for a in range(0, n, 1000):  # small batches: ordinary stores
+        part = np.empty((min(1000, n - a), 7))
+        assert K.fk_pose_batch(q[a:a + 1000], *arrays, lim, part)
+        parts[a:a + part.shape[0]] = part
+    assert np.array_equal(out, parts)  # no NaN left: every row written
+    one = np.empty(7)
+    for i in (0, n // 2, n - 1):
+        K.fk_pose_one(q[i], *arrays, one)
+        np.testing.assert_allclose(out[i], one, atol=1e-12)
+    q[n - 3, 4] = 2e6
+    assert not K.fk_pose_batch(q, *arrays, lim, out)

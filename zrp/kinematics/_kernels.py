@@ -10,7 +10,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import njit
+from numba import njit, types
+from numba.core import cgutils
+from numba.extending import intrinsic
 
 # Layout of one pose in the kernels: position (3) then Euler-Rodrigues parameters (4).
 
@@ -30,6 +32,7 @@ _C1, _C2, _C3 = 4.16666666666666019037e-02, -1.38888888888741095749e-03, 2.48015
 _C4, _C5, _C6 = -2.75573143513906633035e-07, 2.08757232129817482790e-09, -1.13596475577881948265e-11
 _FM = {"contract"}  # allow fused multiply-add only; no reassociation (keeps the reduction exact)
 _BLOCK = 256
+_STREAM_MIN = 32768  # poses (1.8 MB of output): from here on fk_pose_batch streams its stores
 
 
 @njit(inline="always", fastmath=_FM)
@@ -219,9 +222,47 @@ def _turn_block(e0, e1, e2, e3, qb, m, code, ux, uy, uz):
                                                    qb[i])
 
 
+# ---- streamed (non-temporal) stores -----------------------------------------------------------
+# A batch of 1e6 poses writes 56 MB that the kernel never reads back: an ordinary store first
+# reads each cache line from memory (read-for-ownership), i.e. 112 B of traffic a pose instead
+# of 56. A non-temporal store writes whole lines through the write-combining buffers without
+# that read (tests/benchmarks/bench_speed.py: ~1.14x the kernel's rate). LLVM's
+# ``!nontemporal`` hint; on targets without such stores it is an ordinary store.
+@intrinsic
+def store_stream(typingctx, arr, idx, val):
+    """``arr[idx] = val`` (1-D C-contiguous float64 ``arr``) as a non-temporal store; the
+    caller ends with :func:`store_fence`."""
+    if not (isinstance(arr, types.Array) and arr.ndim == 1 and arr.layout == "C"
+            and arr.dtype == types.float64):
+        return None
+    sig = types.void(arr, types.intp, types.float64)
+
+    def codegen(context, builder, signature, args):
+        a, i, v = args
+        data = context.make_array(signature.args[0])(context, builder, a).data
+        st = builder.store(v, builder.gep(data, [i]))
+        st.set_metadata("nontemporal", builder.module.add_metadata([cgutils.int32_t(1)]))
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
+@intrinsic
+def store_fence(typingctx):
+    """A full memory fence: the streamed stores are visible to every thread after it (they
+    are weakly ordered)."""
+    sig = types.void()
+
+    def codegen(context, builder, signature, args):
+        builder.fence("seq_cst")
+        return context.get_dummy_value()
+
+    return sig, codegen
+
+
 @njit(cache=True, fastmath=_FM)
 def fk_pose_batch(q, axes, bodies, prism, lim, out):
-    """Batched :func:`fk_pose_one`: q (N, n) -> out (N, 7); returns True when every
+    """Batched :func:`fk_pose_one`: q (N, n) -> out (N, 7) (C-contiguous); returns True when every
     |q[:, k]| <= lim[k] (finite), False otherwise (out is then not to be used).
 
     The range check rides on the copy of each joint's values into the block (no separate
@@ -249,6 +290,10 @@ def fk_pose_batch(q, axes, bodies, prism, lim, out):
     py = np.empty(_BLOCK)
     pz = np.empty(_BLOCK)
     qb = np.empty(_BLOCK)  # joint k's values, contiguous (a strided read stops SIMD)
+    flat = out.reshape(-1)  # out is C-contiguous (N, 7)
+    # streamed stores only when out outgrows the caches (a small out is read back at once
+    # by the caller, from the cache when written the ordinary way)
+    stream = N >= _STREAM_MIN
     bad = 0
     for start in range(0, N, _BLOCK):
         m = min(_BLOCK, N - start)
@@ -277,15 +322,28 @@ def fk_pose_batch(q, axes, bodies, prism, lim, out):
                             axes[k, 2])
         _body_block(e0, e1, e2, e3, px, py, pz, m, bcode[n], bodies[n, 0], bodies[n, 1],
                     bodies[n, 2])
-        for i in range(m):
-            j = start + i
-            out[j, 0] = px[i]
-            out[j, 1] = py[i]
-            out[j, 2] = pz[i]
-            out[j, 3] = e0[i]
-            out[j, 4] = e1[i]
-            out[j, 5] = e2[i]
-            out[j, 6] = e3[i]
+        if stream:  # out is written once and not read here
+            for i in range(m):
+                j = 7 * (start + i)
+                store_stream(flat, j, px[i])
+                store_stream(flat, j + 1, py[i])
+                store_stream(flat, j + 2, pz[i])
+                store_stream(flat, j + 3, e0[i])
+                store_stream(flat, j + 4, e1[i])
+                store_stream(flat, j + 5, e2[i])
+                store_stream(flat, j + 6, e3[i])
+        else:
+            for i in range(m):
+                j = 7 * (start + i)
+                flat[j] = px[i]
+                flat[j + 1] = py[i]
+                flat[j + 2] = pz[i]
+                flat[j + 3] = e0[i]
+                flat[j + 4] = e1[i]
+                flat[j + 5] = e2[i]
+                flat[j + 6] = e3[i]
+    if stream:
+        store_fence()
     return bad == 0
 
 

@@ -42,7 +42,9 @@ def _step(e0, e1, e2, e3, px, py, pz, bx, by, bz, ux, uy, uz, c, s):
             px, py, pz)
 
 
-@njit(cache=True, fastmath=True, parallel=True)
+# nogil: on a Dask worker the event loop (heartbeats, the next task, sending results) keeps
+# running while a chunk computes
+@njit(cache=True, fastmath=True, parallel=True, nogil=True)
 def mc_max_deviation(ch, sh, qv, axes, bodies, prism, offsets, use_offsets, pd, ed,
                      out_dp, out_s):
     """Per robot max_t delta_p and max_t sin(theta_eps / 2).

@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
 from zrp.manufacturing._checks import check_distribution, check_percentile, positive_int
-from zrp.manufacturing.chunks import ChunkResult, ChunkTask, run_chunk
+from zrp.manufacturing.chunks import ChunkResult, ChunkTask, chunk_size, run_chunk
 from zrp.manufacturing.maxima import first_order_max as first_order_max
 from zrp.manufacturing.maxima import nonlinear_maxima as nonlinear_maxima
 from zrp.manufacturing.maxima import trajectory_arrays as trajectory_arrays
@@ -143,7 +143,7 @@ def _seed_or_rng(rng: np.random.Generator | None, seed: int | None) -> None:
 
 def chunk_tasks(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robots: int, *,
                 rng: np.random.Generator | None = None, seed: int | None = None,
-                distribution: str = "uniform", chunk: int = 8192,
+                distribution: str = "uniform", chunk: int | None = None,
                 first_order: bool = False,
                 edges: tuple[F64, F64] | None = None) -> list[ChunkTask]:
     """The chunks of :func:`monte_carlo` (same arguments), for an application that maps
@@ -151,10 +151,13 @@ def chunk_tasks(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robo
     ``edges``: reduce each chunk on its worker (:mod:`zrp.manufacturing.reduction`)."""
     check_distribution(distribution)
     n_robots = positive_int(n_robots, "n_robots")
-    chunk = positive_int(chunk, "chunk")
+    if chunk is not None:
+        chunk = positive_int(chunk, "chunk")
     _seed_or_rng(rng, seed)
     _check_tolerances(model, tolerances)
     arrays = trajectory_arrays(model, q)
+    if chunk is None:  # from the work only: the same chunks for any executor
+        chunk = chunk_size(n_robots, arrays[0].shape[0])
     tasks = []
     for idx, start in enumerate(range(0, n_robots, chunk)):
         m = min(chunk, n_robots - start)
@@ -189,7 +192,8 @@ def gather_chunks(model: Manipulator, tasks: list[ChunkTask], results: list[Chun
 
 def monte_carlo(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robots: int, *,
                 rng: np.random.Generator | None = None, seed: int | None = None,
-                distribution: str = "uniform", chunk: int = 8192, progress: bool = False,
+                distribution: str = "uniform", chunk: int | None = None,
+                progress: bool = False,
                 first_order: bool = False,
                 percentiles: tuple[float, ...] = DEFAULT_PERCENTILES,
                 executor: Executor | Any | None = None) -> MonteCarloResult:
@@ -206,7 +210,8 @@ def monte_carlo(model: Manipulator, q: ArrayLike, tolerances: Tolerances, n_robo
             nothing but the seed travels (give exactly one of ``rng`` and ``seed``).
         distribution: "uniform" or "normal" (see the module docstring).
         chunk: robots per task (the seeded draws depend on it; the result never depends on
-            the executor or its number of workers).
+            the executor or its number of workers); None: chosen from the work
+            (:func:`~.chunks.chunk_size`: tasks of ~1e7 poses, a multiple of 4 of them).
         progress: show a tqdm progress bar (advanced as chunks finish, also on a cluster).
         first_order: also evaluate the first-order model with the same draws.
         executor: None (this process; the kernel uses numba's threads) or any

@@ -113,7 +113,7 @@ class MonteCarloSummary:
 def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances,
                         n_robots: int, *, seed: int | None = None,
                         rng: np.random.Generator | None = None,
-                        distribution: str = "uniform", chunk: int = 8192,
+                        distribution: str = "uniform", chunk: int | None = None,
                         progress: bool = False,
                         percentiles: tuple[float, ...] = DEFAULT_PERCENTILES,
                         executor: Executor | Any | None = None) -> MonteCarloSummary:
