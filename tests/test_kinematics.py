@@ -229,3 +229,26 @@ def test_streamed_stores_of_a_large_batch_give_the_same_bits(rng):
         np.testing.assert_allclose(out[i], one, atol=1e-12)
     q[n - 3, 4] = 2e6
     assert not K.fk_pose_batch(q, *arrays, lim, out)
+
+
+def test_end_effector_pose_into_a_given_buffer(rng):
+    """``out=``: the same bits as a fresh result, written into the caller's buffer (views),
+    for a batch and for one pose; a wrong buffer is refused naming ``out``."""
+    puma = zrp.load_model("puma")
+    q = rng.uniform(-2, 2, (3, 5, 6))
+    p, e = zrp.end_effector_pose(puma, q)
+    buf = np.full((3, 5, 7), np.nan)
+    p2, e2 = zrp.end_effector_pose(puma, q, out=buf)
+    assert np.shares_memory(p2, buf) and np.shares_memory(e2, buf)
+    np.testing.assert_array_equal(p2, p)
+    np.testing.assert_array_equal(e2, e)
+    one = np.empty(7)
+    p1, e1 = zrp.end_effector_pose(puma, q[1, 2], out=one)
+    np.testing.assert_array_equal(one, np.concatenate([p[1, 2], e[1, 2]]))
+    assert np.shares_memory(p1, one) and np.shares_memory(e1, one)
+    for bad in (np.empty((3, 5, 6)), np.empty((3, 5, 7), np.float32),
+                np.empty((3, 7, 5)).transpose(0, 2, 1), [[0.0] * 7]):
+        with pytest.raises(zrp.InputError, match=r"^out: expected .*shape \(3, 5, 7\)"):
+            zrp.end_effector_pose(puma, q, out=bad)
+    with pytest.raises(zrp.InputError):  # the range is still checked
+        zrp.end_effector_pose(puma, np.full((2, 6), np.inf), out=np.empty((2, 7)))
