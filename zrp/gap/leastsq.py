@@ -231,19 +231,24 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
         raise InputError(f"{prob.n_residuals // 3} measured points give {prob.n_residuals} "
                          f"coordinates, not enough for {prob.size} parameters; measure more "
                          "poses")
-    cache: dict[bytes, tuple[F64, F64]] = {}
+    cache: dict[bytes, tuple[F64, F64, F64, F64]] = {}  # the last two points evaluated
 
-    def both(th: F64) -> tuple[F64, F64]:
+    def evaluated(th: F64) -> tuple[F64, F64, F64, F64]:
         key = th.tobytes()
         if key not in cache:
-            cache.clear()
-            cache[key] = _compressed(*prob.residual_and_jacobian(th))
+            if len(cache) > 1:
+                del cache[next(iter(cache))]
+            r, J = prob.residual_and_jacobian(th)
+            cache[key] = (*_compressed(r, J), r, J)
         return cache[key]
+
+    def both(th: F64) -> tuple[F64, F64]:
+        return evaluated(th)[:2]
 
     res = least_squares(lambda th: both(th)[0], theta0, jac=lambda th: both(th)[1],
                         method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12,
                         max_nfev=max_nfev)
-    r, J = prob.residual_and_jacobian(res.x)
+    r, J = evaluated(res.x)[2:]  # the solution is one of the last two points evaluated
     ok = bool(res.status > 0)
     if not ok:
         warnings.warn(f"least squares did not converge ({res.message}) with "

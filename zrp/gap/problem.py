@@ -34,6 +34,14 @@ __all__ = ["Problem"]
 F64 = NDArray[np.float64]
 
 
+def _cross(a: F64, b: F64) -> F64:
+    """a x b over the last axis (3), broadcast; the arithmetic of np.cross without its
+    axis shuffling (~3x faster on the small arrays of a fit)."""
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
+
+
 def _axis_rotations(u: F64, q: F64) -> F64:
     """Rotations about the unit axis u (3,) by angles q (S,): shape (S, 3, 3)."""
     k = skew(u)
@@ -220,7 +228,7 @@ class Problem:
         rp = self.row_pose
         rel = x[:, None, :] - ch.pts[rp]  # (R, n, 3)
         dxdq = np.where(self.ctx.model.prismatic[None, :, None], ch.ucur[rp],
-                        np.cross(ch.ucur[rp], rel))
+                        _cross(ch.ucur[rp], rel))
         J[:, :, self.idx["dq"]] = np.matmul(dxdq.transpose(0, 2, 1), self.B[rp])  # 4x einsum
 
     def _link_columns(self, J: F64, ch: _Chain) -> None:
@@ -240,9 +248,9 @@ class Problem:
                 J[:, :, i] = (q[:, k, None] * (ch.rprev[:, k] @ du))[rp]
             else:
                 loc = (np.sin(q[:, k])[:, None] * du
-                       + (1.0 - np.cos(q[:, k]))[:, None] * np.cross(uk, du))
+                       + (1.0 - np.cos(q[:, k]))[:, None] * _cross(uk, du))
                 om = np.einsum("sij,sj->si", ch.rprev[:, k], loc)
-                J[:, :, i] = np.cross(om[rp], x - ch.pts[rp, k])
+                J[:, :, i] = _cross(om[rp], x - ch.pts[rp, k])
 
     def residual(self, theta: ArrayLike) -> F64:
         """Predicted minus measured, shape (3R,) (x, y, z per row)."""
