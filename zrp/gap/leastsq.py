@@ -17,7 +17,7 @@ from scipy.optimize import least_squares
 
 from zrp.errors import InputError, ZRPWarning
 from zrp.gap.effects import Context, ParamSpec
-from zrp.gap.problem import Problem
+from zrp.gap.problem import Evaluation, Problem, compressed
 
 __all__ = [
     "Aliased",
@@ -28,6 +28,7 @@ __all__ = [
     "f_test",
     "fit",
     "group_key",
+    "identifiable_start",
     "initial_registration",
     "orthonormal_basis",
     "point_errors",
@@ -200,22 +201,9 @@ def _covariance(jac: F64, residual: F64) -> F64:
     return s2 * cov / np.outer(d, d)
 
 
-def _compressed(r: F64, jac: F64) -> tuple[F64, F64]:
-    """The least-squares problem (r (m,), J (m, p)) reduced to p + 1 rows with the same
-    Levenberg-Marquardt steps: R of the QR factorisation [J r] = Q R, g = R[:, p] = Q^T r
-    (so ||g|| = ||r||, g[p] = the part of r outside span(J)) and J' = R[:, :p] (J'^T J' =
-    J^T J, J'^T g = J^T r, the same column norms). MINPACK's own unblocked QR of the tall J
-    then becomes one blocked LAPACK QR per evaluation (~2x faster, zrp/gap/README.md#speed)."""
-    p = jac.shape[1]
-    aug = np.empty((jac.shape[0], p + 1))
-    aug[:, :p] = jac
-    aug[:, p] = r
-    R = np.linalg.qr(aug, mode="r")
-    return R[:, p].copy(), np.ascontiguousarray(R[:, :p])
-
-
 def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: ArrayLike,
-        base_rotation: ArrayLike, *, max_nfev: int = 100) -> FitResult:
+        base_rotation: ArrayLike, *, max_nfev: int = 100,
+        start: Evaluation | None = None) -> FitResult:
     """Least squares (scipy ``least_squares``, Levenberg-Marquardt) with the analytic
     Jacobian of :class:`~zrp.gap.problem.Problem`.
 
@@ -224,6 +212,8 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
         poses: pose indices, shape (S,).
         theta0: starting values, shape (p,).
         base_rotation: R_b0, shape (3, 3).
+        start: the evaluation at theta0 when already known (used only when its poses and
+            theta equal ``poses`` and ``theta0``).
     """
     prob = Problem(ctx, specs, poses, base_rotation)
     theta0 = np.asarray(theta0, dtype=float)
@@ -239,11 +229,16 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
             if len(cache) > 1:
                 del cache[next(iter(cache))]
             r, J = prob.residual_and_jacobian(th)
-            cache[key] = (*_compressed(r, J), r, J)
+            cache[key] = (*compressed(r, J), r, J)
         return cache[key]
 
     def both(th: F64) -> tuple[F64, F64]:
         return evaluated(th)[:2]
+
+    if (start is not None and np.array_equal(start.poses, prob.poses)
+            and np.array_equal(start.theta, theta0) and start.jac.shape[1] == prob.size):
+        cache[theta0.tobytes()] = (*compressed(start.residual, start.jac), start.residual,
+                                   start.jac)
 
     res = least_squares(lambda th: both(th)[0], theta0, jac=lambda th: both(th)[1],
                         method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12,
@@ -289,11 +284,20 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
     Returns:
         the identifiable candidates, and the aliasing report.
     """
+    keep, report, _ = identifiable_start(ctx, base, candidates, poses)
+    return keep, report
+
+
+def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[ParamSpec],
+                       poses: ArrayLike | None = None
+                       ) -> tuple[list[ParamSpec], list[Aliased], Evaluation]:
+    """:func:`check_identifiable`, and the evaluation of base + the kept candidates at
+    (base.theta, 0) that it computed (the start of the fit that usually follows)."""
     poses = base.poses if poses is None else np.asarray(poses, dtype=np.int64)
     specs = list(base.specs) + list(candidates)
     prob = Problem(ctx, specs, poses, base.base_rotation)
     theta = np.concatenate([base.theta, np.zeros(len(candidates))])
-    _, J = prob.residual_and_jacobian(theta)
+    r, J = prob.residual_and_jacobian(theta)
     norms = np.linalg.norm(J, axis=0)
     nb = len(base.specs)
     A = J[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
@@ -336,7 +340,7 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
         accepted_cols.append(nb + i)
         Qa[:, na] = rr / frac
         na += 1
-    return keep, report
+    return keep, report, Evaluation(prob.poses, theta[accepted_cols], r, J[:, accepted_cols])
 
 
 def group_key(spec: ParamSpec) -> str:
