@@ -44,7 +44,7 @@ def _cross(a: F64, b: F64) -> F64:
 
 def _axis_rotations(u: F64, q: F64) -> F64:
     """Rotations about the unit axis u (3,) by angles q (S,): shape (S, 3, 3)."""
-    k = skew(u)
+    k = np.array([[0.0, -u[2], u[1]], [u[2], 0.0, -u[0]], [-u[1], u[0], 0.0]])  # skew(u)
     s = np.sin(q)[:, None, None]
     c = np.cos(q)[:, None, None]
     return np.eye(3) + s * k + (1.0 - c) * (k @ k)
@@ -217,10 +217,14 @@ class Problem:
 
     def _tool_columns(self, J: F64, rn: F64) -> None:
         rp, rpt = self.row_pose, self.row_point
+        rows: dict[int, tuple[NDArray[np.bool_], F64]] = {}  # per tool point: rows, R_n
         for i in self.idx["tool"]:
             m, cc = divmod(self.specs[i].comp, 3)
-            sel = rpt == m
-            J[sel, :, i] = rn[rp[sel], :, cc]
+            if m not in rows:
+                sel = rpt == m
+                rows[m] = (sel, rn[rp[sel]])
+            sel, rsel = rows[m]
+            J[sel, :, i] = rsel[:, :, cc]
 
     def _dq_columns(self, J: F64, ch: _Chain, x: F64) -> None:
         if not self.idx["dq"].size:
