@@ -273,7 +273,16 @@ def compressed(r: F64, jac: F64) -> tuple[F64, F64]:
     Levenberg-Marquardt steps: R of the QR factorisation [J r] = Q R, g = R[:, p] = Q^T r
     (so ||g|| = ||r||, g[p] = the part of r outside span(J)) and J' = R[:, :p] (J'^T J' =
     J^T J, J'^T g = J^T r, the same column norms). MINPACK's own unblocked QR of the tall J
-    then becomes one blocked LAPACK QR per evaluation (~2x faster, zrp/gap/README.md#speed)."""
+    then becomes one blocked LAPACK QR per evaluation (~2x faster; see the speed section of
+    zrp/kinematics/README.md).
+
+    Args:
+        r: residual, shape (m,).
+        jac: Jacobian, shape (m, p), m > p.
+
+    Returns:
+        g (p + 1,) and J' (p + 1, p), J'[p] = 0.
+    """
     p = jac.shape[1]
     aug = np.empty((jac.shape[0], p + 1))
     aug[:, :p] = jac
