@@ -1,6 +1,7 @@
 """Speed against the issue-15 targets, every figure beside a baseline measured in the same run.
 
-Run: python tests/benchmarks/bench_speed.py [--quick]   (from the repository root)
+Run: python tests/benchmarks/bench_speed.py [--quick] [--only diagnosis]   (from the
+repository root)
 
 One core for the kernels (NUMBA_NUM_THREADS=1, set before numba loads). Prints one table:
 figure, measured value, target, the baseline of the same run and the ratio:
@@ -14,8 +15,10 @@ figure, measured value, target, the baseline of the same run and the ratio:
   and reduced on the workers (histograms); then on a Dask LocalCluster of 1 and of 2 workers
   (baseline: 1 worker; the chunk chosen from the work, zrp.manufacturing.chunks.chunk_size);
 * the full diagnosis of the IRB 120 laser-tracker data in ../shared (2,946 points) and of its
-  first 999 points; baselines: the registration fit alone, and the same diagnosis on
-  OpenBLAS's own threads (the former; zrp/blas.py) (skipped without ../shared);
+  first 999 points; baselines: the registration fit alone, the same diagnosis with the
+  Levenberg-Marquardt fits on the tall Jacobian (the former: MINPACK's own QR of it instead
+  of the QR-compressed problem, zrp.gap.problem.compressed) and on OpenBLAS's own threads
+  (the former; zrp/blas.py) (skipped without ../shared);
 * the blind benchmark's simulation of a 200-pose scenario; baselines: the same poses measured
   by forward kinematics only, and the former procedure (every move to a pre-pose simulated).
 """
@@ -233,9 +236,10 @@ def diagnosis() -> None:
     import contextlib
 
     from zrp.blas import blas_threads
-    from zrp.gap import diagnose, load_measurements, pipeline
+    from zrp.gap import diagnose, leastsq, load_measurements, pipeline
     from zrp.gap.effects import Context, registration_parameters
     from zrp.gap.leastsq import fit, initial_registration
+    from zrp.gap.problem import compressed
 
     model = zrp.load_model(str(SHARED / "irb120.toml"))
     lines = (SHARED / "measurements.csv").read_text(encoding="utf-8").splitlines()
@@ -253,6 +257,13 @@ def diagnosis() -> None:
                 th0, rb0 = initial_registration(ctx, specs, poses)
                 return fit(ctx, specs, poses, th0, rb0)
 
+            def tall(model=model, meas=meas):  # the former fit: MINPACK's QR of the tall J
+                leastsq.compressed = lambda r, jac: (r, jac)
+                try:
+                    return diagnose(model, meas, seed=0)
+                finally:
+                    leastsq.compressed = compressed
+
             def threaded(model=model, meas=meas):  # the former: OpenBLAS's own threads
                 pipeline.blas_threads = lambda _n: contextlib.nullcontext()
                 try:
@@ -262,11 +273,13 @@ def diagnosis() -> None:
 
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
-                t_reg, t_full, t_thr = best(
+                t_reg, t_full, t_tall, t_thr = best(
                     registration, lambda model=model, meas=meas: diagnose(model, meas, seed=0),
-                    threaded, repeat=2)
+                    tall, threaded, repeat=3)
             row(f"diagnosis, IRB 120 {label} (s)", f"{t_full:.2f}", goal,
                 f"registration {t_reg:.3f} s", f"{t_full / t_reg:.0f}x")
+            row("  the same, LM on the tall Jacobian (s)", f"{t_tall:.2f}", "",
+                f"QR-compressed {t_full:.2f} s", f"{t_tall / t_full:.2f}x slower")
             row("  the same on OpenBLAS's own threads (s)", f"{t_thr:.2f}", "",
                 f"one BLAS thread {t_full:.2f} s", f"{t_thr / t_full:.2f}x slower")
 
@@ -308,8 +321,13 @@ def simulation(poses: int) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, no cluster")
+    ap.add_argument("--only", choices=("diagnosis",), help="only this figure")
     args = ap.parse_args()
     print(f"issue-15 speed figures (one core for the kernels; load {os.getloadavg()[0]:.1f})")
+    if args.only == "diagnosis":
+        diagnosis()
+        print(f"(load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
+        return
     model = zrp.load_model("puma")
     fk_rate = batched(model, 200_000 if args.quick else 1_000_000)
     single_calls(model)

@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.gap.effects import Context, ParamSpec, effect_parameters
-from zrp.gap.leastsq import FitResult, check_identifiable, cv_rms, fit
+from zrp.gap.leastsq import FitResult, cv_rms, fit, identifiable_start
 from zrp.gap.metrics import Metrics
 from zrp.gap.problem import Problem
 
@@ -79,9 +79,9 @@ def _withheld(ctx: Context, f: FitResult, withheld: NDArray[np.int64]) -> Metric
 
 def _on_top(ctx: Context, base: FitResult, extra: list[ParamSpec], fitting: NDArray[np.int64],
             rb0: NDArray[np.float64]) -> tuple[FitResult, int, int]:
-    keep, _ = check_identifiable(ctx, base, extra)
+    keep, _, start = identifiable_start(ctx, base, extra)
     f = fit(ctx, list(base.specs) + keep, fitting,
-            np.concatenate([base.theta, np.zeros(len(keep))]), rb0)
+            np.concatenate([base.theta, np.zeros(len(keep))]), rb0, start=start)
     return f, len(keep), len(extra) - len(keep)
 
 

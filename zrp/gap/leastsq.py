@@ -17,7 +17,7 @@ from scipy.optimize import least_squares
 
 from zrp.errors import InputError, ZRPWarning
 from zrp.gap.effects import Context, ParamSpec
-from zrp.gap.problem import Problem
+from zrp.gap.problem import Evaluation, Problem, compressed
 
 __all__ = [
     "Aliased",
@@ -28,6 +28,7 @@ __all__ = [
     "f_test",
     "fit",
     "group_key",
+    "identifiable_start",
     "initial_registration",
     "orthonormal_basis",
     "point_errors",
@@ -201,7 +202,8 @@ def _covariance(jac: F64, residual: F64) -> F64:
 
 
 def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: ArrayLike,
-        base_rotation: ArrayLike, *, max_nfev: int = 100) -> FitResult:
+        base_rotation: ArrayLike, *, max_nfev: int = 100,
+        start: Evaluation | None = None) -> FitResult:
     """Least squares (scipy ``least_squares``, Levenberg-Marquardt) with the analytic
     Jacobian of :class:`~zrp.gap.problem.Problem`.
 
@@ -210,6 +212,8 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
         poses: pose indices, shape (S,).
         theta0: starting values, shape (p,).
         base_rotation: R_b0, shape (3, 3).
+        start: the evaluation at theta0 when already known (used only when its poses and
+            theta equal ``poses`` and ``theta0``).
     """
     prob = Problem(ctx, specs, poses, base_rotation)
     theta0 = np.asarray(theta0, dtype=float)
@@ -217,19 +221,29 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
         raise InputError(f"{prob.n_residuals // 3} measured points give {prob.n_residuals} "
                          f"coordinates, not enough for {prob.size} parameters; measure more "
                          "poses")
-    cache: dict[bytes, tuple[F64, F64]] = {}
+    cache: dict[bytes, tuple[F64, F64, F64, F64]] = {}  # the last two points evaluated
 
-    def both(th: F64) -> tuple[F64, F64]:
+    def evaluated(th: F64) -> tuple[F64, F64, F64, F64]:
         key = th.tobytes()
         if key not in cache:
-            cache.clear()
-            cache[key] = prob.residual_and_jacobian(th)
+            if len(cache) > 1:
+                del cache[next(iter(cache))]
+            r, J = prob.residual_and_jacobian(th)
+            cache[key] = (*compressed(r, J), r, J)
         return cache[key]
+
+    def both(th: F64) -> tuple[F64, F64]:
+        return evaluated(th)[:2]
+
+    if (start is not None and np.array_equal(start.poses, prob.poses)
+            and np.array_equal(start.theta, theta0) and start.jac.shape[1] == prob.size):
+        cache[theta0.tobytes()] = (*compressed(start.residual, start.jac), start.residual,
+                                   start.jac)
 
     res = least_squares(lambda th: both(th)[0], theta0, jac=lambda th: both(th)[1],
                         method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12,
                         max_nfev=max_nfev)
-    r, J = prob.residual_and_jacobian(res.x)
+    r, J = evaluated(res.x)[2:]  # the solution is one of the last two points evaluated
     ok = bool(res.status > 0)
     if not ok:
         warnings.warn(f"least squares did not converge ({res.message}) with "
@@ -270,11 +284,20 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
     Returns:
         the identifiable candidates, and the aliasing report.
     """
+    keep, report, _ = identifiable_start(ctx, base, candidates, poses)
+    return keep, report
+
+
+def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[ParamSpec],
+                       poses: ArrayLike | None = None
+                       ) -> tuple[list[ParamSpec], list[Aliased], Evaluation]:
+    """:func:`check_identifiable`, and the evaluation of base + the kept candidates at
+    (base.theta, 0) that it computed (the start of the fit that usually follows)."""
     poses = base.poses if poses is None else np.asarray(poses, dtype=np.int64)
     specs = list(base.specs) + list(candidates)
     prob = Problem(ctx, specs, poses, base.base_rotation)
     theta = np.concatenate([base.theta, np.zeros(len(candidates))])
-    _, J = prob.residual_and_jacobian(theta)
+    r, J = prob.residual_and_jacobian(theta)
     norms = np.linalg.norm(J, axis=0)
     nb = len(base.specs)
     A = J[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
@@ -317,7 +340,7 @@ def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[Param
         accepted_cols.append(nb + i)
         Qa[:, na] = rr / frac
         na += 1
-    return keep, report
+    return keep, report, Evaluation(prob.poses, theta[accepted_cols], r, J[:, accepted_cols])
 
 
 def group_key(spec: ParamSpec) -> str:

@@ -22,11 +22,11 @@ from zrp.gap.identifiability import GEOMETRIC, geometric_overlap
 from zrp.gap.leastsq import (
     Aliased,
     FitResult,
-    check_identifiable,
     cv_rms,
     f_test,
     fit,
     group_key,
+    identifiable_start,
     wald_groups,
 )
 from zrp.gap.metrics import Metrics
@@ -137,12 +137,12 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
     """Fit ``effect`` on top of ``current`` and judge it (F test, BIC, CV RMS gain)."""
     if not specs:
         return _not_tried(effect, f"not tried: {why}")
-    keep, aliased = check_identifiable(ctx, current, specs)
+    keep, aliased, start = identifiable_start(ctx, current, specs)
     if not keep:
         return _not_tried(effect, "no parameter identifiable on top of the current model",
                           aliased)
     f1 = fit(ctx, list(current.specs) + keep, s.fitting,
-             np.concatenate([current.theta, np.zeros(len(keep))]), s.rb0)
+             np.concatenate([current.theta, np.zeros(len(keep))]), s.rb0, start=start)
     f1, kept = _significant(ctx, current, f1, keep, s)
     if not kept:
         return _Trial(Candidate(effect, (), 0, cv_rms(ctx, f1, s.folds), f1.bic - current.bic,

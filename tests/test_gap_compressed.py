@@ -1,0 +1,85 @@
+"""The fits' QR-compressed least-squares problem (zrp.gap.problem.compressed) and the reuse of
+the identifiability check's evaluation as a fit's start (issue 15: diagnosis speed)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import zrp
+from zrp.errors import InputError
+from zrp.gap import leastsq
+from zrp.gap.effects import Context, effect_parameters, registration_parameters
+from zrp.gap.leastsq import fit, identifiable_start, initial_registration
+from zrp.gap.problem import Evaluation, compressed
+from zrp.gap.synthetic import Injection, synthesize
+from zrp.kinematics import reachable_poses
+
+PUMA = zrp.load_model("puma")
+
+
+def test_compressed_keeps_the_normal_equations():
+    rng = np.random.default_rng(3)
+    J = rng.normal(size=(400, 7)) * np.array([1e-3, 1.0, 10.0, 1.0, 1e2, 1.0, 0.1])
+    r = rng.normal(size=400)
+    g, Jc = compressed(r, J)
+    assert g.shape == (8,) and Jc.shape == (8, 7)
+    np.testing.assert_allclose(np.linalg.norm(g), np.linalg.norm(r), rtol=1e-13)
+    np.testing.assert_allclose(Jc.T @ Jc, J.T @ J, rtol=1e-12, atol=1e-12 * np.abs(J.T @ J).max())
+    np.testing.assert_allclose(Jc.T @ g, J.T @ r, rtol=1e-10, atol=1e-10 * np.abs(J.T @ r).max())
+    np.testing.assert_allclose(np.linalg.norm(Jc, axis=0), np.linalg.norm(J, axis=0),
+                               rtol=1e-13)
+    # the least-squares solution of the reduced problem is the original one (lstsq reference)
+    np.testing.assert_allclose(np.linalg.lstsq(Jc, g, rcond=None)[0],
+                               np.linalg.lstsq(J, r, rcond=None)[0], rtol=1e-10)
+    assert np.allclose(Jc[-1], 0.0)  # the last row carries only the part of r outside span(J)
+
+
+def _case():
+    rng = np.random.default_rng(7)
+    q = reachable_poses(PUMA, 40, rng)
+    meas = synthesize(PUMA, q, Injection(joint_offset={2: 4e-4, 3: -3e-4},
+                                         encoder_scale={5: 2e-3}), rng=rng, noise_sigma=0.01)
+    ctx = Context(PUMA, meas)
+    poses = np.arange(len(meas.pose_ids))
+    specs = registration_parameters(ctx)
+    th0, rb0 = initial_registration(ctx, specs, poses)
+    return ctx, poses, specs, th0, rb0
+
+
+def test_fit_equals_levenberg_marquardt_on_the_tall_jacobian(monkeypatch):
+    ctx, poses, specs, th0, rb0 = _case()
+    reg = fit(ctx, specs, poses, th0, rb0)
+    keep, _ = leastsq.check_identifiable(ctx, reg, effect_parameters(ctx, "joint_offset")[0])
+    assert keep  # the offsets the registration does not absorb
+    specs = list(specs) + keep
+    th0 = np.concatenate([th0, np.zeros(len(keep))])
+    new = fit(ctx, specs, poses, th0, rb0)
+    monkeypatch.setattr(leastsq, "compressed", lambda r, jac: (r, jac))  # the former fit
+    tall = fit(ctx, specs, poses, th0, rb0)
+    assert new.converged and tall.converged
+    se = np.sqrt(np.diag(tall.cov))
+    assert np.max(np.abs(new.theta - tall.theta) / se) < 1e-6  # in standard errors
+    np.testing.assert_allclose(new.residual, tall.residual, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(new.cov, tall.cov, rtol=1e-6)
+
+
+def test_fit_from_the_identifiability_evaluation_is_the_same_fit():
+    ctx, poses, specs, th0, rb0 = _case()
+    reg = fit(ctx, specs, poses, th0, rb0)
+    cand = effect_parameters(ctx, "encoder_scale")[0]
+    keep, _, start = identifiable_start(ctx, reg, cand)
+    assert keep and start.jac.shape == (start.residual.size, len(specs) + len(keep))
+    theta0 = np.concatenate([reg.theta, np.zeros(len(keep))])
+    plain = fit(ctx, list(specs) + keep, poses, theta0, rb0)
+    reused = fit(ctx, list(specs) + keep, poses, theta0, rb0, start=start)
+    np.testing.assert_allclose(reused.theta, plain.theta, rtol=1e-12, atol=1e-15)
+    # a start at another point is not used: the same fit again
+    other = Evaluation(start.poses, start.theta + 1.0, start.residual, start.jac)
+    again = fit(ctx, list(specs) + keep, poses, theta0, rb0, start=other)
+    np.testing.assert_array_equal(again.theta, plain.theta)
+
+
+def test_evaluation_checks_its_shapes():
+    with pytest.raises(InputError, match="Jacobian of shape"):
+        Evaluation(np.arange(2), np.zeros(3), np.zeros(6), np.zeros((6, 2)))
