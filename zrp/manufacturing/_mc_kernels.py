@@ -22,7 +22,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
-from zrp.kinematics._kernels import sincos_batch
+from zrp.kinematics._kernels import sincos
 
 
 @njit(inline="always", fastmath=True)
@@ -64,7 +64,7 @@ def mc_max_deviation(ch, sh, qv, axes, bodies, prism, offsets, use_offsets, pd, 
     n = axes.shape[1]
     nt = ch.shape[1]
     for i in prange(nrob):
-        w = np.empty((10, nt))  # e0..e3, px, py, pz, then cos/sin of (q + offset)/2
+        w = np.empty((9, nt))  # e0..e3, px, py, pz, then cos/sin of (q + offset)/2
         e0 = w[0]
         e1 = w[1]
         e2 = w[2]
@@ -74,7 +74,6 @@ def mc_max_deviation(ch, sh, qv, axes, bodies, prism, offsets, use_offsets, pd, 
         pz = w[6]
         cw = w[7]
         sw = w[8]
-        hw = w[9]
         ax = axes[i]
         bd = bodies[i]
         for t in range(nt):
@@ -111,10 +110,13 @@ def mc_max_deviation(ch, sh, qv, axes, bodies, prism, offsets, use_offsets, pd, 
             if use_offsets:
                 qk = qv[k]
                 h = offsets[i, k]
+                # inlined, so under this kernel's fastmath: the half angles are a few rad at
+                # most (k <= 2 in the reduction), where reassociating the three-part
+                # reduction costs < 1e-16. Not a call to the shared sincos_batch: numba
+                # compiled that dispatcher under this caller's flags and cached it, which
+                # broke its libm-exactness test for |x| ~ 100 (4e-12) in later callers.
                 for t in range(nt):
-                    hw[t] = 0.5 * (qk[t] + h)
-                # not inlined: its range reduction must keep its own (contract-only) flags
-                sincos_batch(hw, sw, cw)
+                    sw[t], cw[t] = sincos(0.5 * (qk[t] + h))
                 ck = cw
                 sk = sw
             else:
