@@ -146,8 +146,7 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
             gravity_torque = _kept_rows(gravity_torque, kept, n_poses)
         with blas_threads(1):  # small dense problems: one BLAS thread is ~3x faster (zrp.blas)
             result = run_diagnosis(model, measurements, gravity_torque, opts, rng)
-            if use_orientation and measurements.quat is not None:
-                result = _with_full_pose(result, orientation_sigma)
+            result = _with_full_pose(result, bool(use_orientation), orientation_sigma)
     # raised again, every one at the caller's line (whatever the stage that found it)
     caller = sys._getframe(1)
     for w in wlist:
@@ -165,16 +164,19 @@ def _check_orientation(meas: Measurements, use: object, sigma: object) -> None:
     check_float(sigma, "orientation_sigma", 0.0, 1.0, open_lo=True, unit="rad")
     if meas.quat is None or not use:
         raise InputError("orientation_sigma: given, but " + (
-            f"{meas.source} has no qw, qx, qy, qz columns" if meas.quat is None
-            else "use_orientation is False") + "; orientations are not used")
+            f"{meas.source} has no qw, qx, qy, qz columns to weight" if meas.quat is None
+            else "orientations are switched off: use_orientation=False (--no-orientation on "
+            "the command line)"))
 
 
-def _with_full_pose(diag: Diagnosis, sigma: float | None) -> Diagnosis:
-    """``diag`` with its final model refitted from positions and orientations
-    (:mod:`zrp.gap.posefit`), the options recorded in its settings."""
-    full = refit_full_pose(diag.context, diag.final_fit, diag.fitting_poses,
-                           diag.withheld_poses, len(diag.registration), sigma)
-    settings = {**diag.settings, "orientation": True, "orientation_sigma_rad": sigma}
+def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosis:
+    """``diag`` with its final model refitted from positions and orientations when the
+    measurements carry them and ``use`` (:mod:`zrp.gap.posefit`), recorded in its settings."""
+    used = use and diag.context.meas.quat is not None
+    full = (refit_full_pose(diag.context, diag.final_fit, diag.fitting_poses,
+                            diag.withheld_poses, len(diag.registration), sigma)
+            if used else None)
+    settings = {**diag.settings, "orientation": used, "orientation_sigma_rad": sigma}
     return dataclasses.replace(diag, full_pose=full, settings=settings)
 
 
