@@ -104,7 +104,7 @@ def test_bad_orientation_options(kw, match):
 
 
 def test_orientation_sigma_needs_orientations():
-    with pytest.raises(InputError, match="orientation_sigma: .*no qw, qx, qy, qz"):
+    with pytest.raises(InputError, match=r"orientation_sigma: .*no qw, qx, qy, qz"):
         diagnose(PUMA, _measure(quat=False), orientation_sigma=1e-4)
 
 
