@@ -173,9 +173,14 @@ def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosi
     """``diag`` with its final model refitted from positions and orientations when the
     measurements carry them and ``use`` (:mod:`zrp.gap.posefit`), recorded in its settings."""
     used = use and diag.context.meas.quat is not None
-    full = (refit_full_pose(diag.context, diag.final_fit, diag.fitting_poses,
-                            diag.withheld_poses, len(diag.registration), sigma)
-            if used else None)
+    full = None
+    if used:
+        ctx, st = diag.context, diag.settings
+        cands = {e: excited_only(ctx, effect_parameters(ctx, e))[0] for e in st["effects"]}
+        full = refit_full_pose(ctx, diag.final_fit, diag.fitting_poses, diag.withheld_poses,
+                               len(diag.registration), sigma, candidates=cands,
+                               alpha=st["alpha"], min_gain=st["min_gain"],
+                               max_steps=st["max_steps"])
     settings = {**diag.settings, "orientation": used, "orientation_sigma_rad": sigma}
     return dataclasses.replace(diag, full_pose=full, settings=settings)
 

@@ -5,13 +5,17 @@ final model (registration included) from positions and orientations together on 
 fitting poses, each block weighted by its own noise (:mod:`zrp.gap.fullpose`, eqs. O1-O2),
 and judges both estimates on the diagnosis's own withheld poses:
 
+- effects only the orientations reveal are added by a score-test search on the fitting
+  poses (:mod:`zrp.gap.posesearch`), each confirmed on the withheld orientations;
 - orientation error before: the position-only final fit, with the probe rotation R_t0 that
   fits it best on the fitting poses (:func:`zrp.gap.fullpose.probe_start`);
 - orientation error after: the full-pose fit with its identified probe rotation R_t;
-- the withheld position RMS of both, and each parameter's standard error with and without
-  orientations (normal theory of the weighted problem, the same formula for both).
+- the withheld position RMS of both (position-only: the final model refitted), and each
+  parameter's standard error with and without orientations (normal theory of the weighted
+  problem, the same formula for both).
 
-The withheld poses never enter either fit.
+The withheld poses never enter a fit; they confirm each group the orientation search adds
+(as they choose between the search's model and the geometric baseline in the diagnosis).
 """
 
 from __future__ import annotations
@@ -24,7 +28,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.effects import Context
+from zrp.gap.effects import Context, ParamSpec
 from zrp.gap.fullpose import (
     FullPoseFit,
     fit_full_pose,
@@ -33,6 +37,7 @@ from zrp.gap.fullpose import (
     probe_start,
 )
 from zrp.gap.leastsq import FitResult
+from zrp.gap.posesearch import OrientationStep, forward_search
 from zrp.gap.problem import Problem
 from zrp.rotations import er_from_matrix, er_to_rotvec
 
@@ -88,6 +93,8 @@ class FullPoseResult:
         withheld_rms_position_only, withheld_rms: 3-D position RMS on the withheld poses of
             the position-only and the full-pose estimates (length unit).
         parameters: the effect parameters' precision, with and without orientations.
+        added: groups the orientations revealed (:mod:`zrp.gap.posesearch`), in order; the
+            fit includes them, the position-only figures ("before") do not.
     """
 
     fit: FullPoseFit
@@ -99,6 +106,7 @@ class FullPoseResult:
     withheld_rms_position_only: float
     withheld_rms: float
     parameters: tuple[ParameterPrecision, ...]
+    added: tuple[OrientationStep, ...] = ()
 
     def __post_init__(self) -> None:
         vals = (self.sigma_orientation, self.withheld_orientation_before,
@@ -136,6 +144,7 @@ class FullPoseResult:
                 "withheld_rms": {"position_only": self.withheld_rms_position_only,
                                  "full_pose": self.withheld_rms},
                 "std_ratio_median": self.std_ratio_median,
+                "added_by_orientation": [a.to_dict() for a in self.added],
                 "parameters": [p.to_dict() for p in self.parameters]}
 
 
@@ -150,9 +159,12 @@ def _rms(prob: Problem, theta: F64) -> float:
 
 def refit_full_pose(ctx: Context, final: FitResult, fitting: NDArray[np.int64],
                     withheld: NDArray[np.int64], n_registration: int,
-                    orientation_sigma: float | None = None) -> FullPoseResult:
-    """Refit ``final``'s parameters with the measured orientations and judge both estimates on
-    the withheld poses (module doc).
+                    orientation_sigma: float | None = None, *,
+                    candidates: dict[str, list[ParamSpec]] | None = None, alpha: float = 1e-3,
+                    min_gain: float = 0.01, max_steps: int = 2) -> FullPoseResult:
+    """Refit ``final``'s parameters with the measured orientations, add the effects only the
+    orientations reveal (:mod:`zrp.gap.posesearch`) and judge the estimates on the withheld
+    poses (module doc).
 
     Args:
         ctx: the data context (measurements with ``qw..qz``).
@@ -160,24 +172,40 @@ def refit_full_pose(ctx: Context, final: FitResult, fitting: NDArray[np.int64],
         fitting, withheld: the diagnosis's pose split, shapes (Pf,), (Pw,).
         n_registration: number of leading registration parameters in ``final.specs``.
         orientation_sigma: orientation noise per component (rad); None: estimated.
+        candidates: effect -> parameters the orientation search may add (None: no search).
+        alpha, min_gain, max_steps: of the orientation search (the diagnosis's own).
 
     Raises:
         InputError: no orientations, a non-positive ``orientation_sigma``.
     """
     meas_rot = pose_rotations(ctx)  # refuses data without orientations, naming the columns
-    specs = final.specs
-    fp = fit_full_pose(ctx, specs, fitting, orientation_sigma=orientation_sigma)
-    pos = fp.position
-    rb0 = pos.base_rotation
     w = np.asarray(withheld, dtype=np.int64)
-    rt0 = probe_start(Problem(ctx, specs, fitting, rb0), pos.theta, meas_rot[fitting])
-    prob = Problem(ctx, specs, w, rb0)
-    before, _ = orientation_residual(prob, pos.theta, np.zeros(3), rt0, meas_rot[w])
-    after, _ = orientation_residual(prob, fp.theta, np.zeros(3), fp.probe_rotation, meas_rot[w])
+
+    def judge(fp: FullPoseFit) -> tuple[float, float]:
+        prob = Problem(ctx, fp.specs, w, fp.position.base_rotation)
+        e, _ = orientation_residual(prob, fp.theta, np.zeros(3), fp.probe_rotation, meas_rot[w])
+        return _angle_rms(e), _rms(prob, fp.theta)
+
+    def refit(specs: tuple[ParamSpec, ...]) -> tuple[FullPoseFit, float, float]:
+        fp = fit_full_pose(ctx, specs, fitting, orientation_sigma=orientation_sigma)
+        return (fp, *judge(fp))
+
+    fp0, ori0, pos0 = refit(tuple(final.specs))
+    fp, added = fp0, ()
+    if candidates:
+        fp, added = forward_search(ctx, fp0, candidates, fitting, meas_rot[fitting], refit,
+                                   (ori0, pos0), alpha, min_gain, max_steps)
+    start = fp0.position  # the diagnosis's final model, positions only
+    rt0 = probe_start(Problem(ctx, start.specs, fitting, start.base_rotation), start.theta,
+                      meas_rot[fitting])
+    prob0 = Problem(ctx, start.specs, w, start.base_rotation)
+    before, _ = orientation_residual(prob0, start.theta, np.zeros(3), rt0, meas_rot[w])
+    ori, pos_rms = judge(fp)
+    pos = fp.position
     params = tuple(ParameterPrecision(s.name, s.effect, s.unit, float(fp.theta[i]),
                                       float(pos.stderr[i]), float(fp.stderr[i]))
-                   for i, s in enumerate(specs) if i >= n_registration
+                   for i, s in enumerate(fp.specs) if i >= n_registration
                    and np.isfinite(pos.stderr[i]) and np.isfinite(fp.stderr[i]))
     return FullPoseResult(fp, fp.sigma_orientation, fp.sigma_orientation_given,
-                          fp.probe_rotation, _angle_rms(before), _angle_rms(after),
-                          _rms(prob, pos.theta), _rms(prob, fp.theta), params)
+                          fp.probe_rotation, _angle_rms(before), ori,
+                          _rms(prob0, start.theta), pos_rms, params, added)
