@@ -344,6 +344,12 @@ def _full_pose(diag: Diagnosis) -> list[str]:
          f"({1e3 * b:.3g} mrad), full pose {a:.3g} rad ({1e3 * a:.3g} mrad)",
          f"- withheld position RMS: position-only {fp.withheld_rms_position_only:.4g} {u}, "
          f"full pose {fp.withheld_rms:.4g} {u}\n"]
+    for a in fp.added:
+        L.append(f"Added by the orientation search (score test p = {a.p_value:.2g}, "
+                 f"{a.n_tried} groups tried): {a.effect} on joint {a.joint} "
+                 f"({', '.join(a.names)}); withheld orientation error "
+                 f"{1e3 * a.withheld_orientation_before:.3g} -> "
+                 f"{1e3 * a.withheld_orientation_after:.3g} mrad.\n")
     if fp.parameters:
         L += ["| parameter | unit | value (full pose) | std, positions only | std, full pose "
               "| ratio |", "|---|---|---|---|---|---|"]

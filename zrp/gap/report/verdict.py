@@ -177,11 +177,14 @@ def full_pose_text(diag: Diagnosis) -> str:
     std = ("no effect parameter to compare" if best is None else
            f"effect-parameter standard errors x{fp.std_ratio_median:.2f} of the position-only "
            f"fit (median; {best.name} x{best.ratio:.2f})")
+    reveal = "".join(f" Orientations reveal {a.effect} (joint {a.joint}; p = {a.p_value:.2g}), "
+                     "which positions see weakly." for a in fp.added)
     return (f"Measured orientations (noise {1e3 * fp.sigma_orientation:.3g} mrad, {src}) "
             f"add: {std}; withheld orientation error "
             f"{1e3 * fp.withheld_orientation_before:.3g} -> "
             f"{1e3 * fp.withheld_orientation_after:.3g} mrad, withheld position RMS "
-            f"{fp.withheld_rms_position_only:.4g} -> {fp.withheld_rms:.4g} {diag.length_unit}.")
+            f"{fp.withheld_rms_position_only:.4g} -> {fp.withheld_rms:.4g} {diag.length_unit}."
+            + reveal)
 
 
 def verdict_text(diag: Diagnosis) -> str:
