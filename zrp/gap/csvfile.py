@@ -374,7 +374,8 @@ def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: 
         warnings.warn(f"{src}: measured orientations (qw..qz) are loaded; the diagnosis chooses "
                       "the effects from the positions, then refits its final model with the "
                       "orientations and adds effects only they reveal (the report's full-pose "
-                      "section; use_orientation=False / --no-orientation: positions only)", DataWarning, stacklevel=2)
+                      "section; use_orientation=False / --no-orientation: positions only)",
+                      DataWarning, stacklevel=2)
     return Measurements(c.pose, c.point, c.q, c.xyz, frame, c.scalars.get("t"),
                         c.scalars.get("temp"), c.scalars.get("load"), c.quat, c.dirs, c.lines,
                         src)
