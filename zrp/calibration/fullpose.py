@@ -76,8 +76,12 @@ def full_pose_calibration(diag: Diagnosis, orientation_sigma: float | None = Non
     """
     ctx = diag.context
     pose_rotations(ctx)  # refuses data without orientations, naming the columns
-    specs = diag.final_fit.specs
-    fp = fit_full_pose(ctx, specs, diag.fitting_poses, orientation_sigma=orientation_sigma)
+    same = (diag.full_pose is not None
+            and diag.settings.get("orientation_sigma_rad") == orientation_sigma)
+    fp = (diag.full_pose.fit if same  # the diagnosis's own full-pose refit (zrp.gap.posefit)
+          else fit_full_pose(ctx, diag.final_fit.specs, diag.fitting_poses,
+                             orientation_sigma=orientation_sigma))
+    specs = fp.specs  # with the groups the orientations revealed (zrp.gap.posesearch)
     rb0 = fp.position.base_rotation
     fit = FitResult(tuple(specs), fp.theta, np.diag(fp.stderr ** 2), fp.position.residual,
                     fp.position.jac, rb0, np.asarray(diag.fitting_poses), True)

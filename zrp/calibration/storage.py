@@ -2,8 +2,9 @@
 
 The compensation file (``schema_version`` 1, lengths in the model's ``length_unit``, angles
 in rad) holds everything the model file cannot: the nominal model, the instrument-from-base
-transform, the tool points in full, the folded offsets, the joint map, thermal expansion and
-the backlash flank model; its keys are documented in zrp/calibration/README.md.
+transform, the tool points in full, the folded offsets, the joint map, thermal expansion,
+the backlash flank model and, after a full-pose fit, the probe rotation and noise weights;
+its keys are documented in zrp/calibration/README.md.
 """
 
 from __future__ import annotations
@@ -17,18 +18,36 @@ import numpy as np
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.jointmap import Term
 from zrp.errors import InputError
+from zrp.gap.fullpose import FullPoseFit
 from zrp.jsonio import dumps
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.output import check_writable, write_text
 from zrp.rotations import er_from_matrix, er_to_rotvec
 
-__all__ = ["SCHEMA_VERSION", "calibration_document", "read_calibration", "write_calibration"]
+__all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "read_calibration",
+           "write_calibration"]
 
 SCHEMA_VERSION = 1
 
 
-def calibration_document(cal: CalibratedRobot, model_file: str) -> dict[str, Any]:
-    """The compensation file's JSON document (see the module doc)."""
+def full_pose_document(fp: FullPoseFit | None) -> dict[str, Any] | None:
+    """The ``full_pose`` entry: the probe rotation R_t (probe frame in the hand frame) and the
+    noise weights of a full-pose fit (:mod:`zrp.gap.fullpose`); None without one."""
+    if fp is None or not fp.orientation:
+        return None
+    rt = np.asarray(fp.probe_rotation)
+    return {"probe_rotation": rt.tolist(),
+            "probe_rotvec_rad": er_to_rotvec(er_from_matrix(rt)).tolist(),
+            "sigma_orientation_rad": fp.sigma_orientation,
+            "sigma_orientation_source": "given" if fp.sigma_orientation_given else "estimated",
+            "sigma_position": fp.sigma_position,
+            "orientation_rms_rad": fp.orientation_rms}
+
+
+def calibration_document(cal: CalibratedRobot, model_file: str,
+                         full_pose: FullPoseFit | None = None) -> dict[str, Any]:
+    """The compensation file's JSON document (see the module doc); ``full_pose``: the
+    full-pose fit the calibration came from (its probe rotation and noise are recorded)."""
     return {
         "schema_version": SCHEMA_VERSION,
         "kind": "zrp calibration (non-geometric part and registration)",
@@ -52,6 +71,7 @@ def calibration_document(cal: CalibratedRobot, model_file: str) -> dict[str, Any
         "withheld_rms": cal.withheld_rms,
         "gravity_side_weights": (None if cal.gravity_side_weights is None
                                  else np.asarray(cal.gravity_side_weights).tolist()),
+        "full_pose": full_pose_document(full_pose),
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
                   "= R_b (p'(x) + R'_n(x) t'_j) + t_b with p', R'_n the forward kinematics of "
                   "model_file, bodies scaled by 1 + kappa (temp - t_ref)"),
@@ -59,15 +79,17 @@ def calibration_document(cal: CalibratedRobot, model_file: str) -> dict[str, Any
 
 
 def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: str | Path, *,
-                      overwrite: bool = False) -> tuple[Path, Path]:
+                      overwrite: bool = False, full_pose: FullPoseFit | None = None
+                      ) -> tuple[Path, Path]:
     """Write the calibrated model (TOML) and the compensation file (JSON), atomically; both
-    names are checked before either is written.
+    names are checked before either is written. ``full_pose``: the full-pose fit of ``cal``
+    (its probe rotation and orientation noise go to the file's ``full_pose``).
 
     Raises:
         OutputExistsError: a file exists and ``overwrite`` is False.
     """
     check_writable([model_path, comp_path], overwrite)
-    doc = calibration_document(cal, Path(model_path).name)
+    doc = calibration_document(cal, Path(model_path).name, full_pose)
     m = write_text(model_path, dumps_model(cal.model), overwrite=overwrite)
     c = write_text(comp_path, dumps(doc), overwrite=overwrite)
     return m, c

@@ -372,8 +372,10 @@ def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: 
     _check_scalars(c.scalars, c.lines, src)
     if c.quat is not None:
         warnings.warn(f"{src}: measured orientations (qw..qz) are loaded; the diagnosis chooses "
-                      "the effects from the positions only (zrp calibrate refits the final "
-                      "model with the orientations)", DataWarning, stacklevel=2)
+                      "the effects from the positions, then refits its final model with the "
+                      "orientations and adds effects only they reveal (the report's full-pose "
+                      "section; use_orientation=False / --no-orientation: positions only)",
+                      DataWarning, stacklevel=2)
     return Measurements(c.pose, c.point, c.q, c.xyz, frame, c.scalars.get("t"),
                         c.scalars.get("temp"), c.scalars.get("load"), c.quat, c.dirs, c.lines,
                         src)

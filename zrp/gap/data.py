@@ -74,7 +74,8 @@ class Measurements:
         temp: temperature, deg C, shape (R,), or None.
         load: payload, kg, shape (R,), or None.
         quat: measured orientation (qw, qx, qy, qz), shape (R, 4), or None (used by
-            :mod:`zrp.gap.fullpose`; the stepwise diagnosis uses positions only).
+            :mod:`zrp.gap.fullpose`; the stepwise search uses positions only, the final
+            model is refitted with them, :mod:`zrp.gap.posefit`).
         direction: approach direction per joint (-1, 0, +1), shape (R, n), or None.
         lines: source line number of each row (for messages), shape (R,).
         source: file name or a description, for messages.

@@ -39,7 +39,8 @@ from zrp.gap.leastsq import FitResult, _covariance, fit, initial_registration
 from zrp.gap.problem import Problem
 from zrp.rotations import left_jacobian
 
-__all__ = ["FullPoseFit", "fit_full_pose", "orientation_residual", "pose_rotations"]
+__all__ = ["FullPoseFit", "fit_full_pose", "orientation_residual", "pose_rotations",
+           "probe_start"]
 
 F64 = NDArray[np.float64]
 
@@ -120,6 +121,7 @@ class FullPoseFit:
         orientation_rms: RMS rotation angle of the orientation residuals (rad; nan without).
         position: the position-only fit (the start).
         orientation: orientations were used.
+        sigma_orientation_given: sigma_orientation was given (False: estimated).
     """
 
     specs: tuple[ParamSpec, ...]
@@ -131,6 +133,7 @@ class FullPoseFit:
     orientation_rms: float
     position: FitResult
     orientation: bool
+    sigma_orientation_given: bool = False
 
     def __post_init__(self) -> None:
         p = len(self.specs)
@@ -150,7 +153,7 @@ class FullPoseFit:
         return names.index(name)
 
 
-def _probe_start(prob: Problem, theta: F64, measured: F64) -> F64:
+def probe_start(prob: Problem, theta: F64, measured: F64) -> F64:
     """R_t0: the rotation closest to the mean of (R_b R_n)^T R_meas over the poses."""
     n = prob.ctx.model.n
     rb, _ = prob.base(theta)
@@ -190,7 +193,7 @@ def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
                          f"{orientation_sigma!r}")
     measured = pose_rotations(ctx)[poses]
     prob = Problem(ctx, specs, poses, rb0)
-    rt0 = _probe_start(prob, pos.theta, measured)
+    rt0 = probe_start(prob, pos.theta, measured)
     p = prob.size
     x = np.concatenate([pos.theta, np.zeros(3)])
     e, _ = orientation_residual(prob, pos.theta, np.zeros(3), rt0, measured)
@@ -217,4 +220,5 @@ def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))[:p]
     rt = Rotation.from_rotvec(x[p:]).as_matrix() @ rt0
     ang = float(np.sqrt(np.mean(np.sum(e ** 2, axis=1))))
-    return FullPoseFit(tuple(specs), x[:p], se, rt, sp, so, ang, pos, True)
+    return FullPoseFit(tuple(specs), x[:p], se, rt, sp, so, ang, pos, True,
+                       orientation_sigma is not None)

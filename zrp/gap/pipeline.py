@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from zrp.arguments import check_instance, check_int, check_seed
+from zrp.arguments import check_float, check_instance, check_int, check_seed
 from zrp.blas import blas_threads
 from zrp.errors import InputError
 from zrp.gap.assessment import Assessment, compliance_units, remainder_evidence
@@ -47,6 +47,7 @@ from zrp.gap.leastsq import FitResult, fit, initial_registration
 from zrp.gap.metrics import Metrics
 from zrp.gap.noise import noise_floor
 from zrp.gap.options import DiagnosisOptions
+from zrp.gap.posefit import refit_full_pose
 from zrp.gap.profiles import with_gravity_side
 from zrp.gap.registration import registration_of
 from zrp.gap.results import (
@@ -84,7 +85,9 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
              harmonics: tuple[int, ...] = (1, 2),
              gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0),
              progress: bool = False,
-             max_points: int | None = MAX_POINTS) -> Diagnosis:
+             max_points: int | None = MAX_POINTS,
+             use_orientation: bool = True,
+             orientation_sigma: float | None = None) -> Diagnosis:
     """Diagnose the gap between ``model`` and ``measurements``.
 
     Args:
@@ -103,6 +106,11 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         max_points: most measured points used; beyond it a seeded random subsample of whole
             poses (the rule in :mod:`zrp.gap.subsample`, announced in a warning and in the
             diagnosis's ``warnings``); None uses every point.
+        use_orientation: when the measurements carry ``qw..qz``, refit the final model
+            with positions and orientations together (:mod:`zrp.gap.posefit`; the result's
+            ``full_pose``); False: positions only.
+        orientation_sigma: orientation noise per component (rad) weighting the orientation
+            residuals; None: estimated from them. Needs measured orientations.
 
     Returns:
         the :class:`Diagnosis`.
@@ -128,6 +136,7 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
                          f"the model {model.name!r} has {model.n} joints")
     if max_points is not None:
         check_int(max_points, "max_points", 1)
+    _check_orientation(measurements, use_orientation, orientation_sigma)
     rng = np.random.default_rng(seed) if rng is None else rng
     with warnings.catch_warnings(record=True) as wlist:
         warnings.simplefilter("always")
@@ -137,6 +146,7 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
             gravity_torque = _kept_rows(gravity_torque, kept, n_poses)
         with blas_threads(1):  # small dense problems: one BLAS thread is ~3x faster (zrp.blas)
             result = run_diagnosis(model, measurements, gravity_torque, opts, rng)
+            result = _with_full_pose(result, bool(use_orientation), orientation_sigma)
     # raised again, every one at the caller's line (whatever the stage that found it)
     caller = sys._getframe(1)
     for w in wlist:
@@ -144,6 +154,35 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
                                caller.f_lineno)
     caught = tuple(dict.fromkeys(str(w.message) for w in wlist))
     return dataclasses.replace(result, warnings=caught)
+
+
+def _check_orientation(meas: Measurements, use: object, sigma: object) -> None:
+    if not isinstance(use, (bool, np.bool_)):
+        raise InputError(f"use_orientation: expected True or False, got {use!r}")
+    if sigma is None:
+        return
+    check_float(sigma, "orientation_sigma", 0.0, 1.0, open_lo=True, unit="rad")
+    if meas.quat is None or not use:
+        raise InputError("orientation_sigma: given, but " + (
+            f"{meas.source} has no qw, qx, qy, qz columns to weight" if meas.quat is None
+            else "orientations are switched off: use_orientation=False (--no-orientation on "
+            "the command line)"))
+
+
+def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosis:
+    """``diag`` with its final model refitted from positions and orientations when the
+    measurements carry them and ``use`` (:mod:`zrp.gap.posefit`), recorded in its settings."""
+    used = use and diag.context.meas.quat is not None
+    full = None
+    if used:
+        ctx, st = diag.context, diag.settings
+        cands = {e: excited_only(ctx, effect_parameters(ctx, e))[0] for e in st["effects"]}
+        full = refit_full_pose(ctx, diag.final_fit, diag.fitting_poses, diag.withheld_poses,
+                               len(diag.registration), sigma, candidates=cands,
+                               alpha=st["alpha"], min_gain=st["min_gain"],
+                               max_steps=st["max_steps"])
+    settings = {**diag.settings, "orientation": used, "orientation_sigma_rad": sigma}
+    return dataclasses.replace(diag, full_pose=full, settings=settings)
 
 
 def _kept_rows(gravity_torque: ArrayLike, kept: NDArray[np.int64], n_poses: int

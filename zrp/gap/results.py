@@ -21,6 +21,7 @@ from zrp.gap.assessment import Assessment
 from zrp.gap.effects import EFFECTS, Context
 from zrp.gap.leastsq import Aliased, FitResult
 from zrp.gap.metrics import Metrics, NoiseFloor
+from zrp.gap.posefit import FullPoseResult
 from zrp.gap.uncertainty import simultaneous_z
 from zrp.gap.where import WhereAnalysis
 
@@ -312,6 +313,7 @@ class Diagnosis:
         assessment: the geometric baseline, robust intervals, correlations, plausibility,
             the full registration and the evidence on what remains
             (:class:`~zrp.gap.assessment.Assessment`).
+        full_pose: the final model refitted with orientations (:mod:`zrp.gap.posefit`).
     """
 
     model_name: str
@@ -336,6 +338,7 @@ class Diagnosis:
     withheld_poses: NDArray[np.int64]
     settings: dict[str, Any] = field(default_factory=dict)
     assessment: Assessment | None = None
+    full_pose: FullPoseResult | None = None
 
     def __post_init__(self) -> None:
         if not all(isinstance(st, Step) for st in self.steps):
@@ -433,4 +436,5 @@ class Diagnosis:
             "aliased": [alias_dict(a) for a in self.aliased],
             "warnings": list(self.warnings),
             **({} if self.assessment is None else self.assessment.to_dict()),
+            "full_pose": None if self.full_pose is None else self.full_pose.to_dict(),
         }

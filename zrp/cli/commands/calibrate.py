@@ -66,15 +66,18 @@ def _run(args: argparse.Namespace) -> int:
     try:
         with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES + FILES) as out:
             diag = diagnose(model, meas, gravity_torque=tau, effects=args.effects,
-                            seed=args.seed, max_steps=args.max_steps, noise_sigma=args.noise)
+                            seed=args.seed, max_steps=args.max_steps, noise_sigma=args.noise,
+                            use_orientation=not args.no_orientation,
+                            orientation_sigma=args.orientation_sigma)
             cal = CalibratedRobot.from_diagnosis(diag)
             full = None
-            if meas.quat is not None and not args.no_orientation:
+            if diag.full_pose is not None:
                 full = full_pose_calibration(diag, args.orientation_sigma)
                 cal = full.robot
             files = write_outputs(diag, out, plots=False)
             files += list(write_calibration(cal, out_dir / FILES[0], out_dir / FILES[1],
-                                            overwrite=True))
+                                            overwrite=True,
+                                            full_pose=None if full is None else full.fit))
     except BaseException:
         if created:
             with contextlib.suppress(OSError):
@@ -84,7 +87,7 @@ def _run(args: argparse.Namespace) -> int:
             f"{model.length_unit} (effects: {', '.join(diag.effects)})\n"
             + ("" if full is None else _full_pose_line(full, model.length_unit))
             + "\n".join(f"wrote {f}" for f in files))
-    emit(args, calibration_document(cal, FILES[0]), text)
+    emit(args, calibration_document(cal, FILES[0], None if full is None else full.fit), text)
     return 0
 
 

@@ -59,6 +59,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--noise", type=LENGTH, metavar="SIGMA",
                    help="known instrument noise per coordinate (length unit); default: "
                         "estimated from rigidly linked points or repeats")
+    p.add_argument("--orientation-sigma", type=real(0.0, 1.0, open_lo=True), metavar="RAD",
+                   help="orientation noise per component (rad) when the data carry qw..qz; "
+                        "default: estimated from the orientation residuals")
+    p.add_argument("--no-orientation", action="store_true",
+                   help="ignore measured orientations (qw..qz): no full-pose refit")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
                    help="show progress on stderr: a bar on a terminal, a line every 10 s "
@@ -83,6 +88,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "gravity_torque": "--mjcf",
         "max_points": "--max-points",
         "max_rows": "--max-rows",
+        "orientation_sigma": "--orientation-sigma",
     })
 
 
@@ -131,7 +137,9 @@ def _run(args: argparse.Namespace) -> int:
             diag = run_diagnosis(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, withheld_fraction=args.withheld, folds=args.folds,
                             alpha=args.alpha, max_steps=args.max_steps, noise_sigma=args.noise,
-                            progress=args.progress, max_points=args.max_points or None)
+                            progress=args.progress, max_points=args.max_points or None,
+                            use_orientation=not args.no_orientation,
+                            orientation_sigma=args.orientation_sigma)
             files = write_outputs(diag, out, plots=not args.no_plots)
     except BaseException:
         if created:  # a failed run leaves no empty folder it made

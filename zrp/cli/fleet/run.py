@@ -66,7 +66,9 @@ def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[Robot
         raise InputError(f"--mjcf: {mjcf} is not a file")
     opts = {"effects": args.effects, "seed": args.seed, "withheld_fraction": args.withheld,
             "folds": args.folds, "alpha": args.alpha, "max_steps": args.max_steps,
-            "noise_sigma": args.noise, "progress": False}
+            "noise_sigma": args.noise, "progress": False,
+            "use_orientation": not args.no_orientation,
+            "orientation_sigma": args.orientation_sigma}
     read = {"deg": args.deg, "frame": args.frame}
     return [RobotTask(f.stem, f.resolve(), (out / "robots" / f.stem).resolve(), model, mjcf,
                       read, opts, not args.no_plots) for f in files]

@@ -7,7 +7,8 @@ import numpy as np
 from zrp.gap.results import Diagnosis
 from zrp.gap.where import WhereAnalysis
 
-__all__ = ["baseline_text", "final_effects_text", "remains_text", "verdict_text"]
+__all__ = ["baseline_text", "final_effects_text", "full_pose_text", "remains_text",
+           "verdict_text"]
 
 #: R^2 below which the residual is said to depend on nothing in particular.
 NO_TREND_R2 = 0.1
@@ -166,6 +167,26 @@ def _weighed(diag: Diagnosis) -> list[str]:
     return out
 
 
+def full_pose_text(diag: Diagnosis) -> str:
+    """One sentence on what the measured orientations add ("" without a full-pose fit)."""
+    fp = diag.full_pose
+    if fp is None:
+        return ""
+    src = "given" if fp.sigma_orientation_given else "estimated"
+    best = fp.best
+    std = ("no effect parameter to compare" if best is None else
+           f"effect-parameter standard errors x{fp.std_ratio_median:.2f} of the position-only "
+           f"fit (median; {best.name} x{best.ratio:.2f})")
+    reveal = "".join(f" Orientations reveal {a.effect} (joint {a.joint}; p = {a.p_value:.2g}), "
+                     "which positions see weakly." for a in fp.added)
+    return (f"Measured orientations (noise {1e3 * fp.sigma_orientation:.3g} mrad, {src}) "
+            f"add: {std}; withheld orientation error "
+            f"{1e3 * fp.withheld_orientation_before:.3g} -> "
+            f"{1e3 * fp.withheld_orientation_after:.3g} mrad, withheld position RMS "
+            f"{fp.withheld_rms_position_only:.4g} -> {fp.withheld_rms:.4g} {diag.length_unit}."
+            + reveal)
+
+
 def verdict_text(diag: Diagnosis) -> str:
     """One paragraph: the effects of the final model (and ties), how far the withheld error
     shrinks, the geometric baseline beside it, how the error compares with the noise floor
@@ -180,4 +201,6 @@ def verdict_text(diag: Diagnosis) -> str:
         parts.append(bl)
     parts += _against_floor(diag)
     parts += _trust(diag)
+    if diag.full_pose is not None:
+        parts.append(full_pose_text(diag))
     return " ".join(parts)
