@@ -510,18 +510,23 @@ def jac_batch(q, axes, bodies, prism, lim, pose, jac):
 # bodies b_{k,0} (3(n + 1)), then the prismatic flags as 0/1 (n).
 
 
+@njit(inline="always")
+def _packed_q_ok(q, n):
+    """True when every |q[k]| <= 1e6 (the revolute range of _range_kernels; non-finite values
+    fail): otherwise the packed kernels decline and the general path names the joint."""
+    for k in range(n):
+        if not abs(q[k]) <= 1e6:
+            return False
+    return True
+
+
 @njit(cache=True, fastmath=_FM)
 def fk_pose_packed(q, packed, out):
     """:func:`fk_pose_one` on the packed model; returns False (out untouched) when q has a
     non-finite value, |q| > 1e6 or not the model's n values."""
     n = (packed.shape[0] - 3) // 7
-    if q.shape[0] != n:
+    if q.shape[0] != n or not _packed_q_ok(q, n):
         return False
-    for k in range(n):
-        # declines non-finite values and |q| > 1e6 (the revolute range of _range_kernels): the
-        # general path then names the joint in its error
-        if not abs(q[k]) <= 1e6:
-            return False
     nb = 3 * n
     npr = nb + 3 * (n + 1)
     e0, e1, e2, e3 = 1.0, 0.0, 0.0, 0.0
@@ -559,13 +564,8 @@ def jac_packed(q, packed, jac):
     """The eq (7) Jacobian (6, n) of one joint vector on the packed model; returns False
     (jac untouched) when q has a non-finite value or not the model's n values."""
     n = (packed.shape[0] - 3) // 7
-    if q.shape[0] != n or jac.shape[1] != n:
+    if q.shape[0] != n or jac.shape[1] != n or not _packed_q_ok(q, n):
         return False
-    for k in range(n):
-        # declines non-finite values and |q| > 1e6 (the revolute range of _range_kernels): the
-        # general path then names the joint in its error
-        if not abs(q[k]) <= 1e6:
-            return False
     nb = 3 * n
     npr = nb + 3 * (n + 1)
     e0, e1, e2, e3 = 1.0, 0.0, 0.0, 0.0
