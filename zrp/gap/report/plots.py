@@ -121,7 +121,7 @@ def _shrink(plt: Any, diag: Diagnosis) -> Any:
     ax.set_xticks(xs, labels, rotation=20, ha="right")
     ax.set_ylabel(f"withheld error ({unit}, log)")
     ax.set_title("Withheld error per step (log axis)")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # beside, not over bars
     fig.tight_layout()
     return fig
 
