@@ -3,7 +3,11 @@ localhost. Every result computed on it must equal the single-process one bit for
 
 from __future__ import annotations
 
+import ast
 import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -12,7 +16,7 @@ import pytest
 import zrp
 from sim.benchmark import BenchmarkConfig, run_benchmark
 from zrp.cli import main
-from zrp.cli.cluster import WORKER_ENV
+from zrp.cli.cluster import LOCAL_CONFIG, local_cluster
 from zrp.gap import Injection, synthesize
 from zrp.kinematics import uniform_joint_values
 from zrp.manufacturing import Tolerances, allocate_tolerances, chunk_rng, monte_carlo
@@ -25,12 +29,41 @@ distributed = pytest.importorskip("distributed")
 
 @pytest.fixture(scope="module")
 def cluster():
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  protocol="tcp", host="127.0.0.1", dashboard_address=":0",
-                                  env=WORKER_ENV) as lc, distributed.Client(lc) as client:
-        assert lc.scheduler_address.startswith("tcp://127.0.0.1:")
+    with local_cluster(2) as client:
+        assert client.scheduler.address.startswith("tcp://127.0.0.1:")
         assert len(client.scheduler_info()["workers"]) == 2
         yield client
+
+
+WORKER_PROBE = """
+import os, sys
+import zrp  # imports numba here, so a spawned worker imports it too before Dask's env=
+from zrp.cli.cluster import executor
+
+def probe(_):
+    import dask, numba
+    return (numba.config.NUMBA_NUM_THREADS, numba.get_num_threads(),
+            dask.config.get("distributed.worker.profile.enabled"), os.getpid())
+
+if __name__ == "__main__":
+    before = dict(os.environ)
+    with executor(2) as ex:
+        rows = list(ex.map(probe, range(4)))
+    print(repr((rows, dict(os.environ) == before)))
+"""
+
+
+def test_local_workers_run_numba_on_one_thread_when_main_imports_zrp(tmp_path):
+    # the `zrp` script imports numba in __main__; a Nanny's env= came too late for that (each
+    # worker ran a 2-thread numba kernel on a 2-core machine), pre-spawn-environ does not
+    script = tmp_path / "probe.py"
+    script.write_text(WORKER_PROBE)
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_NUM_THREADS"}
+    out = subprocess.run([sys.executable, str(script)], capture_output=True, text=True,
+                         env=env, timeout=300, check=True)
+    rows, env_restored = ast.literal_eval(out.stdout.strip().splitlines()[-1])
+    assert {r[:3] for r in rows} == {(1, 1, LOCAL_CONFIG["distributed.worker.profile.enabled"])}
+    assert env_restored
 
 
 def _path(n: int, steps: int = 60) -> np.ndarray:
