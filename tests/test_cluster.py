@@ -204,6 +204,15 @@ def test_tolerance_cli_on_the_cluster_equals_in_process(cluster, capsys):
     there = json.loads(capsys.readouterr().out)
     for k in ("max_delta_p_mm", "max_angle_rad", "p99_max_delta_p", "first_order"):
         assert here[k] == there[k]
+    # reduced on the workers: histograms merged in chunk order, so even the mean is bit-equal
+    assert main([*base, "--reduce"]) == 0
+    here = json.loads(capsys.readouterr().out)
+    assert main([*base, "--reduce", "--scheduler", cluster.scheduler.address]) == 0
+    there = json.loads(capsys.readouterr().out)
+    assert here["reduced_on_workers"] and there["reduced_on_workers"]
+    for k in ("max_delta_p_mm", "max_angle_rad", "p99_max_delta_p", "p99_max_delta_p_ci95",
+              "first_order", "mc_max_over_worst_case_p"):
+        assert here[k] == there[k], k
     with pytest.raises(SystemExit) as exit_:  # a checked option type: argparse refuses it
         main([*base, "--workers", "0"])
     assert exit_.value.code == 2

@@ -22,6 +22,7 @@ from zrp.model.manipulator import Manipulator
 
 if TYPE_CHECKING:
     from zrp.manufacturing.population import MonteCarloResult
+    from zrp.manufacturing.reduction import MonteCarloSummary
 
 __all__ = ["Contribution", "contributions", "tolerance_report", "worst_case_bound"]
 
@@ -146,9 +147,9 @@ def contributions(jac: ArrayLike, tolerances: ArrayLike, names: tuple[str, ...],
 
 
 def tolerance_report(model: Manipulator, q: ArrayLike, tolerances: Tolerances,
-                     mc: MonteCarloResult | None = None) -> dict[str, Any]:
+                     mc: MonteCarloResult | MonteCarloSummary | None = None) -> dict[str, Any]:
     """First-order analysis of given tolerances: contributions, worst case, and (if ``mc`` is
-    given) its comparison with the Monte Carlo maxima."""
+    given, gathered or reduced on the workers) its comparison with the Monte Carlo maxima."""
     q = check_q(model, q)
     jac = parameter_jacobian(model, q, joint_offsets=tolerances.joint_offsets)
     dist = mc.distribution if mc is not None else "uniform"
@@ -163,8 +164,8 @@ def tolerance_report(model: Manipulator, q: ArrayLike, tolerances: Tolerances,
         "contribution": contrib,
     }
     if mc is not None:
-        out["mc_max_delta_p"] = float(mc.max_delta_p.max())
-        out["mc_max_angle_rad"] = float(mc.max_angle_rad.max())
-        out["mc_over_worst_case_p"] = float(mc.max_delta_p.max() / wc_p.max()) \
-            if wc_p.max() > 0 else 0.0
+        mc_p, mc_r = mc.maxima()
+        out["mc_max_delta_p"] = mc_p
+        out["mc_max_angle_rad"] = mc_r
+        out["mc_over_worst_case_p"] = float(mc_p / wc_p.max()) if wc_p.max() > 0 else 0.0
     return out

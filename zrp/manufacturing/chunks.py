@@ -84,8 +84,9 @@ class ChunkTask:
         first_order: also the first-order maxima (the worker computes the identification
             Jacobian, ~30 ms, rather than receive its T x 6 x P x 8 bytes with every chunk).
         edges: bin edges (delta_p, angle) to reduce the chunk on the worker to two
-            :class:`~zrp.manufacturing.histogram.Histogram` (a few KB whatever its size)
-            instead of returning per-robot maxima; None returns the maxima.
+            :class:`~zrp.manufacturing.histogram.Histogram` (four with ``first_order``: the
+            first-order maxima over the same edges; a few KB whatever its size) instead of
+            returning per-robot maxima; None returns the maxima.
     """
 
     index: int
@@ -103,8 +104,6 @@ class ChunkTask:
     def __post_init__(self) -> None:
         if (self.seed is None) == (self.dx is None):
             raise InputError("ChunkTask: give exactly one of seed and dx")
-        if self.edges is not None and self.first_order:
-            raise InputError("ChunkTask: first_order needs the per-robot maxima (edges=None)")
         if self.dx is not None and self.dx.shape[0] != self.size:
             raise InputError(f"ChunkTask.dx: expected {self.size} rows, got {self.dx.shape[0]}")
 
@@ -121,7 +120,8 @@ class ChunkTask:
 class ChunkResult:
     """Per-robot maxima of one chunk, each shape (size,) (None when reduced on the worker);
     first-order ones or None; ``elapsed_s``: wall time of the nonlinear kernel on the worker;
-    ``histograms``: (delta_p, angle) histograms when the task gave ``edges``, else None."""
+    ``histograms``: (delta_p, angle) histograms when the task gave ``edges``, followed by the
+    first-order (delta_p, angle) ones when it also asked for ``first_order``; else None."""
 
     index: int
     max_delta_p: F64 | None
@@ -155,10 +155,13 @@ def run_chunk(task: ChunkTask) -> ChunkResult:
     t0 = time.perf_counter()
     dp, ang = nonlinear_maxima(task.model, task.arrays, dx, task.tolerances.joint_offsets)
     elapsed = time.perf_counter() - t0
-    if task.edges is not None:  # reduce here: only the histograms travel back
-        return ChunkResult(task.index, None, None, None, None, elapsed,
-                           (Histogram.of(dp, task.edges[0]), Histogram.of(ang, task.edges[1])))
     fo_p = fo_r = None
     if task.first_order:
         fo_p, fo_r = first_order_max(_jacobian(task), dx)
+    if task.edges is not None:  # reduce here: only the histograms travel back
+        e_p, e_r = task.edges
+        hists = (Histogram.of(dp, e_p), Histogram.of(ang, e_r))
+        if fo_p is not None and fo_r is not None:
+            hists += (Histogram.of(fo_p, e_p), Histogram.of(fo_r, e_r))
+        return ChunkResult(task.index, None, None, None, None, elapsed, hists)
     return ChunkResult(task.index, dp, ang, fo_p, fo_r, elapsed)

@@ -103,6 +103,18 @@ class Histogram:
         hi = self.maximum if j == self.edges.size else self.edges[j]
         return float(max(lo, self.minimum)), float(min(hi, self.maximum))
 
+    def order_statistic(self, k: int) -> tuple[float, float]:
+        """[lo, hi] holding the ``k``-th smallest value (0-based, 0 <= k < total): the
+        range of its bin, or the exact value for the extremes."""
+        if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or \
+                not 0 <= k < self.total:
+            raise InputError(f"k: expected a rank 0 <= k < {self.total}, got {k!r}")
+        if k == 0 or k == self.total - 1:
+            x = self.minimum if k == 0 else self.maximum
+            return x, x
+        j = int(np.searchsorted(np.cumsum(self.counts), int(k), side="right"))
+        return self._bin_range(j)
+
     def percentile(self, pct: float) -> tuple[float, float, float]:
         """(estimate, lo, hi) of the ``pct`` percentile (NumPy's linear definition): the
         exact percentile of the values lies in [lo, hi], the bins holding the order

@@ -24,7 +24,7 @@ from zrp.manufacturing.maxima import first_order_max as first_order_max
 from zrp.manufacturing.maxima import nonlinear_maxima as nonlinear_maxima
 from zrp.manufacturing.maxima import trajectory_arrays as trajectory_arrays
 from zrp.manufacturing.sensitivity import parameter_space
-from zrp.manufacturing.tolerance import Tolerances, draw_parameters
+from zrp.manufacturing.tolerance import Tolerances, draw_parameters, percentile_ci
 from zrp.model.manipulator import Manipulator
 from zrp.tasks import map_tasks
 
@@ -90,6 +90,15 @@ class MonteCarloResult:
     @property
     def poses_per_s(self) -> float:
         return self.n_robots * self.n_points / max(self.elapsed_s, 1e-12)
+
+    def maxima(self) -> tuple[float, float]:
+        """The largest max_t delta_p and max_t theta over the robots."""
+        return float(self.max_delta_p.max()), float(self.max_angle_rad.max())
+
+    def percentile_ci(self, pct: float, confidence: float = 0.95) -> tuple[float, float]:
+        """Distribution-free ``confidence`` interval of the ``pct`` percentile of
+        max_t delta_p (:func:`~zrp.manufacturing.tolerance.percentile_ci`)."""
+        return percentile_ci(self.max_delta_p, pct, confidence)
 
     def percentile(self, pct: float) -> tuple[float, float]:
         """(delta_p, angle_rad) percentiles of the per-robot maxima; 0 <= pct <= 100."""

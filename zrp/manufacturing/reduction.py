@@ -32,7 +32,7 @@ from zrp.manufacturing.chunks import ChunkResult, run_chunk
 from zrp.manufacturing.histogram import Histogram, geometric_edges
 from zrp.manufacturing.population import DEFAULT_PERCENTILES, chunk_tasks
 from zrp.manufacturing.sensitivity import parameter_jacobian
-from zrp.manufacturing.tolerance import Tolerances
+from zrp.manufacturing.tolerance import Tolerances, percentile_ci_ranks
 from zrp.model.manipulator import Manipulator
 from zrp.tasks import map_tasks
 
@@ -66,6 +66,8 @@ class MonteCarloSummary:
         angle_rad: histogram of max_t theta_eps (rad).
         tolerances, distribution, n_points, elapsed_s, unit, percentiles: as in
             :class:`~zrp.manufacturing.population.MonteCarloResult`.
+        first_order_delta_p, first_order_angle_rad: histograms of the first-order model's
+            maxima for the same robots (same edges), or None.
     """
 
     delta_p: Histogram
@@ -76,10 +78,17 @@ class MonteCarloSummary:
     elapsed_s: float
     unit: str = "mm"
     percentiles: tuple[float, ...] = field(default=DEFAULT_PERCENTILES)
+    first_order_delta_p: Histogram | None = None
+    first_order_angle_rad: Histogram | None = None
 
     def __post_init__(self) -> None:
         if self.delta_p.total != self.angle_rad.total:
             raise InputError("MonteCarloSummary: delta_p and angle_rad count different robots")
+        fo = (self.first_order_delta_p, self.first_order_angle_rad)
+        if (fo[0] is None) != (fo[1] is None) or any(
+                h is not None and h.total != self.delta_p.total for h in fo):
+            raise InputError("MonteCarloSummary: first_order_delta_p and first_order_angle_rad"
+                             " must both be given, for the same robots, or neither")
         for pct in self.percentiles:
             check_percentile(pct, "percentiles")
 
@@ -91,6 +100,23 @@ class MonteCarloSummary:
         """(delta_p, angle_rad) percentile estimates (each within its bin's bracket)."""
         return self.delta_p.percentile(pct)[0], self.angle_rad.percentile(pct)[0]
 
+    @property
+    def poses_per_s(self) -> float:
+        return self.n_robots * self.n_points / max(self.elapsed_s, 1e-12)
+
+    def maxima(self) -> tuple[float, float]:
+        """The largest max_t delta_p and max_t theta over the robots (exact)."""
+        return self.delta_p.maximum, self.angle_rad.maximum
+
+    def percentile_ci(self, pct: float, confidence: float = 0.95) -> tuple[float, float]:
+        """A conservative distribution-free ``confidence`` interval of the ``pct`` percentile
+        of max_t delta_p: the order statistics of
+        :func:`~zrp.manufacturing.tolerance.percentile_ci_ranks` are known to their bins, so
+        the interval runs from the lower end of the first one's bin to the upper end of the
+        second one's (it contains the interval the gathered robots give)."""
+        lo, hi = percentile_ci_ranks(self.n_robots, pct, confidence)
+        return self.delta_p.order_statistic(lo)[0], self.delta_p.order_statistic(hi)[1]
+
     def summary(self) -> dict[str, Any]:
         u = self.unit
         out: dict[str, Any] = {
@@ -101,12 +127,18 @@ class MonteCarloSummary:
             f"max_delta_p_{u}": {"max": self.delta_p.maximum, "mean": self.delta_p.mean},
             "max_angle_rad": {"max": self.angle_rad.maximum, "mean": self.angle_rad.mean},
         }
+        blocks = [(out, f"max_delta_p_{u}", self.delta_p), (out, "max_angle_rad", self.angle_rad)]
+        if self.first_order_delta_p is not None and self.first_order_angle_rad is not None:
+            fo: dict[str, Any] = {f"max_delta_p_{u}": {}, "max_angle_rad": {}}
+            out["first_order"] = fo
+            blocks += [(fo, f"max_delta_p_{u}", self.first_order_delta_p),
+                       (fo, "max_angle_rad", self.first_order_angle_rad)]
         for pct in self.percentiles:
             key = f"p{pct:g}"
-            for name, h in ((f"max_delta_p_{u}", self.delta_p), ("max_angle_rad", self.angle_rad)):
+            for parent, name, h in blocks:
                 est, lo, hi = h.percentile(pct)
-                out[name][key] = est
-                out[name][f"{key}_bracket"] = [lo, hi]
+                parent[name][key] = est
+                parent[name][f"{key}_bracket"] = [lo, hi]
         return out
 
 
@@ -114,32 +146,43 @@ def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances
                         n_robots: int, *, seed: int | None = None,
                         rng: np.random.Generator | None = None,
                         distribution: str = "uniform", chunk: int | None = None,
-                        progress: bool = False,
+                        progress: bool = False, first_order: bool = False,
                         percentiles: tuple[float, ...] = DEFAULT_PERCENTILES,
                         executor: Executor | Any | None = None) -> MonteCarloSummary:
     """:func:`~zrp.manufacturing.population.monte_carlo` reduced on the workers (same
-    arguments but ``first_order``): each chunk returns two histograms, merged as they arrive,
-    so the memory does not grow with ``n_robots`` (give ``seed`` for very large runs: with
-    ``rng`` the draws are made here and shipped)."""
+    arguments): each chunk returns two histograms (four with ``first_order``), merged as they
+    arrive, so the memory does not grow with ``n_robots`` (give ``seed`` for very large runs:
+    with ``rng`` the draws are made here and shipped). The histograms are merged in chunk
+    order (a result that arrives early waits, a few KB, for the ones before it), so even the
+    floating-point sums behind the mean are the same bit for bit on any number of workers."""
     for pct in percentiles:
         check_percentile(pct, "percentiles")
     edges = histogram_edges(model, q, tolerances)
     tasks = chunk_tasks(model, q, tolerances, n_robots, rng=rng, seed=seed,
-                        distribution=distribution, chunk=chunk, edges=edges)
+                        distribution=distribution, chunk=chunk, first_order=first_order,
+                        edges=edges)
     from tqdm import tqdm
 
-    hp = Histogram.of(np.empty(0), edges[0])
-    ha = Histogram.of(np.empty(0), edges[1])
+    empty = [Histogram.of(np.empty(0), e) for e in edges]
+    merged = empty * 2 if first_order else empty
+    waiting: dict[int, ChunkResult] = {}
+    ready = 0  # chunks 0 .. ready - 1 are merged
     elapsed = 0.0
     with tqdm(total=n_robots, disable=not progress, unit="robot", desc="Monte Carlo") as bar:
         for i, res in map_tasks(run_chunk, tasks, executor):
             assert isinstance(res, ChunkResult) and res.histograms is not None
-            hp = hp.merge(res.histograms[0])
-            ha = ha.merge(res.histograms[1])
-            elapsed += res.elapsed_s
+            waiting[res.index] = res
             bar.update(tasks[i].size)
-    return MonteCarloSummary(hp, ha, tasks[0].tolerances, distribution,
+            while ready in waiting:
+                done = waiting.pop(ready)
+                assert done.histograms is not None
+                merged = [m.merge(h) for m, h in zip(merged, done.histograms, strict=True)]
+                elapsed += done.elapsed_s
+                ready += 1
+    assert not waiting and ready == len(tasks)  # map_tasks yields every task once
+    fo = (merged[2], merged[3]) if first_order else (None, None)
+    return MonteCarloSummary(merged[0], merged[1], tasks[0].tolerances, distribution,
                              int(tasks[0].arrays[0].shape[0]), elapsed, model.length_unit,
-                             tuple(percentiles))
+                             tuple(percentiles), fo[0], fo[1])
 
 

@@ -18,16 +18,23 @@ from __future__ import annotations
 import fnmatch
 from collections.abc import Mapping
 from dataclasses import dataclass
+from statistics import NormalDist
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
-from zrp.manufacturing._checks import DISTRIBUTIONS, check_distribution, nonnegative
+from zrp.manufacturing._checks import (
+    DISTRIBUTIONS,
+    check_distribution,
+    check_percentile,
+    nonnegative,
+)
 from zrp.manufacturing.sensitivity import parameter_space
 from zrp.model.manipulator import MAX_LENGTH, Manipulator
 
-__all__ = ["DISTRIBUTIONS", "Tolerances", "draw_parameters", "percentile_ci"]
+__all__ = ["DISTRIBUTIONS", "Tolerances", "draw_parameters", "percentile_ci",
+           "percentile_ci_ranks"]
 
 F64 = NDArray[np.float64]
 
@@ -127,17 +134,29 @@ def draw_parameters(tolerances: Tolerances, n: int, distribution: str,
     return z * tolerances.values
 
 
-def percentile_ci(samples: ArrayLike, pct: float, confidence: float = 0.95) -> tuple[float,
-                                                                                       float]:
-    """Distribution-free confidence interval of a percentile from order statistics.
-
-    Uses the normal approximation of the binomial count below the percentile.
-    """
-    x = np.sort(np.asarray(samples, dtype=float))
-    n = x.size
+def percentile_ci_ranks(n: int, pct: float, confidence: float = 0.95) -> tuple[int, int]:
+    """0-based ranks (lo, hi) of the order statistics that bound a distribution-free
+    ``confidence`` interval of the ``pct`` percentile of ``n`` samples (normal approximation
+    of the binomial count below the percentile, clipped to the sample)."""
+    check_percentile(pct)
+    if isinstance(n, bool) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise InputError(f"n: expected a sample size >= 1, got {n!r}")
+    if not 0.0 < confidence < 1.0:
+        raise InputError(f"confidence: expected 0 < confidence < 1 (e.g. 0.95), got "
+                         f"{confidence!r}")
     p = pct / 100.0
-    z = {0.9: 1.645, 0.95: 1.96, 0.99: 2.576}.get(confidence, 1.96)
-    half = z * np.sqrt(n * p * (1 - p))
+    half = NormalDist().inv_cdf(0.5 + 0.5 * confidence) * np.sqrt(n * p * (1 - p))
     lo = int(np.clip(np.floor(n * p - half), 0, n - 1))
     hi = int(np.clip(np.ceil(n * p + half), 0, n - 1))
+    return lo, hi
+
+
+def percentile_ci(samples: ArrayLike, pct: float, confidence: float = 0.95) -> tuple[float,
+                                                                                       float]:
+    """Distribution-free confidence interval of a percentile from order statistics
+    (:func:`percentile_ci_ranks`); ``samples`` shape (N,)."""
+    x = np.sort(np.asarray(samples, dtype=float).ravel())
+    if x.size == 0:
+        raise InputError("samples: expected at least one value")
+    lo, hi = percentile_ci_ranks(int(x.size), pct, confidence)
     return float(x[lo]), float(x[hi])

@@ -18,11 +18,18 @@ from zrp.manufacturing.allocation import allocate_tolerances
 from zrp.manufacturing.budget import tolerance_report
 from zrp.manufacturing.plots import check_png_path, histogram_png
 from zrp.manufacturing.population import monte_carlo
+from zrp.manufacturing.reduction import monte_carlo_summary
 from zrp.manufacturing.study import JointPath
-from zrp.manufacturing.tolerance import DISTRIBUTIONS, Tolerances, percentile_ci
+from zrp.manufacturing.tolerance import DISTRIBUTIONS, Tolerances
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable
+
+#: Above this many robots `zrp tolerance` reduces on the workers (gathering costs 32 bytes a
+#: robot with the first-order maxima: 320 MB here); --allocate verifies with at most this many.
+GATHER_LIMIT = 10_000_000
+#: Largest --robots: 1e12 robots x 360 points is ~1e5 core-hours (zrp/cli/README.md).
+MAX_ROBOTS = 10**12
 
 
 def _parse_tol(items: list[str] | None) -> dict[str, float]:
@@ -60,8 +67,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     g.add_argument("--distribution", choices=DISTRIBUTIONS, default="uniform",
                    help="uniform: U(-tol, tol); normal: N(0, (tol/3)^2) (default uniform)")
     m = p.add_argument_group("Monte Carlo")
-    m.add_argument("-n", "--robots", type=whole(1, 10_000_000),
-                   default=20000, help="robots N (default 20000)")
+    m.add_argument("-n", "--robots", type=whole(1, MAX_ROBOTS),
+                   default=20000, help="robots N (default 20000; above "
+                   f"{GATHER_LIMIT:,} the run is reduced on the workers, see --reduce)")
+    m.add_argument("--reduce", action="store_true",
+                   help="reduce each chunk on its worker to histograms of the per-robot maxima "
+                        "(memory independent of N; percentiles known to a 0.56 %% bin); "
+                        f"implied above {GATHER_LIMIT:,} robots")
     m.add_argument("--seed", type=SEED, default=1, help="random seed (default 1)")
     m.add_argument("--percentile", type=real(0.0, 100.0),
                    default=99.0, help="reported percentile (99)")
@@ -102,6 +114,10 @@ def _tolerance(args: argparse.Namespace) -> int:
     if not 0.0 < args.percentile < 100.0:
         raise InputError(f"--percentile: expected 0 < P < 100 (e.g. 99), got {args.percentile}")
     check_cluster_options(args)
+    if args.allocate and (args.robots > GATHER_LIMIT or args.reduce):
+        raise InputError(f"--robots, --reduce: --allocate verifies its tolerances with at most "
+                         f"{GATHER_LIMIT:,} robots gathered here (got --robots {args.robots:,}"
+                         + (" and --reduce" if args.reduce else "") + ")")
     if args.hist:
         check_png_path(args.hist, "--hist")
         check_writable([args.hist], args.force)
@@ -163,19 +179,21 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
              ex: Executor | None) -> int:
     """Monte Carlo of the given tolerances, with the first-order budget beside it. Chunk i
     draws its robots from (--seed, i), so the result is the same in this process and on any
-    number of workers."""
+    number of workers. With --reduce (implied above GATHER_LIMIT robots) each chunk comes back
+    as histograms: percentiles are known to their bin, extremes exactly."""
     u = model.length_unit
     offsets = args.offsets is not None
     tol = Tolerances.build(model, length=args.length, angle_rad=args.angle,
                            offset=args.offsets or 0.0, per_parameter=_parse_tol(args.tol),
                            joint_offsets=offsets)
-    mc = monte_carlo(model, path.q, tol, args.robots, seed=args.seed,
-                     distribution=args.distribution, progress=not args.no_progress,
-                     first_order=True, executor=ex)
+    reduced = args.reduce or args.robots > GATHER_LIMIT
+    run = monte_carlo_summary if reduced else monte_carlo
+    mc = run(model, path.q, tol, args.robots, seed=args.seed, distribution=args.distribution,
+             progress=not args.no_progress, first_order=True, executor=ex)
     rep = tolerance_report(model, path.q, tol, mc)
     pct = args.percentile
     dp, ang = mc.percentile(pct)
-    lo, hi = percentile_ci(mc.max_delta_p, pct)
+    lo, hi = mc.percentile_ci(pct)
     payload: dict[str, Any] = mc.summary()
     payload.update({
         "model": model.name, "trajectory": path.label, "seed": args.seed,
@@ -187,23 +205,25 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
         "mc_max_over_worst_case_p": rep["mc_over_worst_case_p"],
         "contribution": rep["contribution"].rows(),
     })
-    fo_p = float(np.percentile(mc.first_order_delta_p, pct)) \
-        if mc.first_order_delta_p is not None else float("nan")
+    fo_p = payload["first_order"][f"max_delta_p_{u}"][f"p{pct:g}"]
     lines = [
         f"{model.name}: {path.label} ({path.t.size} samples)",
-        f"{mc.n_robots} robots, {args.distribution} "
+        f"{mc.n_robots:,} robots, {args.distribution} "
         f"({'half-width' if args.distribution == 'uniform' else '3 sigma'}), seed {args.seed}: "
         f"length {args.length:g} {u}, angle {args.angle:g} rad"
         + (f", offsets {args.offsets:g}" if offsets else "")
         + (f", overrides {args.tol}" if args.tol else ""),
         f"kernel: {mc.elapsed_s:.3f} s summed over chunks, {mc.poses_per_s / 1e6:.2f} M "
         "poses/s per kernel",
+    ]
+    if reduced:
+        lines.append(f"each chunk reduced to histograms where it ran: a percentile is known to "
+                     f"its bin ({100 * mc.delta_p.relative_width:.2g} % wide; brackets in the "
+                     "JSON), count, extremes and mean exactly")
+    lines += [
         "",
-        f"max_t delta_p ({u}) percentiles: "
-        + ", ".join(f"{p.upper()} {v:.4g}" for p, v in
-                    payload[f"max_delta_p_{u}"].items()),
-        "max_t angle (rad) percentiles:  "
-        + ", ".join(f"{p.upper()} {v:.4g}" for p, v in payload["max_angle_rad"].items()),
+        f"max_t delta_p ({u}) percentiles: " + _row(payload[f"max_delta_p_{u}"]),
+        "max_t angle (rad) percentiles:  " + _row(payload["max_angle_rad"]),
         f"P{pct:g} delta_p = {dp:.4g} {u} (95 % CI {lo:.4g}..{hi:.4g}); first-order model "
         f"with the same draws: {fo_p:.4g} {u}",
         f"first-order worst case over the +-tol box: {rep['worst_case_delta_p']:.4g} {u}, "
@@ -219,3 +239,10 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
         lines.append(f"wrote {payload['histogram']}")
     emit(args, payload, "\n".join(lines))
     return 0
+
+
+def _row(block: dict[str, Any]) -> str:
+    """"P50 0.05449, P90 ..." from a summary block (percentile keys; brackets and the
+    reduced run's max/mean are left to the JSON)."""
+    return ", ".join(f"{k.upper()} {v:.4g}" for k, v in block.items()
+                     if k.startswith("p") and not k.endswith("_bracket"))
