@@ -28,8 +28,8 @@ from zrp.output import check_writable
 #: Above this many robots `zrp tolerance` reduces on the workers (gathering costs 32 bytes a
 #: robot with the first-order maxima: 320 MB here); --allocate verifies with at most this many.
 GATHER_LIMIT = 10_000_000
-#: Largest --robots: 1e12 robots x 360 points is ~1e5 core-hours (zrp/cli/README.md).
-MAX_ROBOTS = 10**12
+#: Largest --robots: 1e10 robots x 360 points is ~3e4 core-hours (zrp/cli/README.md).
+MAX_ROBOTS = 10**10
 
 
 def _parse_tol(items: list[str] | None) -> dict[str, float]:
