@@ -18,6 +18,8 @@ full result lies in the bracket the summary gives (tested).
 
 from __future__ import annotations
 
+import os
+import time
 from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from typing import Any
@@ -28,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.errors import InputError
 from zrp.manufacturing._checks import check_percentile
 from zrp.manufacturing.budget import worst_case_bound
+from zrp.manufacturing.checkpoint import OrderedMerge, load_merge, run_identity, save_merge
 from zrp.manufacturing.chunks import ChunkResult, run_chunk
 from zrp.manufacturing.histogram import Histogram, geometric_edges
 from zrp.manufacturing.population import DEFAULT_PERCENTILES, chunk_tasks
@@ -68,6 +71,7 @@ class MonteCarloSummary:
             :class:`~zrp.manufacturing.population.MonteCarloResult`.
         first_order_delta_p, first_order_angle_rad: histograms of the first-order model's
             maxima for the same robots (same edges), or None.
+        resumed_robots: robots taken from a checkpoint rather than run now.
     """
 
     delta_p: Histogram
@@ -80,6 +84,7 @@ class MonteCarloSummary:
     percentiles: tuple[float, ...] = field(default=DEFAULT_PERCENTILES)
     first_order_delta_p: Histogram | None = None
     first_order_angle_rad: Histogram | None = None
+    resumed_robots: int = 0
 
     def __post_init__(self) -> None:
         if self.delta_p.total != self.angle_rad.total:
@@ -122,7 +127,7 @@ class MonteCarloSummary:
         out: dict[str, Any] = {
             "n_robots": self.n_robots, "n_points": self.n_points,
             "distribution": self.distribution, "elapsed_s": self.elapsed_s,
-            "reduced_on_workers": True,
+            "reduced_on_workers": True, "resumed_robots": self.resumed_robots,
             "relative_bin_width": self.delta_p.relative_width,
             f"max_delta_p_{u}": {"max": self.delta_p.maximum, "mean": self.delta_p.mean},
             "max_angle_rad": {"max": self.angle_rad.maximum, "mean": self.angle_rad.mean},
@@ -148,41 +153,61 @@ def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances
                         distribution: str = "uniform", chunk: int | None = None,
                         progress: bool = False, first_order: bool = False,
                         percentiles: tuple[float, ...] = DEFAULT_PERCENTILES,
-                        executor: Executor | Any | None = None) -> MonteCarloSummary:
+                        executor: Executor | Any | None = None,
+                        checkpoint: str | os.PathLike[str] | None = None, resume: bool = False,
+                        overwrite: bool = False,
+                        checkpoint_every_s: float = 5.0) -> MonteCarloSummary:
     """:func:`~zrp.manufacturing.population.monte_carlo` reduced on the workers (same
     arguments): each chunk returns two histograms (four with ``first_order``), merged as they
     arrive, so the memory does not grow with ``n_robots`` (give ``seed`` for very large runs:
     with ``rng`` the draws are made here and shipped). The histograms are merged in chunk
     order (a result that arrives early waits, a few KB, for the ones before it), so even the
-    floating-point sums behind the mean are the same bit for bit on any number of workers."""
+    floating-point sums behind the mean are the same bit for bit on any number of workers.
+
+    Args:
+        checkpoint: a ``.npz`` file the merge state is written to every ``checkpoint_every_s``
+            seconds, when the run stops (an error, Ctrl-C) and at the end
+            (:mod:`~zrp.manufacturing.checkpoint`; needs ``seed``).
+        resume: continue the run the checkpoint holds (the same inputs, else an error naming
+            those that differ); the result equals an uninterrupted run's bit for bit.
+        overwrite: replace a checkpoint that exists (without ``resume``, or of another run).
+    """
     for pct in percentiles:
         check_percentile(pct, "percentiles")
+    if checkpoint is not None and not checkpoint_every_s > 0:
+        raise InputError(f"checkpoint_every_s: expected seconds > 0, got {checkpoint_every_s!r}")
     edges = histogram_edges(model, q, tolerances)
     tasks = chunk_tasks(model, q, tolerances, n_robots, rng=rng, seed=seed,
                         distribution=distribution, chunk=chunk, first_order=first_order,
                         edges=edges)
     from tqdm import tqdm
 
-    empty = [Histogram.of(np.empty(0), e) for e in edges]
-    merged = empty * 2 if first_order else empty
-    waiting: dict[int, ChunkResult] = {}
-    ready = 0  # chunks 0 .. ready - 1 are merged
-    elapsed = 0.0
-    with tqdm(total=n_robots, disable=not progress, unit="robot", desc="Monte Carlo") as bar:
-        for i, res in map_tasks(run_chunk, tasks, executor):
-            assert isinstance(res, ChunkResult) and res.histograms is not None
-            waiting[res.index] = res
-            bar.update(tasks[i].size)
-            while ready in waiting:
-                done = waiting.pop(ready)
-                assert done.histograms is not None
-                merged = [m.merge(h) for m, h in zip(merged, done.histograms, strict=True)]
-                elapsed += done.elapsed_s
-                ready += 1
-    assert not waiting and ready == len(tasks)  # map_tasks yields every task once
-    fo = (merged[2], merged[3]) if first_order else (None, None)
-    return MonteCarloSummary(merged[0], merged[1], tasks[0].tolerances, distribution,
-                             int(tasks[0].arrays[0].shape[0]), elapsed, model.length_unit,
-                             tuple(percentiles), fo[0], fo[1])
-
-
+    state = OrderedMerge([Histogram.of(np.empty(0), e) for e in edges * (1 + first_order)])
+    identity: dict[str, str] = {}
+    if checkpoint is not None:
+        identity = run_identity(tasks)
+        state = load_merge(checkpoint, identity, edges, resume=resume,
+                           overwrite=overwrite) or state
+        save_merge(checkpoint, identity, state)  # fails here, before any work, if unwritable
+    todo = [t for t in tasks if not state.done(t.index)]
+    resumed = n_robots - sum(t.size for t in todo)
+    last = time.monotonic()
+    with tqdm(total=n_robots, initial=resumed,
+              disable=not progress, unit="robot", desc="Monte Carlo") as bar:
+        try:
+            for i, res in map_tasks(run_chunk, todo, executor):
+                assert isinstance(res, ChunkResult)
+                state.add(res)
+                bar.update(todo[i].size)
+                if checkpoint is not None and time.monotonic() - last >= checkpoint_every_s:
+                    save_merge(checkpoint, identity, state)
+                    last = time.monotonic()
+        finally:  # also when stopped: the chunks done so far are kept
+            if checkpoint is not None:
+                save_merge(checkpoint, identity, state)
+    assert not state.waiting and state.ready == len(tasks)  # map_tasks yields every task once
+    m = state.merged
+    fo = (m[2], m[3]) if first_order else (None, None)
+    return MonteCarloSummary(m[0], m[1], tasks[0].tolerances, distribution,
+                             int(tasks[0].arrays[0].shape[0]), state.elapsed_s,
+                             model.length_unit, tuple(percentiles), fo[0], fo[1], resumed)

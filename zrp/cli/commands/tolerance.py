@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 from concurrent.futures import Executor
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -17,8 +18,8 @@ from zrp.errors import InputError
 from zrp.manufacturing.allocation import allocate_tolerances
 from zrp.manufacturing.budget import tolerance_report
 from zrp.manufacturing.plots import check_png_path, histogram_png
-from zrp.manufacturing.population import monte_carlo
-from zrp.manufacturing.reduction import monte_carlo_summary
+from zrp.manufacturing.population import MonteCarloResult, monte_carlo
+from zrp.manufacturing.reduction import MonteCarloSummary, monte_carlo_summary
 from zrp.manufacturing.study import JointPath
 from zrp.manufacturing.tolerance import DISTRIBUTIONS, Tolerances
 from zrp.model.files import load_model
@@ -77,6 +78,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     m.add_argument("--seed", type=SEED, default=1, help="random seed (default 1)")
     m.add_argument("--percentile", type=real(0.0, 100.0),
                    default=99.0, help="reported percentile (99)")
+    m.add_argument("--checkpoint", default=None, metavar="NPZ",
+                   help="write the run's state to this .npz file every few seconds and when it "
+                        "stops (implies --reduce); run the same command with --resume to "
+                        "continue an interrupted run (same result bit for bit)")
+    m.add_argument("--resume", action="store_true",
+                   help="continue the run held by --checkpoint (its inputs must be the same)")
     m.add_argument("--hist", default=None, metavar="PNG",
                    help="write a histogram PNG (checked before the Monte Carlo runs)")
     m.add_argument("--top", type=whole(1, 100_000),
@@ -118,6 +125,7 @@ def _tolerance(args: argparse.Namespace) -> int:
         raise InputError(f"--robots, --reduce: --allocate verifies its tolerances with at most "
                          f"{GATHER_LIMIT:,} robots gathered here (got --robots {args.robots:,}"
                          + (" and --reduce" if args.reduce else "") + ")")
+    _check_checkpoint(args)
     if args.hist:
         check_png_path(args.hist, "--hist")
         check_writable([args.hist], args.force)
@@ -126,6 +134,22 @@ def _tolerance(args: argparse.Namespace) -> int:
         if args.allocate:
             return _allocate(args, model, path, ex)
         return _analyse(args, model, path, ex)
+
+
+def _check_checkpoint(args: argparse.Namespace) -> None:
+    """--checkpoint / --resume, before any work."""
+    if args.resume and not args.checkpoint:
+        raise InputError("--resume: continues the run held by --checkpoint NPZ; give it")
+    if not args.checkpoint:
+        return
+    if args.allocate:
+        raise InputError("--checkpoint: --allocate's verification runs are not checkpointed")
+    if not str(args.checkpoint).endswith(".npz"):
+        raise InputError(f"--checkpoint: {args.checkpoint!r} is not a .npz file name (the state"
+                         " is a NumPy archive, e.g. run.npz)")
+    if Path(args.checkpoint).exists() and not (args.resume or args.force):
+        raise InputError(f"--checkpoint: {args.checkpoint} exists (the state of an earlier "
+                         f"run): --resume continues it, --force starts over")
 
 
 def _allocate(args: argparse.Namespace, model: Manipulator, path: JointPath,
@@ -186,10 +210,13 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
     tol = Tolerances.build(model, length=args.length, angle_rad=args.angle,
                            offset=args.offsets or 0.0, per_parameter=_parse_tol(args.tol),
                            joint_offsets=offsets)
-    reduced = args.reduce or args.robots > GATHER_LIMIT
-    run = monte_carlo_summary if reduced else monte_carlo
-    mc = run(model, path.q, tol, args.robots, seed=args.seed, distribution=args.distribution,
-             progress=not args.no_progress, first_order=True, executor=ex)
+    reduced = args.reduce or args.checkpoint is not None or args.robots > GATHER_LIMIT
+    common = dict(seed=args.seed, distribution=args.distribution,
+                  progress=not args.no_progress, first_order=True, executor=ex)
+    mc: MonteCarloResult | MonteCarloSummary = (
+        monte_carlo_summary(model, path.q, tol, args.robots, checkpoint=args.checkpoint,
+                            resume=args.resume, overwrite=args.force, **common)
+        if reduced else monte_carlo(model, path.q, tol, args.robots, **common))
     rep = tolerance_report(model, path.q, tol, mc)
     pct = args.percentile
     dp, ang = mc.percentile(pct)
@@ -220,6 +247,9 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
         lines.append(f"each chunk reduced to histograms where it ran: a percentile is known to "
                      f"its bin ({100 * mc.delta_p.relative_width:.2g} % wide; brackets in the "
                      "JSON), count, extremes and mean exactly")
+        if args.checkpoint:
+            lines.append(f"checkpoint {args.checkpoint}: {mc.resumed_robots:,} robots resumed "
+                         f"from it, {mc.n_robots - mc.resumed_robots:,} run now")
     lines += [
         "",
         f"max_t delta_p ({u}) percentiles: " + _row(payload[f"max_delta_p_{u}"]),
