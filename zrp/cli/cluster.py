@@ -19,7 +19,10 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import logging
 import os
+import signal
+import threading
 from collections.abc import Iterator
 from concurrent.futures import Executor
 from typing import Any
@@ -46,6 +49,12 @@ WORKER_ENV = {"NUMBA_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "OPENBLAS_NUM_TH
 #: worker near its memory limit reacts within 1 s instead of 0.1 s, blocked event loops are
 #: detected within 1 s, no statistical profile of the tasks (10 ms samples), and no work
 #: stealing (the scheduler's queue already hands a task to whichever worker frees up first).
+#: Log level below which a local cluster's Dask processes print nothing. A task's error reaches
+#: the command through its future (with the task's input); what Dask itself logs at ERROR on a
+#: local cluster is shutdown noise (a worker's heartbeat finding the closing scheduler gone,
+#: with a traceback, after Ctrl-C). Set ZRP_DASK_LOGS=1 to see Dask's warnings and errors.
+SILENCE_LOGS = logging.WARNING if os.environ.get("ZRP_DASK_LOGS") == "1" else logging.CRITICAL
+
 LOCAL_CONFIG = {
     "distributed.admin.tick.interval": "1s",
     "distributed.admin.system-monitor.interval": "5s",
@@ -90,14 +99,32 @@ def local_cluster(workers: int) -> Iterator[Any]:
             # the Nannies read the settings as they start (inside LocalCluster()) and pass
             # them on to their workers; the environment is put in os.environ while spawning
             with dask.config.set({**LOCAL_CONFIG,
-                                  "distributed.nanny.pre-spawn-environ": environ}):
+                                  "distributed.nanny.pre-spawn-environ": environ}), \
+                    _workers_ignore_ctrl_c():
                 cluster = stack.enter_context(LocalCluster(
                     n_workers=workers, threads_per_worker=1, processes=True, protocol="tcp",
-                    host="127.0.0.1", dashboard_address=":0"))
+                    host="127.0.0.1", dashboard_address=":0", silence_logs=SILENCE_LOGS))
         finally:  # the Nanny leaves WORKER_ENV in this process's environment: undo it
             os.environ.clear()
             os.environ.update(saved)
         yield stack.enter_context(Client(cluster))
+
+
+@contextlib.contextmanager
+def _workers_ignore_ctrl_c() -> Iterator[None]:
+    """Ctrl-C in a terminal signals every process of the group: the workers would each print
+    a KeyboardInterrupt traceback. A process started while SIGINT is ignored keeps ignoring it
+    (Python installs its handler only over the default one), so only this process sees Ctrl-C
+    and closes the cluster, which stops its workers. Only from the main thread (where Python
+    allows changing signal handlers); elsewhere nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
 
 
 @contextlib.contextmanager

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from concurrent.futures import Executor
 from pathlib import Path
 from typing import Any
@@ -130,10 +131,16 @@ def _tolerance(args: argparse.Namespace) -> int:
         check_png_path(args.hist, "--hist")
         check_writable([args.hist], args.force)
     path = path_from_args(args, model)
-    with executor_from_args(args) as ex:
-        if args.allocate:
-            return _allocate(args, model, path, ex)
-        return _analyse(args, model, path, ex)
+    try:
+        with executor_from_args(args) as ex:
+            if args.allocate:
+                return _allocate(args, model, path, ex)
+            return _analyse(args, model, path, ex)
+    except KeyboardInterrupt:
+        if args.checkpoint:
+            print(f"the run's state is in {args.checkpoint}: the same command with --resume "
+                  "continues it", file=sys.stderr)
+        raise
 
 
 def _check_checkpoint(args: argparse.Namespace) -> None:
