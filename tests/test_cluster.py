@@ -217,3 +217,38 @@ def test_tolerance_cli_on_the_cluster_equals_in_process(cluster, capsys):
         main([*base, "--workers", "0"])
     assert exit_.value.code == 2
     assert "--workers" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("how", ["ctrl-c", "sigterm"])
+def test_a_stopped_local_cluster_run_keeps_its_checkpoint_and_prints_no_traceback(tmp_path,
+                                                                                   how):
+    # Ctrl-C in a terminal sends SIGINT to the whole process group (the command and its
+    # workers); a batch scheduler's time limit sends SIGTERM
+    import signal
+    import time
+
+    ck = tmp_path / "mc.npz"
+    cmd = [sys.executable, "-m", "zrp", "tolerance", "-n", "20000000", "--workers", "2",
+           "--checkpoint", str(ck), "--no-progress"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            start_new_session=True, cwd=Path(__file__).resolve().parents[1])
+    try:
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline and proc.poll() is None:
+            if ck.exists():
+                head = json.loads(str(np.load(ck)["header"]))
+                if head["ready"] >= 2:
+                    break
+            time.sleep(0.2)
+        if how == "ctrl-c":
+            os.killpg(proc.pid, signal.SIGINT)
+        else:
+            proc.send_signal(signal.SIGTERM)
+        _, err = proc.communicate(timeout=60)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+    assert proc.returncode != 0 and "Traceback" not in err, err[-2000:]
+    assert "interrupted" in err and "--resume continues it" in err
+    head = json.loads(str(np.load(ck)["header"]))
+    assert head["ready"] >= 2 and head["identity"]["robots"] == "20000000"

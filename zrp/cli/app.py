@@ -8,11 +8,14 @@ sets ``func`` (called with the parsed namespace, returning an exit code). Errors
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import pkgutil
 import re
+import signal
 import sys
-from collections.abc import Sequence
+import threading
+from collections.abc import Iterator, Sequence
 from typing import Any
 
 from zrp import __version__
@@ -72,6 +75,25 @@ def cli_message(exc: BaseException, api_names: dict[str, str] | None = None) -> 
     return text
 
 
+@contextlib.contextmanager
+def _terminate_as_interrupt() -> Iterator[None]:
+    """SIGTERM (a batch scheduler's time limit, ``kill``) stops a command like Ctrl-C does:
+    through KeyboardInterrupt, so that it closes its cluster and keeps what it saves when
+    stopped (a Monte Carlo checkpoint, files already written). Main thread only."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def stop(signum: int, frame: object) -> None:
+        raise KeyboardInterrupt
+
+    previous = signal.signal(signal.SIGTERM, stop)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
@@ -79,7 +101,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 1
     try:
-        return int(args.func(args) or 0)
+        with _terminate_as_interrupt():
+            return int(args.func(args) or 0)
     except ZRPError as exc:
         msg = cli_message(exc, getattr(args, "api_names", None))
         print(f"zrp {args.command}: error: {msg}", file=sys.stderr)
