@@ -25,6 +25,7 @@ from zrp.gap.metrics import Metrics, NoiseFloor
 from zrp.gap.posefit import FullPoseResult
 from zrp.gap.steps import Z95 as Z95
 from zrp.gap.steps import Candidate as Candidate
+from zrp.gap.steps import EffectsFound
 from zrp.gap.steps import ParameterEstimate as ParameterEstimate
 from zrp.gap.steps import Step as Step
 from zrp.gap.steps import alias_dict as alias_dict
@@ -158,7 +159,7 @@ def install_verdict_renderer(render: Callable[[Diagnosis], str]) -> None:
 
 
 @dataclass(frozen=True, eq=False)
-class Diagnosis:
+class Diagnosis(EffectsFound):
     """The result of :func:`~zrp.gap.diagnose` (see zrp/gap/README.md for the JSON form).
 
     Attributes:
@@ -218,16 +219,6 @@ class Diagnosis:
                              f"{self.unexplained!r}")
         if np.intersect1d(self.fitting_poses, self.withheld_poses).size:
             raise InputError("Diagnosis: fitting and withheld poses overlap")
-
-    @property
-    def effects(self) -> tuple[str, ...]:
-        """Effects found, in order ("none" alone when nothing helped)."""
-        return tuple(s.effect for s in self.steps) or ("none",)
-
-    @property
-    def top_effect(self) -> str:
-        """The first effect found, or "none"."""
-        return self.effects[0]
 
     @property
     def shrink(self) -> float:

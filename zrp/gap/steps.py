@@ -22,6 +22,7 @@ from zrp.gap.uncertainty import simultaneous_z
 
 __all__ = [
     "Candidate",
+    "EffectsFound",
     "ParameterEstimate",
     "Step",
     "alias_dict",
@@ -165,3 +166,21 @@ class Step:
                 "cv_rms": self.cv_rms, "p_value": self.p_value, "bic_delta": self.bic_delta,
                 "candidates": [c.to_dict() for c in self.candidates],
                 "aliased": [alias_dict(a) for a in self.aliased]}
+
+
+class EffectsFound:
+    """The effects a diagnosis found, read from its ``steps`` (each has an ``effect``): one
+    home for :class:`~zrp.gap.results.Diagnosis` and
+    :class:`~zrp.gap.motion.results.MotionDiagnosis` (a mixin without fields)."""
+
+    steps: tuple[Any, ...]
+
+    @property
+    def effects(self) -> tuple[str, ...]:
+        """Effects found, in order ("none" alone when nothing helped)."""
+        return tuple(s.effect for s in self.steps) or ("none",)
+
+    @property
+    def top_effect(self) -> str:
+        """The first effect found, or "none"."""
+        return self.effects[0]
