@@ -16,8 +16,9 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm import tqdm
 
 from mjcf import MJCFOptions, build
+from sim.playback import check_timed_q
 from zrp.errors import InputError
-from zrp.kinematics.forward import check_q, forward_kinematics
+from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import rotation_angle
 
@@ -112,13 +113,7 @@ def dynamic_playback(
             the rate servos; False = plain position servo with damping kv.
         progress: show a tqdm bar.
     """
-    q = check_q(model, q)
-    t = np.asarray(t, dtype=float)
-    if q.ndim != 2 or t.shape != (q.shape[0],) or len(t) < 2:
-        raise InputError(f"t, q: expected shapes (N,) and (N, {model.n}) with N >= 2, got "
-                         f"{t.shape} and {q.shape}")
-    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-        raise InputError("t: expected finite, strictly increasing times (s)")
+    t, q = check_timed_q(model, t, q)
     if not (np.isfinite(settle_s) and settle_s >= 0):
         raise InputError(f"settle_s: expected a time >= 0 (s), got {settle_s!r}")
     options = options or default_dynamic_options(model)

@@ -49,10 +49,9 @@ from sim.overlays import (
     delta_p_figure,
     shown_value,
 )
-from sim.playback import kinematic_playback
+from sim.playback import check_timed_q, kinematic_playback
 from sim.render import OffscreenRenderer
 from zrp.errors import InputError, ZRPError
-from zrp.kinematics.forward import check_q
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import rotation_angle
 
@@ -174,13 +173,7 @@ def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: Arra
     if (nominal.n != perturbed.n or nominal.joint_types != perturbed.joint_types
             or nominal.length_unit != perturbed.length_unit):
         raise InputError("nominal, perturbed: must have the same joints and length unit")
-    q = check_q(nominal, q)
-    t = np.asarray(t, dtype=float)
-    if q.ndim != 2 or t.shape != (q.shape[0],) or len(t) < 2:
-        raise InputError(f"t, q: expected shapes (N,) and (N, {nominal.n}) with N >= 2, got "
-                         f"{t.shape} and {q.shape}")
-    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
-        raise InputError("t: expected finite, strictly increasing times (s)")
+    t, q = check_timed_q(nominal, t, q)
     tf = np.linspace(t[0], t[-1], frames)
     qf = np.stack([np.interp(tf, t, q[:, j]) for j in range(nominal.n)], axis=1)
     arm_a = build(perturbed, MJCFOptions(offscreen_size=size, link_rgba=ARM_RGBA))

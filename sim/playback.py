@@ -18,11 +18,26 @@ __all__ = [
     "ConsistencyReport",
     "SitePoses",
     "as_built",
+    "check_timed_q",
     "consistency_check",
     "kinematic_playback",
 ]
 
 F64 = NDArray[np.float64]
+
+
+def check_timed_q(model: Manipulator, t: ArrayLike, q: ArrayLike) -> tuple[F64, F64]:
+    """Joint values sampled at times, checked: ``t`` finite and strictly increasing, s, shape
+    (N,) with N >= 2, and ``q`` (:func:`~zrp.kinematics.check_q`), shape (N, n). Returns
+    (t, q) as float arrays."""
+    q = check_q(model, q)
+    t = np.asarray(t, dtype=float)
+    if q.ndim != 2 or t.shape != (q.shape[0],) or len(t) < 2:
+        raise InputError(f"t, q: expected shapes (N,) and (N, {model.n}) with N >= 2, got "
+                         f"{t.shape} and {q.shape}")
+    if not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise InputError("t: expected finite, strictly increasing times (s)")
+    return t, q
 
 
 def as_built(arm: BuiltArm | Manipulator, options: MJCFOptions | None = None) -> BuiltArm:

@@ -90,11 +90,7 @@ def robust_covariance(ctx: Context, result: FitResult) -> F64:
     per_pose = np.zeros((G, p))
     np.add.at(per_pose, inv, score.sum(axis=1))
     meat = per_pose.T @ per_pose * (G / max(G - 1, 1))
-    cov = bread @ meat @ bread / np.outer(d, d)
-    bad = ~np.isfinite(np.diag(result.cov))
-    cov[bad, :] = np.inf
-    cov[:, bad] = np.inf
-    return cov
+    return _unscaled(bread @ meat @ bread, d, result)
 
 
 def _scaled_bread(J: F64) -> tuple[F64, F64, F64]:
@@ -106,6 +102,16 @@ def _scaled_bread(J: F64) -> tuple[F64, F64, F64]:
     w, v = np.linalg.eigh(js.T @ js)
     ok = w > max(w.max(), 1e-300) * 1e-12
     return d, js, (v[:, ok] / w[ok]) @ v[:, ok].T
+
+
+def _unscaled(cov_scaled: F64, d: F64, result: FitResult) -> F64:
+    """A covariance of the scaled parameters theta d (p, p) back in the units of theta, inf in
+    the rows and columns where the normal-theory one (``result.cov``) is not finite."""
+    cov = cov_scaled / np.outer(d, d)
+    bad = ~np.isfinite(np.diag(result.cov))
+    cov[bad, :] = np.inf
+    cov[:, bad] = np.inf
+    return cov
 
 
 def jackknife_covariance(ctx: Context, result: FitResult) -> F64:
@@ -136,11 +142,7 @@ def jackknife_covariance(ctx: Context, result: FitResult) -> F64:
             return np.full((p, p), np.inf)
         deltas[g] = bread @ (jg.T @ u)
     dev = deltas - deltas.mean(axis=0)
-    cov = dev.T @ dev * ((G - 1) / max(G, 1)) / np.outer(d, d)
-    bad = ~np.isfinite(np.diag(result.cov))
-    cov[bad, :] = np.inf
-    cov[:, bad] = np.inf
-    return cov
+    return _unscaled(dev.T @ dev * ((G - 1) / max(G, 1)), d, result)
 
 
 def interval_covariance(ctx: Context, result: FitResult) -> F64:

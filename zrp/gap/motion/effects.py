@@ -43,7 +43,7 @@ zeta start from the profile search of :mod:`zrp.gap.motion.profile`, within a tr
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -137,28 +137,29 @@ def _sync(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
     return [Column("sync.delay", "s", "sync_delay", 0, delta, d, D)]
 
 
-def _lag(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+def _per_joint(traj: Trajectory, values: Mapping[str, float], suffix: str, unit: str,
+               effect: str, response: Callable[[F64, float], tuple[F64, F64]]) -> list[Column]:
+    """One column ``q{k}.{suffix}`` per moving joint k of an effect that passes the joint's
+    commanded path u (S,) through ``response(u, value) -> (y, dy/dvalue)``, shapes (S,):
+    d = y - u and D = dy/dvalue on joint k, zero on the others."""
     s, n = traj.q.shape
     out = []
     for k in _moving(traj):
-        name = f"q{k + 1}.lag"
-        tau = float(values.get(name, 0.0))
-        y, dy = first_order_lag(traj.t, traj.q[:, k], tau)
-        out.append(Column(name, "s", "servo_lag", k + 1, tau,
+        name = f"q{k + 1}.{suffix}"
+        v = float(values.get(name, 0.0))
+        y, dy = response(traj.q[:, k], v)
+        out.append(Column(name, unit, effect, k + 1, v,
                           _one_joint(s, n, k, y - traj.q[:, k]), _one_joint(s, n, k, dy)))
     return out
+
+
+def _lag(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+    return _per_joint(traj, values, "lag", "s", "servo_lag",
+                      lambda u, tau: first_order_lag(traj.t, u, tau))
 
 
 def _friction(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
-    s, n = traj.q.shape
-    out = []
-    for k in _moving(traj):
-        name = f"q{k + 1}.friction"
-        r = float(values.get(name, 0.0))
-        y, dy = play(traj.q[:, k], r)
-        out.append(Column(name, "rad", "reversal_friction", k + 1, r,
-                          _one_joint(s, n, k, y - traj.q[:, k]), _one_joint(s, n, k, dy)))
-    return out
+    return _per_joint(traj, values, "friction", "rad", "reversal_friction", play)
 
 
 def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | None

@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from zrp.errors import InputError
 from zrp.gap.metrics import Metrics
+from zrp.gap.steps import EffectsFound
 
 __all__ = ["MotionDiagnosis", "MotionEstimate", "MotionStep", "PhaseError"]
 
@@ -97,7 +98,7 @@ class PhaseError:
 
 
 @dataclass(frozen=True, eq=False)
-class MotionDiagnosis:
+class MotionDiagnosis(EffectsFound):
     """Where, which and how far, along a trajectory.
 
     Attributes:
@@ -141,15 +142,6 @@ class MotionDiagnosis:
             raise InputError("MotionDiagnosis: path_before and path_after shapes differ")
         if self.noise_method not in ("given", "second_differences"):
             raise InputError(f"MotionDiagnosis.noise_method: {self.noise_method!r}")
-
-    @property
-    def effects(self) -> tuple[str, ...]:
-        """The effects found, in order, or ("none",)."""
-        return tuple(s.effect for s in self.steps) or ("none",)
-
-    @property
-    def top_effect(self) -> str:
-        return self.effects[0]
 
     @property
     def noise_rms(self) -> float:
