@@ -19,7 +19,11 @@ from zrp.errors import InputError, ZRPWarning
 from zrp.gap.effects import Context, ParamSpec
 from zrp.gap.problem import Evaluation, Problem, compressed
 
+#: Two-sided 95 % quantile of the standard normal (the one home of the constant in zrp.gap).
+Z95 = 1.959963984540054
+
 __all__ = [
+    "Z95",
     "Aliased",
     "FitResult",
     "FitWarning",

@@ -20,13 +20,12 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.leastsq import FitResult
+from zrp.gap.leastsq import Z95, FitResult
 from zrp.rotations import er_from_matrix, er_to_rotvec, matrix_from_rotvec
 
 __all__ = ["Quantity", "Registration", "registration_of"]
 
 F64 = NDArray[np.float64]
-Z95 = 1.959963984540054
 
 
 @dataclass(frozen=True)

@@ -16,6 +16,7 @@ from numpy.typing import NDArray
 
 from zrp.errors import InputError
 from zrp.gap.effects import EFFECTS
+from zrp.gap.leastsq import Z95 as Z95
 from zrp.gap.leastsq import Aliased, FitResult
 from zrp.gap.metrics import Metrics
 from zrp.gap.uncertainty import simultaneous_z
@@ -31,7 +32,6 @@ __all__ = [
 
 F64 = NDArray[np.float64]
 #: two-sided 95 % quantile of the standard normal distribution.
-Z95 = 1.959963984540054
 
 
 @dataclass(frozen=True)

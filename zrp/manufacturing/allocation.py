@@ -264,8 +264,9 @@ def allocate_tolerances(
             body components, golden-section search in [1/4, 4] on the nonlinear percentile):
             the RSS shape is optimal within each kind only to first order.
         executor: where the verification Monte Carlo runs (see
-            :func:`~zrp.manufacturing.population.monte_carlo`; the robots are drawn here from
-            ``rng``, so the result does not depend on it).
+            :func:`~zrp.manufacturing.population.monte_carlo`; each round takes a master seed
+            from ``rng`` and every chunk draws its robots from it where it runs, so only the
+            seed travels and the result does not depend on the executor).
     """
     req_p, req_r, pct = _requirement(model, max_delta_p, max_angle_rad, percentile)
     angle_scale_mm, n_search, n_verify = _check_search(distribution, angle_scale_mm, margin,
@@ -312,8 +313,11 @@ def allocate_tolerances(
     while True:
         rounds += 1
         tol = tolerances(alpha, shape)
-        ver = monte_carlo(model, arrays[0], tol, n_verify, rng=rng, distribution=distribution,
-                          progress=progress, executor=executor)
+        # a master seed from rng: each chunk draws its own robots where it runs, so only the
+        # seed travels (shipping 1e7 robots' draws would be 4.3 GB) and any executor gives the
+        # same robots
+        ver = monte_carlo(model, arrays[0], tol, n_verify, seed=int(rng.integers(2**63 - 1)),
+                          distribution=distribution, progress=progress, executor=executor)
         dp, ang = ver.percentile(pct)
         r = max(dp / req_p if req_p else 0.0, ang / req_r if req_r else 0.0)
         if r <= 1.0 or rounds >= 6:

@@ -10,6 +10,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
+from zrp.gap.leastsq import Z95
 from zrp.gap.metrics import Metrics
 from zrp.gap.steps import EffectsFound
 
@@ -17,7 +18,6 @@ __all__ = ["MotionDiagnosis", "MotionEstimate", "MotionStep", "PhaseError"]
 
 F64 = NDArray[np.float64]
 #: 97.5 % quantile of the standard normal (95 % two-sided intervals).
-Z975 = 1.959963984540054
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,7 @@ class MotionEstimate:
 
     @property
     def ci95(self) -> tuple[float, float]:
-        return (self.value - Z975 * self.stderr, self.value + Z975 * self.stderr)
+        return (self.value - Z95 * self.stderr, self.value + Z95 * self.stderr)
 
     def to_dict(self) -> dict[str, Any]:
         return {"name": self.name, "effect": self.effect, "joint": self.joint,
