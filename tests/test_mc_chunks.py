@@ -42,3 +42,26 @@ def test_default_chunk_is_chosen_from_the_work_and_is_deterministic():
     b = monte_carlo(setup.model, q, tol, 1000, seed=5, chunk=chunk_size(1000, 60))
     assert np.array_equal(a.max_delta_p, b.max_delta_p)
     assert np.array_equal(a.max_angle_rad, b.max_angle_rad)
+
+
+def test_first_order_maxima_kernel_matches_numpy_products():
+    # the compiled kernel against the plain definition: max_t || J(t) dx || per robot, by a
+    # NumPy product of the whole (N, T, 6) deviations; N not a multiple of the block, zero
+    # entries and an all-zero parameter column included
+    from zrp.manufacturing.maxima import first_order_max
+
+    rng = np.random.default_rng(11)
+    jac = rng.normal(size=(37, 6, 9)) * (rng.random((37, 6, 9)) > 0.4)
+    jac[:, :, 4] = 0.0
+    dx = rng.normal(size=(130, 9))
+    y = np.einsum("tkp,np->ntk", jac, dx)
+    ref_r = np.linalg.norm(y[..., 0:3], axis=-1).max(axis=1)
+    ref_p = np.linalg.norm(y[..., 3:6], axis=-1).max(axis=1)
+    got_p, got_r = first_order_max(jac, dx)
+    np.testing.assert_allclose(got_p, ref_p, rtol=1e-14)
+    np.testing.assert_allclose(got_r, ref_r, rtol=1e-14)
+    # each robot's value does not depend on the others in its block
+    alone = first_order_max(jac, dx[77:78])
+    assert alone[0][0] == got_p[77] and alone[1][0] == got_r[77]
+    with pytest.raises(InputError, match=r"expected shapes \(T, 6, P\) and \(N, P\)"):
+        first_order_max(jac, dx[:, :5])

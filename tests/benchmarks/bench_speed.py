@@ -205,6 +205,9 @@ def monte_carlo(n_robots: int, workers: bool, fk_rate: float) -> None:
         f"({rate / fk_rate:.2f}x; perturbed arms: no sparse axes)")
     row("  the same reduced on the workers (s)", f"{t_red:.2f}", "", f"gathered {t1:.2f} s",
         f"{t_red / t1:.2f}x")
+    t_fo = best(lambda: mc(setup.model, q, tol, n_robots, seed=1, first_order=True), repeat=2)
+    row("  with the first-order maxima too, as zrp tolerance (s)", f"{t_fo:.2f}", "",
+        f"nonlinear only {t1:.2f} s", f"{t_fo / t1:.2f}x")
     if not workers:
         return
     from zrp.cli.cluster import executor

@@ -47,24 +47,26 @@ def nonlinear_maxima(model: Manipulator, arrays: tuple[F64, F64, F64, F64, F64],
     return out_dp, 2.0 * np.arcsin(np.minimum(out_s, 1.0))
 
 
-def first_order_max(jac: ArrayLike, dx: ArrayLike, chunk: int = 2048) -> tuple[F64, F64]:
+def first_order_max(jac: ArrayLike, dx: ArrayLike) -> tuple[F64, F64]:
     """First-order per-robot maxima: max_t ||J_p(t) dx|| and max_t ||J_r(t) dx||.
 
     Args:
-        jac: identification Jacobian along the trajectory, shape (T, 6, P).
+        jac: identification Jacobian along the trajectory, shape (T, 6, P) (rows 0-2
+            rotation, 3-5 position).
         dx: parameter steps, shape (N, P).
 
     Returns:
         max delta_p (length unit) and max angle (rad), each shape (N,).
     """
-    jac = np.asarray(jac, dtype=float)
+    jac = np.ascontiguousarray(jac, dtype=float)
     dx = np.asarray(dx, dtype=float)
-    t_n, _, p = jac.shape
-    flat = jac.reshape(t_n * 6, p).T  # (P, T*6)
-    out_p = np.empty(dx.shape[0])
-    out_r = np.empty(dx.shape[0])
-    for i in range(0, dx.shape[0], chunk):
-        y = (dx[i:i + chunk] @ flat).reshape(-1, t_n, 6)
-        out_r[i:i + chunk] = np.linalg.norm(y[..., 0:3], axis=-1).max(axis=1)
-        out_p[i:i + chunk] = np.linalg.norm(y[..., 3:6], axis=-1).max(axis=1)
+    if jac.ndim != 3 or jac.shape[1] != 6 or dx.ndim != 2 or dx.shape[1] != jac.shape[2]:
+        raise InputError(f"jac, dx: expected shapes (T, 6, P) and (N, P), got {jac.shape} "
+                         f"and {dx.shape}")
+    n, b = dx.shape[0], MK.FO_BLOCK
+    dxt = np.zeros((dx.shape[1], -(-n // b) * b))  # robots last, padded to whole blocks
+    dxt[:, :n] = dx.T
+    out_p = np.empty(n)
+    out_r = np.empty(n)
+    MK.first_order_maxima(jac, dxt, out_p, out_r)
     return out_p, out_r
