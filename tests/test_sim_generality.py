@@ -3,10 +3,15 @@ folded upright at q = 0, models in metres)."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import mujoco
 import numpy as np
+import pytest
 
 import zrp
+from sim.benchmark import BenchmarkConfig
+from sim.benchmark.scenarios import DEFAULT_NOISE_MM, draw_scenarios
 from sim.effects import HiddenEffects
 from sim.measurement import Instrument, measure
 from sim.real_robot import RealRobot
@@ -59,3 +64,22 @@ def test_a_7_axis_arm_settles_on_its_kinematics_at_stretched_poses():
     expected = np.asarray(fk.position)[:, None, :] + np.einsum("pij,mj->pmi", R, tp)
     pts = np.asarray(run.truth["poses"]["points_base_noisefree"])
     assert np.max(np.abs(pts - expected)) < 1e-3  # mm, << tracker noise (0.01 mm)
+
+
+def _in_metres(model: zrp.Manipulator) -> zrp.Manipulator:
+    return dataclasses.replace(model.with_arrays(bodies=model.bodies * 1e-3), length_unit="m")
+
+
+def test_benchmark_noise_default_is_a_tracker_in_any_length_unit():
+    """0.01-0.03 mm, not 0.01-0.03 of whatever the model's unit is (10-30 mm on a model in
+    metres hid every effect: 0 of 17 visible)."""
+    puma = zrp.load_model("puma")
+    cfg = BenchmarkConfig(scenarios=6)
+    assert cfg.noise_range(puma) == DEFAULT_NOISE_MM == (0.01, 0.03)
+    lo, hi = cfg.noise_range(_in_metres(puma))
+    assert lo == pytest.approx(1e-5, rel=1e-12) and hi == pytest.approx(3e-5, rel=1e-12)
+    sig_mm = [s.noise_sigma for s in draw_scenarios(puma, cfg)]
+    sig_m = [s.noise_sigma for s in draw_scenarios(_in_metres(puma), cfg)]
+    np.testing.assert_allclose(np.array(sig_m) * 1e3, sig_mm, rtol=1e-12)
+    # an explicit range stays in the model's unit
+    assert BenchmarkConfig(noise=(0.5, 1.0)).noise_range(_in_metres(puma)) == (0.5, 1.0)

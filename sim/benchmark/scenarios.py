@@ -20,8 +20,10 @@ from sim.effects import EFFECT_NAMES, HiddenEffects
 from sim.real_robot import RealRobot
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
+from zrp.units import metres_per_unit
 
 __all__ = [
+    "DEFAULT_NOISE_MM",
     "KINDS",
     "BenchmarkConfig",
     "Scenario",
@@ -31,6 +33,8 @@ __all__ = [
 
 F64 = NDArray[np.float64]
 KINDS = ("none", "single", "pair")
+#: The default range of the tracker noise sigma per coordinate, mm (a laser tracker's 10-30 um).
+DEFAULT_NOISE_MM = (0.01, 0.03)
 
 
 @dataclass(frozen=True)
@@ -45,7 +49,9 @@ class BenchmarkConfig:
         none_fraction, pair_fraction: shares of scenarios with no hidden effect and with two
             (the rest have one).
         effects: effects to draw from (names of :data:`sim.effects.EFFECT_NAMES`).
-        noise: range of the tracker noise sigma per coordinate, model length unit.
+        noise: range of the tracker noise sigma per coordinate, model length unit; None (the
+            default): :data:`DEFAULT_NOISE_MM`, 0.01-0.03 mm expressed in the model's unit
+            (a model in metres gets 1e-5-3e-5, not 10-30 mm), see :meth:`noise_range`.
         poses_from: "random" (random reachable poses) or "circle" (the PUMA's circle).
         approach: "random", "gravity" or "order" (see :class:`sim.measurement.Procedure`).
         payload_probability: chance that a scenario carries a payload (0.5-3 kg, known: it is
@@ -65,7 +71,7 @@ class BenchmarkConfig:
     none_fraction: float = 0.1
     pair_fraction: float = 0.15
     effects: tuple[str, ...] = ()
-    noise: tuple[float, float] = (0.01, 0.03)
+    noise: tuple[float, float] | None = None
     poses_from: str = "random"
     approach: str = "gravity"
     payload_probability: float = 0.5
@@ -97,10 +103,12 @@ class BenchmarkConfig:
         if self.pair_fraction > 0 and len(eff) < 2:
             raise InputError("pair_fraction > 0 needs at least two effects to draw from")
         object.__setattr__(self, "effects", eff)
-        lo, hi = (float(x) for x in self.noise)
-        if not 0 < lo <= hi:
-            raise InputError(f"noise: expected 0 < low <= high (length unit), got {self.noise!r}")
-        object.__setattr__(self, "noise", (lo, hi))
+        if self.noise is not None:
+            lo, hi = (float(x) for x in self.noise)
+            if not 0 < lo <= hi:
+                raise InputError(f"noise: expected 0 < low <= high (length unit), got "
+                                 f"{self.noise!r}")
+            object.__setattr__(self, "noise", (lo, hi))
         if self.poses_from not in ("random", "circle"):
             raise InputError(f"poses_from: {self.poses_from!r}; expected 'random' or 'circle'")
         if self.approach not in ("random", "order", "gravity"):
@@ -110,6 +118,14 @@ class BenchmarkConfig:
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v > 0):
                 raise InputError(f"{name}: expected a positive number, got {v!r}")
+
+    def noise_range(self, model: Manipulator) -> tuple[float, float]:
+        """(low, high) tracker noise sigma per coordinate in ``model``'s length unit:
+        :attr:`noise`, or :data:`DEFAULT_NOISE_MM` converted with :mod:`zrp.units`."""
+        if self.noise is not None:
+            return self.noise
+        per_mm = 1e-3 / metres_per_unit(model.length_unit, "model.length_unit")
+        return (DEFAULT_NOISE_MM[0] * per_mm, DEFAULT_NOISE_MM[1] * per_mm)
 
 
 @dataclass(frozen=True, eq=False)
@@ -187,6 +203,7 @@ def _draw_effect(name: str, model: Manipulator, rng: np.random.Generator, payloa
 def draw_scenarios(model: Manipulator, config: BenchmarkConfig) -> list[Scenario]:
     """The K scenarios of ``config`` (reproducible from ``config.seed``)."""
     children = np.random.SeedSequence(config.seed).spawn(config.scenarios)
+    noise = config.noise_range(model)
     out = []
     tau_cache: dict[float, F64] = {}
     for i, child in enumerate(children):
@@ -197,7 +214,7 @@ def draw_scenarios(model: Manipulator, config: BenchmarkConfig) -> list[Scenario
         payload = (float(rng.uniform(0.5, 3.0)) if rng.uniform() < config.payload_probability
                    else 0.0)
         payload = round(payload, 2)
-        sigma = float(rng.uniform(*config.noise))
+        sigma = float(rng.uniform(*noise))
         count = {"none": 0, "single": 1, "pair": 2}[kind]
         # balanced classes: the first effect cycles through a seeded permutation of the
         # effects (one per block of len(effects) scenarios), the second is drawn at random

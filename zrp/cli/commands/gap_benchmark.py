@@ -40,8 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--effects", nargs="+", choices=EFFECT_NAMES, default=list(EFFECT_NAMES),
                    metavar="EFFECT", help="effects to draw from (default all)")
     p.add_argument("--noise", type=real(0.0, 1e3),
-                   nargs=2, default=(0.01, 0.03), metavar=("LO", "HI"),
-                   help="range of the tracker noise sigma per coordinate (default 0.01 0.03)")
+                   nargs=2, default=None, metavar=("LO", "HI"),
+                   help="range of the tracker noise sigma per coordinate, model length unit "
+                        "(default 0.01-0.03 mm in the model's unit)")
     p.add_argument("--poses-from", choices=("random", "circle"), default="random",
                    help="random reachable poses (default) or the PUMA circle")
     p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
@@ -91,7 +92,8 @@ def _run(args: argparse.Namespace) -> int:
     check_cluster_options(args)
     cfg = BenchmarkConfig(scenarios=args.scenarios, seed=args.seed, poses=args.poses,
                           none_fraction=args.none, pair_fraction=args.pairs,
-                          effects=tuple(args.effects), noise=tuple(args.noise),
+                          effects=tuple(args.effects),
+                          noise=None if args.noise is None else tuple(args.noise),
                           poses_from=args.poses_from, approach=args.approach,
                           use_mjcf=not args.no_mjcf, compensate=args.compensate)
     model = load_model(args.model)

@@ -1,0 +1,61 @@
+"""The diagnosis of an arm described in metres is the diagnosis of the same arm in mm: every
+threshold, noise estimate and result scales with the length unit (no absolute mm constants)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+import zrp
+from zrp.gap import Injection, diagnose, synthesize
+from zrp.kinematics import reachable_poses
+
+TOOLS_MM = np.array([[50.0, 0.0, 30.0], [-40.0, 60.0, 30.0], [0.0, -70.0, 40.0]])
+
+
+def _in_metres(model: zrp.Manipulator) -> zrp.Manipulator:
+    return dataclasses.replace(model.with_arrays(bodies=model.bodies * 1e-3), length_unit="m")
+
+
+def _measure(model, q, inj, s):
+    inj = dataclasses.replace(inj, link={k: tuple(np.array(v) * s) for k, v in inj.link.items()})
+    return synthesize(model, q, inj, rng=np.random.default_rng(5), noise_sigma=0.02 * s,
+                      tool_offsets=TOOLS_MM * s,
+                      base_translation=np.array([1500.0, -300.0, 200.0]) * s)
+
+
+def test_synthetic_gravity_torque_is_the_same_in_any_length_unit():
+    """A compliance of c rad/(N m) deflects the same arm by the same angle whether it is
+    described in mm or in m (the lumped masses' torque used to assume mm)."""
+    puma = zrp.load_model("puma")
+    q = reachable_poses(puma, 10, np.random.default_rng(1))
+    inj = Injection(compliance={2: 2e-5})
+    a = synthesize(puma, q, inj, rng=np.random.default_rng(0), noise_sigma=0.0,
+                   tool_offsets=[[0.0, 0.0, 0.0]])
+    b = synthesize(_in_metres(puma), q, inj, rng=np.random.default_rng(0), noise_sigma=0.0,
+                   tool_offsets=[[0.0, 0.0, 0.0]],
+                   base_translation=np.array([1500.0, -300.0, 200.0]) * 1e-3)
+    plain = synthesize(puma, q, Injection(), rng=np.random.default_rng(0), noise_sigma=0.0,
+                       tool_offsets=[[0.0, 0.0, 0.0]])
+    assert np.max(np.abs(a.xyz - plain.xyz)) > 0.5  # mm: the sag is there (>> 1e-9)
+    np.testing.assert_allclose(b.xyz * 1e3, a.xyz, atol=1e-9)
+
+
+@pytest.mark.parametrize("inj", [Injection(backlash={2: 1e-3}),
+                                 Injection(compliance={2: 2e-5, 3: 3e-5})],
+                         ids=["backlash", "compliance"])
+def test_diagnosis_in_metres_equals_the_diagnosis_in_mm(inj):
+    puma = zrp.load_model("puma")
+    q = reachable_poses(puma, 80, np.random.default_rng(3))
+    d_mm = diagnose(puma, _measure(puma, q, inj, 1.0), seed=0)
+    d_m = diagnose(_in_metres(puma), _measure(_in_metres(puma), q, inj, 1e-3), seed=0)
+    assert [(s.effect, s.joints) for s in d_m.steps] == [(s.effect, s.joints)
+                                                         for s in d_mm.steps]
+    assert d_mm.steps  # the effect is found at all
+    for attr in ("nominal", "final"):
+        assert getattr(d_m, attr).rms * 1e3 == pytest.approx(getattr(d_mm, attr).rms, rel=1e-6)
+    assert d_m.noise_floor.rms * 1e3 == pytest.approx(d_mm.noise_floor.rms, rel=1e-6)
+    assert d_m.unexplained == d_mm.unexplained is False
+    assert " m " in d_m.verdict and " mm " in d_mm.verdict
