@@ -11,7 +11,7 @@ import pytest
 
 import zrp
 from sim.benchmark import BenchmarkConfig
-from sim.benchmark.scenarios import DEFAULT_NOISE_MM, draw_scenarios
+from sim.benchmark.scenarios import DEFAULT_NOISE_MM, draw_scenarios, pose_limits
 from sim.effects import HiddenEffects
 from sim.measurement import Instrument, measure
 from sim.real_robot import RealRobot
@@ -83,3 +83,43 @@ def test_benchmark_noise_default_is_a_tracker_in_any_length_unit():
     np.testing.assert_allclose(np.array(sig_m) * 1e3, sig_mm, rtol=1e-12)
     # an explicit range stays in the model's unit
     assert BenchmarkConfig(noise=(0.5, 1.0)).noise_range(_in_metres(puma)) == (0.5, 1.0)
+
+
+def test_benchmark_poses_move_a_slide_and_keep_within_the_limits():
+    """A prismatic joint travels +-10 % of the reach (it moved +-2.5 length units: 5 mm of the
+    Stanford arm's 1079 mm, too little for the diagnosis to place a slide's play on it), and
+    a joint's own limits bound its poses (the Panda's joint 4 is never positive)."""
+    stanford = zrp.load_model("stanford")
+    lim = pose_limits(stanford)
+    np.testing.assert_allclose(lim[2], [-0.1 * stanford.reach, 0.1 * stanford.reach])
+    np.testing.assert_array_equal(lim[[0, 1, 3, 4, 5]], np.tile([-2.5, 2.5], (5, 1)))
+    panda = panda_like()
+    lim = pose_limits(panda)
+    assert np.all(lim[:, 0] >= panda.lower) and np.all(lim[:, 1] <= panda.upper)
+    assert lim[3, 1] == pytest.approx(-0.0698)
+    puma = zrp.load_model("puma")
+    np.testing.assert_array_equal(pose_limits(puma), np.tile([-2.5, 2.5], (6, 1)))
+
+
+def test_benchmark_draws_lengths_for_a_slide_and_no_cyclic_error_on_it():
+    stanford = zrp.load_model("stanford")
+    cfg = BenchmarkConfig(scenarios=60, pair_fraction=0.0, none_fraction=0.0,
+                          effects=("joint_offset", "backlash", "cyclic_error"))
+    slide = {"joint_offset": [], "backlash": []}
+    for s in draw_scenarios(stanford, cfg):
+        assert 3 not in s.effects.cyclic_error  # the diagnosis has no cyclic error on slides
+        for name, got in slide.items():
+            got += [abs(v) for k, v in getattr(s.effects, name).items() if k == 3]
+    for name, got in slide.items():
+        assert got, name  # the slide was drawn at least once in 60 scenarios
+        # 0.2-1.6 mrad-equivalent of the reach: 0.017-0.14 mm, not 0.2-1.6 um
+        assert all(0.015 < v < 0.15 for v in got), (name, got)
+
+
+def test_benchmark_one_reflector():
+    cfg = BenchmarkConfig(reflectors=1)
+    puma = zrp.load_model("puma")
+    tp = np.asarray(cfg.robot_options(puma).tool_points)
+    assert tp.shape == (1, 3)
+    with pytest.raises(zrp.InputError, match="reflectors"):
+        BenchmarkConfig(reflectors=4)

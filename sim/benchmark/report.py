@@ -54,7 +54,8 @@ def render_text(result: BenchmarkResult) -> str:
     sc = result.scores
     out = [f"# Blind gap benchmark: {result.model_name}", "",
            f"{len(sc)} scenarios (seed {cfg.seed}), {cfg.poses} poses each "
-           f"({cfg.poses_from} poses, {cfg.approach} approach), tracker noise "
+           f"({cfg.poses_from} poses, {cfg.approach} approach, {cfg.reflectors} "
+           f"reflector{'s' if cfg.reflectors > 1 else ''}), tracker noise "
            f"{_noise_text(cfg)} per coordinate, MJCF inertias "
            f"{'given' if cfg.use_mjcf else 'not given'} to the diagnosis. Visible: signature "
            f"after registration >= {cfg.excitation_threshold:g} x noise RMS. Target: withheld "

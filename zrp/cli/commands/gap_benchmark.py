@@ -49,6 +49,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="final approach against gravity for the gravity-loaded joints and "
                         "from a random side for the others (default), from a random side for "
                         "all, or straight moves in measurement order")
+    p.add_argument("--reflectors", type=whole(1, 3), default=3, metavar="M",
+                   help="reflectors on the tool, 1-3 (default 3; with 1 the diagnosis has no "
+                        "noise floor from rigid links)")
     p.add_argument("--no-mjcf", action="store_true",
                    help="do not give the diagnosis the nominal MJCF (lumped-mass compliance)")
     p.add_argument("--out", default=None, metavar="DIR",
@@ -95,7 +98,8 @@ def _run(args: argparse.Namespace) -> int:
                           effects=tuple(args.effects),
                           noise=None if args.noise is None else tuple(args.noise),
                           poses_from=args.poses_from, approach=args.approach,
-                          use_mjcf=not args.no_mjcf, compensate=args.compensate)
+                          use_mjcf=not args.no_mjcf, compensate=args.compensate,
+                          reflectors=args.reflectors)
     model = load_model(args.model)
     # the folder is locked and its files checked before the (long) run
     with OutputDir(out, overwrite=overwrite, names=output_names(not args.no_plots)) as folder:
