@@ -59,3 +59,26 @@ def test_diagnosis_in_metres_equals_the_diagnosis_in_mm(inj):
     assert d_m.noise_floor.rms * 1e3 == pytest.approx(d_mm.noise_floor.rms, rel=1e-6)
     assert d_m.unexplained == d_mm.unexplained is False
     assert " m " in d_m.verdict and " mm " in d_mm.verdict
+
+
+def test_small_arm_with_a_slide_in_metres_equals_the_same_arm_in_mm():
+    """A 0.43 m Stanford-type arm: thresholds scaled by the characteristic length (a slide's
+    excitation, the refusal of a wrong model) used a floor of 1 length unit, i.e. 1 m here,
+    so a slide moving +-12 mm counted as unexcited in metres and excited in mm."""
+    big = zrp.load_model("stanford")
+    small_mm = big.with_arrays(bodies=big.bodies * 0.4)
+    small_m = _in_metres(small_mm)
+    assert small_m.characteristic_length == pytest.approx(small_m.reach)
+    rng = np.random.default_rng(4)
+    lim = np.tile([-2.0, 2.0], (6, 1))
+    lim[2] = (-12.0, 12.0)
+    q = reachable_poses(small_mm, 80, rng, limits=lim, min_height=-1e9)
+    q_m = q.copy()
+    q_m[:, 2] *= 1e-3
+    inj = Injection(backlash={3: 0.1})
+    d_mm = diagnose(small_mm, _measure(small_mm, q, inj, 1.0), seed=0)
+    meas_m = _measure(small_m, q_m, dataclasses.replace(inj, backlash={3: 0.1e-3}), 1e-3)
+    d_m = diagnose(small_m, meas_m, seed=0)
+    assert [(s.effect, s.joints) for s in d_mm.steps] == [("backlash", (3,))]
+    assert [(s.effect, s.joints) for s in d_m.steps] == [("backlash", (3,))]
+    assert d_m.final.rms * 1e3 == pytest.approx(d_mm.final.rms, rel=1e-6)
