@@ -4,6 +4,7 @@ folded upright at q = 0, models in metres)."""
 from __future__ import annotations
 
 import dataclasses
+import json
 
 import mujoco
 import numpy as np
@@ -16,6 +17,7 @@ from sim.effects import HiddenEffects
 from sim.measurement import Instrument, measure
 from sim.real_robot import RealRobot
 from sim.robot_model import _servo_inertias
+from zrp.cli import main
 from zrp.kinematics import forward_kinematics, reachable_poses
 
 EXACT = Instrument(noise_sigma=0.0, rotvec=(0.0, 0.0, 0.0), translation=(0.0, 0.0, 0.0))
@@ -123,3 +125,29 @@ def test_benchmark_one_reflector():
     assert tp.shape == (1, 3)
     with pytest.raises(zrp.InputError, match="reflectors"):
         BenchmarkConfig(reflectors=4)
+
+
+def test_cli_measure_default_noise_is_20_um_in_any_length_unit(tmp_path, capsys):
+    path = tmp_path / "puma_m.toml"
+    zrp.save_model(_in_metres(zrp.load_model("puma")), path)
+    assert main(["measure", "--model", str(path), "--poses", "8",
+                 "--out", str(tmp_path / "m.csv"), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out)
+    assert info["noise_sigma"] == pytest.approx(2e-5, rel=1e-12)  # not 0.02 m
+
+
+def test_cli_plan_default_noise_is_20_um_in_any_length_unit(tmp_path, capsys):
+    """The predicted standard deviations of a plan for the PUMA in m match those in mm (the
+    default noise was 0.02 model units: 20 mm in metres, 1000x too pessimistic)."""
+    path = tmp_path / "puma_m.toml"
+    zrp.save_model(_in_metres(zrp.load_model("puma")), path)
+    std = {}
+    for model, floor in (("puma", "-400"), (str(path), "-0.4")):
+        assert main(["plan", "--model", model, "--poses", "20", "--effects", "joint_offset",
+                     "--out", str(tmp_path / "p.csv"), "--floor", floor, "--candidates",
+                     "200", "--json", "--force"]) == 0
+        doc = json.loads(capsys.readouterr().out)
+        std[model] = {p["name"]: p["std"] for p in doc["parameters"]}
+    mm, m = std["puma"], std[str(path)]
+    assert m["base.rx"] == pytest.approx(mm["base.rx"], rel=0.3)
+    assert m["base.tx"] * 1e3 == pytest.approx(mm["base.tx"], rel=0.3)
