@@ -45,7 +45,8 @@ class RealRobotOptions:
         inertia: "auto" (PUMA 560 values for a 6R arm, rods otherwise), "puma560" or "rods".
         servo_kp: stiffness of the servos of joints without compliance, N m/rad (N/m); their
             integral action removes the steady-state error whatever it is.
-        damping_ratio: servo damping ratio (kv from kp and the joint's inertia at q = 0).
+        damping_ratio: servo damping ratio (kv from kp and the joint's inertia at q = 0; the
+            integral gain is capped for stability at the largest inertia, see ``_tune``).
         load_friction: Coulomb friction of each load-side hinge (backlash joints only), N m,
             shape (n,); None: :data:`PUMA560_LOAD_FRICTION` for the PUMA, 1 N m otherwise.
         tool_points: reflector offsets from the end-effector point, zero-reference base frame,
@@ -183,25 +184,53 @@ def _add_drives(spec: mujoco.MjSpec, chain: _Chain, kps: F64, load_friction: F64
         act.set_to_velocity(kv=1.0)
 
 
-def _tune(spec: mujoco.MjSpec, chain: _Chain, kps: F64, options: RealRobotOptions
-          ) -> tuple[F64, F64]:
-    """Damping, time step and constraint stiffness from the inertia each servo sees at q = 0.
+def _servo_inertias(probe: mujoco.MjModel, chain: _Chain, lower: F64, upper: F64,
+                    poses: int = 64) -> F64:
+    """The inertia each servo sees (diagonal of the joint-space inertia at its motor joint),
+    at q = 0 (row 0) and at ``poses - 1`` seeded random poses within +-2.5 rad and the joint
+    limits (prismatic joints within their limits, else at 0), shape (poses, n), kg m^2."""
+    d = mujoco.MjData(probe)
+    adr = [probe.jnt_qposadr[mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm)]
+           for nm in chain.motor]
+    dof = [probe.jnt_dofadr[mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm)]
+           for nm in chain.motor]
+    rng = np.random.default_rng(0)
+    full = np.zeros((probe.nv, probe.nv))
+    out = np.empty((poses, len(adr)))
+    for i in range(poses):
+        d.qpos[:] = probe.qpos0
+        if i:
+            d.qpos[adr] = rng.uniform(lower, upper)
+        mujoco.mj_forward(probe, d)
+        mujoco.mj_fullM(probe, d, full)
+        out[i] = full[dof, dof]
+    return out
+
+
+def _tune(spec: mujoco.MjSpec, chain: _Chain, kps: F64, options: RealRobotOptions,
+          lower: F64, upper: F64) -> tuple[F64, F64]:
+    """Damping, integral gain, time step and constraint stiffness from the inertia each servo
+    sees.
+
+    kv = 2 zeta sqrt(kp I_0) with I_0 the inertia at q = 0; the integral gain
+    ki = 0.15 sqrt(kp / I_0), capped at half of kv / I_max: the servo with integral action,
+    I s^3 + kv s^2 + kp s + kp ki = 0, is stable only for ki < kv / I (Routh), and an arm
+    folded upright at q = 0 (a Panda: joint 1 sees 45x more inertia stretched out) would
+    otherwise diverge. The time step is 0.4 sqrt(I_min / kp) at most (1 ms), I_min over the
+    same poses. On the PUMA, IRB 120, UR5e and Stanford arms neither the cap nor I_min
+    changes a gain or the step (their inertias vary by less than 3.4x).
 
     Returns:
-        (rate gains kv, the inertia each servo sees), shape (n,) each.
+        (rate gains kv, integral gains ki), shape (n,) each.
     """
     probe = spec.compile()
-    d = mujoco.MjData(probe)
-    mujoco.mj_forward(probe, d)
-    full = np.zeros((probe.nv, probe.nv))
-    mujoco.mj_fullM(probe, d, full)
-    mdof = [probe.jnt_dofadr[mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm)]
-            for nm in chain.motor]
-    inertia = np.array([full[i, i] for i in mdof])
-    kvs = 2.0 * options.damping_ratio * np.sqrt(kps * inertia)
+    inertia = _servo_inertias(probe, chain, lower, upper)
+    i0 = inertia[0]
+    kvs = 2.0 * options.damping_ratio * np.sqrt(kps * i0)
+    kis = np.minimum(0.15 * np.sqrt(kps / i0), 0.5 * kvs / inertia.max(axis=0))
     dt = options.timestep
     if dt is None:
-        dt = float(min(1e-3, 0.4 * np.min(np.sqrt(inertia / kps))))
+        dt = float(min(1e-3, 0.4 * np.min(np.sqrt(inertia.min(axis=0) / kps))))
     spec.option.timestep = dt
     for k, name in enumerate(chain.play):
         if name is not None:
@@ -213,7 +242,7 @@ def _tune(spec: mujoco.MjSpec, chain: _Chain, kps: F64, options: RealRobotOption
             ten.solimp_friction = [0.99999, 0.99999, 0.001, 0.5, 2.0]
     for k in range(len(chain.motor)):
         spec.actuator(f"servo{k + 1}_rate").set_to_velocity(kv=float(kvs[k]))
-    return kvs, inertia
+    return kvs, kis
 
 
 def build_robot_model(true_model: Manipulator, effects: HiddenEffects,
@@ -249,10 +278,17 @@ def build_robot_model(true_model: Manipulator, effects: HiddenEffects,
     for k, c in effects.joint_compliance.items():
         kps[k - 1] = 1.0 / c
     _add_drives(spec, chain, kps, load_friction)
-    kvs, inertia = _tune(spec, chain, kps, options)
+    # poses the benchmark commands: +-2.5 rad within the limits (length unit -> m for sliders)
+    lo = np.where(true_model.prismatic, true_model.lower * scale, -2.5)
+    hi = np.where(true_model.prismatic, true_model.upper * scale, 2.5)
+    lo = np.where(true_model.prismatic, np.where(np.isfinite(lo), lo, 0.0),
+                  np.maximum(lo, true_model.lower))
+    hi = np.where(true_model.prismatic, np.where(np.isfinite(hi), hi, 0.0),
+                  np.minimum(hi, true_model.upper))
+    kvs, kis = _tune(spec, chain, kps, options, lo, hi)
     compiled = spec.compile()
     return compiled, _indices(compiled, chain, effects, len(tool_points), tip,
-                              {"kp": kps, "kv": kvs, "ki": 0.15 * np.sqrt(kps / inertia)})
+                              {"kp": kps, "kv": kvs, "ki": kis})
 
 
 def _indices(m: mujoco.MjModel, chain: _Chain, eff: HiddenEffects, points: int, tip: F64,

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 
 from mjcf.gravity import gravity_torques
-from sim.benchmark.scenarios import BenchmarkConfig, Scenario
+from sim.benchmark.scenarios import BenchmarkConfig, Scenario, pose_limits
 from sim.measurement import (
     Procedure,
     measure,
@@ -39,10 +39,11 @@ def simulate_scenario(model: Manipulator, scenario: Scenario, config: BenchmarkC
     ``truth_dir/scenario_XXX.truth.json``. Returns both paths and the wall time (s)."""
     t0 = time.perf_counter()
     rng = np.random.default_rng(scenario.seed)
-    q = (reachable_poses(model, config.poses, rng) if config.poses_from == "random"
+    q = (reachable_poses(model, config.poses, rng, limits=pose_limits(model))
+         if config.poses_from == "random"
          else trajectory_poses(model, config.poses, "circle"))
     inst = random_instrument(model, rng, scenario.noise_sigma)
-    robot = RealRobot(model, scenario.effects)
+    robot = RealRobot(model, scenario.effects, config.robot_options(model))
     run = measure(robot, q, inst, rng, Procedure(approach=config.approach))
     run.truth["scenario"] = {"index": scenario.index, "seed": scenario.seed,
                              "kind": scenario.kind, "labels": list(scenario.labels)}

@@ -22,6 +22,7 @@ from sim.benchmark.scenarios import Scenario
 from sim.compensation_check import compensate_and_measure
 from sim.measurement import Instrument
 from sim.real_robot import RealRobot
+from sim.robot_model import RealRobotOptions
 from zrp.errors import InputError
 from zrp.gap import Diagnosis
 from zrp.model.manipulator import Manipulator
@@ -48,7 +49,8 @@ def compensated_column(model: Manipulator, scenario: Scenario, truth: dict[str, 
     ins = truth["instrument"]
     inst = Instrument(float(ins["noise_sigma"]), tuple(ins["rotvec"]),
                       tuple(ins["translation"]))
-    robot = RealRobot(model, scenario.effects)
+    tool = tuple(tuple(float(x) for x in r) for r in truth["robot"]["tool_points"])
+    robot = RealRobot(model, scenario.effects, RealRobotOptions(tool_points=tool))
     rng = np.random.default_rng([scenario.seed, 11])
     n_circle = targets // 2 if model.n == 6 and targets // 2 >= 8 else 0
     nan = float("nan")

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from sim.benchmark.results import BenchmarkResult, confusion_matrix, summary_rows
+from sim.benchmark.scenarios import DEFAULT_NOISE_MM, BenchmarkConfig
 from sim.measurement import REPLACE
 from zrp.errors import OutputExistsError
 from zrp.output import OutputDir
@@ -41,14 +42,21 @@ def _md_table(header: list[str], rows: list[list[Any]]) -> str:
     return "\n".join(lines)
 
 
+def _noise_text(cfg: BenchmarkConfig) -> str:
+    """The configured noise range (model length unit), or the default's in mm."""
+    lo, hi = cfg.noise if cfg.noise is not None else DEFAULT_NOISE_MM
+    return f"{lo:g}-{hi:g}" + (" mm" if cfg.noise is None else "")
+
+
 def render_text(result: BenchmarkResult) -> str:
     """Markdown: summary table, confusion matrix, pairs, failures and timings."""
     cfg = result.config
     sc = result.scores
     out = [f"# Blind gap benchmark: {result.model_name}", "",
            f"{len(sc)} scenarios (seed {cfg.seed}), {cfg.poses} poses each "
-           f"({cfg.poses_from} poses, {cfg.approach} approach), tracker noise "
-           f"{cfg.noise[0]:g}-{cfg.noise[1]:g} per coordinate, MJCF inertias "
+           f"({cfg.poses_from} poses, {cfg.approach} approach, {cfg.reflectors} "
+           f"reflector{'s' if cfg.reflectors > 1 else ''}), tracker noise "
+           f"{_noise_text(cfg)} per coordinate, MJCF inertias "
            f"{'given' if cfg.use_mjcf else 'not given'} to the diagnosis. Visible: signature "
            f"after registration >= {cfg.excitation_threshold:g} x noise RMS. Target: withheld "
            f"RMS after correction <= {cfg.ratio_target:g} x noise RMS.", "", "## Summary", ""]

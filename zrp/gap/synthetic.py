@@ -20,6 +20,7 @@ from zrp.kinematics.forward import check_q, forward_kinematics
 from zrp.manufacturing.sensitivity import axis_tangents, tilt_axes
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import matrix_from_rotvec
+from zrp.units import G_STANDARD, metres_per_unit
 
 __all__ = ["Injection", "synthesize"]
 
@@ -67,7 +68,9 @@ class Injection:
 
 def _gravity_torque(model: Manipulator, q: F64, masses: Mapping[str, float],
                     g_dir: F64) -> F64:
-    """tau[p, k] = sum_j m_j 9.80665 u_k . ((P_j - p_k) x g_dir) * 1e-3 (N m for mm)."""
+    """tau[p, k] = sum_j m_j g u_k . ((P_j - p_k) x g_dir) * s, N m, shape (P, n); s metres
+    per length unit (1e-3 for mm, 1 for m: the same arm gives the same torque in any unit)."""
+    to_m = metres_per_unit(model.length_unit, "model.length_unit")
     fk = forward_kinematics(model, q)
     tau = np.zeros(q.shape)
     for lab, m in masses.items():
@@ -79,7 +82,7 @@ def _gravity_torque(model: Manipulator, q: F64, masses: Mapping[str, float],
         for k in range(model.n):
             if k < owner and not model.prismatic[k]:
                 arm = np.cross(pt - fk.points[:, k], g_dir)
-                tau[:, k] += m * 9.80665 * 1e-3 * np.einsum("pi,pi->p", fk.axes[:, k], arm)
+                tau[:, k] += m * G_STANDARD * to_m * np.einsum("pi,pi->p", fk.axes[:, k], arm)
     return tau
 
 

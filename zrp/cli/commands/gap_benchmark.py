@@ -40,14 +40,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--effects", nargs="+", choices=EFFECT_NAMES, default=list(EFFECT_NAMES),
                    metavar="EFFECT", help="effects to draw from (default all)")
     p.add_argument("--noise", type=real(0.0, 1e3),
-                   nargs=2, default=(0.01, 0.03), metavar=("LO", "HI"),
-                   help="range of the tracker noise sigma per coordinate (default 0.01 0.03)")
+                   nargs=2, default=None, metavar=("LO", "HI"),
+                   help="range of the tracker noise sigma per coordinate, model length unit "
+                        "(default 0.01-0.03 mm in the model's unit)")
     p.add_argument("--poses-from", choices=("random", "circle"), default="random",
                    help="random reachable poses (default) or the PUMA circle")
     p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
                    help="final approach against gravity for the gravity-loaded joints and "
                         "from a random side for the others (default), from a random side for "
                         "all, or straight moves in measurement order")
+    p.add_argument("--reflectors", type=whole(1, 3), default=3, metavar="M",
+                   help="reflectors on the tool, 1-3 (default 3; with 1 the diagnosis has no "
+                        "noise floor from rigid links)")
     p.add_argument("--no-mjcf", action="store_true",
                    help="do not give the diagnosis the nominal MJCF (lumped-mass compliance)")
     p.add_argument("--out", default=None, metavar="DIR",
@@ -91,9 +95,11 @@ def _run(args: argparse.Namespace) -> int:
     check_cluster_options(args)
     cfg = BenchmarkConfig(scenarios=args.scenarios, seed=args.seed, poses=args.poses,
                           none_fraction=args.none, pair_fraction=args.pairs,
-                          effects=tuple(args.effects), noise=tuple(args.noise),
+                          effects=tuple(args.effects),
+                          noise=None if args.noise is None else tuple(args.noise),
                           poses_from=args.poses_from, approach=args.approach,
-                          use_mjcf=not args.no_mjcf, compensate=args.compensate)
+                          use_mjcf=not args.no_mjcf, compensate=args.compensate,
+                          reflectors=args.reflectors)
     model = load_model(args.model)
     # the folder is locked and its files checked before the (long) run
     with OutputDir(out, overwrite=overwrite, names=output_names(not args.no_plots)) as folder:

@@ -16,6 +16,7 @@ from zrp.jsonio import dumps
 from zrp.kinematics import reachable_poses
 from zrp.model.files import builtin_models, load_model
 from zrp.output import check_writable, write_text
+from zrp.units import metres_per_unit
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -57,8 +58,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "gravity torque, the others from a random side (default; written as "
                         "dir columns), every joint from a random side, or straight moves in "
                         "measurement order")
-    p.add_argument("--noise", type=real(0.0, 1e3), default=0.02, metavar="SIGMA",
-                   help="tracker noise per coordinate, model length unit (default 0.02)")
+    p.add_argument("--noise", type=real(0.0, 1e3), default=None, metavar="SIGMA",
+                   help="tracker noise per coordinate, model length unit (default 0.02 mm in "
+                        "the model's unit)")
     p.add_argument("--temp-rise", type=real(-100.0, 100.0, unit="K"), default=10.0, metavar="K",
                    help="warm-up of the robot during the session, K (default 10)")
     p.add_argument("--seed", type=SEED, default=0, help="seed of poses, noise and instrument")
@@ -79,7 +81,7 @@ def _run(args: argparse.Namespace) -> int:
 
     if args.poses < 8:
         raise InputError(f"--poses: expected at least 8 poses, got {args.poses}")
-    if not args.noise > 0:
+    if args.noise is not None and not args.noise > 0:
         raise InputError(f"--noise: expected a positive sigma (model length unit), got "
                          f"{args.noise}")
     if args.seed < 0:
@@ -90,6 +92,8 @@ def _run(args: argparse.Namespace) -> int:
         raise InputError("--truth: must differ from --out")
     check_writable([out, truth], args.force)  # before the simulation, which takes a while
     model = load_model(args.model)
+    if args.noise is None:  # a laser tracker's 20 um, whatever the model's unit
+        args.noise = 0.02e-3 / metres_per_unit(model.length_unit, "model.length_unit")
     if args.stream is not None:
         return _stream(args, model, out, truth)
     effects = sim.parse_effects(args.effect, model, args.payload, field="--effect")

@@ -16,6 +16,7 @@ from zrp.errors import InputError
 from zrp.gap.effects import EFFECTS
 from zrp.model.files import load_model
 from zrp.output import check_writable, write_text
+from zrp.units import metres_per_unit
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -39,8 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "above z = Z (base frame, length unit)")
     p.add_argument("--tool", nargs=3, type=FINITE, action="append", metavar=("X", "Y", "Z"),
                    help="a tool point offset (repeat per reflector; default the end point)")
-    p.add_argument("--noise", type=LENGTH, default=0.02, metavar="SIGMA",
-                   help="instrument noise per coordinate (default 0.02)")
+    p.add_argument("--noise", type=LENGTH, default=None, metavar="SIGMA",
+                   help="instrument noise per coordinate, model length unit (default 0.02 mm "
+                        "in the model's unit)")
     p.add_argument("--candidates", type=whole(1, 1_000_000), default=1000,
                    help="candidate poses (1000)")
     p.add_argument("--seed", type=SEED, default=0, help="random seed")
@@ -66,12 +68,14 @@ def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
 def _run(args: argparse.Namespace) -> int:
     check_writable([args.out], args.force)
     model = load_model(args.model)
+    noise = (0.02e-3 / metres_per_unit(model.length_unit, "model.length_unit")
+             if args.noise is None else args.noise)  # a tracker's 20 um in any unit
     with warnings.catch_warnings(record=True) as wl:
         warnings.simplefilter("always")
         plan = plan_poses(model, args.poses, args.effects, rng=np.random.default_rng(args.seed),
                           limits=_limits(args.limits, model.n, args.deg),
                           tool_points=args.tool or ((0.0, 0.0, 0.0),), floor_z=args.floor,
-                          noise_sigma=args.noise, candidates=args.candidates)
+                          noise_sigma=noise, candidates=args.candidates)
     n = model.n
     buf = io.StringIO()
     w = csv.writer(buf)
