@@ -107,3 +107,31 @@ def test_gap_payload_and_gravity_torques_do_not_depend_on_the_unit(puma, q, unit
     for name in cols_mm:
         np.testing.assert_allclose(cols_u[name], cols_mm[name], rtol=1e-9, atol=1e-9,
                                    err_msg=name)
+
+
+def test_units_per_mm_and_the_planning_default_follow_the_model_unit(puma):
+    import warnings
+
+    from zrp.calibration.planning import PlanWarning, design_std, plan_poses
+    from zrp.errors import InputError
+    from zrp.units import TRACKER_NOISE_MM, units_per_mm
+
+    assert units_per_mm("mm") == 1.0 and units_per_mm("m") == pytest.approx(1e-3)
+    assert units_per_mm("in") == pytest.approx(1 / 25.4)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", PlanWarning)  # aliased link components are left out
+        p_mm, p_m = (plan_poses(model, 30, ["link_length"], rng=np.random.default_rng(0),
+                                candidates=60) for model in (puma, in_unit(puma, "m")))
+    assert p_mm.names == p_m.names and np.array_equal(p_mm.q, p_m.q)
+    # the default is the same 20 um instrument in both units: an angle's std is the same, a
+    # length's is the same length (1e-3 times the number); it used to be 0.02 model units
+    length = np.array([u != "rad" for u in p_mm.units])
+    assert length.any() and (~length).any()
+    np.testing.assert_allclose(p_m.std[~length], p_mm.std[~length], rtol=1e-6)
+    np.testing.assert_allclose(p_m.std[length] * 1e3, p_mm.std[length], rtol=1e-6)
+    d = np.ones_like(p_mm.q)
+    _, default = design_std(puma, p_mm.q, d, ["link_length"])
+    _, explicit = design_std(puma, p_mm.q, d, ["link_length"], noise_sigma=TRACKER_NOISE_MM)
+    np.testing.assert_allclose(default, explicit, rtol=1e-12)
+    with pytest.raises(InputError, match="noise_sigma"):
+        design_std(puma, p_mm.q, d, ["link_length"], noise_sigma=-1.0)

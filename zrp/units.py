@@ -8,7 +8,8 @@ from __future__ import annotations
 
 from zrp.errors import UnitError
 
-__all__ = ["G_STANDARD", "LENGTH_UNITS", "canonical_length_unit", "metres_per_unit"]
+__all__ = ["G_STANDARD", "LENGTH_UNITS", "TRACKER_NOISE_MM", "canonical_length_unit",
+           "metres_per_unit", "units_per_mm"]
 
 #: Standard gravity, m/s^2 (CGPM 1901).
 G_STANDARD = 9.80665
@@ -52,3 +53,15 @@ def metres_per_unit(unit: str, field: str = "length_unit") -> float:
         InputError: naming ``field`` and listing the known units.
     """
     return LENGTH_UNITS[canonical_length_unit(unit, field)]
+
+
+#: A laser tracker's typical noise per coordinate, mm (the default of the commands that
+#: simulate or plan measurements; convert with :func:`units_per_mm`).
+TRACKER_NOISE_MM = 0.02
+
+
+def units_per_mm(unit: str, field: str = "length_unit") -> float:
+    """How many ``unit`` make one millimetre (1 for ``"mm"``, 1e-3 for ``"m"``): a length
+    fixed in mm, such as an instrument's noise, in a model's own unit."""
+    return 1e-3 / metres_per_unit(unit, field)
+

@@ -21,7 +21,7 @@ from sim.real_robot import RealRobot
 from sim.robot_model import RealRobotOptions
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
-from zrp.units import metres_per_unit
+from zrp.units import metres_per_unit, units_per_mm
 
 __all__ = [
     "DEFAULT_NOISE_MM",
@@ -139,7 +139,7 @@ class BenchmarkConfig:
         :attr:`noise`, or :data:`DEFAULT_NOISE_MM` converted with :mod:`zrp.units`."""
         if self.noise is not None:
             return self.noise
-        per_mm = 1e-3 / metres_per_unit(model.length_unit, "model.length_unit")
+        per_mm = units_per_mm(model.length_unit, "model.length_unit")
         return (DEFAULT_NOISE_MM[0] * per_mm, DEFAULT_NOISE_MM[1] * per_mm)
 
 

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arguments import check_float
 from zrp.errors import InputError, ZRPWarning
 from zrp.gap.data import Measurements
 from zrp.gap.effects import Context, ParamSpec, effect_parameters, registration_parameters
@@ -35,6 +36,7 @@ from zrp.gap.problem import Problem
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.sampling import uniform_joint_values
 from zrp.model.manipulator import Manipulator
+from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
 __all__ = ["Plan", "PlanWarning", "design_std", "plan_poses"]
 
@@ -172,7 +174,8 @@ def _exchange(A: F64, design: NDArray[np.int64], max_iter: int) -> NDArray[np.in
 def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
                rng: np.random.Generator, limits: ArrayLike | None = None,
                tool_points: ArrayLike = ((0.0, 0.0, 0.0),), floor_z: float | None = None,
-               noise_sigma: float = 0.02, candidates: int = 1000, max_iter: int = 300,
+               noise_sigma: float | None = None, candidates: int = 1000,
+               max_iter: int = 300,
                gravity_torque_fn: object = None, direction_fn: object = None) -> Plan:
     """Choose ``n_poses`` poses that identify registration + ``effects`` (module doc).
 
@@ -185,7 +188,8 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
         tool_points: tool offsets t_j (zero-reference base frame, length unit), shape (M, 3).
         floor_z: candidates with any joint point or tool point below this z (base frame) are
             excluded (None: no keep-out).
-        noise_sigma: instrument noise per coordinate (length unit) for the predicted std.
+        noise_sigma: instrument noise per coordinate (length unit) for the predicted std;
+            None: a laser tracker's :data:`~zrp.units.TRACKER_NOISE_MM` in the model's unit.
         candidates: size of the candidate set.
         gravity_torque_fn: optional q (C, n) -> MJCF gravity torques (C, n) (N m).
         direction_fn: optional q (C, n) -> approach directions (C, n) in {-1, 0, +1} that the
@@ -225,7 +229,7 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
     start = rng.choice(len(q), size=n_poses, replace=False)
     design = _exchange(A, start, max_iter)
     Mi = np.linalg.inv(np.einsum("skp,skq->pq", J[design], J[design]))
-    std = noise_sigma * np.sqrt(np.diag(Mi))
+    std = _noise(model, noise_sigma) * np.sqrt(np.diag(Mi))
     order = np.sort(design)
     return Plan(q[order], d[order], tuple(s.name for s in specs), std,
                 tuple(s.unit for s in specs), lost,
@@ -233,7 +237,7 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
 
 
 def design_std(model: Manipulator, q: ArrayLike, direction: ArrayLike, effects: Sequence[str], *,
-               tool_points: ArrayLike = ((0.0, 0.0, 0.0),), noise_sigma: float = 0.02,
+               tool_points: ArrayLike = ((0.0, 0.0, 0.0),), noise_sigma: float | None = None,
                gravity_torque: ArrayLike | None = None) -> tuple[tuple[str, ...], F64]:
     """Predicted standard deviation of registration + ``effects`` for a given design (any
     poses, e.g. random ones, to set beside a plan): sigma sqrt(diag((J^T J)^-1)) over the
@@ -242,6 +246,8 @@ def design_std(model: Manipulator, q: ArrayLike, direction: ArrayLike, effects: 
     Args:
         q: the poses, rad, shape (N, n); direction: approach directions (N, n), -1/0/+1.
         gravity_torque: MJCF gravity torques at q (N, n), N m, or None (lumped masses).
+        noise_sigma: instrument noise per coordinate (length unit); None: a laser tracker's
+            :data:`~zrp.units.TRACKER_NOISE_MM` in the model's unit.
 
     Returns:
         the parameter names (p,) and their standard deviations (p,) (their units).
@@ -261,4 +267,11 @@ def design_std(model: Manipulator, q: ArrayLike, direction: ArrayLike, effects: 
     Jk = J[:, keep] / np.linalg.norm(J[:, keep], axis=0)
     Mi = np.linalg.inv(Jk.T @ Jk) / np.outer(*(2 * [np.linalg.norm(J[:, keep], axis=0)]))
     names = tuple(s.name for s, k in zip(specs, keep, strict=True) if k)
-    return names, noise_sigma * np.sqrt(np.diag(Mi))
+    return names, _noise(model, noise_sigma) * np.sqrt(np.diag(Mi))
+
+
+def _noise(model: Manipulator, noise_sigma: float | None) -> float:
+    """``noise_sigma`` checked, or a laser tracker's noise in the model's unit (None)."""
+    if noise_sigma is None:
+        return TRACKER_NOISE_MM * units_per_mm(model.length_unit, "model.length_unit")
+    return check_float(noise_sigma, "noise_sigma", 0.0, unit=model.length_unit)

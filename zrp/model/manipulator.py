@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import ModelError, ZRPWarning
-from zrp.units import canonical_length_unit, metres_per_unit
+from zrp.units import canonical_length_unit, units_per_mm
 
 __all__ = [
     "JOINT_TYPES",
@@ -347,7 +347,7 @@ class Manipulator:
         """Length that scales positions to be comparable with angles: the reach, at least 1 mm
         in the model's unit (was 1 length unit: 1 m for a 0.5 m arm described in metres, which
         loosened every threshold of the gap diagnosis scaled by it 2x)."""
-        return max(self.reach, 1e-3 / metres_per_unit(self.length_unit))
+        return max(self.reach, units_per_mm(self.length_unit))
 
     def with_arrays(self, axes: ArrayLike | None = None, bodies: ArrayLike | None = None,
                     axial: ArrayLike | None = None, transverse: ArrayLike | None = None,

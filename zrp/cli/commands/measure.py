@@ -16,7 +16,7 @@ from zrp.jsonio import dumps
 from zrp.kinematics import reachable_poses
 from zrp.model.files import builtin_models, load_model
 from zrp.output import check_writable, write_text
-from zrp.units import metres_per_unit
+from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -93,7 +93,7 @@ def _run(args: argparse.Namespace) -> int:
     check_writable([out, truth], args.force)  # before the simulation, which takes a while
     model = load_model(args.model)
     if args.noise is None:  # a laser tracker's 20 um, whatever the model's unit
-        args.noise = 0.02e-3 / metres_per_unit(model.length_unit, "model.length_unit")
+        args.noise = TRACKER_NOISE_MM * units_per_mm(model.length_unit, "model.length_unit")
     if args.stream is not None:
         return _stream(args, model, out, truth)
     effects = sim.parse_effects(args.effect, model, args.payload, field="--effect")

@@ -16,7 +16,6 @@ from zrp.errors import InputError
 from zrp.gap.effects import EFFECTS
 from zrp.model.files import load_model
 from zrp.output import check_writable, write_text
-from zrp.units import metres_per_unit
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -68,14 +67,13 @@ def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
 def _run(args: argparse.Namespace) -> int:
     check_writable([args.out], args.force)
     model = load_model(args.model)
-    noise = (0.02e-3 / metres_per_unit(model.length_unit, "model.length_unit")
-             if args.noise is None else args.noise)  # a tracker's 20 um in any unit
     with warnings.catch_warnings(record=True) as wl:
         warnings.simplefilter("always")
         plan = plan_poses(model, args.poses, args.effects, rng=np.random.default_rng(args.seed),
                           limits=_limits(args.limits, model.n, args.deg),
                           tool_points=args.tool or ((0.0, 0.0, 0.0),), floor_z=args.floor,
-                          noise_sigma=noise, candidates=args.candidates)
+                          noise_sigma=args.noise,  # None: a tracker's 20 um in the model's unit
+                          candidates=args.candidates)
     n = model.n
     buf = io.StringIO()
     w = csv.writer(buf)
