@@ -43,9 +43,11 @@ from zrp.model.manipulator import Manipulator
 from zrp.output import atomic_path, check_writable, write_json
 from zrp.paper.scenario import puma_circle
 from zrp.rotations import matrix_from_rotvec
+from zrp.units import units_per_mm
 
 __all__ = [
     "APPROACHES",
+    "TRACKER_NOISE_RANGE_MM",
     "TRANSFERS",
     "TRUTH_FORMAT",
     "Instrument",
@@ -106,11 +108,19 @@ class Instrument:
         return matrix_from_rotvec(self.rotvec)
 
 
+#: The range of laser-tracker noise per coordinate the simulations draw from, mm.
+TRACKER_NOISE_RANGE_MM = (0.01, 0.03)
+
+
 def random_instrument(model: Manipulator, rng: np.random.Generator,
-                      noise_sigma: float | tuple[float, float] = (0.01, 0.03)) -> Instrument:
+                      noise_sigma: float | tuple[float, float] | None = None) -> Instrument:
     """A tracker 1.2-2.4 reaches away in a random direction, turned about the vertical at
     random and levelled within 0.02 rad; noise drawn uniformly from ``noise_sigma`` (a range,
-    or one value)."""
+    or one value, model length unit; None: :data:`TRACKER_NOISE_RANGE_MM` in the model's
+    unit)."""
+    if noise_sigma is None:
+        per_mm = units_per_mm(model.length_unit, "model.length_unit")
+        noise_sigma = (TRACKER_NOISE_RANGE_MM[0] * per_mm, TRACKER_NOISE_RANGE_MM[1] * per_mm)
     lo, hi = (noise_sigma, noise_sigma) if np.isscalar(noise_sigma) else noise_sigma  # type: ignore[misc]
     sigma = float(rng.uniform(float(lo), float(hi)))
     rot = np.array([*rng.uniform(-0.02, 0.02, 2), rng.uniform(-math.pi, math.pi)])

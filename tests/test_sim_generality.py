@@ -151,3 +151,17 @@ def test_cli_plan_default_noise_is_20_um_in_any_length_unit(tmp_path, capsys):
     mm, m = std["puma"], std[str(path)]
     assert m["base.rx"] == pytest.approx(mm["base.rx"], rel=0.3)
     assert m["base.tx"] * 1e3 == pytest.approx(mm["base.tx"], rel=0.3)
+
+
+def test_random_instrument_noise_defaults_to_mm_in_the_model_unit():
+    from sim.measurement import TRACKER_NOISE_RANGE_MM, random_instrument
+
+    puma = zrp.load_model("puma")
+    in_m = dataclasses.replace(puma.with_arrays(bodies=puma.bodies * 1e-3), length_unit="m")
+    a = random_instrument(puma, np.random.default_rng(3))
+    b = random_instrument(in_m, np.random.default_rng(3))
+    lo, hi = TRACKER_NOISE_RANGE_MM
+    assert lo <= a.noise_sigma <= hi  # mm
+    assert b.noise_sigma == pytest.approx(a.noise_sigma * 1e-3, rel=1e-12)  # the same, in m
+    np.testing.assert_allclose(np.array(b.translation) * 1e3, a.translation, rtol=1e-12)
+    assert random_instrument(puma, np.random.default_rng(3), 0.5).noise_sigma == 0.5

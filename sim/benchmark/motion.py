@@ -140,7 +140,7 @@ def _run_one(model: Manipulator, scn: MotionScenario, work: Path, arm_model: Any
              moves: int) -> MotionScore:
     rng = np.random.default_rng(scn.seed)
     command, duration = named_command(model, "moves", rng, moves)
-    inst = random_instrument(model, rng, (0.01, 0.03))
+    inst = random_instrument(model, rng)  # 0.01-0.03 mm in the model's unit
     t0 = time.perf_counter()
     run = execute_trajectory(model, command, duration, scn.effects, inst, rng)
     csv_path = work / "measurements" / f"motion_{scn.index:03d}.csv"

@@ -17,6 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.effects import EFFECT_NAMES, HiddenEffects, default_tool_points
+from sim.measurement import TRACKER_NOISE_RANGE_MM
 from sim.real_robot import RealRobot
 from sim.robot_model import RealRobotOptions
 from zrp.errors import InputError
@@ -36,7 +37,7 @@ __all__ = [
 F64 = NDArray[np.float64]
 KINDS = ("none", "single", "pair")
 #: The default range of the tracker noise sigma per coordinate, mm (a laser tracker's 10-30 um).
-DEFAULT_NOISE_MM = (0.01, 0.03)
+DEFAULT_NOISE_MM = TRACKER_NOISE_RANGE_MM
 
 
 @dataclass(frozen=True)
