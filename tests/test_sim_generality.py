@@ -101,6 +101,11 @@ def test_benchmark_poses_move_a_slide_and_keep_within_the_limits():
     assert lim[3, 1] == pytest.approx(-0.0698)
     puma = zrp.load_model("puma")
     np.testing.assert_array_equal(pose_limits(puma), np.tile([-2.5, 2.5], (6, 1)))
+    # the core samplers use the same default: random poses within the model's own limits
+    q = reachable_poses(panda, 300, np.random.default_rng(2))
+    assert np.all(q >= panda.lower) and np.all(q <= panda.upper) and np.all(q[:, 3] < 0)
+    qs = zrp.uniform_joint_values(stanford, 300, np.random.default_rng(2))
+    assert np.abs(qs[:, 2]).max() > 0.05 * stanford.reach  # the slide moves (was +-2.5 mm)
 
 
 def test_benchmark_draws_lengths_for_a_slide_and_no_cyclic_error_on_it():

@@ -21,6 +21,7 @@ from sim.measurement import TRACKER_NOISE_RANGE_MM
 from sim.real_robot import RealRobot
 from sim.robot_model import RealRobotOptions
 from zrp.errors import InputError
+from zrp.kinematics.sampling import default_limits
 from zrp.model.manipulator import Manipulator
 from zrp.units import metres_per_unit, units_per_mm
 
@@ -169,22 +170,16 @@ class Scenario:
             raise InputError(f"kind: {self.kind!r}; expected one of {KINDS}")
 
 
-#: Slide travel about the zero reference when a prismatic joint has no limits, fraction of the
-#: reach; and the length per rad of the joint-space magnitudes drawn for a prismatic joint,
-#: fraction of the reach (1 mrad of a revolute joint's range <-> 0.1 mm on the PUMA).
-SLIDE_TRAVEL = 0.1
+#: The length per rad of the joint-space magnitudes drawn for a prismatic joint, fraction of the
+#: reach (1 mrad of a revolute joint's range <-> 0.1 mm on the PUMA).
 SLIDE_PER_RAD = 100.0 / 1244.6
 
 
 def pose_limits(model: Manipulator) -> F64:
-    """Where the benchmark's random poses lie, shape (n, 2): +-2.5 rad within the model's
-    limits for a revolute joint; the model's limits for a prismatic one, or +-SLIDE_TRAVEL of
-    the reach when it has none (+-2.5 length units moved a slide by 5 mm of a 1 m arm, or by
-    5 m of an arm described in metres)."""
-    lo = np.where(model.prismatic, -SLIDE_TRAVEL * model.reach, np.maximum(-2.5, model.lower))
-    hi = np.where(model.prismatic, SLIDE_TRAVEL * model.reach, np.minimum(2.5, model.upper))
-    fin = model.prismatic & np.isfinite(model.lower) & np.isfinite(model.upper)
-    return np.column_stack([np.where(fin, model.lower, lo), np.where(fin, model.upper, hi)])
+    """Where the benchmark's random poses lie, shape (n, 2): the core's
+    :func:`zrp.kinematics.sampling.default_limits` (+-2.5 rad within the model's limits; slides
+    within theirs, or +-10 % of the reach)."""
+    return default_limits(model)
 
 
 def typical_gravity_torque(model: Manipulator, payload: float,
