@@ -93,6 +93,9 @@ def test_the_checkpoint_resumes_only_its_own_run(tmp_path):
     with pytest.raises(InputError, match="needs seed="):
         monte_carlo_summary(model, q, tol, 1000, rng=np.random.default_rng(1), chunk=250,
                             checkpoint=tmp_path / "b.npz")
+    with pytest.raises(InputError, match=r"checkpoint_every_s: expected a finite number in \(0"):
+        monte_carlo_summary(model, q, tol, 1000, seed=5, checkpoint=tmp_path / "c.npz",
+                            checkpoint_every_s=0.0)
     (tmp_path / "junk.npz").write_bytes(b"not an archive")
     with pytest.raises(InputError, match="not a Monte Carlo checkpoint"):
         monte_carlo_summary(model, q, tol, 1000, seed=5, checkpoint=tmp_path / "junk.npz",

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arguments import check_float
 from zrp.errors import InputError
 from zrp.manufacturing._checks import check_percentile
 from zrp.manufacturing.budget import worst_case_bound
@@ -174,8 +175,8 @@ def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances
     """
     for pct in percentiles:
         check_percentile(pct, "percentiles")
-    if checkpoint is not None and not checkpoint_every_s > 0:
-        raise InputError(f"checkpoint_every_s: expected seconds > 0, got {checkpoint_every_s!r}")
+    if checkpoint is not None:
+        check_float(checkpoint_every_s, "checkpoint_every_s", 0.0, open_lo=True, unit="s")
     edges = histogram_edges(model, q, tolerances)
     tasks = chunk_tasks(model, q, tolerances, n_robots, rng=rng, seed=seed,
                         distribution=distribution, chunk=chunk, first_order=first_order,
