@@ -14,23 +14,9 @@ import pytest
 import zrp
 from zrp.gap import Injection, Measurements, diagnose, synthesize, write_outputs
 from zrp.kinematics import uniform_joint_values
+from zrp.testing import PANDA_LIMITS, panda_mdh
 
 PUMA = zrp.load_model("puma")
-PANDA_LIMITS = [(-2.8973, 2.8973), (-1.7628, 1.7628), (-2.8973, 2.8973), (-3.0718, -0.0698),
-                (-2.8973, 2.8973), (-0.0175, 3.7525), (-2.8973, 2.8973)]
-
-
-def _panda() -> zrp.Manipulator:
-    """The Franka Panda from its published modified-DH table (mm; tool: flange + hand)."""
-    rows = [(0, 0, 333, 0), (0, -np.pi / 2, 0, 0), (0, np.pi / 2, 316, 0),
-            (82.5, np.pi / 2, 0, 0), (-82.5, -np.pi / 2, 384, 0), (0, np.pi / 2, 0, 0),
-            (88, np.pi / 2, 0, 0)]
-    tool = np.eye(4)
-    tool[2, 3] = 107 + 103.4
-    m = zrp.from_mdh(rows, tool=tool)
-    return zrp.Manipulator.from_arrays(
-        m.axes, m.bodies, axial=m.end_effector.axial, transverse=m.end_effector.transverse,
-        limits=PANDA_LIMITS)
 
 
 def _quiet(*args, **kw):
@@ -95,7 +81,7 @@ def test_panda_single_reflector_optical_noise_and_payloads(tmp_path):
     z) and a load column of three payloads: the report says plainly that no noise floor can
     be estimated, the final error is not above the geometric calibration's, and the intervals
     are finite."""
-    panda = _panda()
+    panda = panda_mdh()
     rng = np.random.default_rng(8)
     lo, hi = np.array(PANDA_LIMITS).T
     q = rng.uniform(lo + 0.1, hi - 0.1, size=(180, 7))

@@ -14,10 +14,9 @@ import pytest
 import zrp
 from zrp.kinematics.posture import solve_pose
 from zrp.kinematics.redundant import track_posture
+from zrp.testing import panda_mdh
 
 Q_READY = np.array([0, -0.785, 0, -2.356, 0, 1.571, 0.785])
-PANDA_LIMITS = [(-2.8973, 2.8973), (-1.7628, 1.7628), (-2.8973, 2.8973), (-3.0718, -0.0698),
-                (-2.8973, 2.8973), (-0.0175, 3.7525), (-2.8973, 2.8973)]
 
 
 def _panda() -> zrp.Manipulator:
@@ -30,15 +29,7 @@ def _panda() -> zrp.Manipulator:
             return zrp.import_urdf(f, end_link="panda_hand").model
     except ImportError:
         pass
-    rows = [(0, 0, 333, 0), (0, -np.pi / 2, 0, 0), (0, np.pi / 2, 316, 0),
-            (82.5, np.pi / 2, 0, 0), (-82.5, -np.pi / 2, 384, 0), (0, np.pi / 2, 0, 0),
-            (88, np.pi / 2, 0, 0)]
-    tool = np.eye(4)
-    tool[2, 3] = 107 + 103.4
-    m = zrp.from_mdh(rows, tool=tool)
-    return zrp.Manipulator.from_arrays(
-        m.axes, m.bodies, axial=m.end_effector.axial, transverse=m.end_effector.transverse,
-        limits=PANDA_LIMITS)
+    return panda_mdh()
 
 
 @pytest.fixture(scope="module")

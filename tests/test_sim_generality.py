@@ -19,6 +19,7 @@ from sim.real_robot import RealRobot
 from sim.robot_model import _servo_inertias
 from zrp.cli import main
 from zrp.kinematics import forward_kinematics, reachable_poses
+from zrp.testing import PANDA_LIMITS
 
 EXACT = Instrument(noise_sigma=0.0, rotvec=(0.0, 0.0, 0.0), translation=(0.0, 0.0, 0.0))
 
@@ -29,10 +30,8 @@ def panda_like() -> zrp.Manipulator:
     axes = [[0, 0, 1], [0, 1, 0], [0, 0, 1], [0, -1, 0], [0, 0, 1], [0, -1, 0], [0, 0, -1]]
     bodies = [[0, 0, 333], [0, 0, 0], [0, 0, 316], [82.5, 0, 0], [-82.5, 0, 384], [0, 0, 0],
               [88, 0, 0], [0, 0, -107]]
-    lim = [(-2.8973, 2.8973), (-1.7628, 1.7628), (-2.8973, 2.8973), (-3.0718, -0.0698),
-           (-2.8973, 2.8973), (-0.0175, 3.7525), (-2.8973, 2.8973)]
     return zrp.Manipulator.from_arrays(axes, bodies, axial=[0, 0, -1], transverse=[0, 1, 0],
-                                       name="panda-like", limits=lim)
+                                       name="panda-like", limits=PANDA_LIMITS)
 
 
 def test_servo_gains_are_stable_at_every_pose_of_a_7_axis_arm():
