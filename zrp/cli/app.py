@@ -8,18 +8,17 @@ sets ``func`` (called with the parsed namespace, returning an exit code). Errors
 from __future__ import annotations
 
 import argparse
-import contextlib
 import importlib
 import pkgutil
 import re
 import signal
 import sys
-import threading
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from typing import Any
 
 from zrp import __version__
 from zrp.cli import commands
+from zrp.cli.signals import handling
 from zrp.errors import OutputExistsError, ZRPError
 from zrp.jsonio import dumps
 
@@ -75,23 +74,8 @@ def cli_message(exc: BaseException, api_names: dict[str, str] | None = None) -> 
     return text
 
 
-@contextlib.contextmanager
-def _terminate_as_interrupt() -> Iterator[None]:
-    """SIGTERM (a batch scheduler's time limit, ``kill``) stops a command like Ctrl-C does:
-    through KeyboardInterrupt, so that it closes its cluster and keeps what it saves when
-    stopped (a Monte Carlo checkpoint, files already written). Main thread only."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-
-    def stop(signum: int, frame: object) -> None:
-        raise KeyboardInterrupt
-
-    previous = signal.signal(signal.SIGTERM, stop)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+def _interrupt(signum: int, frame: object) -> None:
+    raise KeyboardInterrupt
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -101,7 +85,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         parser.print_help()
         return 1
     try:
-        with _terminate_as_interrupt():
+        # SIGTERM (a batch scheduler's time limit, `kill`) stops a command like Ctrl-C: it
+        # closes its cluster and keeps what it saves when stopped (a Monte Carlo checkpoint)
+        with handling(signal.SIGTERM, _interrupt):
             return int(args.func(args) or 0)
     except ZRPError as exc:
         msg = cli_message(exc, getattr(args, "api_names", None))

@@ -22,12 +22,12 @@ import contextlib
 import logging
 import os
 import signal
-import threading
 from collections.abc import Iterator
 from concurrent.futures import Executor
 from typing import Any
 
 from zrp.cli.options import whole
+from zrp.cli.signals import handling
 from zrp.errors import InputError
 
 __all__ = ["LOCAL_CONFIG", "WORKER_ENV", "add_cluster_options", "check_cluster_options",
@@ -100,7 +100,11 @@ def local_cluster(workers: int) -> Iterator[Any]:
             # them on to their workers; the environment is put in os.environ while spawning
             with dask.config.set({**LOCAL_CONFIG,
                                   "distributed.nanny.pre-spawn-environ": environ}), \
-                    _workers_ignore_ctrl_c():
+                    handling(signal.SIGINT, signal.SIG_IGN):
+                # Ctrl-C in a terminal signals every process of the group, and each worker
+                # would print a KeyboardInterrupt traceback. A process started while SIGINT is
+                # ignored keeps ignoring it (Python installs its handler only over the
+                # default one): only this process sees Ctrl-C and closes the cluster.
                 cluster = stack.enter_context(LocalCluster(
                     n_workers=workers, threads_per_worker=1, processes=True, protocol="tcp",
                     host="127.0.0.1", dashboard_address=":0", silence_logs=SILENCE_LOGS))
@@ -108,23 +112,6 @@ def local_cluster(workers: int) -> Iterator[Any]:
             os.environ.clear()
             os.environ.update(saved)
         yield stack.enter_context(Client(cluster))
-
-
-@contextlib.contextmanager
-def _workers_ignore_ctrl_c() -> Iterator[None]:
-    """Ctrl-C in a terminal signals every process of the group: the workers would each print
-    a KeyboardInterrupt traceback. A process started while SIGINT is ignored keeps ignoring it
-    (Python installs its handler only over the default one), so only this process sees Ctrl-C
-    and closes the cluster, which stops its workers. Only from the main thread (where Python
-    allows changing signal handlers); elsewhere nothing changes."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    previous = signal.signal(signal.SIGINT, signal.SIG_IGN)
-    try:
-        yield
-    finally:
-        signal.signal(signal.SIGINT, previous)
 
 
 @contextlib.contextmanager
