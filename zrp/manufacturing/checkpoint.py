@@ -45,15 +45,15 @@ class OrderedMerge:
     Attributes:
         merged: the merged histograms of chunks ``0 .. ready - 1`` (2, or 4 with first order).
         ready: number of chunks merged.
-        waiting: chunks that finished before an earlier one, by index: their histograms.
+        waiting: chunks that finished before an earlier one, by index: their histograms and
+            kernel time (s).
         elapsed_s: kernel time summed over the merged chunks (s).
     """
 
     merged: list[Histogram]
     ready: int = 0
-    waiting: dict[int, tuple[Histogram, ...]] = field(default_factory=dict)
+    waiting: dict[int, tuple[tuple[Histogram, ...], float]] = field(default_factory=dict)
     elapsed_s: float = 0.0
-    waiting_s: dict[int, float] = field(default_factory=dict)
 
     def done(self, index: int) -> bool:
         """Is chunk ``index`` already in the state (merged or waiting)?"""
@@ -64,12 +64,11 @@ class OrderedMerge:
         if res.histograms is None or len(res.histograms) != len(self.merged):
             raise InputError(f"results: chunk {res.index} was not reduced to "
                              f"{len(self.merged)} histograms on its worker")
-        self.waiting[res.index] = res.histograms
-        self.waiting_s[res.index] = res.elapsed_s
+        self.waiting[res.index] = (res.histograms, res.elapsed_s)
         while self.ready in self.waiting:
-            hists = self.waiting.pop(self.ready)
+            hists, elapsed = self.waiting.pop(self.ready)
             self.merged = [m.merge(h) for m, h in zip(self.merged, hists, strict=True)]
-            self.elapsed_s += self.waiting_s.pop(self.ready)
+            self.elapsed_s += elapsed
             self.ready += 1
 
 
@@ -110,7 +109,7 @@ def save_merge(path: str | os.PathLike[str], identity: dict[str, str],
                state: OrderedMerge) -> Path:
     """Write ``state`` and ``identity`` to ``path`` (compressed ``.npz``, replaced atomically)."""
     idx = sorted(state.waiting)
-    hists = [*state.merged, *(h for i in idx for h in state.waiting[i])]
+    hists = [*state.merged, *(h for i in idx for h in state.waiting[i][0])]
     buf = io.BytesIO()
     np.savez_compressed(
         buf, header=np.array(json.dumps({"version": VERSION, "identity": identity,
@@ -118,7 +117,7 @@ def save_merge(path: str | os.PathLike[str], identity: dict[str, str],
                                          "per_chunk": len(state.merged)})),
         counts=np.stack([h.counts for h in hists]),
         stats=np.array([[h.total, h.minimum, h.maximum, h.sum, h.sumsq] for h in hists]),
-        elapsed=np.array([state.elapsed_s, *(state.waiting_s[i] for i in idx)]))
+        elapsed=np.array([state.elapsed_s, *(state.waiting[i][1] for i in idx)]))
     return write_bytes(path, buf.getvalue(), overwrite=True)
 
 
@@ -165,6 +164,5 @@ def load_merge(path: str | os.PathLike[str], identity: dict[str, str],
     n = int(head["per_chunk"])
     state = OrderedMerge(hists[:n], int(head["ready"]), elapsed_s=float(elapsed[0]))
     for j, i in enumerate(head["waiting"]):
-        state.waiting[int(i)] = tuple(hists[n * (j + 1):n * (j + 2)])
-        state.waiting_s[int(i)] = float(elapsed[j + 1])
+        state.waiting[int(i)] = (tuple(hists[n * (j + 1):n * (j + 2)]), float(elapsed[j + 1]))
     return state
