@@ -22,6 +22,7 @@ from numpy.typing import NDArray
 from mjcf.inertia import BodyInertia
 from sim.effects import HiddenEffects, finite
 from zrp.errors import InputError
+from zrp.kinematics.sampling import default_limits
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["PUMA560_LOAD_FRICTION", "RealRobotOptions", "build_robot_model"]
@@ -187,8 +188,8 @@ def _add_drives(spec: mujoco.MjSpec, chain: _Chain, kps: F64, load_friction: F64
 def _servo_inertias(probe: mujoco.MjModel, chain: _Chain, lower: F64, upper: F64,
                     poses: int = 64) -> F64:
     """The inertia each servo sees (diagonal of the joint-space inertia at its motor joint),
-    at q = 0 (row 0) and at ``poses - 1`` seeded random poses within +-2.5 rad and the joint
-    limits (prismatic joints within their limits, else at 0), shape (poses, n), kg m^2."""
+    at q = 0 (row 0) and at ``poses - 1`` seeded random poses within ``lower``..``upper``
+    (rad, m), shape (poses, n), kg m^2."""
     d = mujoco.MjData(probe)
     adr = [probe.jnt_qposadr[mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm)]
            for nm in chain.motor]
@@ -278,14 +279,10 @@ def build_robot_model(true_model: Manipulator, effects: HiddenEffects,
     for k, c in effects.joint_compliance.items():
         kps[k - 1] = 1.0 / c
     _add_drives(spec, chain, kps, load_friction)
-    # poses the benchmark commands: +-2.5 rad within the limits (length unit -> m for sliders)
-    lo = np.where(true_model.prismatic, true_model.lower * scale, -2.5)
-    hi = np.where(true_model.prismatic, true_model.upper * scale, 2.5)
-    lo = np.where(true_model.prismatic, np.where(np.isfinite(lo), lo, 0.0),
-                  np.maximum(lo, true_model.lower))
-    hi = np.where(true_model.prismatic, np.where(np.isfinite(hi), hi, 0.0),
-                  np.minimum(hi, true_model.upper))
-    kvs, kis = _tune(spec, chain, kps, options, lo, hi)
+    # the poses random measurements command (zrp.kinematics.sampling.default_limits), slides
+    # from the model's length unit to m
+    lim = default_limits(true_model) * np.where(true_model.prismatic, scale, 1.0)[:, None]
+    kvs, kis = _tune(spec, chain, kps, options, lim[:, 0], lim[:, 1])
     compiled = spec.compile()
     return compiled, _indices(compiled, chain, effects, len(tool_points), tip,
                               {"kp": kps, "kv": kvs, "ki": kis})
