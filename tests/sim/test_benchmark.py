@@ -104,7 +104,7 @@ def test_benchmark_runs_are_reproducible_from_the_seed(puma, tmp_path):
         assert (tmp_path / "a/measurements" / name).read_bytes() == \
             (tmp_path / "b/measurements" / name).read_bytes()
     # an interrupted run resumes: the score written as it arrived is kept, the missing one
-    # is run again and the result is the same (worker processes: tests/test_cluster.py)
+    # is run again and the result is the same (worker processes: tests/cli/test_cluster.py)
     (tmp_path / "a/scores/scenario_001.score.json").unlink()
     c = run_benchmark(puma, cfg, tmp_path / "a", progress=False, resume=True)
     assert c.resumed == 1 and not c.failures

@@ -25,7 +25,7 @@ from zrp.paper.placement import (
 )
 from zrp.paper.published import half_ulp, le3_readings
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_default_placement_is_the_default_circle():

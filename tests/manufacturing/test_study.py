@@ -22,7 +22,7 @@ from zrp.manufacturing.study import (
 )
 from zrp.paper.scenario import circle_joint_path
 
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+SHARED = Path(__file__).resolve().parents[2].parent / "shared"
 
 
 def _path(n: int, steps: int = 150, seed: int = 0) -> JointPath:

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("zrp", "mjcf", "sim")
 LAYER = {"core": 0, "mjcf": 1, "sim": 2, "cli": 3}
 # threadpoolctl: BLAS thread limits for the diagnosis (zrp/blas.py)

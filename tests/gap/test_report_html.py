@@ -20,7 +20,7 @@ from zrp.kinematics import uniform_joint_values
 BROWSER = next((b for b in ("chromium", "chromium-browser", "google-chrome")
                 if shutil.which(b)), None)
 needs_browser = pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
-REAL = Path(__file__).resolve().parents[2] / "shared" / "data" / "irb120-lasertracker"
+REAL = Path(__file__).resolve().parents[3] / "shared" / "data" / "irb120-lasertracker"
 #: the verdict box's background (report/html.py: #fff4d6)
 VERDICT_RGB = np.array([255, 244, 214])
 

@@ -5,7 +5,7 @@ recorded in compensation.json.
 
 References: the synthetic robot (nominal PUMA with a joint-2 offset and an exact axis-5
 tilt, a known probe rotation RT and orientation noise 1e-4 rad) is measured through
-zrp.forward_kinematics (tests/test_calibration_fullpose.py), not the fitting code; the
+zrp.forward_kinematics (tests/calibration/test_fullpose.py), not the fitting code; the
 withheld orientation error of a correct model is the noise's own, sqrt(3) sigma_o."""
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ import warnings
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
-from test_calibration_fullpose import PUMA, RB, RT, TB, _measure
 
 import zrp
+from tests.calibration.test_fullpose import PUMA, RB, RT, TB, _measure
 from zrp.cli.app import main
 from zrp.errors import InputError
 from zrp.gap import Measurements, diagnose

@@ -19,7 +19,7 @@ from zrp.cli import build_parser, main
 from zrp.kinematics import uniform_joint_values
 from zrp.output import GENERATED_MARK
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")

@@ -29,7 +29,7 @@ from zrp.gap.uncertainty import robust_covariance
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _quiet(*args, **kw):

@@ -231,7 +231,7 @@ def test_a_stopped_local_cluster_run_keeps_its_checkpoint_and_prints_no_tracebac
     cmd = [sys.executable, "-m", "zrp", "tolerance", "-n", "20000000", "--workers", "2",
            "--checkpoint", str(ck), "--no-progress"]
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True, cwd=Path(__file__).resolve().parents[1])
+                            start_new_session=True, cwd=Path(__file__).resolve().parents[2])
     try:
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline and proc.poll() is None:

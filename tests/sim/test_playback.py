@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_mjcf import perturbed_puma, random_arm
 
 import mjcf
 import sim
 import zrp
 import zrp.rotations
+from tests.arms import perturbed_puma, random_arm
 from zrp.errors import InputError
 
 POS_TOL_MM = 1e-9

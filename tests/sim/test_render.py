@@ -5,13 +5,13 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
-from test_mjcf import perturbed_puma
 
 import mjcf
 import sim
 import sim.frames
 import sim.gl
 import zrp
+from tests.arms import perturbed_puma
 from zrp.errors import InputError, OutputExistsError
 
 

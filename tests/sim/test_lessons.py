@@ -19,7 +19,7 @@ from zrp.paper.figures import coincident_with
 from zrp.paper.index import index_entries, write_index
 from zrp.paper.scenes import paper_video_scene, teaching_sweep_scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
