@@ -15,7 +15,6 @@ import pytest
 import zrp
 from zrp.calibration import (
     CalibratedRobot,
-    PoseConditions,
     compensate,
     compensate_program,
     read_calibration,
@@ -53,26 +52,13 @@ def non_geometric():
     return _diagnosed(NON_GEOMETRIC)
 
 
-def _withheld_residual(cal, diag):
-    """Predicted minus measured on the withheld poses, in the diagnosis's row order."""
-    ctx = diag.context
-    w = diag.withheld_poses
-    cond = PoseConditions(direction=ctx.meas.approach_direction()[w])
-    pred = np.stack([cal.predict(ctx.q[w], lab, cond) for lab in cal.tool_labels], 1)
-    rows = np.flatnonzero(np.isin(ctx.meas.pose_index, w))
-    local = np.full(len(ctx.meas.pose_ids), -1)
-    local[w] = np.arange(len(w))
-    got = pred[local[ctx.meas.pose_index[rows]], ctx.meas.point_index[rows]]
-    return (got - ctx.meas.xyz[rows]).ravel()
-
-
 @pytest.mark.parametrize("which", ["geometric", "non_geometric"])
-def test_round_trip_reproduces_withheld_error(which, request, tmp_path):
+def test_round_trip_reproduces_withheld_error(which, request, withheld_residual, tmp_path):
     diag = request.getfixturevalue(which)
     cal = CalibratedRobot.from_diagnosis(diag)
     m, c = write_calibration(cal, tmp_path / "cal.toml", tmp_path / "comp.json")
     back = read_calibration(c)
-    r = _withheld_residual(back, diag)
+    r = withheld_residual(back, diag)
     assert np.abs(r - diag.withheld_residual_after).max() < 1e-9
     assert np.sqrt(np.mean(np.sum(r.reshape(-1, 3) ** 2, 1))) == pytest.approx(
         diag.final.rms, rel=1e-9)

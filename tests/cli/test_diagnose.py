@@ -4,17 +4,14 @@ from __future__ import annotations
 
 import json
 import warnings
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import zrp
 from zrp.cli.app import main
-from zrp.gap import Injection, diagnose, load_measurements, synthesize
+from zrp.gap import Injection, synthesize
 from zrp.kinematics import uniform_joint_values
-
-REAL = Path("/work/shared/data/irb120-lasertracker")
 
 
 def _no_nan(name):
@@ -84,14 +81,9 @@ def test_cli_json_output(csv_file, tmp_path, capsys):
     assert not (tmp_path / "j" / "shrink.png").exists()
 
 
-@pytest.mark.skipif(not REAL.is_dir(), reason="shared IRB 120 laser-tracker data not present")
-def test_real_irb120_report_is_believable():
-    model = zrp.load_model(str(REAL / "irb120.toml"))
-    meas = load_measurements(REAL / "measurements.csv", model, deg=True)
+def test_real_irb120_report_is_believable(irb120_real):
+    meas, d = irb120_real.measurements, irb120_real.diagnosis
     assert meas.n_rows == 2946 and len(meas.pose_ids) == 982
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        d = diagnose(model, meas, seed=0)
     # registration: the tracker is ~3 m away, the reflectors ~150 mm apart on the tool
     assert 0.3 < d.nominal.rms < 3.0  # mm: an uncalibrated industrial arm
     assert d.noise_floor.method == "rigid_links" and d.noise_floor.rms < 0.05

@@ -11,24 +11,12 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-import zrp
 from zrp.cli import build_parser, main
-from zrp.kinematics import uniform_joint_values
 from zrp.output import GENERATED_MARK
 
 ROOT = Path(__file__).resolve().parents[2]
-
-
-@pytest.fixture(scope="module")
-def data_csv(tmp_path_factory) -> Path:
-    model = zrp.load_model("puma")
-    rng = np.random.default_rng(0)
-    meas = zrp.gap.synthesize(model, uniform_joint_values(model, 40, rng),
-                              zrp.gap.Injection(joint_offset={2: 1e-3}), rng=rng)
-    return meas.to_csv(tmp_path_factory.mktemp("data") / "d.csv")
 
 
 def _refused(capsys, argv: list[str], match: str) -> str:
@@ -109,7 +97,7 @@ def test_render_keeps_an_existing_video(tmp_path, capsys):
     ("/proc/x", "/proc/x: cannot create the folder"),
     ("afile/below", "afile is a file, not a folder"),
 ])
-def test_diagnose_output_refused_before_the_work(tmp_path, capsys, data_csv, out, match,
+def test_diagnose_output_refused_before_the_work(tmp_path, capsys, measured_csv, out, match,
                                                  monkeypatch):
     (tmp_path / "afile").write_text("keep")
     import zrp.gap.pipeline as pipeline
@@ -119,7 +107,7 @@ def test_diagnose_output_refused_before_the_work(tmp_path, capsys, data_csv, out
 
     monkeypatch.setattr(pipeline, "run_diagnosis", never)
     target = out if out.startswith("/") else str(tmp_path / out)
-    err = _refused(capsys, ["diagnose", "--model", "puma", "--data", str(data_csv),
+    err = _refused(capsys, ["diagnose", "--model", "puma", "--data", str(measured_csv),
                             "--no-plots", "--out", target], "")
     assert match in err, err
     assert (tmp_path / "afile").read_text() == "keep"
@@ -179,16 +167,16 @@ def test_study_joints_in_degrees_refused(tmp_path, capsys):
                  "line 2: q2 is 10, more than 2 pi rad: the joint values look like degrees")
 
 
-def test_diagnose_large_file_subsampled_with_notice(tmp_path, capsys, data_csv):
+def test_diagnose_large_file_subsampled_with_notice(tmp_path, capsys, measured_csv):
     out = tmp_path / "o"
-    assert main(["diagnose", "--model", "puma", "--data", str(data_csv), "--max-steps", "1",
+    assert main(["diagnose", "--model", "puma", "--data", str(measured_csv), "--max-steps", "1",
                  "--no-plots", "--max-points", "60", "--out", str(out)]) == 0
     doc = json.loads((out / "diagnosis.json").read_text())
     assert any("exceed max_points=60" in w for w in doc["warnings"])
     capsys.readouterr()
 
 
-def test_diagnose_max_rows(tmp_path, capsys, data_csv):
-    _refused(capsys, ["diagnose", "--model", "puma", "--data", str(data_csv), "--max-rows",
+def test_diagnose_max_rows(tmp_path, capsys, measured_csv):
+    _refused(capsys, ["diagnose", "--model", "puma", "--data", str(measured_csv), "--max-rows",
                       "10", "--out", str(tmp_path / "o")], "more than --max-rows=10")
     assert not (tmp_path / "o").exists()

@@ -9,12 +9,9 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
 
-import zrp
 from zrp.cli import build_parser, main
-from zrp.kinematics import uniform_joint_values
 from zrp.output import LOCK_NAME
 
 OUTPUT_OPTIONS = {"--out", "--out-dir", "--hist", "--truth", "--workdir"}
@@ -34,15 +31,6 @@ def test_every_command_that_writes_has_force():
             writers[name] = "--force" in opts
     assert len(writers) >= 9, writers
     assert all(writers.values()), {k: v for k, v in writers.items() if not v}
-
-
-@pytest.fixture(scope="module")
-def measured_csv(tmp_path_factory) -> Path:
-    model = zrp.load_model("puma")
-    rng = np.random.default_rng(0)
-    meas = zrp.gap.synthesize(model, uniform_joint_values(model, 40, rng),
-                              zrp.gap.Injection(joint_offset={2: 1e-3}), rng=rng)
-    return meas.to_csv(tmp_path_factory.mktemp("data") / "d.csv")
 
 
 def cases(tmp: Path, data: Path) -> dict[str, tuple[list[str], Path]]:

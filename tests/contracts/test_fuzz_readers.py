@@ -7,7 +7,7 @@ RuntimeError...).
 CI runs a seeded slice (``derandomize=True``: the same cases every run) of
 ``ZRP_FUZZ_EXAMPLES`` cases per reader (default 60). The documented long run
 
-    ZRP_FUZZ_EXAMPLES=2500 python3 -m pytest -q -p no:cacheprovider tests/contracts/test_fuzz_readers.py
+    ZRP_FUZZ_EXAMPLES=2500 python3 -m pytest -q tests/contracts/test_fuzz_readers.py
 
 runs 2,500 cases for each of the four readers (10,000 in all). Its first run found one escape
 (a non-UTF-8 joint name in an MJCF file: UnicodeDecodeError from MuJoCo's name lookup; fixed,

@@ -23,11 +23,6 @@ def in_unit(model: zrp.Manipulator, unit: str) -> zrp.Manipulator:
 
 
 @pytest.fixture(scope="module")
-def puma():
-    return zrp.load_model("puma")
-
-
-@pytest.fixture(scope="module")
 def q():
     return zrp.uniform_joint_values(zrp.load_model("puma"), 12, np.random.default_rng(3))
 

@@ -12,38 +12,26 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import zrp
+from tests.measured import BASE_ROTATION, full_pose_measurements
 from zrp.errors import InputError
 from zrp.gap import Measurements
 from zrp.gap.effects import Context, effect_parameters, registration_parameters
 from zrp.gap.fullpose import fit_full_pose, orientation_residual, pose_rotations
 from zrp.gap.problem import Problem
 from zrp.kinematics import uniform_joint_values
-from zrp.manufacturing.sensitivity import axis_tangents
 
 PUMA = zrp.load_model("puma")
 TILT = 1.0e-3          # rad, axis 6 towards its first tangent
 SIGMA_P, SIGMA_O = 0.02, 5e-5   # mm, rad
-RB = Rotation.from_rotvec([0.02, -0.01, 0.8]).as_matrix()
-TB = np.array([1500.0, -300.0, 200.0])
 RT = Rotation.from_rotvec([0.3, -0.2, 0.1]).as_matrix()
 # one reflector 3 mm off the wrist centre: positions see the axis-6 tilt only through 3 mm
 TOOL = np.array([[3.0, 0.0, 127.0]])
 
 
 def _measure(n_poses: int, seed: int) -> Measurements:
-    rng = np.random.default_rng(seed)
-    q = uniform_joint_values(PUMA, n_poses, rng, np.tile([-2.5, 2.5], (6, 1)))
-    axes = np.array(PUMA.axes, dtype=float)
-    t1 = axis_tangents(axes[5])[0]
-    axes[5] = (axes[5] + TILT * t1) / np.linalg.norm(axes[5] + TILT * t1)
-    fk = zrp.forward_kinematics(PUMA.with_arrays(axes=axes), q)
-    y = fk.position + fk.rotation @ TOOL[0]
-    xyz = y @ RB.T + TB + rng.normal(scale=SIGMA_P, size=y.shape)
-    noise = Rotation.from_rotvec(rng.normal(scale=SIGMA_O, size=(n_poses, 3))).as_matrix()
-    rot = noise @ RB @ fk.rotation @ RT
-    quat = Rotation.from_matrix(rot).as_quat()[:, [3, 0, 1, 2]]
-    return Measurements.from_arrays(np.arange(n_poses), q, xyz, point=["s1"] * n_poses,
-                                    quat=quat)
+    return full_pose_measurements(PUMA, n_poses, seed, tilt=(6, 0, TILT), tools=TOOL,
+                                  probe_rotation=RT, sigma_position=SIGMA_P,
+                                  sigma_orientation=SIGMA_O)
 
 
 def _specs(ctx):
@@ -53,7 +41,7 @@ def _specs(ctx):
 def test_orientation_jacobian_matches_finite_differences():
     ctx = Context(PUMA, _measure(12, 0))
     specs = _specs(ctx)
-    prob = Problem(ctx, specs, np.arange(12), RB)
+    prob = Problem(ctx, specs, np.arange(12), BASE_ROTATION)
     rng = np.random.default_rng(1)
     theta = rng.normal(scale=1e-3, size=len(specs))
     psi = np.array([0.01, -0.02, 0.005])

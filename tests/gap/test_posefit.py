@@ -5,7 +5,7 @@ recorded in compensation.json.
 
 References: the synthetic robot (nominal PUMA with a joint-2 offset and an exact axis-5
 tilt, a known probe rotation RT and orientation noise 1e-4 rad) is measured through
-zrp.forward_kinematics (tests/calibration/test_fullpose.py), not the fitting code; the
+zrp.forward_kinematics (tests/measured.py), not the fitting code; the
 withheld orientation error of a correct model is the noise's own, sqrt(3) sigma_o."""
 
 from __future__ import annotations
@@ -18,14 +18,14 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 import zrp
-from tests.calibration.test_fullpose import PUMA, RB, RT, TB, _measure
+from tests.measured import PROBE_ROTATION as RT
+from tests.measured import full_pose_measurements, puma_full_pose
 from zrp.cli.app import main
 from zrp.errors import InputError
 from zrp.gap import Measurements, diagnose
-from zrp.kinematics import uniform_joint_values
-from zrp.manufacturing.sensitivity import axis_tangents
 
-SIGMA_O = 1e-4   # rad, the orientation noise of _measure
+PUMA = zrp.load_model("puma")
+SIGMA_O = 1e-4   # rad, the orientation noise of puma_full_pose
 # the data's 1.5 mrad axis-5 tilt is explained by the (aliased) q4 offset the position search
 # picks; that model turns the probe frame by up to the tilt, so R_t is found to ~1.5 mrad
 RT_TOL = 2e-3
@@ -39,9 +39,8 @@ def _diagnose(meas, **kw):
 
 
 @pytest.fixture(scope="module")
-def both():
-    meas = _measure()
-    return _diagnose(meas), _diagnose(meas, use_orientation=False)
+def both(full_pose_diagnosis):
+    return full_pose_diagnosis, _diagnose(puma_full_pose(), use_orientation=False)
 
 
 def test_diagnosis_refits_the_final_model_with_orientations(both):
@@ -90,7 +89,7 @@ def test_orientation_results_in_json_report_and_verdict(both):
 
 
 def test_given_orientation_sigma_is_used():
-    diag = _diagnose(_measure(), orientation_sigma=2e-4)
+    diag = _diagnose(puma_full_pose(), orientation_sigma=2e-4)
     assert diag.full_pose.sigma_orientation_given
     assert diag.full_pose.sigma_orientation == 2e-4
     assert diag.to_dict()["full_pose"]["sigma_orientation_source"] == "given"
@@ -104,17 +103,17 @@ def test_given_orientation_sigma_is_used():
 ])
 def test_bad_orientation_options(kw, match):
     with pytest.raises(InputError, match=match):
-        diagnose(PUMA, _measure(), **kw)
+        diagnose(PUMA, puma_full_pose(), **kw)
 
 
 def test_orientation_sigma_needs_orientations():
     with pytest.raises(InputError, match=r"orientation_sigma: .*no qw, qx, qy, qz"):
-        diagnose(PUMA, _measure(quat=False), orientation_sigma=1e-4)
+        diagnose(PUMA, puma_full_pose(quat=False), orientation_sigma=1e-4)
 
 
 def test_cli_diagnose_and_calibrate_record_the_full_pose(tmp_path, capsys):
-    _measure().to_csv(tmp_path / "d.csv")
-    _measure(quat=False).to_csv(tmp_path / "p.csv")
+    puma_full_pose().to_csv(tmp_path / "d.csv")
+    puma_full_pose(quat=False).to_csv(tmp_path / "p.csv")
     base = ["--model", "puma", "--data", str(tmp_path / "d.csv")]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -150,23 +149,20 @@ def _tilted_wrist(n_poses: int, seed: int) -> Measurements:
     plane of axes 5 and 6: no joint offset can mimic it), one reflector 3 mm off the wrist
     centre (positions see the tilt through 3 mm), orientation noise 5e-5 rad; measured
     through zrp.forward_kinematics."""
-    rng = np.random.default_rng(seed)
-    q = uniform_joint_values(PUMA, n_poses, rng, np.tile([-2.5, 2.5], (6, 1)))
-    axes = np.array(PUMA.axes, dtype=float)
-    v = axes[5] + TILT * axis_tangents(axes[5])[1]
-    axes[5] = v / np.linalg.norm(v)
-    fk = zrp.forward_kinematics(PUMA.with_arrays(axes=axes), q)
-    y = fk.position + fk.rotation @ np.array([3.0, 0.0, 127.0])
-    xyz = y @ RB.T + TB + rng.normal(scale=0.02, size=y.shape)
-    noise = Rotation.from_rotvec(rng.normal(scale=5e-5, size=(n_poses, 3))).as_matrix()
-    quat = Rotation.from_matrix(noise @ RB @ fk.rotation @ RT).as_quat()[:, [3, 0, 1, 2]]
-    return Measurements.from_arrays(np.arange(n_poses), q, xyz, point=["s1"] * n_poses,
-                                    quat=quat)
+    return full_pose_measurements(PUMA, n_poses, seed, tilt=(6, 1, TILT),
+                                  tools=[[3.0, 0.0, 127.0]], probe_rotation=RT,
+                                  sigma_orientation=5e-5)
 
 
-def test_an_effect_only_orientations_reveal_is_added():
+@pytest.fixture(scope="module")
+def tilted_wrist():
+    """The tilted wrist's data and its diagnosis (two tests read the same run)."""
     meas = _tilted_wrist(120, 3)
-    diag = _diagnose(meas)
+    return meas, _diagnose(meas)
+
+
+def test_an_effect_only_orientations_reveal_is_added(tilted_wrist):
+    meas, diag = tilted_wrist
     plain = _diagnose(meas, use_orientation=False)
     # positions alone: nothing significant (the tilt moves the reflector by ~3 um)
     assert plain.effects == ("none",) and diag.effects == ("none",)
@@ -193,7 +189,7 @@ def test_no_orientation_effect_is_added_to_a_complete_model(both):
     assert diag.full_pose.added == ()
 
 
-def test_calibrated_robot_keeps_the_tilt_only_orientations_reveal(tmp_path):
+def test_calibrated_robot_keeps_the_tilt_only_orientations_reveal(tilted_wrist, tmp_path):
     """The calibrated robot (zrp.calibration, its own forward chain, not the fitting code)
     with the full-pose fit's probe rotation predicts the withheld orientations to the noise;
     the position-only calibration misses the tilt by ~1 mrad."""
@@ -202,7 +198,7 @@ def test_calibrated_robot_keeps_the_tilt_only_orientations_reveal(tmp_path):
     from zrp.calibration.storage import write_calibration
     from zrp.gap.fullpose import pose_rotations
 
-    diag = _diagnose(_tilted_wrist(120, 3))
+    _, diag = tilted_wrist
     full = full_pose_calibration(diag)
     assert full.fit is diag.full_pose.fit           # the diagnosis's own refit, reused
     w = diag.withheld_poses

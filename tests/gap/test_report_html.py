@@ -14,13 +14,12 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.gap import Injection, diagnose, load_measurements, synthesize, write_outputs
+from zrp.gap import Injection, diagnose, synthesize, write_outputs
 from zrp.kinematics import uniform_joint_values
 
 BROWSER = next((b for b in ("chromium", "chromium-browser", "google-chrome")
                 if shutil.which(b)), None)
 needs_browser = pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
-REAL = Path(__file__).resolve().parents[3] / "shared" / "data" / "irb120-lasertracker"
 #: the verdict box's background (report/html.py: #fff4d6)
 VERDICT_RGB = np.array([255, 244, 214])
 
@@ -126,13 +125,9 @@ def test_report_html_synthetic(tmp_path):
 
 
 @needs_browser
-@pytest.mark.skipif(not (REAL / "measurements.csv").exists(),
-                    reason="real IRB 120 data (../shared/data) not present")
-def test_report_html_real_irb120(tmp_path):
-    model = zrp.load_model(REAL / "irb120.toml")
-    meas = load_measurements(REAL / "measurements.csv", model, deg=True)
-    with pytest.warns(zrp.gap.GapWarning):
-        d = diagnose(model, meas, seed=0)
+def test_report_html_real_irb120(irb120_real, tmp_path):
+    d = irb120_real.diagnosis
+    assert any(issubclass(w.category, zrp.gap.GapWarning) for w in irb120_real.warnings)
     write_outputs(d, tmp_path / "out")
     _check_page(tmp_path / "out", d.verdict, tmp_path)
     md = (tmp_path / "out" / "report.md").read_text(encoding="utf-8")

@@ -22,14 +22,6 @@ from zrp.paper.scenes import paper_video_scene, teaching_sweep_scene
 ROOT = Path(__file__).resolve().parents[2]
 
 
-@pytest.fixture(scope="module")
-def backend() -> str:
-    try:
-        return sim.resolve_backend()
-    except sim.GLUnavailableError as exc:  # only where no GL backend exists at all
-        pytest.skip(f"no offscreen GL backend: {exc}")
-
-
 def _last_frame(path: Path) -> np.ndarray:
     import imageio_ffmpeg
 

@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques
 from sim.benchmark.motion import draw_motion_scenarios, run_motion_benchmark
 from sim.measurement import Instrument
@@ -19,11 +18,6 @@ from sim.motion_robot import MotionEffects, execute_trajectory
 from zrp.cli.app import main
 from zrp.errors import InputError
 from zrp.gap.motion.paths import exercise_moves
-
-
-@pytest.fixture(scope="module")
-def puma() -> zrp.Manipulator:
-    return zrp.load_model("puma")
 
 
 @pytest.fixture(scope="module")

@@ -16,14 +16,6 @@ from zrp.errors import InputError, OutputExistsError
 
 
 @pytest.fixture(scope="module")
-def backend() -> str:
-    try:
-        return sim.resolve_backend()
-    except sim.GLUnavailableError as exc:  # only where no GL backend exists at all
-        pytest.skip(f"no offscreen GL backend: {exc}")
-
-
-@pytest.fixture(scope="module")
 def puma_arm() -> mjcf.BuiltArm:
     return mjcf.build(zrp.load_model("puma"), mjcf.MJCFOptions(offscreen_size=(640, 480)))
 

@@ -13,7 +13,6 @@ import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
-import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
 from sim.benchmark.motion import MotionScenario, _run_one
 from sim.measurement import Instrument
@@ -22,11 +21,6 @@ from zrp.gap.motion import Trajectory
 from zrp.gap.motion.effects import effect_columns, joint_mode, linearise
 from zrp.gap.motion.kernels import mode_response
 from zrp.gap.motion.paths import exercise_moves
-
-
-@pytest.fixture(scope="module")
-def puma() -> zrp.Manipulator:
-    return zrp.load_model("puma")
 
 
 @pytest.fixture(scope="module")

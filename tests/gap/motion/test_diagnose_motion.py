@@ -9,6 +9,7 @@ import pytest
 from scipy.integrate import solve_ivp
 
 import zrp
+from tests.measured import tracked_tool_point
 from zrp.errors import InputError
 from zrp.gap.motion import Trajectory, diagnose_motion, load_trajectory, write_trajectory
 from zrp.gap.motion.effects import MotionContext, effect_columns, linearise
@@ -16,28 +17,14 @@ from zrp.gap.motion.kernels import first_order_lag, play
 from zrp.gap.motion.paths import exercise_moves
 from zrp.gap.motion.segments import phases, split_segments, stream_noise_sigma
 from zrp.gap.problem import Problem
-from zrp.rotations import matrix_from_rotvec
 
 SIGMA = 0.02  # mm per coordinate
-TOOL = np.array([40.0, 10.0, 30.0])
-
-
-@pytest.fixture(scope="module")
-def puma() -> zrp.Manipulator:
-    return zrp.load_model("puma")
 
 
 @pytest.fixture(scope="module")
 def moves():
     return exercise_moves(np.radians([0, -20, 30, 0, 60, 0]), np.random.default_rng(1),
                           moves=8)
-
-
-def _measure(model, q_actual, rng, sigma=SIGMA):
-    fk = zrp.forward_kinematics(model, q_actual)
-    x = fk.position + fk.rotation @ TOOL
-    x = x @ matrix_from_rotvec([0.1, -0.2, 0.3]).T + np.array([1500.0, -200.0, 300.0])
-    return x + rng.normal(0.0, sigma, x.shape)
 
 
 def _lagged(moves, t, tau):
@@ -78,7 +65,7 @@ def test_play_kernel_derivative_and_hysteresis() -> None:
 def test_effect_and_problem_jacobians_match_finite_differences(puma, moves) -> None:
     rng = np.random.default_rng(2)
     t = np.arange(0, moves.duration, 5e-3)
-    traj = Trajectory(t, moves(t), _measure(puma, moves(t), rng), frame="base")
+    traj = Trajectory(t, moves(t), tracked_tool_point(puma, moves(t), rng), frame="base")
     tau = rng.normal(0, 20, traj.q.shape)
     vals = {"sync.delay": 0.003, "q2.lag": 0.004, "q3.friction": 2e-4,
             "q2.dyn_compliance": 1e-5}
@@ -117,7 +104,7 @@ def test_effect_and_problem_jacobians_match_finite_differences(puma, moves) -> N
 # ---- split, phases, noise ----------------------------------------------------------------------
 def test_time_segments_are_contiguous_and_disjoint(puma, moves) -> None:
     t = np.arange(0, moves.duration, 2e-3)
-    traj = Trajectory(t, moves(t), _measure(puma, moves(t), np.random.default_rng(3)))
+    traj = Trajectory(t, moves(t), tracked_tool_point(puma, moves(t), np.random.default_rng(3)))
     sp = split_segments(traj, np.random.default_rng(0), 20, 0.25, 5)
     assert len(sp.withheld_segments) == 5
     assert np.intersect1d(sp.fitting, sp.withheld).size == 0
@@ -165,7 +152,7 @@ def test_delay_and_lag_look_alike_at_constant_speed_differ_under_acceleration(
 def test_sync_delay_told_apart_from_servo_lag(puma, delay_and_lag, case) -> None:
     t, q, q_delay, q_lag, _rng = delay_and_lag
     qa = q_delay if case == "delay" else q_lag
-    traj = Trajectory(t, q, _measure(puma, qa, np.random.default_rng(5 if case == "delay"
+    traj = Trajectory(t, q, tracked_tool_point(puma, qa, np.random.default_rng(5 if case == "delay"
                                                                      else 6)))
     d = diagnose_motion(puma, traj, seed=0)
     noise = np.sqrt(3) * SIGMA
@@ -189,7 +176,7 @@ def test_withheld_segments_do_not_leak_and_static_effects_work_on_motion_data(pu
     t = np.arange(0, moves.duration, 4e-3)
     q = moves(t)
     qa = q + np.array([0, 8e-4, 0, 0, 0, 0])  # a joint-2 offset (static)
-    xyz = _measure(puma, qa, np.random.default_rng(7))
+    xyz = tracked_tool_point(puma, qa, np.random.default_rng(7))
     traj = Trajectory(t, q, xyz)
     effects = ("sync_delay", "servo_lag", "joint_offset")
     d1 = diagnose_motion(puma, traj, seed=3, effects=effects)
@@ -205,7 +192,7 @@ def test_withheld_segments_do_not_leak_and_static_effects_work_on_motion_data(pu
 # ---- CSV -------------------------------------------------------------------------------------
 def test_csv_round_trip_joint_time_stamps_and_errors(puma, moves, tmp_path) -> None:
     t = np.arange(0, 2.0, 1e-2)
-    traj = Trajectory(t, moves(t), _measure(puma, moves(t), np.random.default_rng(8)))
+    traj = Trajectory(t, moves(t), tracked_tool_point(puma, moves(t), np.random.default_rng(8)))
     path = write_trajectory(traj, tmp_path / "d.csv", deg=True, model=puma)
     back = load_trajectory(path, puma, deg=True)
     np.testing.assert_allclose(back.q, traj.q, rtol=1e-12, atol=1e-14)

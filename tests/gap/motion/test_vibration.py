@@ -14,34 +14,21 @@ from mjcf import MJCFOptions, build, inverse_dynamics_torques
 from sim.measurement import Instrument
 from sim.motion_measure import parse_motion_effects
 from sim.motion_robot import MotionEffects, execute_trajectory
+from tests.measured import tracked_tool_point
 from zrp.gap.motion import Trajectory, diagnose_motion
 from zrp.gap.motion.effects import MotionContext, effect_columns, linearise, plausible
 from zrp.gap.motion.kernels import mode_response
 from zrp.gap.motion.paths import exercise_moves
 from zrp.gap.problem import Problem
-from zrp.rotations import matrix_from_rotvec
 
 SIGMA = 0.02  # mm per coordinate
-TOOL = np.array([40.0, 10.0, 30.0])
 OMEGA, ZETA = 2 * np.pi * 8.0, 0.05
-
-
-@pytest.fixture(scope="module")
-def puma() -> zrp.Manipulator:
-    return zrp.load_model("puma")
 
 
 @pytest.fixture(scope="module")
 def moves():
     return exercise_moves(np.radians([0, -20, 30, 0, 60, 0]), np.random.default_rng(1),
                           moves=6)
-
-
-def _measure(model, q_actual, rng):
-    fk = zrp.forward_kinematics(model, q_actual)
-    x = fk.position + fk.rotation @ TOOL
-    x = x @ matrix_from_rotvec([0.1, -0.2, 0.3]).T + np.array([1500.0, -200.0, 300.0])
-    return x + rng.normal(0.0, SIGMA, x.shape)
 
 
 def _mode(t, f, omega=OMEGA, zeta=ZETA):
@@ -68,7 +55,7 @@ def test_mode_kernel_matches_lsim_and_finite_differences() -> None:
 
 def test_vibration_columns_and_problem_jacobian_match_finite_differences(puma, moves) -> None:
     t = np.arange(0, moves.duration, 5e-3)
-    traj = Trajectory(t, moves(t), _measure(puma, moves(t), np.random.default_rng(2)),
+    traj = Trajectory(t, moves(t), tracked_tool_point(puma, moves(t), np.random.default_rng(2)),
                       frame="base")
     vals = {"q2.vib_gain": 0.8, "q2.vib_omega": OMEGA, "q2.vib_zeta": ZETA}
 
@@ -116,7 +103,7 @@ def test_residual_vibration_recovered_on_synthetic_data(puma, moves) -> None:
     q = moves(t)
     qa = q.copy()
     qa[:, 1] += _mode(t, -moves(t, 2)[:, 1])
-    traj = Trajectory(t, q, _measure(puma, qa, np.random.default_rng(5)))
+    traj = Trajectory(t, q, tracked_tool_point(puma, qa, np.random.default_rng(5)))
     d = diagnose_motion(puma, traj, seed=0)
     assert d.effects == ("residual_vibration",) and d.steps[0].joints == (2,)
     est = {p.name: p for p in d.parameters}
@@ -138,7 +125,7 @@ def test_servo_lag_is_not_taken_for_a_mode(puma, moves) -> None:
     lag = (np.array([[-1.0 / tau]]), np.array([[1.0 / tau]]), np.array([[1.0]]),
            np.array([[0.0]]))  # tau y' + y = u, started on the command
     qa[:, 1] = signal.lsim(lag, q[:, 1], t - t[0], X0=[q[0, 1]])[1]
-    traj = Trajectory(t, q, _measure(puma, qa, np.random.default_rng(6)))
+    traj = Trajectory(t, q, tracked_tool_point(puma, qa, np.random.default_rng(6)))
     d = diagnose_motion(puma, traj, seed=0)
     assert d.effects[0] == "servo_lag" and "residual_vibration" not in d.effects
     ranked = {c["effect"]: c for c in d.steps[0].candidates}
