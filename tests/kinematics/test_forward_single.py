@@ -18,13 +18,12 @@ def test_single_pose_equals_batched_and_numpy(name):
     p_b, e_b = zrp.end_effector_pose(model, qs)
     j_b = zrp.jacobian(model, qs)
     ref = zrp.forward_kinematics(model, qs)
+    singles = [zrp.end_effector_pose(model, q) for q in qs]
+    assert all(p.shape == (3,) and e.shape == (4,) for p, e in singles)
+    one = tuple(np.array(x) for x in zip(*singles, strict=True))
+    zrp.testing.assert_pose_close(one, (p_b, e_b), atol_position=1e-12, atol_rotation_rad=4e-15)
+    zrp.testing.assert_pose_close(one, ref, atol_position=1e-9, atol_rotation_rad=4e-12)
     for i, q in enumerate(qs):
-        p, e = zrp.end_effector_pose(model, q)
-        assert p.shape == (3,) and e.shape == (4,)
-        np.testing.assert_allclose(p, p_b[i], rtol=0, atol=1e-12)
-        np.testing.assert_allclose(e, e_b[i], rtol=0, atol=1e-15)
-        np.testing.assert_allclose(p, ref.position[i], rtol=0, atol=1e-9)
-        np.testing.assert_allclose(e, ref.er[i], rtol=0, atol=1e-12)
         j = zrp.jacobian(model, q)
         assert j.shape == (6, model.n)
         np.testing.assert_allclose(j, j_b[i], rtol=0, atol=1e-12)

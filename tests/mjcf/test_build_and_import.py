@@ -101,13 +101,8 @@ def test_save_refuses_to_overwrite_and_reports_unwritable(tmp_path):
 def test_import_round_trip(name):
     model = ARMS[name]()
     back = mjcf.manipulator_from_mujoco(mjcf.mjcf_xml(model), length_unit=model.length_unit)
-    np.testing.assert_allclose(back.axes, model.axes, atol=1e-15)
-    np.testing.assert_allclose(back.bodies, model.bodies, rtol=0,
-                               atol=1e-12 * max(1.0, float(np.abs(model.bodies).max())))
-    np.testing.assert_allclose(back.end_effector.axial, model.end_effector.axial, atol=1e-15)
-    np.testing.assert_allclose(back.end_effector.transverse, model.end_effector.transverse,
-                               atol=1e-15)
-    assert back.joint_types == model.joint_types
+    zrp.testing.assert_manipulator_close(
+        back, model, atol=1e-15, atol_length=1e-12 * max(1.0, float(np.abs(model.bodies).max())))
     assert back.length_unit == model.length_unit
 
 

@@ -46,9 +46,7 @@ def test_urdf_export_same_fk_in_mujoco_and_zrp(tmp_path):
         assert [j.velocity_limit for j in back.joints] == pytest.approx([1.5] * model.n)
         again = import_urdf(urdf_xml(back), length_unit=model.length_unit).model
         for a, b in ((back, model), (again, back)):  # model -> URDF -> model -> URDF -> model
-            np.testing.assert_allclose(a.bodies, b.bodies, rtol=0, atol=1e-12)
-            np.testing.assert_allclose(a.axes, b.axes, rtol=0, atol=1e-15)
-            np.testing.assert_allclose(a.end_effector.frame, b.end_effector.frame, atol=1e-15)
+            zrp.testing.assert_manipulator_close(a, b, atol=1e-15, atol_length=1e-12)
         m = mujoco.MjModel.from_xml_string(xml)
         d = mujoco.MjData(m)
         tool = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "tool")
