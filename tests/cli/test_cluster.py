@@ -219,6 +219,7 @@ def test_tolerance_cli_on_the_cluster_equals_in_process(cluster, capsys):
     assert "--workers" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("how", ["ctrl-c", "sigterm"])
 def test_a_stopped_local_cluster_run_keeps_its_checkpoint_and_prints_no_traceback(tmp_path,
                                                                                    how):

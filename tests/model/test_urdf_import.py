@@ -52,6 +52,7 @@ def _pin_q(pm, imp, qz):
     return q, cols
 
 
+@pytest.mark.slow
 def test_every_example_robot_data_urdf_matches_pinocchio():
     pin = pytest.importorskip("pinocchio")
     root = _erd_root()

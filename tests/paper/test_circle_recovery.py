@@ -112,6 +112,7 @@ def _zrp(*args: str, cwd: Path) -> subprocess.CompletedProcess:
                           capture_output=True, text=True, timeout=300)
 
 
+@pytest.mark.slow
 def test_cli_recovered_circle(tmp_path):
     p = _zrp("paper", "--circle", "recovered", "--no-video", "--no-figures", "--json",
              "--out", str(tmp_path / "rec"), cwd=tmp_path)
@@ -129,6 +130,7 @@ def test_cli_recovered_circle(tmp_path):
     assert bad.returncode == 2 and "--circle" in bad.stderr and "--q0" in bad.stderr
 
 
+@pytest.mark.slow
 def test_cli_recover_runs_a_tiny_search(tmp_path):
     import json
 

@@ -89,6 +89,7 @@ def test_effect_specs_and_scenarios(puma) -> None:
     assert kinds.count(0) == 2 and kinds.count(1) == 19 and kinds.count(2) == 13
 
 
+@pytest.mark.slow
 def test_cli_streams_the_circle_and_diagnoses_it(tmp_path, capsys) -> None:
     data = tmp_path / "circle.csv"
     args = ["measure", "--trajectory", "circle", "--stream", "250", "--motion-effect",
@@ -107,6 +108,7 @@ def test_cli_streams_the_circle_and_diagnoses_it(tmp_path, capsys) -> None:
                  str(out)]) == 2
 
 
+@pytest.mark.slow
 def test_motion_benchmark_runs_blind_and_scores(puma, tmp_path) -> None:
     s = run_motion_benchmark(puma, 3, 5, tmp_path / "mb", moves=4)
     assert s["scenarios"] == 3 and (tmp_path / "mb" / "summary.md").exists()

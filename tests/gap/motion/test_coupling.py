@@ -133,6 +133,7 @@ def test_real_robot_slow_mode_follows_the_mode_with_the_arms_terms(puma, moves) 
     assert rms_along < rms_plain / 3  # measured 7.7x better there
 
 
+@pytest.mark.slow
 def test_friction_and_compliance_on_the_same_joint_both_named(puma) -> None:
     """A same-joint pair the additive model handles (joint 3, 10 N m of friction on a servo of
     stiffness 1/c, c = 20 urad/(N m): play F c = 0.2 mrad); on the gravity-loaded joint 2 with

@@ -148,6 +148,7 @@ def test_delay_and_lag_look_alike_at_constant_speed_differ_under_acceleration(
     assert mismatch(accel) > 1e-4
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("case", ["delay", "lag"])
 def test_sync_delay_told_apart_from_servo_lag(puma, delay_and_lag, case) -> None:
     t, q, q_delay, q_lag, _rng = delay_and_lag
