@@ -5,6 +5,7 @@ studies)."""
 from __future__ import annotations
 
 import warnings
+from collections.abc import Iterator
 from pathlib import Path
 from typing import NamedTuple
 
@@ -14,9 +15,21 @@ import pytest
 import zrp
 import zrp.testing  # the tests call zrp.testing.random_arm without importing it
 from tests.measured import puma_full_pose
+from zrp.blas import blas_threads
 from zrp.gap import Diagnosis, Measurements, diagnose, load_measurements
 
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+
+
+@pytest.fixture(scope="session", autouse=True)
+def one_blas_thread() -> Iterator[None]:
+    """Every test runs with one BLAS thread. The suite's linear algebra is small dense
+    problems, on which OpenBLAS's threads spin waiting for each other (zrp/blas.py): the
+    diagnosis limits itself to one thread, the motion diagnosis does not, and its tests took
+    15x the CPU time with the default threads (143 s instead of 9 s for the delay-or-lag
+    pair on this 2-core machine). Results agree to rounding either way (zrp/blas.py)."""
+    with blas_threads(1):
+        yield
 
 
 @pytest.fixture
