@@ -89,7 +89,6 @@ def test_effect_specs_and_scenarios(puma) -> None:
     assert kinds.count(0) == 2 and kinds.count(1) == 19 and kinds.count(2) == 13
 
 
-@pytest.mark.slow
 def test_cli_streams_the_circle_and_diagnoses_it(tmp_path, capsys) -> None:
     data = tmp_path / "circle.csv"
     args = ["measure", "--trajectory", "circle", "--stream", "250", "--motion-effect",

@@ -98,7 +98,6 @@ def test_plausible_mode_parameters() -> None:
     assert not plausible("q2.vib_omega", 1.0, 1000.0)  # below 0.5 Hz
 
 
-@pytest.mark.slow
 def test_residual_vibration_recovered_on_synthetic_data(puma, moves) -> None:
     t = np.arange(0, moves.duration, 1e-3)
     q = moves(t)
@@ -135,7 +134,6 @@ def test_servo_lag_is_not_taken_for_a_mode(puma, moves) -> None:
     assert vib["cv_rms"] is None or vib["cv_rms"] > 1.01 * ranked["servo_lag"]["cv_rms"]
 
 
-@pytest.mark.slow
 def test_mujoco_mode_is_named_on_its_joint(puma) -> None:
     eff = parse_motion_effects(["residual_vibration:2=8Hz"], puma)
     assert eff.residual_vibration == {2: 8.0} and eff.active == ("residual_vibration",)
