@@ -106,18 +106,18 @@ def project_modules() -> list[tuple[str, Path]]:
 def test_the_checker_catches_violations():
     """The contract check can fail: each kind of violation is caught in a made-up module."""
     assert violations("zrp.kinematics.forward", "import mujoco\n")
-    assert violations("zrp.kinematics.forward", "def f():\n    import sim.playback\n")
+    assert violations("zrp.kinematics.forward", "def f():\n    import sim.view.playback\n")
     assert violations("zrp.gap.pipeline", "from mjcf import build\n")
     assert violations("zrp.model.files", "from zrp.cli.app import emit\n")
     assert violations("mjcf.builder", "import sim\n")
-    assert violations("sim.video", "from zrp.cli import main\n")
+    assert violations("sim.view.video", "from zrp.cli import main\n")
     assert violations("zrp.gap.where", "import matplotlib.pyplot as plt\n")
     assert violations("zrp.gap.where", "import pandas\n")
     assert violations("zrp.gap.pipeline", "from zrp.gap.report.write import write_outputs\n")
     assert violations("zrp.gap.where", "from .report import plots\n")
     # and lets the allowed ones through
     assert not violations("zrp.gap.report.plots", "import matplotlib\n")
-    assert not violations("sim.video", "import mjcf\nimport mujoco\nimport zrp\n")
+    assert not violations("sim.view.video", "import mjcf\nimport mujoco\nimport zrp\n")
     assert not violations("zrp.cli.commands.render", "import sim\nimport mjcf\n")
     assert not violations("zrp.gap.leastsq", "import numpy\nfrom scipy import special\n")
 

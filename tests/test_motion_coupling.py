@@ -15,9 +15,9 @@ from scipy.integrate import solve_ivp
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
-from sim.benchmark.motion import MotionScenario, _run_one
-from sim.measurement import Instrument
-from sim.motion_robot import MotionEffects, execute_trajectory
+from sim.robot.measurement import Instrument
+from sim.robot.motion import MotionEffects, execute_trajectory
+from sim.studies.benchmark.motion import MotionScenario, _run_one
 from zrp.gap.motion import Trajectory
 from zrp.gap.motion.effects import effect_columns, joint_mode, linearise
 from zrp.gap.motion.kernels import mode_response

@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 import zrp
-from sim.effect_specs import parse_effects
-from sim.effects import HiddenEffects, motor_map, true_geometry
-from sim.measurement import (
+from sim.robot.effect_specs import parse_effects
+from sim.robot.effects import HiddenEffects, motor_map, true_geometry
+from sim.robot.measurement import (
     Instrument,
     Procedure,
     measure,
@@ -20,8 +20,8 @@ from sim.measurement import (
     write_measurements,
     write_truth,
 )
-from sim.real_robot import RealRobot
-from sim.robot_model import RealRobotOptions
+from sim.robot.model import RealRobotOptions
+from sim.robot.real import RealRobot
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap import load_measurements
 from zrp.kinematics import reachable_poses

@@ -18,8 +18,8 @@ import numpy as np
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
-from sim.measurement import random_instrument
-from sim.motion_robot import MotionEffects, execute_trajectory
+from sim.robot.measurement import random_instrument
+from sim.robot.motion import MotionEffects, execute_trajectory
 from zrp.gap.effects import Context, registration_parameters
 from zrp.gap.leastsq import fit, initial_registration
 from zrp.gap.motion import diagnose_motion

@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import zrp
-from sim.benchmark import (
+from sim.studies.benchmark import (
     BenchmarkConfig,
     draw_scenarios,
     render_text,
@@ -34,7 +34,7 @@ TARGET_S = 600.0
 
 def kinematic_baseline(model: zrp.Manipulator, cfg: BenchmarkConfig) -> float:
     """Seconds to compute the same sessions' tool points by forward kinematics only."""
-    from sim.effects import default_tool_points, true_geometry
+    from sim.robot.effects import default_tool_points, true_geometry
     from zrp.kinematics import reachable_poses
 
     tool = default_tool_points(model)

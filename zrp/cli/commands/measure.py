@@ -121,8 +121,8 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> int:
-    """``--stream``: the real robot in motion (sim/motion_measure.py)."""
-    from sim.motion_measure import measure_stream  # MuJoCo: only when this command runs
+    """``--stream``: the real robot in motion (sim/robot/motion_measure.py)."""
+    from sim.robot.motion_measure import measure_stream  # MuJoCo: only when this command runs
 
     if args.effect:
         raise InputError("--effect: static effects are not simulated with --stream; use "
