@@ -15,7 +15,9 @@
 * :mod:`sim.lessons`: runnable lessons, one concept each.
 
 What a video shows is the caller's choice: the paper's scenes are assembled in the core
-(:mod:`zrp.paper.scenes`) and passed to :func:`render_video` as segments.
+(:mod:`zrp.paper.scenes`) and passed to :func:`render_video` as segments. Likewise the
+trajectories the robot is measured along are passed in: the studies and the command line build
+the paper's circle (:mod:`sim.studies.trajectories`), :mod:`sim.robot` never imports the paper.
 
 MuJoCo fixes its GL backend when it is first imported; :mod:`sim.view.gl` imports
 ``mujoco.egl``/``mujoco.osmesa`` directly, so :class:`OffscreenRenderer` works whatever was

@@ -39,9 +39,9 @@ from sim.robot.real import RealRobot
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap.data import Measurements
 from zrp.kinematics.ik import track_trajectory
+from zrp.kinematics.trajectory import Circle
 from zrp.model.manipulator import Manipulator
 from zrp.output import atomic_path, check_writable, write_json
-from zrp.paper.scenario import puma_circle
 from zrp.rotations import matrix_from_rotvec
 from zrp.units import units_per_mm
 
@@ -190,23 +190,20 @@ class Procedure:
         return self.temp_start + self.temp_rise * (1.0 - np.exp(-t / self.temp_tau))
 
 
-def trajectory_poses(model: Manipulator, count: int, trajectory: str = "circle") -> F64:
-    """``count`` poses evenly spaced in time along a trajectory, rad, shape (count, n).
+def trajectory_poses(model: Manipulator, count: int, trajectory: Circle, q0: ArrayLike) -> F64:
+    """``count`` poses evenly spaced along the arc of a circle, rad, shape (count, n).
 
-    ``"circle"``: the paper's 125 mm circle of the PUMA (:func:`zrp.puma_circle`), solved by
-    the nominal inverse kinematics (what a controller would command).
+    ``trajectory`` (a :class:`zrp.Circle`, built by the caller: e.g. the paper's 125 mm circle
+    of the PUMA, :func:`sim.studies.trajectories.circle_poses`) is solved from ``q0`` by the
+    nominal inverse kinematics (what a controller would command); the poses are then picked
+    evenly in angle about its centre (the time law is slow at both ends).
     """
-    if trajectory != "circle":
-        raise InputError(f"trajectory: {trajectory!r}; expected 'circle'")
     if isinstance(count, bool) or not isinstance(count, (int, np.integer)) or count < 8:
         raise InputError(f"count: expected at least 8 poses along the trajectory, got {count!r}")
-    if model.n != 6:
-        raise InputError(f"trajectory 'circle' is the PUMA's; the model {model.name!r} has "
-                         f"{model.n} joints")
-    setup = puma_circle(model)
-    res = track_trajectory(model, setup.trajectory, setup.q0, max(2000, 40 * count))
-    # evenly spaced along the arc (the time law is slow at both ends)
-    c = setup.trajectory
+    if not isinstance(trajectory, Circle):
+        raise InputError(f"trajectory: expected a zrp.Circle, got {type(trajectory).__name__}")
+    res = track_trajectory(model, trajectory, q0, max(2000, 40 * count))
+    c = trajectory
     r = np.asarray(res.desired_position) - np.asarray(c.center)
     e1 = np.asarray(c.start_point) - np.asarray(c.center)
     e1 /= np.linalg.norm(e1)

@@ -37,9 +37,9 @@ from sim.robot.measurement import (
     Procedure,
     _nominal_static_torque,
     measure,
-    trajectory_poses,
 )
 from sim.robot.real import RealRobot
+from sim.studies.trajectories import circle_poses
 from zrp.calibration import CalibratedRobot, Compensation, PoseConditions, compensate
 from zrp.gap import Diagnosis, Measurements, diagnose
 from zrp.kinematics import reachable_poses
@@ -100,7 +100,7 @@ def _targets(model: Manipulator, rng: np.random.Generator, n_random: int, n_circ
              ) -> tuple[F64, tuple[str, ...]]:
     parts, labels = [], []
     if n_circle:
-        parts.append(trajectory_poses(model, n_circle, "circle"))
+        parts.append(circle_poses(model, n_circle))
         labels += ["circle"] * n_circle
     if n_random:
         parts.append(reachable_poses(model, n_random, rng))

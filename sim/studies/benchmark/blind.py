@@ -20,12 +20,12 @@ from sim.robot.measurement import (
     Procedure,
     measure,
     random_instrument,
-    trajectory_poses,
     write_measurements,
     write_truth,
 )
 from sim.robot.real import RealRobot
 from sim.studies.benchmark.scenarios import BenchmarkConfig, Scenario, pose_limits
+from sim.studies.trajectories import circle_poses
 from zrp.gap import Diagnosis, diagnose, load_measurements
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
@@ -41,7 +41,7 @@ def simulate_scenario(model: Manipulator, scenario: Scenario, config: BenchmarkC
     rng = np.random.default_rng(scenario.seed)
     q = (reachable_poses(model, config.poses, rng, limits=pose_limits(model))
          if config.poses_from == "random"
-         else trajectory_poses(model, config.poses, "circle"))
+         else circle_poses(model, config.poses))
     inst = random_instrument(model, rng, scenario.noise_sigma)
     robot = RealRobot(model, scenario.effects, config.robot_options(model))
     run = measure(robot, q, inst, rng, Procedure(approach=config.approach))

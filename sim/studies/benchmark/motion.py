@@ -31,7 +31,7 @@ from mjcf import MJCFOptions, build
 from mjcf.dynamics import inverse_dynamics_torques, mode_terms
 from sim.robot.measurement import random_instrument
 from sim.robot.motion import MOTION_HIDDEN, MotionEffects, execute_trajectory
-from sim.robot.motion_measure import named_command
+from sim.studies.trajectories import named_command
 from zrp import jsonio
 from zrp.errors import InputError
 from zrp.gap.motion import diagnose_motion, load_trajectory, write_trajectory
