@@ -3,8 +3,9 @@
 * :mod:`sim.robot`: the physics "real" robot and its instrument - hidden effects
   (:mod:`~sim.robot.effects`, text specs :mod:`~sim.robot.effect_specs`), its MuJoCo model
   (:mod:`~sim.robot.model`), the robot and its controller at rest (:mod:`~sim.robot.real`) and
-  in motion (:mod:`~sim.robot.motion`), servo dynamics (:mod:`~sim.robot.dynamics`) and the
-  measuring procedures (:mod:`~sim.robot.measurement`, :mod:`~sim.robot.motion_measure`);
+  in motion (:mod:`~sim.robot.motion`), servo dynamics (:mod:`~sim.robot.dynamics`), the
+  laser tracker (:mod:`~sim.robot.instrument`) and the measuring procedures
+  (:mod:`~sim.robot.measurement`, :mod:`~sim.robot.motion_measure`);
 * :mod:`sim.view`: MuJoCo playback and its consistency check against ZRP
   (:mod:`~sim.view.playback`), offscreen rendering (:mod:`~sim.view.gl`,
   :mod:`~sim.view.render`), comparison frames and videos (:mod:`~sim.view.frames`,
@@ -56,12 +57,14 @@ _EXPORTS = {
         "motor_map",
         "true_geometry",
     ),
-    "robot.measurement": (
+    "robot.instrument": (
         "Instrument",
+        "random_instrument",
+    ),
+    "robot.measurement": (
         "MeasurementRun",
         "Procedure",
         "measure",
-        "random_instrument",
         "trajectory_poses",
         "write_measurements",
         "write_truth",

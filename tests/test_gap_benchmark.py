@@ -268,7 +268,8 @@ def test_blind_diagnosis_names_a_physical_backlash(puma, tmp_path):
     """End to end through files: a 1 mrad play on joint 1 (no gravity torque), 80 poses,
     measured and written; the blind diagnosis of the CSV alone names backlash on joint 1
     and ends at the noise floor."""
-    from sim.robot.measurement import Instrument, measure, write_measurements
+    from sim.robot.instrument import Instrument
+    from sim.robot.measurement import measure, write_measurements
     from sim.robot.real import RealRobot
     from zrp.kinematics import reachable_poses
 

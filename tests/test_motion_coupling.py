@@ -15,7 +15,7 @@ from scipy.integrate import solve_ivp
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
-from sim.robot.measurement import Instrument
+from sim.robot.instrument import Instrument
 from sim.robot.motion import MotionEffects, execute_trajectory
 from sim.studies.benchmark.motion import MotionScenario, _run_one
 from zrp.gap.motion import Trajectory

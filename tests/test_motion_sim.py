@@ -12,7 +12,7 @@ from scipy.integrate import solve_ivp
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques
-from sim.robot.measurement import Instrument
+from sim.robot.instrument import Instrument
 from sim.robot.motion import MotionEffects, execute_trajectory
 from sim.robot.motion_measure import parse_motion_effects
 from sim.studies.benchmark.motion import draw_motion_scenarios, run_motion_benchmark

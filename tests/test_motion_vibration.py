@@ -11,7 +11,7 @@ from scipy import signal
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques
-from sim.robot.measurement import Instrument
+from sim.robot.instrument import Instrument
 from sim.robot.motion import MotionEffects, execute_trajectory
 from sim.robot.motion_measure import parse_motion_effects
 from zrp.gap.motion import Trajectory, diagnose_motion

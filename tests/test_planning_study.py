@@ -72,7 +72,8 @@ def test_plan_benchmark_command_end_to_end(tmp_path, capsys):
 
 
 def test_measure_refuses_directions_it_cannot_follow():
-    from sim.robot.measurement import Instrument, Procedure, measure
+    from sim.robot.instrument import Instrument
+    from sim.robot.measurement import Procedure, measure
     from sim.robot.real import RealRobot
 
     robot = RealRobot(PUMA)

@@ -11,11 +11,10 @@ import pytest
 import zrp
 from sim.robot.effect_specs import parse_effects
 from sim.robot.effects import HiddenEffects, motor_map, true_geometry
+from sim.robot.instrument import Instrument, random_instrument
 from sim.robot.measurement import (
-    Instrument,
     Procedure,
     measure,
-    random_instrument,
     trajectory_poses,
     write_measurements,
     write_truth,

@@ -12,7 +12,8 @@ import pytest
 
 import zrp
 from sim.robot.effects import HiddenEffects
-from sim.robot.measurement import Instrument, measure
+from sim.robot.instrument import Instrument
+from sim.robot.measurement import measure
 from sim.robot.model import _servo_inertias
 from sim.robot.real import RealRobot
 from sim.studies.benchmark import BenchmarkConfig
@@ -158,7 +159,7 @@ def test_cli_plan_default_noise_is_20_um_in_any_length_unit(tmp_path, capsys):
 
 
 def test_random_instrument_noise_defaults_to_mm_in_the_model_unit():
-    from sim.robot.measurement import TRACKER_NOISE_RANGE_MM, random_instrument
+    from sim.robot.instrument import TRACKER_NOISE_RANGE_MM, random_instrument
 
     puma = zrp.load_model("puma")
     in_m = dataclasses.replace(puma.with_arrays(bodies=puma.bodies * 1e-3), length_unit="m")

@@ -7,7 +7,8 @@ import numpy as np
 
 from sim.lessons.lesson import Lesson, figure
 from sim.robot.effect_specs import parse_effects
-from sim.robot.measurement import Procedure, measure, random_instrument
+from sim.robot.instrument import random_instrument
+from sim.robot.measurement import Procedure, measure
 from sim.robot.real import RealRobot
 from zrp.gap.pipeline import diagnose
 from zrp.kinematics.sampling import reachable_poses

@@ -54,9 +54,8 @@ def _factor(table: Mapping[str, float] | None, unit: str, model: Manipulator,
     return table[unit]
 
 
-def _parse_one(spec: str, model: Manipulator, field: str) -> tuple[str, int | None, Any]:
-    """(effect, joint or None, value in the effect's unit) of one spec."""
-    where = f"{field} {spec!r}"
+def _match(spec: str, where: str) -> tuple[str, str | None, str | None, str, str]:
+    """(name, joint, harmonic, value list, unit) as written in ``spec``; the name known."""
     m = _SPEC.match(spec)
     if not m:
         raise InputError(f"{where}: expected NAME[:JOINT]=VALUE[UNIT], e.g. "
@@ -65,27 +64,48 @@ def _parse_one(spec: str, model: Manipulator, field: str) -> tuple[str, int | No
     if name not in EFFECT_NAMES:
         raise InputError(f"{where}: unknown effect {name!r}; expected one of "
                          f"{', '.join(EFFECT_NAMES)}")
+    return name, joint, harm, value, unit
+
+
+def _numbers(value: str, where: str) -> list[float]:
+    """The comma-separated numbers of a spec's value."""
     try:
-        vals = [float(v) for v in value.replace(" ", "").split(",") if v]
+        return [float(v) for v in value.replace(" ", "").split(",") if v]
     except ValueError:
         raise InputError(f"{where}: {value!r} is not a number list") from None
+
+
+def _check_place(name: str, joint: str | None, harm: str | None, where: str) -> None:
+    """A joint for per-joint effects only, a harmonic for ``cyclic_error`` only."""
     if name in _GLOBAL and joint is not None:
         raise InputError(f"{where}: {name} takes no joint")
     if name not in _GLOBAL and joint is None:
         raise InputError(f"{where}: {name} needs a joint, e.g. {name}:2=...")
     if harm is not None and name != "cyclic_error":
         raise InputError(f"{where}: :hH (harmonic) is for cyclic_error only")
+
+
+def _entry(name: str, values: list[float], harm: str | None) -> Any:
+    """What :class:`HiddenEffects` holds for one spec: a tuple of several values, the
+    (harmonic, amplitude, phase) of a ``cyclic_error``, or the value."""
+    if len(values) > 1:
+        return tuple(values)
+    if name == "cyclic_error":
+        return (int(harm or 1), values[0], 0.0)
+    return values[0]
+
+
+def _parse_one(spec: str, model: Manipulator, field: str) -> tuple[str, int | None, Any]:
+    """(effect, joint or None, value in the effect's unit) of one spec."""
+    where = f"{field} {spec!r}"
+    name, joint, harm, value, unit = _match(spec, where)
+    vals = _numbers(value, where)
+    _check_place(name, joint, harm, where)
     table, count, default_unit = SPEC_FORMS.get(name, (_ANGLE, 1, "rad"))
     if len(vals) != count:
         raise InputError(f"{where}: {name} takes {count} value(s), got {len(vals)}")
     factor = _factor(table, unit or default_unit, model, where)
-    v = [x * factor for x in vals]
-    if count > 1:
-        entry: Any = tuple(v)
-    elif name == "cyclic_error":
-        entry = (int(harm or 1), v[0], 0.0)
-    else:
-        entry = v[0]
+    entry = _entry(name, [x * factor for x in vals], harm)
     return name, None if joint is None else int(joint), entry
 
 

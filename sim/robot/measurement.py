@@ -24,7 +24,6 @@ blind benchmark never shows to the diagnosis.
 from __future__ import annotations
 
 import csv
-import math
 import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -35,26 +34,22 @@ from numpy.typing import ArrayLike, NDArray
 from tqdm.auto import tqdm
 
 from sim.robot.effects import HiddenEffects
-from sim.robot.real import RealRobot
+from sim.robot.instrument import Instrument, check_number
+from sim.robot.real import Reading, RealRobot, Session
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap.data import Measurements
 from zrp.kinematics.ik import track_trajectory
 from zrp.kinematics.trajectory import Circle
 from zrp.model.manipulator import Manipulator
 from zrp.output import atomic_path, check_writable, write_json
-from zrp.rotations import matrix_from_rotvec
-from zrp.units import units_per_mm
 
 __all__ = [
     "APPROACHES",
-    "TRACKER_NOISE_RANGE_MM",
     "TRANSFERS",
     "TRUTH_FORMAT",
-    "Instrument",
     "MeasurementRun",
     "Procedure",
     "measure",
-    "random_instrument",
     "trajectory_poses",
     "write_measurements",
     "write_truth",
@@ -64,71 +59,6 @@ F64 = NDArray[np.float64]
 APPROACHES = ("random", "order", "gravity")
 TRUTH_FORMAT = "zrp-real-robot-truth"
 TRANSFERS = ("jump", "simulate")
-
-
-def _num(v: object, name: str, unit: str, lo: float | None = None,
-         strict: bool = False) -> float:
-    try:
-        x = float(v)  # type: ignore[arg-type]
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name}: expected a number ({unit}), got {v!r}") from exc
-    if not math.isfinite(x) or (lo is not None and (x <= lo if strict else x < lo)):
-        cond = "" if lo is None else f" {'>' if strict else '>='} {lo:g}"
-        raise InputError(f"{name}: expected a finite number{cond} ({unit}), got {v!r}")
-    return x
-
-
-@dataclass(frozen=True)
-class Instrument:
-    """The laser tracker: its noise and where it stands.
-
-    Attributes:
-        noise_sigma: isotropic Gaussian noise per coordinate, model length unit (0.01-0.03 mm
-            is typical of a laser tracker at a few metres).
-        rotvec: rotation vector of the instrument-from-base rotation, rad, shape (3,).
-        translation: base origin in the instrument frame, model length unit, shape (3,).
-    """
-
-    noise_sigma: float = 0.02
-    rotvec: tuple[float, float, float] = (0.01, -0.02, 2.4)
-    translation: tuple[float, float, float] = (2500.0, 800.0, 300.0)
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "noise_sigma", _num(self.noise_sigma, "noise_sigma",
-                                                     "length unit", 0.0))
-        for name in ("rotvec", "translation"):
-            a = np.asarray(getattr(self, name), dtype=float)
-            if a.shape != (3,) or not np.all(np.isfinite(a)):
-                raise InputError(f"{name}: expected 3 finite numbers, got {getattr(self, name)!r}")
-            object.__setattr__(self, name, tuple(float(x) for x in a))
-
-    @property
-    def rotation(self) -> F64:
-        """Instrument-from-base rotation, shape (3, 3)."""
-        return matrix_from_rotvec(self.rotvec)
-
-
-#: The range of laser-tracker noise per coordinate the simulations draw from, mm.
-TRACKER_NOISE_RANGE_MM = (0.01, 0.03)
-
-
-def random_instrument(model: Manipulator, rng: np.random.Generator,
-                      noise_sigma: float | tuple[float, float] | None = None) -> Instrument:
-    """A tracker 1.2-2.4 reaches away in a random direction, turned about the vertical at
-    random and levelled within 0.02 rad; noise drawn uniformly from ``noise_sigma`` (a range,
-    or one value, model length unit; None: :data:`TRACKER_NOISE_RANGE_MM` in the model's
-    unit)."""
-    if noise_sigma is None:
-        per_mm = units_per_mm(model.length_unit, "model.length_unit")
-        noise_sigma = (TRACKER_NOISE_RANGE_MM[0] * per_mm, TRACKER_NOISE_RANGE_MM[1] * per_mm)
-    lo, hi = (noise_sigma, noise_sigma) if np.isscalar(noise_sigma) else noise_sigma  # type: ignore[misc]
-    sigma = float(rng.uniform(float(lo), float(hi)))
-    rot = np.array([*rng.uniform(-0.02, 0.02, 2), rng.uniform(-math.pi, math.pi)])
-    ang = rng.uniform(-math.pi, math.pi)
-    dist = rng.uniform(1.2, 2.4) * model.reach
-    trans = np.array([dist * math.cos(ang), dist * math.sin(ang),
-                      rng.uniform(-0.3, 0.3) * model.reach])
-    return Instrument(sigma, tuple(rot), tuple(trans))  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)
@@ -181,8 +111,10 @@ class Procedure:
                                    ("speed", "rad/s", True), ("settle_time", "s", True),
                                    ("dwell", "s", False), ("temp_rise", "K", False),
                                    ("temp_tau", "s", True), ("temp_noise", "K", False)):
-            object.__setattr__(self, name, _num(getattr(self, name), name, unit, 0.0, strict))
-        object.__setattr__(self, "temp_start", _num(self.temp_start, "temp_start", "deg C"))
+            object.__setattr__(self, name,
+                               check_number(getattr(self, name), name, unit, 0.0, strict))
+        object.__setattr__(self, "temp_start",
+                           check_number(self.temp_start, "temp_start", "deg C"))
 
     def temperature(self, t: ArrayLike) -> F64:
         """True robot temperature at times ``t`` (s), deg C."""
@@ -246,6 +178,35 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
             instead of the drawn ones with ``approach="random"`` (e.g. ``zrp plan``'s).
     """
     proc = procedure or Procedure()
+    q, planned = _checked_poses(robot, q, proc, directions)
+    lift = (_nominal_static_torque(robot, q) if proc.approach == "gravity" else None)
+    session = robot.session(q[0] - proc.approach_step, proc.temperature(0.0)[()])
+    session.settle(max_time=proc.settle_time)
+    log = _Log.empty(len(q), robot.n, len(robot.tool_points))
+    clock = 0.0
+    prev = q[0] - proc.approach_step
+    for i in tqdm(range(len(q)), desc="measure", unit="pose", disable=not progress,
+                  leave=False):
+        if proc.approach in ("random", "gravity"):
+            d = rng.choice([-1.0, 1.0], size=robot.n) if planned is None else planned[i]
+            if lift is not None:
+                d = np.where(np.abs(lift[i]) > 1e-3, np.sign(lift[i]), d)
+            _approach_from_side(session, proc, q[i], prev, d, clock)
+        else:
+            s = np.sign(q[i] - prev)
+            d = np.where(s != 0, s, log.dirs[i - 1] if i else 0.0)
+            _approach_in_order(session, proc, q[i], prev, clock)
+        log.dirs[i] = d
+        sp = session.settle(max_time=proc.settle_time)
+        log.record(i, session.read(sp), sp, clock + session.time)
+        clock += proc.dwell
+        prev = q[i]
+    return _run(robot, q, instrument, proc, rng, log)
+
+
+def _checked_poses(robot: RealRobot, q: ArrayLike, proc: Procedure,
+                   directions: ArrayLike | None) -> tuple[F64, F64 | None]:
+    """The commanded poses as floats, shape (P, n), and the planned directions (or None)."""
     if not isinstance(robot, RealRobot):
         raise InputError(f"robot: expected a sim.robot.real.RealRobot, got "
                          f"{type(robot).__name__}")
@@ -253,79 +214,97 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
     n = robot.n
     if q.ndim != 2 or q.shape[1] != n or q.shape[0] < 1 or not np.all(np.isfinite(q)):
         raise InputError(f"q: expected finite joint values of shape (P, {n}), got {q.shape}")
-    P = q.shape[0]
-    M = len(robot.tool_points)
-    step = proc.approach_step
-    dirs_plan = None if directions is None else np.asarray(directions, dtype=float)
-    if dirs_plan is not None and (dirs_plan.shape != q.shape or proc.approach != "random"
-                                  or not np.all(np.abs(dirs_plan) == 1.0)):
+    planned = None if directions is None else np.asarray(directions, dtype=float)
+    if planned is not None and (planned.shape != q.shape or proc.approach != "random"
+                                or not np.all(np.abs(planned) == 1.0)):
         raise InputError(f"directions: expected -1/+1 of shape {q.shape} with "
-                         f"approach='random', got shape {dirs_plan.shape}")
-    lift = (_nominal_static_torque(robot, q) if proc.approach == "gravity" else None)
-    session = robot.session(q[0] - step, proc.temperature(0.0)[()])
-    session.settle(max_time=proc.settle_time)
-    clock = 0.0
-    dirs = np.zeros((P, n))
-    prev = q[0] - step
-    pts = np.empty((P, M, 3))
-    q_link = np.empty((P, n))
-    q_motor = np.empty((P, n))
-    torque = np.empty((P, n))
-    temp_true = np.empty(P)
-    t_log = np.empty(P)
-    speed = np.empty(P)
-    motor_err = np.empty(P)
-    for i in tqdm(range(P), desc="measure", unit="pose", disable=not progress, leave=False):
-        if proc.approach in ("random", "gravity"):
-            d = rng.choice([-1.0, 1.0], size=n) if directions is None else dirs_plan[i]
-            if lift is not None:
-                d = np.where(np.abs(lift[i]) > 1e-3, np.sign(lift[i]), d)
-            pre = q[i] - d * step
-            dist = float(np.max(np.abs(pre - prev)))
-            if dist > 0:
-                go = session.jump if proc.transfer == "jump" else session.move
-                go(pre, max(0.2, 1.875 * dist / proc.speed))
-            session.set_temperature(proc.temperature(clock + session.time)[()])
-            session.move(q[i], proc.approach_time)
-        else:
-            s = np.sign(q[i] - prev)
-            d = np.where(s != 0, s, dirs[i - 1] if i else 0.0)
-            dist = float(np.max(np.abs(q[i] - prev)))
-            session.set_temperature(proc.temperature(clock + session.time)[()])
-            if dist > 0:
-                session.move(q[i], max(proc.approach_time, 1.875 * dist / proc.speed))
-        dirs[i] = d
-        sp = session.settle(max_time=proc.settle_time)
-        rd = session.read(sp)
-        pts[i] = rd.points
-        q_link[i] = rd.q_link
-        q_motor[i] = rd.q_motor
-        torque[i] = rd.torque
-        temp_true[i] = rd.temperature
-        speed[i] = sp
-        motor_err[i] = float(np.max(np.abs(rd.motor_target - rd.q_motor)))
-        t_log[i] = clock + session.time
-        clock += proc.dwell
-        prev = q[i]
-    rb = instrument.rotation
-    tb = np.asarray(instrument.translation)
-    clean = pts @ rb.T + tb
+                         f"approach='random', got shape {planned.shape}")
+    return q, planned
+
+
+def _approach_from_side(session: Session, proc: Procedure, target: F64, prev: F64, d: F64,
+                        clock: float) -> None:
+    """Transfer to the pre-pose ``target - d approach_step``, then approach slowly."""
+    pre = target - d * proc.approach_step
+    dist = float(np.max(np.abs(pre - prev)))
+    if dist > 0:
+        go = session.jump if proc.transfer == "jump" else session.move
+        go(pre, max(0.2, 1.875 * dist / proc.speed))
+    session.set_temperature(proc.temperature(clock + session.time)[()])
+    session.move(target, proc.approach_time)
+
+
+def _approach_in_order(session: Session, proc: Procedure, target: F64, prev: F64,
+                       clock: float) -> None:
+    """Move straight from the previous pose (``approach="order"``)."""
+    dist = float(np.max(np.abs(target - prev)))
+    session.set_temperature(proc.temperature(clock + session.time)[()])
+    if dist > 0:
+        session.move(target, max(proc.approach_time, 1.875 * dist / proc.speed))
+
+
+@dataclass(frozen=True, eq=False)
+class _Log:
+    """What the simulation shows at each pose: approach directions, the settled reading (tool
+    points in the base frame, joints, torques, temperature), the residual speed, the largest
+    motor error and the log time."""
+
+    dirs: F64
+    pts: F64
+    q_link: F64
+    q_motor: F64
+    torque: F64
+    temp_true: F64
+    t_log: F64
+    speed: F64
+    motor_err: F64
+
+    @classmethod
+    def empty(cls, poses: int, n: int, points: int) -> _Log:
+        return cls(np.zeros((poses, n)), np.empty((poses, points, 3)), np.empty((poses, n)),
+                   np.empty((poses, n)), np.empty((poses, n)), np.empty(poses),
+                   np.empty(poses), np.empty(poses), np.empty(poses))
+
+    def record(self, i: int, rd: Reading, speed: float, t: float) -> None:
+        self.pts[i] = rd.points
+        self.q_link[i] = rd.q_link
+        self.q_motor[i] = rd.q_motor
+        self.torque[i] = rd.torque
+        self.temp_true[i] = rd.temperature
+        self.speed[i] = speed
+        self.motor_err[i] = float(np.max(np.abs(rd.motor_target - rd.q_motor)))
+        self.t_log[i] = t
+
+
+def _run(robot: RealRobot, q: F64, instrument: Instrument, proc: Procedure,
+         rng: np.random.Generator, log: _Log) -> MeasurementRun:
+    """The tracker's view of the log (instrument frame, noise), the logged temperature and
+    payload as :class:`~zrp.gap.Measurements`, and the truth."""
+    P, M = log.pts.shape[:2]
+    clean = log.pts @ instrument.rotation.T + np.asarray(instrument.translation)
     noise = rng.normal(scale=instrument.noise_sigma, size=clean.shape) \
         if instrument.noise_sigma > 0 else np.zeros(clean.shape)
     xyz = clean + noise
-    temp_log = temp_true + (rng.normal(scale=proc.temp_noise, size=P) if proc.temp_noise > 0
-                            else 0.0)
+    temp_log = log.temp_true + (rng.normal(scale=proc.temp_noise, size=P)
+                                if proc.temp_noise > 0 else 0.0)
     temp_log = np.round(temp_log, 3)
     load = np.full(P, robot.effects.payload)
     labels = [f"smr{j + 1}" for j in range(M)]
-    direction = dirs if proc.approach != "order" else None
+    direction = log.dirs if proc.approach != "order" else None
     meas = Measurements.from_arrays(
         np.repeat([f"P{i + 1:04d}" for i in range(P)], M), np.repeat(q, M, axis=0),
         xyz.reshape(-1, 3), point=np.tile(labels, P), frame="instrument",
-        t=np.repeat(np.round(t_log, 3), M), temp=np.repeat(temp_log, M), load=np.repeat(load, M),
+        t=np.repeat(np.round(log.t_log, 3), M), temp=np.repeat(temp_log, M),
+        load=np.repeat(load, M),
         direction=None if direction is None else np.repeat(direction, M, axis=0),
         source="real robot measurement")
-    truth = {
+    return MeasurementRun(meas, direction, _truth(robot, q, instrument, proc, log))
+
+
+def _truth(robot: RealRobot, q: F64, instrument: Instrument, proc: Procedure,
+           log: _Log) -> dict[str, Any]:
+    """Everything hidden from the user (see :func:`write_truth`)."""
+    return {
         "format": TRUTH_FORMAT,
         "version": 1,
         "model": robot.nominal.name,
@@ -338,17 +317,16 @@ def measure(robot: RealRobot, q: ArrayLike, instrument: Instrument, rng: np.rand
         "robot": robot.describe(),
         "poses": {
             "q_command": q.tolist(),
-            "q_link": q_link.tolist(),
-            "q_motor": q_motor.tolist(),
-            "approach_direction": dirs.tolist(),
-            "servo_torque_Nm": torque.tolist(),
-            "temperature_true": temp_true.tolist(),
-            "points_base_noisefree": pts.tolist(),
-            "residual_speed": speed.tolist(),
-            "motor_error_rad": motor_err.tolist(),
+            "q_link": log.q_link.tolist(),
+            "q_motor": log.q_motor.tolist(),
+            "approach_direction": log.dirs.tolist(),
+            "servo_torque_Nm": log.torque.tolist(),
+            "temperature_true": log.temp_true.tolist(),
+            "points_base_noisefree": log.pts.tolist(),
+            "residual_speed": log.speed.tolist(),
+            "motor_error_rad": log.motor_err.tolist(),
         },
     }
-    return MeasurementRun(meas, direction, truth)
 
 
 def _nominal_static_torque(robot: RealRobot, q: F64) -> F64:

@@ -70,31 +70,50 @@ class RealRobotOptions:
         if self.inertia not in ("auto", "puma560", "rods"):
             raise InputError(f"inertia: {self.inertia!r}; expected 'auto', 'puma560' or 'rods'")
         for name, unit in (("servo_kp", "N m/rad"), ("damping_ratio", "1")):
-            v = finite(getattr(self, name), name, unit)
-            if v <= 0:
-                raise InputError(f"{name}: expected a value > 0 ({unit}), got {v!r}")
-            object.__setattr__(self, name, v)
+            object.__setattr__(self, name, _positive(getattr(self, name), name, unit))
         if self.load_friction is not None:
-            f = np.asarray(self.load_friction, dtype=float).ravel()
-            if not np.all(np.isfinite(f)) or np.any(f < 0):
-                raise InputError(f"load_friction: expected finite values >= 0 (N m), got "
-                                 f"{self.load_friction!r}")
-            object.__setattr__(self, "load_friction", tuple(float(x) for x in f))
+            object.__setattr__(self, "load_friction", _load_friction(self.load_friction))
         if self.tool_points is not None:
-            t = np.asarray(self.tool_points, dtype=float)
-            if t.ndim != 2 or t.shape[1] != 3 or t.shape[0] < 1 or not np.all(np.isfinite(t)):
-                raise InputError(f"tool_points: expected shape (M, 3) of finite numbers (model "
-                                 f"length unit), got {np.shape(self.tool_points)}")
-            object.__setattr__(self, "tool_points", tuple(tuple(float(x) for x in r) for r in t))
+            object.__setattr__(self, "tool_points", _tool_points(self.tool_points))
         finite(self.t_ref, "t_ref", "deg C")
-        g = np.asarray(self.gravity, dtype=float)
-        if g.shape != (3,) or not np.all(np.isfinite(g)):
-            raise InputError(f"gravity: expected 3 finite numbers (m/s^2), got {self.gravity!r}")
-        object.__setattr__(self, "gravity", tuple(float(x) for x in g))
+        object.__setattr__(self, "gravity", _gravity(self.gravity))
         if self.timestep is not None:
-            dt = finite(self.timestep, "timestep", "s")
-            if not 0 < dt <= 0.01:
-                raise InputError(f"timestep: expected 0 < dt <= 0.01 s, got {self.timestep!r}")
+            _check_timestep(self.timestep)
+
+
+def _positive(value: object, name: str, unit: str) -> float:
+    v = finite(value, name, unit)
+    if v <= 0:
+        raise InputError(f"{name}: expected a value > 0 ({unit}), got {v!r}")
+    return v
+
+
+def _load_friction(value: Sequence[float]) -> tuple[float, ...]:
+    f = np.asarray(value, dtype=float).ravel()
+    if not np.all(np.isfinite(f)) or np.any(f < 0):
+        raise InputError(f"load_friction: expected finite values >= 0 (N m), got {value!r}")
+    return tuple(float(x) for x in f)
+
+
+def _tool_points(value: Sequence[Sequence[float]]) -> tuple[tuple[float, float, float], ...]:
+    t = np.asarray(value, dtype=float)
+    if t.ndim != 2 or t.shape[1] != 3 or t.shape[0] < 1 or not np.all(np.isfinite(t)):
+        raise InputError(f"tool_points: expected shape (M, 3) of finite numbers (model "
+                         f"length unit), got {np.shape(value)}")
+    return tuple(tuple(float(x) for x in r) for r in t)  # type: ignore[misc]
+
+
+def _gravity(value: Sequence[float]) -> tuple[float, float, float]:
+    g = np.asarray(value, dtype=float)
+    if g.shape != (3,) or not np.all(np.isfinite(g)):
+        raise InputError(f"gravity: expected 3 finite numbers (m/s^2), got {value!r}")
+    return (float(g[0]), float(g[1]), float(g[2]))
+
+
+def _check_timestep(value: float) -> None:
+    dt = finite(value, "timestep", "s")
+    if not 0 < dt <= 0.01:
+        raise InputError(f"timestep: expected 0 < dt <= 0.01 s, got {value!r}")
 
 
 @dataclass

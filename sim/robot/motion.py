@@ -43,7 +43,7 @@ from numpy.typing import NDArray
 from scipy import signal
 
 from sim.robot.effects import HiddenEffects
-from sim.robot.measurement import Instrument
+from sim.robot.instrument import Instrument
 from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
 from zrp.errors import InputError

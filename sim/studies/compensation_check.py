@@ -32,12 +32,8 @@ from numpy.typing import NDArray
 from mjcf import MJCFOptions, build, save_mjcf
 from mjcf.gravity import gravity_torques
 from sim.robot.effects import HiddenEffects
-from sim.robot.measurement import (
-    Instrument,
-    Procedure,
-    _nominal_static_torque,
-    measure,
-)
+from sim.robot.instrument import Instrument
+from sim.robot.measurement import Procedure, _nominal_static_torque, measure
 from sim.robot.real import RealRobot
 from sim.studies.trajectories import circle_poses
 from zrp.calibration import CalibratedRobot, Compensation, PoseConditions, compensate

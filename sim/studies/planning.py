@@ -34,7 +34,8 @@ import numpy as np
 from numpy.typing import NDArray
 
 from mjcf.gravity import gravity_torques
-from sim.robot.measurement import Procedure, _nominal_static_torque, measure, random_instrument
+from sim.robot.instrument import random_instrument
+from sim.robot.measurement import Procedure, _nominal_static_torque, measure
 from sim.robot.real import RealRobot, default_tool_points
 from sim.studies.benchmark.runner import _nominal_mjcf
 from sim.studies.benchmark.scenarios import BenchmarkConfig, Scenario, draw_scenarios
@@ -246,38 +247,55 @@ def design_rows(scores: list[DesignScore]) -> list[dict[str, Any]]:
     """Per design (random N, planned K): scenarios, successes, right effect, joints, median
     and worst validation ratio, and the median over scenarios of the median / worst
     parameter std over the random design's (same scenario)."""
-    ref: dict[int, DesignScore] = {}
-    for s in scores:                 # the reference: each scenario's largest random design
-        if s.design == "random" and (s.scenario not in ref or s.poses > ref[s.scenario].poses):
-            ref[s.scenario] = s
+    ref = _reference_designs(scores)
     top = max((s.poses for s in ref.values()), default=0)
     keys = sorted({(s.design, s.poses) for s in scores},   # reference, planned, controls
                   key=lambda k: (0 if k == ("random", top) else 1 if k[0] == "planned" else 2,
                                  k[1]))
-    rows = []
-    for design, poses in keys:
-        sel = [s for s in scores if (s.design, s.poses) == (design, poses)]
-        med, worst = [], []
-        for s in sel:
-            r = ref.get(s.scenario)
-            if r is None:
-                continue
-            names = [k for k in s.std if k in r.std and r.std[k] > 0]
-            ratio = np.array([s.std[k] / r.std[k] for k in names])
-            if ratio.size:
-                med.append(float(np.median(ratio)))
-                worst.append(float(ratio.max()))
-        ratios = np.array([s.ratio for s in sel])
-        rows.append({"design": design, "poses": poses, "scenarios": len(sel),
-                     "success": sum(s.success for s in sel),
-                     "top_correct": sum(s.top_correct for s in sel),
-                     "joints_correct": sum(s.joints_correct for s in sel),
-                     "ratio_median": float(np.median(ratios)),
-                     "ratio_max": float(ratios.max()),
-                     "within_target": int(np.sum(ratios <= 1.5)),
-                     "std_ratio_median": float(np.median(med)) if med else float("nan"),
-                     "std_ratio_worst": float(np.median(worst)) if worst else float("nan")})
-    return rows
+    return [_design_row(design, poses,
+                        [s for s in scores if (s.design, s.poses) == (design, poses)], ref)
+            for design, poses in keys]
+
+
+def _reference_designs(scores: list[DesignScore]) -> dict[int, DesignScore]:
+    """The reference of each scenario: its largest random design."""
+    ref: dict[int, DesignScore] = {}
+    for s in scores:
+        if s.design == "random" and (s.scenario not in ref or s.poses > ref[s.scenario].poses):
+            ref[s.scenario] = s
+    return ref
+
+
+def _std_ratios(sel: list[DesignScore], ref: dict[int, DesignScore]
+                ) -> tuple[list[float], list[float]]:
+    """Per scenario with a reference: the median and the worst ratio of the parameter stds
+    over the reference's (parameters both estimate, with a reference std > 0)."""
+    med, worst = [], []
+    for s in sel:
+        r = ref.get(s.scenario)
+        if r is None:
+            continue
+        names = [k for k in s.std if k in r.std and r.std[k] > 0]
+        ratio = np.array([s.std[k] / r.std[k] for k in names])
+        if ratio.size:
+            med.append(float(np.median(ratio)))
+            worst.append(float(ratio.max()))
+    return med, worst
+
+
+def _design_row(design: str, poses: int, sel: list[DesignScore],
+                ref: dict[int, DesignScore]) -> dict[str, Any]:
+    med, worst = _std_ratios(sel, ref)
+    ratios = np.array([s.ratio for s in sel])
+    return {"design": design, "poses": poses, "scenarios": len(sel),
+            "success": sum(s.success for s in sel),
+            "top_correct": sum(s.top_correct for s in sel),
+            "joints_correct": sum(s.joints_correct for s in sel),
+            "ratio_median": float(np.median(ratios)),
+            "ratio_max": float(ratios.max()),
+            "within_target": int(np.sum(ratios <= 1.5)),
+            "std_ratio_median": float(np.median(med)) if med else float("nan"),
+            "std_ratio_worst": float(np.median(worst)) if worst else float("nan")}
 
 
 def smallest_matching_k(scores: list[DesignScore]) -> int | None:

@@ -19,7 +19,8 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import NDArray
 
-from sim.robot.measurement import random_instrument, trajectory_poses
+from sim.robot.instrument import random_instrument
+from sim.robot.measurement import trajectory_poses
 from sim.robot.motion import MotionRun, execute_trajectory
 from sim.robot.motion_measure import Command, parse_motion_effects, spline_command
 from zrp.errors import InputError

@@ -124,12 +124,8 @@ class VideoOptions:
             v = getattr(self, name)
             if not isinstance(v, (int, np.integer)) or isinstance(v, bool) or v < 1:
                 raise InputError(f"{name}: expected a positive integer, got {v!r}")
-        if self.seconds is not None and not (math.isfinite(self.seconds) and self.seconds > 0):
-            raise InputError(f"seconds: expected a positive duration (s) or None, got "
-                             f"{self.seconds!r}")
-        if self.magnify is not None and not (math.isfinite(self.magnify) and self.magnify > 0):
-            raise InputError(f"magnify: expected a positive factor or None (auto), got "
-                             f"{self.magnify!r}")
+        _check_positive_or_none(self.seconds, "seconds", "a positive duration (s) or None")
+        _check_positive_or_none(self.magnify, "magnify", "a positive factor or None (auto)")
         if self.format not in FORMATS:
             raise InputError(f"format: unknown video format {self.format!r}; expected one of "
                              f"{FORMATS}")
@@ -142,6 +138,10 @@ class VideoOptions:
         if self.backend is not None:
             _check_name(self.backend, "backend")
 
+
+def _check_positive_or_none(value: float | None, name: str, expected: str) -> None:
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise InputError(f"{name}: expected {expected}, got {value!r}")
 
 
 # ---- one segment -------------------------------------------------------------------------

@@ -18,7 +18,7 @@ import numpy as np
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
-from sim.robot.measurement import random_instrument
+from sim.robot.instrument import random_instrument
 from sim.robot.motion import MotionEffects, execute_trajectory
 from zrp.gap.effects import Context, registration_parameters
 from zrp.gap.leastsq import fit, initial_registration

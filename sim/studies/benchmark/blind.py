@@ -16,13 +16,8 @@ from typing import Any
 import numpy as np
 
 from mjcf.gravity import gravity_torques
-from sim.robot.measurement import (
-    Procedure,
-    measure,
-    random_instrument,
-    write_measurements,
-    write_truth,
-)
+from sim.robot.instrument import random_instrument
+from sim.robot.measurement import Procedure, measure, write_measurements, write_truth
 from sim.robot.real import RealRobot
 from sim.studies.benchmark.scenarios import BenchmarkConfig, Scenario, pose_limits
 from sim.studies.trajectories import circle_poses

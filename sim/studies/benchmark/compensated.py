@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from sim.robot.measurement import Instrument
+from sim.robot.instrument import Instrument
 from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
 from sim.studies.benchmark.scenarios import Scenario

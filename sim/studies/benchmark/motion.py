@@ -29,7 +29,7 @@ from tqdm.auto import tqdm
 
 from mjcf import MJCFOptions, build
 from mjcf.dynamics import inverse_dynamics_torques, mode_terms
-from sim.robot.measurement import random_instrument
+from sim.robot.instrument import random_instrument
 from sim.robot.motion import MOTION_HIDDEN, MotionEffects, execute_trajectory
 from sim.studies.trajectories import named_command
 from zrp import jsonio
@@ -182,23 +182,31 @@ def run_motion_benchmark(model: Manipulator, count: int, seed: int, out: str | P
     return summary
 
 
+def _rate(sel: list[MotionScore], attr: str) -> list[int]:
+    """[how many of ``sel`` have ``attr`` true, how many there are]."""
+    return [sum(bool(getattr(s, attr)) for s in sel), len(sel)]
+
+
+def _ratio_ok(sel: list[MotionScore]) -> list[int]:
+    """[how many of ``sel`` end within 1.5x the noise, how many there are]."""
+    return [sum(s.ratio <= 1.5 for s in sel), len(sel)]
+
+
+def _kind_row(sel: list[MotionScore]) -> dict[str, list[int]]:
+    return {"top_correct": _rate(sel, "top_correct"),
+            "joints_correct": _rate(sel, "joints_correct"), "ratio_ok": _ratio_ok(sel),
+            "all_found": _rate(sel, "all_found"), "success": _rate(sel, "success")}
+
+
 def summarise(scores: list[MotionScore]) -> dict[str, Any]:
     """Counts and rates over all scenarios, per kind (none / single / pair)."""
-    def rate(sel: list[MotionScore], attr: str) -> list[int]:
-        return [sum(bool(getattr(s, attr)) for s in sel), len(sel)]
-
     kinds = {"none": [s for s in scores if not s.hidden],
              "single": [s for s in scores if len(s.hidden) == 1],
              "pair": [s for s in scores if len(s.hidden) == 2]}
-    table = {k: {"top_correct": rate(v, "top_correct"),
-                 "joints_correct": rate(v, "joints_correct"),
-                 "ratio_ok": [sum(s.ratio <= 1.5 for s in v), len(v)],
-                 "all_found": rate(v, "all_found"), "success": rate(v, "success")}
-             for k, v in kinds.items()}
     right = [s.top_correct and s.joints_correct for s in scores]
-    return {"scenarios": len(scores), "by_kind": table,
+    return {"scenarios": len(scores), "by_kind": {k: _kind_row(v) for k, v in kinds.items()},
             "right_effect_and_joints": [sum(right), len(scores)],
-            "ratio_ok": [sum(s.ratio <= 1.5 for s in scores), len(scores)],
+            "ratio_ok": _ratio_ok(scores),
             "median_ratio": float(np.median([s.ratio for s in scores])),
             "diagnose_s_median": float(np.median([s.diagnose_s for s in scores])),
             "sim_s_median": float(np.median([s.sim_s for s in scores])),

@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import math
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -16,6 +17,7 @@ import numpy as np
 from sim.robot.measurement import REPLACE
 from sim.studies.benchmark.results import BenchmarkResult, confusion_matrix, summary_rows
 from sim.studies.benchmark.scenarios import DEFAULT_NOISE_MM, BenchmarkConfig
+from sim.studies.benchmark.scoring import ScenarioScore
 from zrp.errors import OutputExistsError
 from zrp.output import OutputDir
 
@@ -50,63 +52,92 @@ def _noise_text(cfg: BenchmarkConfig) -> str:
 
 def render_text(result: BenchmarkResult) -> str:
     """Markdown: summary table, confusion matrix, pairs, failures and timings."""
-    cfg = result.config
-    sc = result.scores
-    out = [f"# Blind gap benchmark: {result.model_name}", "",
-           f"{len(sc)} scenarios (seed {cfg.seed}), {cfg.poses} poses each "
-           f"({cfg.poses_from} poses, {cfg.approach} approach, {cfg.reflectors} "
-           f"reflector{'s' if cfg.reflectors > 1 else ''}), tracker noise "
-           f"{_noise_text(cfg)} per coordinate, MJCF inertias "
-           f"{'given' if cfg.use_mjcf else 'not given'} to the diagnosis. Visible: signature "
-           f"after registration >= {cfg.excitation_threshold:g} x noise RMS. Target: withheld "
-           f"RMS after correction <= {cfg.ratio_target:g} x noise RMS.", "", "## Summary", ""]
     rows = summary_rows(result)
-    out.append(_md_table(["group", "visible", "n", "right effect first",
-                          "right or reported tie", "+ joints located",
-                          f"RMS <= {cfg.ratio_target:g}x noise", "all three", "median ratio",
-                          "median shrink", "both found"],
-                         [[r["group"], r["visible"], r["n"], r["top"], r["top_or_tie"],
-                           r["top_and_joints"],
-                           r["ratio_ok"], r["all_three"], r["median_ratio"],
-                           r["median_shrink"], r.get("both_found", "")] for r in rows]))
-    out += ["", "95 % interval coverage of the true values (final parameters of the hidden "
+    out = [*_intro(result), *_summary_section(result.config, rows), *_coverage_section(rows),
+           *_confusion_section(result), *_pairs_section(result.scores),
+           *_compensated_section(result), *_not_right_section(result.scores),
+           *_failures_section(result)]
+    if result.resumed:
+        out += ["", f"Resumed: {result.resumed} scores taken from the interrupted run."]
+    out += ["", f"Wall time {result.wall_s:.1f} s: simulation {result.sim_s:.1f} s, diagnosis "
+            f"{result.diag_s:.1f} s ({result.wall_s / max(len(result.scores), 1):.2f} s per "
+            f"scenario)."]
+    return "\n".join(out) + "\n"
+
+
+def _intro(result: BenchmarkResult) -> list[str]:
+    cfg = result.config
+    return [f"# Blind gap benchmark: {result.model_name}", "",
+            f"{len(result.scores)} scenarios (seed {cfg.seed}), {cfg.poses} poses each "
+            f"({cfg.poses_from} poses, {cfg.approach} approach, {cfg.reflectors} "
+            f"reflector{'s' if cfg.reflectors > 1 else ''}), tracker noise "
+            f"{_noise_text(cfg)} per coordinate, MJCF inertias "
+            f"{'given' if cfg.use_mjcf else 'not given'} to the diagnosis. Visible: signature "
+            f"after registration >= {cfg.excitation_threshold:g} x noise RMS. Target: withheld "
+            f"RMS after correction <= {cfg.ratio_target:g} x noise RMS."]
+
+
+def _summary_section(cfg: BenchmarkConfig, rows: list[dict[str, Any]]) -> list[str]:
+    return ["", "## Summary", "", _md_table(
+        ["group", "visible", "n", "right effect first", "right or reported tie",
+         "+ joints located", f"RMS <= {cfg.ratio_target:g}x noise", "all three",
+         "median ratio", "median shrink", "both found"],
+        [[r["group"], r["visible"], r["n"], r["top"], r["top_or_tie"], r["top_and_joints"],
+          r["ratio_ok"], r["all_three"], r["median_ratio"], r["median_shrink"],
+          r.get("both_found", "")] for r in rows])]
+
+
+def _coverage_section(rows: list[dict[str, Any]]) -> list[str]:
+    return ["", "95 % interval coverage of the true values (final parameters of the hidden "
             "effect, 0 where not injected; sim/studies/benchmark/coverage.py):", "",
             _md_table(["group", "parameters covered", "scenarios with all covered",
                        "same, simultaneous 95 % intervals of the effect"],
                       [[r["group"], r["ci95_parameters"], r["ci95_scenarios"],
                         r.get("ci95_effect_scenarios", "-")] for r in rows])]
+
+
+def _confusion_section(result: BenchmarkResult) -> list[str]:
     conf = confusion_matrix(result)
     cols = sorted({c for r in conf.values() for c in r})
-    out += ["", "## Confusion matrix (single effect and none; row: hidden, column: named first)",
+    return ["", "## Confusion matrix (single effect and none; row: hidden, column: named first)",
             "", _md_table(["hidden \\ named", *cols],
                           [[r, *[conf[r].get(c, 0) or "" for c in cols]] for r in sorted(conf)])]
-    pairs = [s for s in sc if s.kind == "pair"]
-    if pairs:
-        out += ["", "## Pairs", "", _md_table(
-            ["#", "hidden (SNR)", "named", "both found", "ratio"],
-            [[s.index, ", ".join(f"{e} {list(s.hidden_joints[e])} ({s.snr.get(e, 0):.2g})"
-                                 for e in s.hidden),
-              ", ".join(s.found), s.all_found, s.ratio] for s in pairs])]
-    out += _compensated_section(result)
-    bad = [s for s in sc if not s.success]
-    if bad:
-        out += ["", "## Scenarios not fully right", "", _md_table(
-            ["#", "kind", "hidden [joints] (SNR)", "named [joints]", "ratio", "note"],
-            [[s.index, s.kind,
-              ", ".join(f"{e} {list(s.hidden_joints[e])} ({s.snr.get(e, 0):.2g})"
-                        for e in s.hidden) or "none",
-              ", ".join(f"{e} {list(j)}" for e, j in zip(s.found, s.found_joints,
-                                                          strict=False)) or "none",
-              s.ratio, s.note]
-             for s in bad])]
-    if result.failures:
-        out += ["", "## Scenarios that failed (the others completed)", "", _md_table(
-            ["input", "error"], [[f.task, f.error] for f in result.failures])]
-    if result.resumed:
-        out += ["", f"Resumed: {result.resumed} scores taken from the interrupted run."]
-    out += ["", f"Wall time {result.wall_s:.1f} s: simulation {result.sim_s:.1f} s, diagnosis "
-            f"{result.diag_s:.1f} s ({result.wall_s / max(len(sc), 1):.2f} s per scenario)."]
-    return "\n".join(out) + "\n"
+
+
+def _hidden_text(s: ScenarioScore) -> str:
+    """The hidden effects of a scenario with their joints and signal-to-noise ratios."""
+    return ", ".join(f"{e} {list(s.hidden_joints[e])} ({s.snr.get(e, 0):.2g})"
+                     for e in s.hidden)
+
+
+def _pairs_section(scores: Sequence[ScenarioScore]) -> list[str]:
+    pairs = [s for s in scores if s.kind == "pair"]
+    if not pairs:
+        return []
+    return ["", "## Pairs", "", _md_table(
+        ["#", "hidden (SNR)", "named", "both found", "ratio"],
+        [[s.index, _hidden_text(s), ", ".join(s.found), s.all_found, s.ratio]
+         for s in pairs])]
+
+
+def _not_right_section(scores: Sequence[ScenarioScore]) -> list[str]:
+    bad = [s for s in scores if not s.success]
+    if not bad:
+        return []
+    return ["", "## Scenarios not fully right", "", _md_table(
+        ["#", "kind", "hidden [joints] (SNR)", "named [joints]", "ratio", "note"],
+        [[s.index, s.kind, _hidden_text(s) or "none",
+          ", ".join(f"{e} {list(j)}" for e, j in zip(s.found, s.found_joints,
+                                                      strict=False)) or "none",
+          s.ratio, s.note]
+         for s in bad])]
+
+
+def _failures_section(result: BenchmarkResult) -> list[str]:
+    if not result.failures:
+        return []
+    return ["", "## Scenarios that failed (the others completed)", "", _md_table(
+        ["input", "error"], [[f.task, f.error] for f in result.failures])]
 
 
 def _comp(s: Any, key: str) -> float:

@@ -94,26 +94,42 @@ def coverage(scores: Sequence[ScenarioScore]) -> dict[str, Any]:
 def summary_rows(result: BenchmarkResult) -> list[dict[str, Any]]:
     """Rows of the summary table: per hidden effect (single scenarios), then totals."""
     t = result.config.ratio_target
-    sc = result.scores
+    singles = [s for s in result.scores if s.kind == "single"]
+    return [*_effect_rows(singles, result.config.effects, t), *_single_rows(singles, t),
+            *_none_rows(result.scores, t), *_pair_rows(result.scores, t)]
+
+
+def _effect_rows(singles: Sequence[ScenarioScore], effects: Sequence[str], target: float
+                 ) -> list[dict[str, Any]]:
+    """One row per effect hidden alone in some scenario: its visible scenarios."""
     rows = []
-    singles = [s for s in sc if s.kind == "single"]
-    for e in result.config.effects:
+    for e in effects:
         grp = [s for s in singles if s.hidden == (e,)]
         if grp:
             vis = [s for s in grp if s.excited]
-            rows.append({"group": e, "visible": f"{len(vis)}/{len(grp)}", **_group(vis, t)})
-    vis = [s for s in singles if s.excited]
-    rows.append({"group": "single, visible", "visible": f"{len(vis)}/{len(singles)}",
-                 **_group(vis, t)})
-    rows.append({"group": "single, all", "visible": f"{len(vis)}/{len(singles)}",
-                 **_group(singles, t)})
-    nones = [s for s in sc if s.kind == "none"]
-    if nones:
-        rows.append({"group": "none", "visible": "-", **_group(nones, t)})
-    pairs = [s for s in sc if s.kind == "pair"]
-    if pairs:
-        row = {"group": "pairs", "visible": f"{sum(s.excited for s in pairs)}/{len(pairs)}",
-               **_group(pairs, t)}
-        row["both_found"] = _pct(sum(s.all_found for s in pairs), len(pairs))
-        rows.append(row)
+            rows.append({"group": e, "visible": f"{len(vis)}/{len(grp)}", **_group(vis, target)})
     return rows
+
+
+def _single_rows(singles: Sequence[ScenarioScore], target: float) -> list[dict[str, Any]]:
+    """The single-effect scenarios: the visible ones, then all."""
+    vis = [s for s in singles if s.excited]
+    return [{"group": "single, visible", "visible": f"{len(vis)}/{len(singles)}",
+             **_group(vis, target)},
+            {"group": "single, all", "visible": f"{len(vis)}/{len(singles)}",
+             **_group(singles, target)}]
+
+
+def _none_rows(scores: Sequence[ScenarioScore], target: float) -> list[dict[str, Any]]:
+    nones = [s for s in scores if s.kind == "none"]
+    return [{"group": "none", "visible": "-", **_group(nones, target)}] if nones else []
+
+
+def _pair_rows(scores: Sequence[ScenarioScore], target: float) -> list[dict[str, Any]]:
+    pairs = [s for s in scores if s.kind == "pair"]
+    if not pairs:
+        return []
+    row = {"group": "pairs", "visible": f"{sum(s.excited for s in pairs)}/{len(pairs)}",
+           **_group(pairs, target)}
+    row["both_found"] = _pct(sum(s.all_found for s in pairs), len(pairs))
+    return [row]

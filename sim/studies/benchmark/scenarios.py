@@ -17,7 +17,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from sim.robot.effects import EFFECT_NAMES, HiddenEffects, default_tool_points
-from sim.robot.measurement import TRACKER_NOISE_RANGE_MM
+from sim.robot.instrument import TRACKER_NOISE_RANGE_MM
 from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
 from zrp.errors import InputError
@@ -91,35 +91,14 @@ class BenchmarkConfig:
     def __post_init__(self) -> None:
         for name, lo, hi in (("scenarios", 1, None), ("poses", 16, None),
                              ("compensate", 0, None), ("reflectors", 1, 3)):
-            v = getattr(self, name)
-            if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo \
-                    or (hi is not None and v > hi):
-                raise InputError(f"{name}: expected an integer >= {lo}"
-                                 + (f" and <= {hi}" if hi is not None else "") + f", got {v!r}")
+            _check_int(getattr(self, name), name, lo, hi)
         if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) \
                 or self.seed < 0:
             raise InputError(f"seed: expected an integer >= 0, got {self.seed!r}")
-        for name in ("none_fraction", "pair_fraction", "payload_probability"):
-            v = float(getattr(self, name))
-            if not 0.0 <= v <= 1.0:
-                raise InputError(f"{name}: expected a fraction in [0, 1], got {v!r}")
-        if self.none_fraction + self.pair_fraction > 1.0:
-            raise InputError(f"none_fraction + pair_fraction = "
-                             f"{self.none_fraction + self.pair_fraction:g} > 1")
-        names = EFFECT_NAMES
-        eff = tuple(self.effects) or names
-        bad = [e for e in eff if e not in names]
-        if bad:
-            raise InputError(f"effects: unknown {bad}; expected some of {list(names)}")
-        if self.pair_fraction > 0 and len(eff) < 2:
-            raise InputError("pair_fraction > 0 needs at least two effects to draw from")
-        object.__setattr__(self, "effects", eff)
+        _check_fractions(self)
+        object.__setattr__(self, "effects", _checked_effects(self.effects, self.pair_fraction))
         if self.noise is not None:
-            lo, hi = (float(x) for x in self.noise)
-            if not 0 < lo <= hi:
-                raise InputError(f"noise: expected 0 < low <= high (length unit), got "
-                                 f"{self.noise!r}")
-            object.__setattr__(self, "noise", (lo, hi))
+            object.__setattr__(self, "noise", _checked_noise(self.noise))
         if self.poses_from not in ("random", "circle"):
             raise InputError(f"poses_from: {self.poses_from!r}; expected 'random' or 'circle'")
         if self.approach not in ("random", "order", "gravity"):
@@ -143,6 +122,42 @@ class BenchmarkConfig:
             return self.noise
         per_mm = units_per_mm(model.length_unit, "model.length_unit")
         return (DEFAULT_NOISE_MM[0] * per_mm, DEFAULT_NOISE_MM[1] * per_mm)
+
+
+def _check_int(v: object, name: str, lo: int, hi: int | None) -> None:
+    if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or v < lo \
+            or (hi is not None and v > hi):
+        raise InputError(f"{name}: expected an integer >= {lo}"
+                         + (f" and <= {hi}" if hi is not None else "") + f", got {v!r}")
+
+
+def _check_fractions(config: BenchmarkConfig) -> None:
+    for name in ("none_fraction", "pair_fraction", "payload_probability"):
+        v = float(getattr(config, name))
+        if not 0.0 <= v <= 1.0:
+            raise InputError(f"{name}: expected a fraction in [0, 1], got {v!r}")
+    if config.none_fraction + config.pair_fraction > 1.0:
+        raise InputError(f"none_fraction + pair_fraction = "
+                         f"{config.none_fraction + config.pair_fraction:g} > 1")
+
+
+def _checked_effects(effects: tuple[str, ...], pair_fraction: float) -> tuple[str, ...]:
+    """The effects to draw from (all when empty), each known; two at least for pairs."""
+    names = EFFECT_NAMES
+    eff = tuple(effects) or names
+    bad = [e for e in eff if e not in names]
+    if bad:
+        raise InputError(f"effects: unknown {bad}; expected some of {list(names)}")
+    if pair_fraction > 0 and len(eff) < 2:
+        raise InputError("pair_fraction > 0 needs at least two effects to draw from")
+    return eff
+
+
+def _checked_noise(noise: tuple[float, float]) -> tuple[float, float]:
+    lo, hi = (float(x) for x in noise)
+    if not 0 < lo <= hi:
+        raise InputError(f"noise: expected 0 < low <= high (length unit), got {noise!r}")
+    return (lo, hi)
 
 
 @dataclass(frozen=True, eq=False)
@@ -192,52 +207,95 @@ def typical_gravity_torque(model: Manipulator, payload: float,
     return np.sqrt(np.mean(tau**2, axis=0))
 
 
+@dataclass(frozen=True, eq=False)
+class _Pick:
+    """What every effect's draw shares: the joint ``k`` (1-based) and sign drawn, the
+    joint-space scale (a slide's lengths per rad, 1 for a revolute joint) and the tool-length
+    scale (the PUMA's reach: magnitudes in mm scale with the arm)."""
+
+    model: Manipulator
+    rng: np.random.Generator
+    k: int
+    sign: float
+    jscale: float
+    lscale: float
+    tau_rms: Callable[[], F64]
+
+
+Drawn = tuple[dict[str, Any], tuple[int, ...]]
+
+
+def _offset(p: _Pick) -> Drawn:
+    return {"joint_offset": {p.k: p.sign * p.rng.uniform(0.2e-3, 1.0e-3) * p.jscale}}, (p.k,)
+
+
+def _scale(p: _Pick) -> Drawn:
+    return {"encoder_scale": {p.k: p.sign * p.rng.uniform(1.5e-4, 6e-4)}}, (p.k,)
+
+
+def _cyclic(p: _Pick) -> Drawn:
+    amp = p.rng.uniform(0.2e-3, 0.8e-3)
+    ph = p.rng.uniform(0, 2 * math.pi)
+    h = int(p.rng.integers(1, 3))
+    return {"cyclic_error": {p.k: (h, amp * math.cos(ph), amp * math.sin(ph))}}, (p.k,)
+
+
+def _link(p: _Pick) -> Drawn:
+    b = int(p.rng.integers(1, p.model.n + 2))
+    v = p.rng.normal(size=3)
+    v *= p.rng.uniform(0.2, 0.8) * p.lscale / np.linalg.norm(v)
+    return {"link_length": {b: tuple(float(x) for x in v)}}, (b,)
+
+
+def _tilt(p: _Pick) -> Drawn:
+    ang = p.rng.uniform(0, 2 * math.pi)
+    mag = p.rng.uniform(0.3e-3, 1.5e-3)
+    return {"axis_misalignment": {p.k: (mag * math.cos(ang), mag * math.sin(ang))}}, (p.k,)
+
+
+def _compliance(p: _Pick) -> Drawn:
+    """A sag of 0.3-1.5 mrad under the joint's typical static torque, stiffness kept within
+    200 .. 5e5 N m/rad (a joint without a gravity torque gets the softest)."""
+    tau = float(p.tau_rms()[p.k - 1])
+    sag = p.rng.uniform(0.3e-3, 1.5e-3)
+    if p.model.prismatic[p.k - 1]:  # m per N (the servo's 1/kp in MuJoCo's metres)
+        to_m = metres_per_unit(p.model.length_unit, "model.length_unit")
+        c = sag * p.jscale * to_m / tau if tau > 1e-9 else 5e-5
+        return {"joint_compliance": {p.k: float(np.clip(c, 2e-8, 5e-5))}}, (p.k,)
+    c = sag / tau if tau > 1e-9 else 5e-3
+    return {"joint_compliance": {p.k: float(np.clip(c, 2e-6, 5e-3))}}, (p.k,)
+
+
+def _backlash(p: _Pick) -> Drawn:
+    return {"backlash": {p.k: p.rng.uniform(0.4e-3, 1.6e-3) * p.jscale}}, (p.k,)
+
+
+def _thermal(p: _Pick) -> Drawn:
+    return {"thermal_expansion": p.rng.uniform(1.0e-5, 2.5e-5)}, ()
+
+
+_DRAWS: dict[str, Callable[[_Pick], Drawn]] = {
+    "joint_offset": _offset, "encoder_scale": _scale, "cyclic_error": _cyclic,
+    "link_length": _link, "axis_misalignment": _tilt, "joint_compliance": _compliance,
+    "backlash": _backlash, "thermal_expansion": _thermal,
+}
+
+
 def _draw_effect(name: str, model: Manipulator, rng: np.random.Generator, payload: float,
-                 tau_rms: Callable[[], F64]) -> tuple[dict[str, Any], tuple[int, ...]]:
+                 tau_rms: Callable[[], F64]) -> Drawn:
     """Keyword arguments of HiddenEffects for one effect with a random magnitude."""
-    n = model.n
-    k = int(rng.integers(1, n + 1))
+    k = int(rng.integers(1, model.n + 1))
     sign = float(rng.choice([-1.0, 1.0]))
-    lscale = model.reach / 1244.6  # the PUMA's reach: magnitudes in mm scale with the arm
     # a prismatic joint's offset, play and sag are lengths (no cyclic error: not a function
     # of a slide's angle, and the diagnosis has none on slides)
     if name == "cyclic_error" and model.prismatic[k - 1]:
         rev = np.flatnonzero(~model.prismatic) + 1
         k = int(rng.choice(rev)) if rev.size else k
     jscale = SLIDE_PER_RAD * model.reach if model.prismatic[k - 1] else 1.0
-    if name == "joint_offset":
-        return {name: {k: sign * rng.uniform(0.2e-3, 1.0e-3) * jscale}}, (k,)
-    if name == "encoder_scale":
-        return {name: {k: sign * rng.uniform(1.5e-4, 6e-4)}}, (k,)
-    if name == "cyclic_error":
-        amp = rng.uniform(0.2e-3, 0.8e-3)
-        ph = rng.uniform(0, 2 * math.pi)
-        return {name: {k: (int(rng.integers(1, 3)), amp * math.cos(ph), amp * math.sin(ph))}}, (k,)
-    if name == "link_length":
-        b = int(rng.integers(1, n + 2))
-        v = rng.normal(size=3)
-        v *= rng.uniform(0.2, 0.8) * lscale / np.linalg.norm(v)
-        return {name: {b: tuple(float(x) for x in v)}}, (b,)
-    if name == "axis_misalignment":
-        ang = rng.uniform(0, 2 * math.pi)
-        mag = rng.uniform(0.3e-3, 1.5e-3)
-        return {name: {k: (mag * math.cos(ang), mag * math.sin(ang))}}, (k,)
-    if name == "joint_compliance":
-        # a sag of 0.3-1.5 mrad under the joint's typical static torque, stiffness kept within
-        # 200 .. 5e5 N m/rad (a joint without a gravity torque gets the softest)
-        tau = float(tau_rms()[k - 1])
-        sag = rng.uniform(0.3e-3, 1.5e-3)
-        if model.prismatic[k - 1]:  # m per N (the servo's 1/kp in MuJoCo's metres)
-            to_m = metres_per_unit(model.length_unit, "model.length_unit")
-            c = sag * jscale * to_m / tau if tau > 1e-9 else 5e-5
-            return {name: {k: float(np.clip(c, 2e-8, 5e-5))}}, (k,)
-        c = sag / tau if tau > 1e-9 else 5e-3
-        return {name: {k: float(np.clip(c, 2e-6, 5e-3))}}, (k,)
-    if name == "backlash":
-        return {name: {k: rng.uniform(0.4e-3, 1.6e-3) * jscale}}, (k,)
-    if name == "thermal_expansion":
-        return {name: rng.uniform(1.0e-5, 2.5e-5)}, ()
-    raise InputError(f"effect: {name!r} cannot be drawn")
+    draw = _DRAWS.get(name)
+    if draw is None:
+        raise InputError(f"effect: {name!r} cannot be drawn")
+    return draw(_Pick(model, rng, k, sign, jscale, model.reach / 1244.6, tau_rms))
 
 
 def draw_scenarios(model: Manipulator, config: BenchmarkConfig) -> list[Scenario]:
