@@ -100,7 +100,7 @@ def _tool_points(value: Sequence[Sequence[float]]) -> tuple[tuple[float, float, 
     if t.ndim != 2 or t.shape[1] != 3 or t.shape[0] < 1 or not np.all(np.isfinite(t)):
         raise InputError(f"tool_points: expected shape (M, 3) of finite numbers (model "
                          f"length unit), got {np.shape(value)}")
-    return tuple(tuple(float(x) for x in r) for r in t)  # type: ignore[misc]
+    return tuple((float(r[0]), float(r[1]), float(r[2])) for r in t)
 
 
 def _gravity(value: Sequence[float]) -> tuple[float, float, float]:
