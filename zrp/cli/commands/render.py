@@ -105,10 +105,12 @@ def _payload(results: list[Any], checks: list[Any], dyn: Any, seg: Any) -> dict[
 
 
 def _text(results: list[Any], checks: list[Any], dyn: Any) -> str:
-    return "\n".join([r.summary() for r in results]
-                     + ["MuJoCo vs ZRP direct kinematics: " + c.summary() for c in checks]
-                     + ([f"perturbed arm, {dyn.summary()} (geometric delta_p max "
-                         f"{results[0].max_delta_p[0]:.4g} mm)"] if dyn is not None else []))
+    lines = [r.summary() for r in results]
+    lines += ["MuJoCo vs ZRP direct kinematics: " + c.summary() for c in checks]
+    if dyn is not None:
+        lines.append(f"perturbed arm, {dyn.summary()} (geometric delta_p max "
+                     f"{results[0].max_delta_p[0]:.4g} mm)")
+    return "\n".join(lines)
 
 
 def _run(args: argparse.Namespace) -> int:
