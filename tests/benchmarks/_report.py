@@ -57,22 +57,36 @@ def add_output_arguments(ap: argparse.ArgumentParser, name: str) -> None:
 def output_path(args: argparse.Namespace) -> Path:
     """The Markdown file to write, checked before the benchmark runs: an explicit ``--out``
     that exists (or its .json) is refused without ``--force`` (SystemExit, exit code 2)."""
-    from zrp.errors import OutputExistsError, ZRPError
-    from zrp.output import check_writable, claim_generated
+    from zrp.output import claim_generated
 
     out = Path(args.out) if args.out else default_path(args.report_name)
     if out.suffix != ".md":
         print(f"error: --out: expected a .md file name, got {str(out)!r}", file=sys.stderr)
         raise SystemExit(2)
+    # the default folder is generated output (marked as such), replaced without --force
+    args.replace = bool(args.force) or (args.out is None and _refused(claim_generated,
+                                                                      out.parent))
+    check_outputs(args, [out, out.with_suffix(".json")])
+    return out
+
+
+def check_outputs(args: argparse.Namespace, paths: Sequence[Path]) -> None:
+    """Refuse (SystemExit, exit code 2, naming ``--force``) files that exist when
+    ``args.replace`` (set by :func:`output_path`) is false."""
+    from zrp.output import check_writable
+
+    _refused(check_writable, paths, overwrite=args.replace)
+
+
+def _refused(fn: Any, *a: Any, **kw: Any) -> Any:
+    from zrp.errors import OutputExistsError, ZRPError
+
     try:
-        # the default folder is generated output (marked as such), replaced without --force
-        args.replace = bool(args.force) or (args.out is None and claim_generated(out.parent))
-        check_writable([out, out.with_suffix(".json")], overwrite=args.replace)
+        return fn(*a, **kw)
     except ZRPError as exc:
         msg = exc.message("--force") if isinstance(exc, OutputExistsError) else str(exc)
         print(f"error: --out: {msg}", file=sys.stderr)
         raise SystemExit(2) from None
-    return out
 
 
 def _git(*argv: str) -> str:
