@@ -1,7 +1,8 @@
 """Speed against the issue-15 targets, every figure beside a baseline measured in the same run.
 
-Run: python tests/benchmarks/bench_speed.py [--quick] [--only diagnosis]   (from the
-repository root)
+Run: python3 tests/benchmarks/bench_speed.py [--quick] [--only diagnosis] [--out FILE.md]
+[--force]   (from the repository root; writes the table to renders/benchmarks/bench_speed.md
+and .json, bench_speed_diagnosis.md with --only diagnosis)
 
 One core for the kernels (NUMBA_NUM_THREADS=1, set before numba loads). Prints one table:
 figure, measured value, target, the baseline of the same run and the ratio:
@@ -42,6 +43,8 @@ import numpy as np
 # measure the checkout this script is in, not whichever copy is installed (an editable
 # install of another checkout would otherwise be imported)
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+from _report import Report, add_output_arguments, output_path
 
 import zrp
 from zrp.kinematics import _kernels as K
@@ -325,19 +328,29 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, no cluster")
     ap.add_argument("--only", choices=("diagnosis",), help="only this figure")
+    add_output_arguments(ap, "bench_speed")
     args = ap.parse_args()
+    if args.only:
+        args.report_name = f"bench_speed_{args.only}"
+    out = output_path(args)
     print(f"issue-15 speed figures (one core for the kernels; load {os.getloadavg()[0]:.1f})")
     if args.only == "diagnosis":
         diagnosis()
-        print(f"(load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
-        return
-    model = zrp.load_model("puma")
-    fk_rate = batched(model, 200_000 if args.quick else 1_000_000)
-    single_calls(model)
-    monte_carlo(10_000 if args.quick else 100_000, workers=not args.quick, fk_rate=fk_rate)
-    diagnosis()
-    simulation(50 if args.quick else 200)
+    else:
+        model = zrp.load_model("puma")
+        fk_rate = batched(model, 200_000 if args.quick else 1_000_000)
+        single_calls(model)
+        monte_carlo(10_000 if args.quick else 100_000, workers=not args.quick, fk_rate=fk_rate)
+        diagnosis()
+        simulation(50 if args.quick else 200)
     print(f"(load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
+    report = Report(args.report_name, "the issue-15 speed figures, each beside a baseline "
+                    "measured in the same run")
+    report.table("Kernels on one core (NUMBA_NUM_THREADS=1); best of interleaved repeats",
+                 ["figure", "measured", "target", "baseline (same run)", "ratio"],
+                 [(("... " + r[0].strip()) if r[0].startswith(" ") else r[0], *r[1:])
+                  for r in ROWS])
+    report.write(out, args)
 
 
 if __name__ == "__main__":
