@@ -33,6 +33,7 @@ from zrp.gap.leastsq import FitResult
 from zrp.gap.registration import Registration
 from zrp.gap.uncertainty import Correlations
 from zrp.gap.where import WhereAnalysis
+from zrp.jsonio import dict_from_dataclass
 from zrp.units import metres_per_unit
 
 __all__ = ["TYPICAL_REPEATABILITY_MM", "Assessment", "Remainder", "compliance_units",
@@ -110,11 +111,8 @@ class Remainder:
         return out
 
     def to_dict(self) -> dict[str, Any]:
-        return {"rms": self.rms, "repeat_rms": self.repeat_rms,
-                "n_repeat_groups": self.n_repeat_groups, "order_r2": self.order_r2,
-                "time_r2": self.time_r2, "distance_r2": self.distance_r2,
-                "common_share": self.common_share, "joint_r2": {"joint": self.joint_r2[0],
-                                                                "r2": self.joint_r2[1]},
+        return {**dict_from_dataclass(self, exclude=("joint_r2", "exceeds_spec")),
+                "joint_r2": {"joint": self.joint_r2[0], "r2": self.joint_r2[1]},
                 "exceeds_typical_repeatability": self.exceeds_spec,
                 "findings": [{"explanation": e, "status": s, "evidence": v}
                              for e, s, v in self.findings()]}
@@ -212,11 +210,7 @@ class Assessment:
     compliance: dict[str, Any] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return {"geometric_baseline": self.baseline.to_dict(),
-                "registration_full": self.frame.to_dict(),
-                "correlation": self.correlations.to_dict(),
-                "implausible": list(self.implausible),
-                "unexcited_joints": list(self.unexcited),
-                "remainder": self.remainder.to_dict(), "resolution": self.resolution,
-                "final_model": None if self.choice is None else self.choice.to_dict(),
-                "compliance_units": self.compliance}
+        return dict_from_dataclass(self, exclude=("stderr",), rename={
+            "baseline": "geometric_baseline", "frame": "registration_full",
+            "correlations": "correlation", "unexcited": "unexcited_joints",
+            "choice": "final_model", "compliance": "compliance_units"})

@@ -35,6 +35,7 @@ from zrp.gap.effects import Context
 from zrp.gap.leastsq import FitResult
 from zrp.gap.metrics import Metrics
 from zrp.gap.problem import Problem
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["SOURCES", "FinalChoice", "choose_final"]
 
@@ -94,9 +95,11 @@ class FinalChoice:
                 "slightly optimistic).")
 
     def to_dict(self) -> dict[str, Any]:
-        return {"source": self.source, "search_withheld_rms": self.search_rms,
-                "baseline_withheld_rms": self.baseline_rms, "fell_back": self.fell_back,
-                "paired_z": self.z, "within_noise": self.within_noise}
+        return {**dict_from_dataclass(self, exclude=("z", "search_fit"),
+                                      rename={"search_rms": "search_withheld_rms",
+                                              "baseline_rms": "baseline_withheld_rms"}),
+                "fell_back": self.fell_back, "paired_z": self.z,
+                "within_noise": self.within_noise}
 
 
 def _paired_z(ctx: Context, withheld: NDArray[np.int64], r_search: NDArray[np.float64],

@@ -7,6 +7,7 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -18,6 +19,7 @@ from scipy.optimize import least_squares
 from zrp.errors import InputError, ZRPWarning
 from zrp.gap.effects import Context, ParamSpec
 from zrp.gap.problem import Evaluation, Problem, compressed
+from zrp.jsonio import dict_from_dataclass
 
 #: Two-sided 95 % quantile of the standard normal (the one home of the constant in zrp.gap).
 Z95 = 1.959963984540054
@@ -273,6 +275,9 @@ class Aliased:
     partners: tuple[str, ...]
     fraction: float
     dropped: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict_from_dataclass(self)
 
 
 def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[ParamSpec],

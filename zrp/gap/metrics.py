@@ -11,6 +11,7 @@ from numpy.typing import NDArray
 
 from zrp.errors import InputError
 from zrp.gap.leastsq import point_errors
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["CHI3_P95", "NOISE_METHODS", "Metrics", "NoiseFloor"]
 
@@ -50,7 +51,7 @@ class Metrics:
                    int(e.size))
 
     def to_dict(self) -> dict[str, Any]:
-        return {"rms": self.rms, "p95": self.p95, "max": self.max, "n_points": self.n_points}
+        return dict_from_dataclass(self)
 
 
 @dataclass(frozen=True)
@@ -89,5 +90,5 @@ class NoiseFloor:
         return None if self.sigma is None else CHI3_P95 * self.sigma
 
     def to_dict(self) -> dict[str, Any]:
-        return {"sigma": self.sigma, "rms": self.rms, "p95": self.p95, "method": self.method,
-                "n_samples": self.n_samples, "detail": self.detail}
+        return {"sigma": self.sigma, "rms": self.rms, "p95": self.p95,
+                **dict_from_dataclass(self, exclude=("sigma",))}

@@ -39,6 +39,7 @@ from zrp.gap.fullpose import (
 from zrp.gap.leastsq import FitResult
 from zrp.gap.posesearch import OrientationStep, forward_search
 from zrp.gap.problem import Problem
+from zrp.jsonio import dict_from_dataclass
 from zrp.rotations import er_from_matrix, er_to_rotvec
 
 __all__ = ["FullPoseResult", "ParameterPrecision", "refit_full_pose"]
@@ -74,9 +75,7 @@ class ParameterPrecision:
                 else math.nan)
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "effect": self.effect, "unit": self.unit,
-                "value": self.value, "std_position_only": self.std_position_only,
-                "std_full_pose": self.std_full_pose, "std_ratio": self.ratio}
+        return {**dict_from_dataclass(self), "std_ratio": self.ratio}
 
 
 @dataclass(frozen=True, eq=False)

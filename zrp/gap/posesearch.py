@@ -34,6 +34,7 @@ from zrp.errors import InputError
 from zrp.gap.effects import Context, ParamSpec
 from zrp.gap.fullpose import FullPoseFit, orientation_residual
 from zrp.gap.problem import Problem
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["OrientationStep", "forward_search", "orientation_groups", "score_test"]
 
@@ -70,8 +71,9 @@ class OrientationStep:
             raise InputError(f"OrientationStep {self.effect}: invalid p-value, count or names")
 
     def to_dict(self) -> dict[str, Any]:
-        return {"effect": self.effect, "joint": self.joint, "parameters": list(self.names),
-                "p_value": self.p_value, "n_tried": self.n_tried,
+        pairs = ("withheld_orientation_before", "withheld_orientation_after",
+                 "withheld_rms_before", "withheld_rms_after")
+        return {**dict_from_dataclass(self, exclude=pairs, rename={"names": "parameters"}),
                 "withheld_orientation_rms_rad": [self.withheld_orientation_before,
                                                  self.withheld_orientation_after],
                 "withheld_rms": [self.withheld_rms_before, self.withheld_rms_after]}

@@ -21,6 +21,7 @@ from numpy.typing import NDArray
 
 from zrp.errors import InputError
 from zrp.gap.leastsq import Z95, FitResult
+from zrp.jsonio import dict_from_dataclass
 from zrp.rotations import er_from_matrix, er_to_rotvec, matrix_from_rotvec
 
 __all__ = ["Quantity", "Registration", "registration_of"]
@@ -74,12 +75,9 @@ class Registration:
     tool_points: dict[str, tuple[Quantity, ...]]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"frame": self.frame, "rotation_matrix": self.rotation.tolist(),
-                "rotation_vector": [q.to_dict() for q in self.rotvec],
-                "zyx_angles": [q.to_dict() for q in self.zyx],
-                "translation": [q.to_dict() for q in self.translation],
-                "tool_points": {k: [q.to_dict() for q in v]
-                                for k, v in self.tool_points.items()}}
+        return dict_from_dataclass(self, rename={"rotation": "rotation_matrix",
+                                                 "rotvec": "rotation_vector",
+                                                 "zyx": "zyx_angles"})
 
 
 def _zyx(r: F64) -> F64:

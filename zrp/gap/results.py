@@ -28,9 +28,9 @@ from zrp.gap.steps import Candidate as Candidate
 from zrp.gap.steps import EffectsFound
 from zrp.gap.steps import ParameterEstimate as ParameterEstimate
 from zrp.gap.steps import Step as Step
-from zrp.gap.steps import alias_dict as alias_dict
 from zrp.gap.steps import parameter_estimates as parameter_estimates
 from zrp.gap.where import WhereAnalysis
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = [
     "SCHEMA_VERSION",
@@ -43,7 +43,6 @@ __all__ = [
     "ParameterEstimate",
     "Step",
     "Where",
-    "alias_dict",
     "install_verdict_renderer",
     "parameter_estimates",
 ]
@@ -73,9 +72,7 @@ class EffectIdentifiability:
     limited_by_data: tuple[str, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
-        return {"not_identifiable": [alias_dict(a) for a in self.not_identifiable],
-                "weak": [alias_dict(a) for a in self.weak],
-                "limited_by_data": list(self.limited_by_data)}
+        return dict_from_dataclass(self)
 
 
 @dataclass(frozen=True)
@@ -95,8 +92,9 @@ class BacklashSwitch:
     payload_kg: float
 
     def to_dict(self) -> dict[str, Any]:
-        return {"backlash_switch": list(self.switch), "backlash_switch_band": list(self.band),
-                "backlash_payload_kg": self.payload_kg}
+        return dict_from_dataclass(self, rename={"switch": "backlash_switch",
+                                                 "band": "backlash_switch_band",
+                                                 "payload_kg": "backlash_payload_kg"})
 
 
 @dataclass(frozen=True, eq=False)
@@ -294,7 +292,7 @@ class Diagnosis(EffectsFound):
             "verdict": self.verdict,
             "split": self.split,
             "where": self.where.to_dict(),
-            "aliased": [alias_dict(a) for a in self.aliased],
+            "aliased": [a.to_dict() for a in self.aliased],
             "warnings": list(self.warnings),
             **({} if self.assessment is None else self.assessment.to_dict()),
             "full_pose": None if self.full_pose is None else self.full_pose.to_dict(),

@@ -20,13 +20,13 @@ from zrp.gap.leastsq import Z95 as Z95
 from zrp.gap.leastsq import Aliased, FitResult
 from zrp.gap.metrics import Metrics
 from zrp.gap.uncertainty import simultaneous_z
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = [
     "Candidate",
     "EffectsFound",
     "ParameterEstimate",
     "Step",
-    "alias_dict",
     "parameter_estimates",
 ]
 
@@ -56,10 +56,7 @@ class ParameterEstimate:
             raise InputError(f"ParameterEstimate {self.name}: stderr {self.stderr} < 0")
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "effect": self.effect, "joint": self.joint,
-                "unit": self.unit, "value": self.value, "stderr": self.stderr,
-                "ci95": list(self.ci95),
-                **({} if self.ci95_effect is None else {"ci95_effect": list(self.ci95_effect)})}
+        return dict_from_dataclass(self, exclude=() if self.ci95_effect else ("ci95_effect",))
 
 
 def parameter_estimates(result: FitResult, first: int, last: int | None = None,
@@ -122,15 +119,7 @@ class Candidate:
             raise InputError(f"Candidate {self.effect}: p_value {self.p_value} not in [0, 1]")
 
     def to_dict(self) -> dict[str, Any]:
-        return {"effect": self.effect, "joints": list(self.joints), "n_params": self.n_params,
-                "cv_rms": _nan_to_none(self.cv_rms), "bic_delta": _nan_to_none(self.bic_delta),
-                "p_value": self.p_value, "significant": self.significant, "note": self.note}
-
-
-def alias_dict(a: Aliased) -> dict[str, Any]:
-    """The JSON form of an :class:`~zrp.gap.leastsq.Aliased` report."""
-    return {"name": a.name, "effect": a.effect, "partners": list(a.partners),
-            "fraction": a.fraction, "dropped": a.dropped}
+        return dict_from_dataclass(self, nan_to_none=("cv_rms", "bic_delta"))
 
 
 @dataclass(frozen=True)
@@ -162,10 +151,8 @@ class Step:
                 "geometric_overlap": _nan_to_none(self.geometric_overlap),
                 "parameters": [p.to_dict() for p in self.parameters],
                 "rms": self.withheld.rms, "p95": self.withheld.p95, "max": self.withheld.max,
-                "withheld": self.withheld.to_dict(), "fitting": self.fitting.to_dict(),
-                "cv_rms": self.cv_rms, "p_value": self.p_value, "bic_delta": self.bic_delta,
-                "candidates": [c.to_dict() for c in self.candidates],
-                "aliased": [alias_dict(a) for a in self.aliased]}
+                **dict_from_dataclass(self, exclude=("effect", "joints", "parameters",
+                                                     "geometric_overlap", "ties"))}
 
 
 class EffectsFound:

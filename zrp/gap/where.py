@@ -19,6 +19,7 @@ from numpy.typing import NDArray
 from zrp.gap.effects import Context, ParamSpec, effect_parameters
 from zrp.gap.leastsq import FitResult, check_identifiable, orthonormal_basis
 from zrp.gap.problem import Problem
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = [
     "Component",
@@ -56,7 +57,7 @@ class JointTrend:
     bins: tuple[tuple[float, float, float | None], ...]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"joint": self.joint, "r2": self.r2, "range": list(self.range),
+        return {**dict_from_dataclass(self, exclude=("bins",)),
                 "bins": [{"lo": lo, "hi": hi, "rms": rms} for lo, hi, rms in self.bins]}
 
 
@@ -70,8 +71,7 @@ class Region:
     n_points: int
 
     def to_dict(self) -> dict[str, Any]:
-        return {"radius": list(self.radius), "height": self.height, "rms": self.rms,
-                "n_points": self.n_points}
+        return dict_from_dataclass(self)
 
 
 @dataclass(frozen=True)
@@ -83,7 +83,7 @@ class JointShare:
     parameters: tuple[str, ...]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"joint": self.joint, "share": self.share, "parameters": list(self.parameters)}
+        return dict_from_dataclass(self)
 
 
 @dataclass(frozen=True)
@@ -96,7 +96,7 @@ class Component:
     parameters: tuple[tuple[str, float], ...]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"share": self.share, "singular_value": self.singular_value,
+        return {**dict_from_dataclass(self, exclude=("parameters",)),
                 "parameters": [{"name": n, "loading": v} for n, v in self.parameters]}
 
 
