@@ -18,7 +18,7 @@ from zrp.gap.effects import Context, effect_parameters, registration_parameters
 from zrp.gap.fullpose import fit_full_pose, orientation_residual, pose_rotations
 from zrp.gap.problem import Problem
 from zrp.kinematics import uniform_joint_values
-from zrp.manufacturing.sensitivity import axis_tangents
+from zrp.kinematics.identification import axis_tangents
 
 PUMA = zrp.load_model("puma")
 TILT = 1.0e-3          # rad, axis 6 towards its first tangent

@@ -23,7 +23,7 @@ from zrp.cli.app import main
 from zrp.errors import InputError
 from zrp.gap import Measurements, diagnose
 from zrp.kinematics import uniform_joint_values
-from zrp.manufacturing.sensitivity import axis_tangents
+from zrp.kinematics.identification import axis_tangents
 
 SIGMA_O = 1e-4   # rad, the orientation noise of _measure
 # the data's 1.5 mrad axis-5 tilt is explained by the (aliased) q4 offset the position search

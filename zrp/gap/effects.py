@@ -34,7 +34,7 @@ from zrp.errors import InputError
 from zrp.gap.data import Measurements
 from zrp.gap.jointbases import joint_bases
 from zrp.kinematics.forward import forward_kinematics
-from zrp.manufacturing.sensitivity import axis_tangents
+from zrp.kinematics.identification import axis_tangents
 from zrp.model.manipulator import Manipulator
 from zrp.units import G_STANDARD, metres_per_unit
 

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.errors import InputError
 from zrp.gap.data import Measurements
 from zrp.kinematics.forward import check_q, forward_kinematics
-from zrp.manufacturing.sensitivity import axis_tangents, tilt_axes
+from zrp.kinematics.identification import axis_tangents, tilt_axes
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import matrix_from_rotvec
 from zrp.units import G_STANDARD, metres_per_unit

@@ -1,4 +1,6 @@
-"""Analytic sensitivities of the end-effector pose to the kinematic parameters.
+"""The kinematic parameter vector of a model and the analytic sensitivities of the end-effector
+pose to it (the primitives of identification: calibration, the gap diagnosis and the tolerance
+analysis use them).
 
 The *identification Jacobian* (also the basis of calibration) is the derivative of the
 end-effector pose with respect to every geometric parameter of a :class:`~zrp.Manipulator`,
