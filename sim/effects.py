@@ -28,7 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
-from zrp.gap.effects import EFFECTS as GAP_EFFECTS
+from zrp.gap.model.context import EFFECTS as GAP_EFFECTS
 from zrp.kinematics.identification import axis_tangents, tilt_axes
 from zrp.model.manipulator import Manipulator
 

@@ -127,7 +127,7 @@ def test_compliance_units_are_stated(with_mjcf, tmp_path):
     m = synthesize(PUMA, q, inj, rng=rng, noise_sigma=0.005)
     tau = None
     if with_mjcf:
-        from zrp.gap.synthetic import _gravity_torque  # the torques synthesize used
+        from zrp.gap.data.synthetic import _gravity_torque  # the torques synthesize used
 
         tau = _gravity_torque(PUMA, m.q_pose, inj.masses, np.array([0.0, 0.0, -1.0]))
     d = _quiet(PUMA, m, seed=0, gravity_torque=tau)

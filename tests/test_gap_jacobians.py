@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.gap.data import Measurements
-from zrp.gap.effects import EFFECTS, Context, effect_parameters, registration_parameters
-from zrp.gap.problem import Problem
+from zrp.gap.data.measurements import Measurements
+from zrp.gap.model.context import EFFECTS, Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
+from zrp.gap.model.problem import Problem
 from zrp.kinematics.identification import parameter_jacobian
 from zrp.rotations import matrix_from_rotvec
 

@@ -1,4 +1,4 @@
-"""``diagnose`` with measured orientations (zrp.gap.posefit, issue 11 "full-pose data"): the
+"""``diagnose`` with measured orientations (zrp.gap.search.posefit, issue 11 "full-pose data"): the
 final model refitted from positions and orientations, judged on the diagnosis's own withheld
 poses, shown in diagnosis.json, report.md and the verdict; the probe rotation and the noise
 recorded in compensation.json.
@@ -200,7 +200,7 @@ def test_calibrated_robot_keeps_the_tilt_only_orientations_reveal(tmp_path):
     from zrp.calibration import CalibratedRobot  # the calibration layer, for the round trip
     from zrp.calibration.fullpose import full_pose_calibration
     from zrp.calibration.storage import write_calibration
-    from zrp.gap.fullpose import pose_rotations
+    from zrp.gap.fit.fullpose import pose_rotations
 
     diag = _diagnose(_tilted_wrist(120, 3))
     full = full_pose_calibration(diag)

@@ -23,9 +23,10 @@ from zrp.gap import (
     synthesize,
     write_outputs,
 )
-from zrp.gap.effects import Context, registration_parameters
-from zrp.gap.leastsq import fit, initial_registration
-from zrp.gap.uncertainty import robust_covariance
+from zrp.gap.fit.leastsq import fit, initial_registration
+from zrp.gap.fit.uncertainty import robust_covariance
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import registration_parameters
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")
@@ -267,7 +268,7 @@ def test_cli_prints_warnings_as_one_line_and_progress_lines_when_piped(tmp_path)
 def test_periodic_progress_lines():
     import io
 
-    from zrp.gap.progress import PeriodicLines
+    from zrp.gap.search.progress import PeriodicLines
     buf = io.StringIO()
     bar = PeriodicLines(4, "diagnose", buf, interval=0.0)
     for _ in range(4):

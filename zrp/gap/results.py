@@ -1,7 +1,7 @@
 """What a diagnosis returns: typed, frozen results with their JSON form (``to_dict``).
 
 The results of each search step (:class:`ParameterEstimate`, :class:`Candidate`,
-:class:`Step`) live in :mod:`zrp.gap.steps` and are re-exported here. The JSON schema is
+:class:`Step`) live in :mod:`zrp.gap.search.steps` and are re-exported here. The JSON schema is
 documented in zrp/gap/README.md; :data:`SCHEMA_VERSION` names it. The plain-words verdict
 (:attr:`Diagnosis.verdict`) is prose, so it belongs to the report
 (:mod:`zrp.gap.report.verdict`); the engine only holds the slot the report fills
@@ -17,20 +17,23 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.errors import InputError, ZRPWarning
-from zrp.gap.assessment import Assessment
-from zrp.gap.effects import Context
-from zrp.gap.leastsq import Aliased, FitResult
-from zrp.gap.metrics import Metrics, NoiseFloor
-from zrp.gap.posefit import FullPoseResult
-from zrp.gap.steps import Z95 as Z95
-from zrp.gap.steps import Candidate as Candidate
-from zrp.gap.steps import EffectsFound
-from zrp.gap.steps import ParameterEstimate as ParameterEstimate
-from zrp.gap.steps import Step as Step
-from zrp.gap.steps import parameter_estimates as parameter_estimates
-from zrp.gap.where import WhereAnalysis
-from zrp.jsonio import dict_from_dataclass
+from zrp.errors import InputError
+from zrp.gap.analysis.assessment import Assessment
+from zrp.gap.analysis.checks import GapWarning as GapWarning
+from zrp.gap.analysis.identifiability import EffectIdentifiability as EffectIdentifiability
+from zrp.gap.analysis.where import WhereAnalysis
+from zrp.gap.data.noise import NoiseFloor
+from zrp.gap.fit.leastsq import Aliased, FitResult
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.model.context import Context
+from zrp.gap.search.posefit import FullPoseResult
+from zrp.gap.search.steps import Z95 as Z95
+from zrp.gap.search.steps import BacklashSwitch as BacklashSwitch
+from zrp.gap.search.steps import Candidate as Candidate
+from zrp.gap.search.steps import EffectsFound
+from zrp.gap.search.steps import ParameterEstimate as ParameterEstimate
+from zrp.gap.search.steps import Step as Step
+from zrp.gap.search.steps import parameter_estimates as parameter_estimates
 
 __all__ = [
     "SCHEMA_VERSION",
@@ -51,50 +54,6 @@ F64 = NDArray[np.float64]
 SCHEMA_VERSION = 1
 #: final withheld RMS above this multiple of the noise-floor RMS counts as unexplained.
 UNEXPLAINED_RATIO = 1.5
-
-
-class GapWarning(ZRPWarning):
-    """The diagnosis ran but something limits what it can say (aliasing, poor data...)."""
-
-
-@dataclass(frozen=True)
-class EffectIdentifiability:
-    """Which parameters of one effect these data cannot identify on top of the registration.
-
-    Attributes:
-        not_identifiable: parameters dropped (aliased with others).
-        weak: parameters kept but only weakly identifiable.
-        limited_by_data: names of the dropped ones that a rich pose set would identify.
-    """
-
-    not_identifiable: tuple[Aliased, ...]
-    weak: tuple[Aliased, ...]
-    limited_by_data: tuple[str, ...] = ()
-
-    def to_dict(self) -> dict[str, Any]:
-        return dict_from_dataclass(self)
-
-
-@dataclass(frozen=True)
-class BacklashSwitch:
-    """Where a joint with play rests (the ``backlash`` effect as added to the model).
-
-    Attributes:
-        switch: per joint, the gravity torque above which it rests on the loaded flank (None:
-            always against its approach direction).
-        band: per joint, the range of plausible switching torques (None where modelled by the
-            approach direction only).
-        payload_kg: the unknown payload at the tool profiled with MJCF torques, kg.
-    """
-
-    switch: tuple[float | None, ...]
-    band: tuple[list[float] | None, ...]
-    payload_kg: float
-
-    def to_dict(self) -> dict[str, Any]:
-        return dict_from_dataclass(self, rename={"switch": "backlash_switch",
-                                                 "band": "backlash_switch_band",
-                                                 "payload_kg": "backlash_payload_kg"})
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,8 +140,8 @@ class Diagnosis(EffectsFound):
         settings: the options of the run.
         assessment: the geometric baseline, robust intervals, correlations, plausibility,
             the full registration and the evidence on what remains
-            (:class:`~zrp.gap.assessment.Assessment`).
-        full_pose: the final model refitted with orientations (:mod:`zrp.gap.posefit`).
+            (:class:`~zrp.gap.analysis.assessment.Assessment`).
+        full_pose: the final model refitted with orientations (:mod:`zrp.gap.search.posefit`).
     """
 
     model_name: str
@@ -247,7 +206,7 @@ class Diagnosis(EffectsFound):
     @property
     def final_parameters(self) -> tuple[ParameterEstimate, ...]:
         """All effect parameters of the final model, estimated jointly (after the backward
-        pass), with robust 95 % intervals (:mod:`zrp.gap.uncertainty`). The per-step values
+        pass), with robust 95 % intervals (:mod:`zrp.gap.fit.uncertainty`). The per-step values
         are each estimated without the effects added later, so these are the ones to use."""
         se = None if self.assessment is None else self.assessment.stderr
         return parameter_estimates(self.final_fit, len(self.registration), stderr=se,

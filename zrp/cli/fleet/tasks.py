@@ -49,7 +49,7 @@ def robot_row(name: str, data: str, d: dict[str, Any]) -> dict[str, Any]:
     top = d["effects"][0] if d.get("effects") else "none"
     if (d.get("final_model") or {}).get("fell_back") and steps:
         joints = {top: steps[0].get("joints", [])}  # final = the geometric calibration: the
-        # joints the search named (zrp/gap/fallback.py)
+        # joints the search named (zrp/gap/analysis/fallback.py)
     return {"robot": name, "data": data, "points": d["nominal"]["n_points"],
             "error_rms": d["nominal"]["rms"], "error_p95": d["nominal"]["p95"],
             "error_max": d["nominal"]["max"], "corrected_rms": d["final"]["rms"],

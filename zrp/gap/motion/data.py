@@ -3,9 +3,9 @@
 :class:`Trajectory` holds S samples (time stamps of the tracker, s), the controller's commanded
 joint values at those times, and the M tool points measured at each sample. Each sample is a
 "pose" of the static engine (:class:`zrp.gap.Measurements`, pose id ``s<i>``), so the static
-fitting (:mod:`zrp.gap.problem`, :mod:`zrp.gap.leastsq`) and the static effects run unchanged
-on the same data. The commanded joint values are interpolated by a cubic spline (eq. M0) for
-the velocities, accelerations and time shifts the motion effects need.
+fitting (:mod:`zrp.gap.model.problem`, :mod:`zrp.gap.fit.leastsq`) and the static effects run
+unchanged on the same data. The commanded joint values are interpolated by a cubic spline
+(eq. M0) for the velocities, accelerations and time shifts the motion effects need.
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
 from zrp.errors import InputError
-from zrp.gap.data import FRAMES, Measurements
+from zrp.gap.data.measurements import FRAMES, Measurements
 
 __all__ = ["MIN_SAMPLES", "Trajectory"]
 

@@ -10,9 +10,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.leastsq import Z95
-from zrp.gap.metrics import Metrics
-from zrp.gap.steps import EffectsFound
+from zrp.gap.fit.leastsq import Z95
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.search.steps import EffectsFound
 from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["MotionDiagnosis", "MotionEstimate", "MotionStep", "PhaseError"]

@@ -1,7 +1,7 @@
 """The greedy search over motion effects (forward steps, then a backward check), on the
-static engine's statistics: identifiability (:func:`~zrp.gap.leastsq.check_identifiable`),
+static engine's statistics: identifiability (:func:`~zrp.gap.fit.leastsq.check_identifiable`),
 Wald tests per joint group, F test and BIC against the current model, and cross-validated RMS
-over folds of whole time segments (:func:`~zrp.gap.leastsq.cv_rms`)."""
+over folds of whole time segments (:func:`~zrp.gap.fit.leastsq.cv_rms`)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,9 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.gap.effects import EFFECTS, effect_parameters
-from zrp.gap.leastsq import check_identifiable, cv_rms, f_test, group_key, wald_groups
+from zrp.gap.fit.leastsq import check_identifiable, cv_rms, f_test, group_key, wald_groups
+from zrp.gap.model.context import EFFECTS
+from zrp.gap.model.effects import effect_parameters
 from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise, plausible, tested
 from zrp.gap.motion.fitting import Engine, ModelFit
 from zrp.gap.motion.profile import vibration_start

@@ -8,9 +8,9 @@ from collections.abc import Sequence
 
 from scipy.spatial.transform import Rotation
 
+from zrp.gap.analysis.where import Region, WhereAnalysis
 from zrp.gap.report.verdict import baseline_text, final_effects_text, full_pose_text
 from zrp.gap.results import Candidate, Diagnosis, ParameterEstimate
-from zrp.gap.where import Region, WhereAnalysis
 
 __all__ = ["decimals", "report_markdown", "value_ci"]
 

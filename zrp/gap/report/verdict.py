@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.results import Diagnosis
-from zrp.gap.where import WhereAnalysis
 
 __all__ = ["baseline_text", "final_effects_text", "full_pose_text", "remains_text",
            "verdict_text"]

@@ -3,8 +3,8 @@ calibrated robot.
 
 Every joint-space parameter theta of an effect enters the corrected model as a joint
 correction dq_k = theta B_k(pose) (zrp/gap/README.md). :func:`joint_bases` gives the bases of
-an effect for every joint on the poses of a :class:`zrp.gap.effects.Context`, before anything
-is dropped: the effect builders (:mod:`zrp.gap.effects`) keep the joints the poses excite, and
+an effect for every joint on the poses of a :class:`zrp.gap.model.context.Context`, before anything
+is dropped: the effect builders (:mod:`zrp.gap.model.effects`) keep the joints the poses excite, and
 :mod:`zrp.calibration.jointmap` re-evaluates the identified ones on new poses (targets), so a
 change here changes both alike.
 
@@ -26,16 +26,12 @@ parameter ``q{k}.{what}``   basis B_k per pose
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
+from zrp.gap.model.context import Context
 from zrp.units import G_STANDARD, metres_per_unit
-
-if TYPE_CHECKING:  # typing only: effects imports this module
-    from zrp.gap.effects import Context
 
 __all__ = ["JOINT_EFFECTS", "joint_bases"]
 

@@ -26,13 +26,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.gap.baseline import GeometricBaseline
-from zrp.gap.effects import Context
-from zrp.gap.fallback import FinalChoice
-from zrp.gap.leastsq import FitResult
-from zrp.gap.registration import Registration
-from zrp.gap.uncertainty import Correlations
-from zrp.gap.where import WhereAnalysis
+from zrp.gap.analysis.baseline import GeometricBaseline
+from zrp.gap.analysis.fallback import FinalChoice
+from zrp.gap.analysis.where import WhereAnalysis
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.fit.registration import Registration
+from zrp.gap.fit.uncertainty import Correlations
+from zrp.gap.model.context import Context
 from zrp.jsonio import dict_from_dataclass
 from zrp.units import metres_per_unit
 
@@ -195,7 +195,7 @@ class Assessment:
             resolved.
         compliance: the unit of ``joint_compliance`` and why (:func:`compliance_units`).
         choice: which model is final - the search's, or the geometric calibration when the
-            search's is worse on the withheld poses (:mod:`zrp.gap.fallback`).
+            search's is worse on the withheld poses (:mod:`zrp.gap.analysis.fallback`).
     """
 
     baseline: GeometricBaseline

@@ -1,7 +1,7 @@
 """Measurement data of the sim-to-real gap diagnosis: validated, immutable arrays.
 
 :class:`Measurements` holds one row per measured point, rows in measurement order (the CSV
-format and its strict reader are in :mod:`zrp.gap.csvfile`; :meth:`Measurements.to_csv` writes
+format and its strict reader are in :mod:`zrp.gap.data.csvfile`; :meth:`Measurements.to_csv` writes
 it). Nothing is dropped silently: a wrong shape, a NaN, a repeated (pose, point) or rows of one
 pose with different joint values are errors naming the source and line.
 """
@@ -74,8 +74,8 @@ class Measurements:
         temp: temperature, deg C, shape (R,), or None.
         load: payload, kg, shape (R,), or None.
         quat: measured orientation (qw, qx, qy, qz), shape (R, 4), or None (used by
-            :mod:`zrp.gap.fullpose`; the stepwise search uses positions only, the final
-            model is refitted with them, :mod:`zrp.gap.posefit`).
+            :mod:`zrp.gap.fit.fullpose`; the stepwise search uses positions only, the final
+            model is refitted with them, :mod:`zrp.gap.search.posefit`).
         direction: approach direction per joint (-1, 0, +1), shape (R, n), or None.
         lines: source line number of each row (for messages), shape (R,).
         source: file name or a description, for messages.

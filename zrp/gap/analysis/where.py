@@ -16,9 +16,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.gap.effects import Context, ParamSpec, effect_parameters
-from zrp.gap.leastsq import FitResult, check_identifiable, orthonormal_basis
-from zrp.gap.problem import Problem
+from zrp.gap.fit.leastsq import FitResult, check_identifiable, orthonormal_basis
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.effects import effect_parameters
+from zrp.gap.model.problem import Problem
 from zrp.jsonio import dict_from_dataclass
 
 __all__ = [

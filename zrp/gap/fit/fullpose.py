@@ -6,7 +6,7 @@ on the hand (registered like the tool offsets), the corrected model predicts
 
     R_i = R_b R_n(q'_i) R_t,        R_t = exp([psi]) R_t0                               (O1)
 
-(R_b, R_n, q' as in :mod:`zrp.gap.problem`). The orientation residual of pose i is the
+(R_b, R_n, q' as in :mod:`zrp.gap.model.problem`). The orientation residual of pose i is the
 rotation vector e_i = log(R_i R_meas,i^T) (rad, instrument frame), and for a left
 perturbation delta of R_i, de = J_l(e)^-1 delta (J_l: left Jacobian of SO(3)). The perturbation
 columns (instrument frame) are
@@ -20,7 +20,7 @@ coordinate, length unit; orientations per component, rad): each block weighted b
 noise. sigma_p is the position-only fit's residual sigma; sigma_o is given, or estimated from
 the orientation residuals (the fit repeated until the estimate settles, 3 passes). The
 standard errors are the normal-theory ones of the weighted problem, comparable with the
-position-only fit's (the same formula, :func:`zrp.gap.leastsq.fit`).
+position-only fit's (the same formula, :func:`zrp.gap.fit.leastsq.fit`).
 """
 
 from __future__ import annotations
@@ -34,9 +34,9 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from zrp.errors import InputError
-from zrp.gap.effects import Context, ParamSpec
-from zrp.gap.leastsq import FitResult, _covariance, fit, initial_registration
-from zrp.gap.problem import Problem
+from zrp.gap.fit.leastsq import FitResult, _covariance, fit, initial_registration
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.problem import Problem
 from zrp.rotations import left_jacobian
 
 __all__ = ["FullPoseFit", "fit_full_pose", "orientation_residual", "pose_rotations",
@@ -170,7 +170,7 @@ def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
 
     Args:
         ctx: the data context (its measurements need ``qw..qz`` for ``orientation``).
-        specs: registration + effect parameters, as for :func:`zrp.gap.leastsq.fit`.
+        specs: registration + effect parameters, as for :func:`zrp.gap.fit.leastsq.fit`.
         poses: pose indices, shape (S,).
         orientation: use the orientations (False: the position-only fit, for comparison).
         orientation_sigma: the orientation noise per component (rad); None: estimated.

@@ -1,10 +1,12 @@
 """Which joints the data excite: no per-joint function of a joint's angle (scale, cyclic
-error, backlash) is placed on a joint that barely moves (:attr:`zrp.gap.effects.Context.excited`,
-threshold :data:`zrp.gap.effects.MIN_EXCITATION_RAD`)."""
+error, backlash) is placed on a joint that barely moves
+(:attr:`zrp.gap.model.context.Context.excited`, threshold
+:data:`zrp.gap.model.context.MIN_EXCITATION_RAD`)."""
 
 from __future__ import annotations
 
-from zrp.gap.effects import Built, Context
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import Built
 
 __all__ = ["PER_JOINT_ANGLE", "excited_only"]
 

@@ -1,8 +1,8 @@
 """Refuse data that cannot give an answer, before and right after the registration.
 
 Each check raises :class:`~zrp.errors.InputError` naming the data source and what to change, or
-warns (:class:`~zrp.gap.data.DataWarning`, :class:`~zrp.gap.results.GapWarning`) when the data
-are usable but limit what the diagnosis can say.
+warns (:class:`~zrp.gap.data.measurements.DataWarning`, :class:`GapWarning`) when the data are
+usable but limit what the diagnosis can say.
 """
 
 from __future__ import annotations
@@ -13,16 +13,16 @@ import warnings
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from zrp.errors import InputError
-from zrp.gap.data import DataWarning, Measurements
-from zrp.gap.effects import Context
-from zrp.gap.leastsq import FitResult
-from zrp.gap.metrics import Metrics
-from zrp.gap.noise import noise_floor
-from zrp.gap.results import GapWarning
-from zrp.gap.split import MIN_POSES
+from zrp.errors import InputError, ZRPWarning
+from zrp.gap.data.measurements import DataWarning, Measurements
+from zrp.gap.data.noise import noise_floor
+from zrp.gap.data.split import MIN_POSES
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.model.context import Context
 
 __all__ = [
+    "GapWarning",
     "check_gravity_torque",
     "check_points",
     "check_poses",
@@ -33,6 +33,10 @@ __all__ = [
 F64 = NDArray[np.float64]
 #: poses below which effects with many parameters are hard to identify.
 FEW_POSES = 50
+
+
+class GapWarning(ZRPWarning):
+    """The diagnosis ran but something limits what it can say (aliasing, poor data...)."""
 
 
 def check_poses(meas: Measurements) -> None:

@@ -10,15 +10,16 @@ One row per measured point, rows in measurement order. Columns (header names, an
   instrument's frame (or the robot's base frame with ``frame="base"``).
 * ``qw``, ``qx``, ``qy``, ``qz`` (optional, all four): measured orientation (loaded and checked;
   the diagnosis chooses effects from positions only and says so with a warning; zrp calibrate
-  and zrp.gap.fullpose use them).
+  and zrp.gap.fit.fullpose use them).
 * ``t`` (s), ``temp`` (deg C), ``load`` (kg) (optional).
 * ``dir1`` .. ``dirn`` (optional, all n): the direction from which each joint approached the
   pose (-1, 0 or +1); when absent it is taken from the measurement order (see
-  :meth:`~zrp.gap.data.Measurements.approach_direction`).
+  :meth:`~zrp.gap.data.measurements.Measurements.approach_direction`).
 
 Lines starting with ``#`` are comments (skipped, with a warning after the header). Nothing is
 dropped silently: an unknown column, a missing value, a non-number or a NaN is an error naming
-the file, line and column. :meth:`~zrp.gap.data.Measurements.to_csv` writes this format.
+the file, line and column. :meth:`~zrp.gap.data.measurements.Measurements.to_csv` writes this
+format.
 
 The file is read in one pass, record by record, into compact arrays (memory about 8 bytes a
 number plus the pose ids), as UTF-8 (with or without a byte-order mark) or UTF-16 with its
@@ -44,7 +45,13 @@ from tqdm import tqdm
 
 from zrp.arguments import check_int
 from zrp.errors import InputError
-from zrp.gap.data import FRAMES, OPTIONAL_SCALARS, QUAT_COLUMNS, DataWarning, Measurements
+from zrp.gap.data.measurements import (
+    FRAMES,
+    OPTIONAL_SCALARS,
+    QUAT_COLUMNS,
+    DataWarning,
+    Measurements,
+)
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["MAX_ROWS", "load_measurements"]

@@ -1,10 +1,10 @@
 """The final model is never worse than a standard complete geometric calibration.
 
-The greedy search (:mod:`zrp.gap.search`) adds one effect at a time and stops after
+The greedy search (:mod:`zrp.gap.search.greedy`) adds one effect at a time and stops after
 ``max_steps`` or when no effect passes its tests, so on a robot with many geometric errors (a
 7-axis arm, an optical tracker's larger noise, several payloads) the model it ends with can
 leave more on the withheld poses than the complete geometric calibration fitted beside it
-(:mod:`zrp.gap.baseline`). The rule here makes "the final withheld error is at or below the
+(:mod:`zrp.gap.analysis.baseline`). The rule here makes "the final withheld error is at or below the
 geometric calibration's" hold by construction:
 
     final = search's model   if RMS_w(search) <= RMS_w(geometric calibration)
@@ -30,11 +30,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.baseline import GeometricBaseline
-from zrp.gap.effects import Context
-from zrp.gap.leastsq import FitResult
-from zrp.gap.metrics import Metrics
-from zrp.gap.problem import Problem
+from zrp.gap.analysis.baseline import GeometricBaseline
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.model.context import Context
+from zrp.gap.model.problem import Problem
 from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["SOURCES", "FinalChoice", "choose_final"]

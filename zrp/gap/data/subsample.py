@@ -11,8 +11,9 @@ a random subsample of whole poses instead of running for hours:
   from the front while the kept points stay within the limit (at least one group);
 * the kept poses stay in measurement order (approach directions and drift are preserved).
 
-The rule is announced in a :class:`~zrp.gap.data.DataWarning` (printed by the command line,
-recorded in ``diagnosis.json`` under ``warnings``); ``max_points=None`` uses every point.
+The rule is announced in a :class:`~zrp.gap.data.measurements.DataWarning` (printed by the
+command line, recorded in ``diagnosis.json`` under ``warnings``); ``max_points=None`` uses every
+point.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.arguments import check_int
-from zrp.gap.data import DataWarning, Measurements
+from zrp.gap.data.measurements import DataWarning, Measurements
 
 __all__ = ["MAX_POINTS", "subsample_poses"]
 

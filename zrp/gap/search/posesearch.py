@@ -1,11 +1,11 @@
 """Effects that the orientations reveal: a forward search on the full-pose problem.
 
-The diagnosis's stepwise search (:mod:`zrp.gap.search`) sees positions only, so an effect
+The diagnosis's stepwise search (:mod:`zrp.gap.search.greedy`) sees positions only, so an effect
 visible mainly in orientation (e.g. the tilt of the last axis when the reflector sits close
 to the wrist centre) is never added. After the full-pose refit of the final model
-(:mod:`zrp.gap.posefit`), this search tries every (effect, joint) group of the candidate
+(:mod:`zrp.gap.search.posefit`), this search tries every (effect, joint) group of the candidate
 effects that turns the hand (joint corrections ``dq`` and axis tilts: the only kinds with
-orientation columns, eq. O2 of :mod:`zrp.gap.fullpose`) by a score (Lagrange multiplier)
+orientation columns, eq. O2 of :mod:`zrp.gap.fit.fullpose`) by a score (Lagrange multiplier)
 test at the current full-pose solution, on the fitting poses only:
 
     r, J: weighted residual (positions / sigma_p, orientations / sigma_o) and Jacobian,
@@ -31,9 +31,9 @@ from numpy.typing import NDArray
 from scipy import stats
 
 from zrp.errors import InputError
-from zrp.gap.effects import Context, ParamSpec
-from zrp.gap.fullpose import FullPoseFit, orientation_residual
-from zrp.gap.problem import Problem
+from zrp.gap.fit.fullpose import FullPoseFit, orientation_residual
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.problem import Problem
 from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["OrientationStep", "forward_search", "orientation_groups", "score_test"]

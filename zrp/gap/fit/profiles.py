@@ -19,8 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.gap.effects import Context, ParamSpec, effect_parameters
-from zrp.gap.leastsq import (
+from zrp.gap.fit.leastsq import (
     FitResult,
     check_identifiable,
     fit,
@@ -28,7 +27,9 @@ from zrp.gap.leastsq import (
     orthonormal_basis,
     wald_groups,
 )
-from zrp.gap.problem import Problem
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.effects import effect_parameters
+from zrp.gap.model.problem import Problem
 from zrp.units import G_STANDARD, metres_per_unit
 
 __all__ = ["PAYLOAD_GRID_KG", "switch_bands", "with_backlash_switch", "with_gravity_side"]

@@ -2,7 +2,7 @@
 
 A calibration engineer's reference: all kinematic parameters (joint offsets, body vectors,
 axis tilts: :data:`KINEMATIC`) on top of the registration, reduced to a base set that these
-poses identify (column-pivoted Gram-Schmidt on the normalised Jacobian, :func:`~zrp.gap.leastsq.
+poses identify (column-pivoted Gram-Schmidt on the normalised Jacobian, :func:`~zrp.gap.fit.leastsq.
 check_identifiable`: a QR reduction), fitted on the fitting poses and judged on the withheld
 ones. Then the non-geometric effects of the final model are added on top of it, which answers
 the question "what do the non-geometric effects add beyond a full geometric calibration, on
@@ -17,10 +17,11 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.gap.effects import Context, ParamSpec, effect_parameters
-from zrp.gap.leastsq import FitResult, cv_rms, fit, identifiable_start
-from zrp.gap.metrics import Metrics
-from zrp.gap.problem import Problem
+from zrp.gap.fit.leastsq import FitResult, cv_rms, fit, identifiable_start
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.effects import effect_parameters
+from zrp.gap.model.problem import Problem
 
 __all__ = ["KINEMATIC", "GeometricBaseline", "geometric_baseline"]
 
@@ -44,7 +45,7 @@ class GeometricBaseline:
             has no non-geometric effect.
         fit: the geometric calibration's fit (registration + base set; the final model when
             the search's model does not beat it on the withheld poses, see
-            :mod:`zrp.gap.fallback`).
+            :mod:`zrp.gap.analysis.fallback`).
     """
 
     n_parameters: int

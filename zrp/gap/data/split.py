@@ -2,7 +2,7 @@
 
 Poses with identical joint values (repeats) always stay on the same side. The withheld poses
 are never used for fitting; they judge the final model, and choose it only between the search's
-model and the complete geometric calibration (:mod:`zrp.gap.fallback`).
+model and the complete geometric calibration (:mod:`zrp.gap.analysis.fallback`).
 """
 
 from __future__ import annotations
@@ -11,7 +11,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.data import Measurements
+from zrp.gap.data.measurements import Measurements
 
 __all__ = ["MIN_POSES", "split_poses"]
 

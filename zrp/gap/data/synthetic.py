@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
-from zrp.gap.data import Measurements
+from zrp.gap.data.measurements import Measurements
 from zrp.kinematics.forward import check_q, forward_kinematics
 from zrp.kinematics.identification import axis_tangents, tilt_axes
 from zrp.model.manipulator import Manipulator

@@ -17,8 +17,8 @@ from scipy import (
 from scipy.optimize import least_squares
 
 from zrp.errors import InputError, ZRPWarning
-from zrp.gap.effects import Context, ParamSpec
-from zrp.gap.problem import Evaluation, Problem, compressed
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.problem import Evaluation, Problem, compressed
 from zrp.jsonio import dict_from_dataclass
 
 #: Two-sided 95 % quantile of the standard normal (the one home of the constant in zrp.gap).
@@ -211,7 +211,7 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
         base_rotation: ArrayLike, *, max_nfev: int = 100,
         start: Evaluation | None = None) -> FitResult:
     """Least squares (scipy ``least_squares``, Levenberg-Marquardt) with the analytic
-    Jacobian of :class:`~zrp.gap.problem.Problem`.
+    Jacobian of :class:`~zrp.gap.model.problem.Problem`.
 
     Args:
         specs: parameters (p).

@@ -26,7 +26,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
-from zrp.gap.effects import Context, ParamSpec
+from zrp.gap.model.context import Context, ParamSpec
 from zrp.rotations import left_jacobian, matrix_from_rotvec, skew
 
 __all__ = ["Evaluation", "Problem", "compressed"]
@@ -294,8 +294,8 @@ def compressed(r: F64, jac: F64) -> tuple[F64, F64]:
 @dataclass(frozen=True)
 class Evaluation:
     """The residual r (3R,) and Jacobian J (3R, p) of a parameter set at theta (p,) on poses
-    (S,), already computed (by :func:`zrp.gap.leastsq.identifiable_start`): a fit
-    (:func:`zrp.gap.leastsq.fit`) starting there reuses it instead of evaluating again."""
+    (S,), already computed (by :func:`zrp.gap.fit.leastsq.identifiable_start`): a fit
+    (:func:`zrp.gap.fit.leastsq.fit`) starting there reuses it instead of evaluating again."""
 
     poses: NDArray[np.int64]
     theta: F64

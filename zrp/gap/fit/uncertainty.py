@@ -39,8 +39,8 @@ from numpy.typing import NDArray
 from scipy import special
 
 from zrp.errors import InputError
-from zrp.gap.effects import Context
-from zrp.gap.leastsq import FitResult
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.model.context import Context
 
 __all__ = [
     "STRONG_CORRELATION",

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.leastsq import Z95, FitResult
+from zrp.gap.fit.leastsq import Z95, FitResult
 from zrp.jsonio import dict_from_dataclass
 from zrp.rotations import er_from_matrix, er_to_rotvec, matrix_from_rotvec
 
@@ -109,7 +109,7 @@ def _delta(fn: Callable[[F64], F64], phi: F64, rb0: F64, cov: F64) -> tuple[F64,
 def registration_of(fit: FitResult, stderr: F64, cov: F64, labels: tuple[str, ...],
                     length_unit: str) -> Registration:
     """The registration of ``fit`` with the standard errors ``stderr`` (p,) and covariance
-    ``cov`` (p, p) of its parameters (robust ones from :mod:`zrp.gap.uncertainty`)."""
+    ``cov`` (p, p) of its parameters (robust ones from :mod:`zrp.gap.fit.uncertainty`)."""
     idx = {s.name: i for i, s in enumerate(fit.specs)}
     rb0 = np.asarray(fit.base_rotation, dtype=float)
 

@@ -15,14 +15,15 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.effects import EFFECTS
-from zrp.gap.leastsq import Z95 as Z95
-from zrp.gap.leastsq import Aliased, FitResult
-from zrp.gap.metrics import Metrics
-from zrp.gap.uncertainty import simultaneous_z
+from zrp.gap.fit.leastsq import Z95 as Z95
+from zrp.gap.fit.leastsq import Aliased, FitResult
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.fit.uncertainty import simultaneous_z
+from zrp.gap.model.context import EFFECTS
 from zrp.jsonio import dict_from_dataclass
 
 __all__ = [
+    "BacklashSwitch",
     "Candidate",
     "EffectsFound",
     "ParameterEstimate",
@@ -38,7 +39,7 @@ F64 = NDArray[np.float64]
 class ParameterEstimate:
     """An identified parameter with its 95 % confidence interval (normal approximation) and,
     for the final model, ``ci95_effect``: the simultaneous 95 % interval that holds for all
-    parameters of its effect at once (:func:`~zrp.gap.uncertainty.simultaneous_z`)."""
+    parameters of its effect at once (:func:`~zrp.gap.fit.uncertainty.simultaneous_z`)."""
 
     name: str
     effect: str
@@ -171,3 +172,25 @@ class EffectsFound:
     def top_effect(self) -> str:
         """The first effect found, or "none"."""
         return self.effects[0]
+
+
+@dataclass(frozen=True)
+class BacklashSwitch:
+    """Where a joint with play rests (the ``backlash`` effect as added to the model).
+
+    Attributes:
+        switch: per joint, the gravity torque above which it rests on the loaded flank (None:
+            always against its approach direction).
+        band: per joint, the range of plausible switching torques (None where modelled by the
+            approach direction only).
+        payload_kg: the unknown payload at the tool profiled with MJCF torques, kg.
+    """
+
+    switch: tuple[float | None, ...]
+    band: tuple[list[float] | None, ...]
+    payload_kg: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict_from_dataclass(self, rename={"switch": "backlash_switch",
+                                                 "band": "backlash_switch_band",
+                                                 "payload_kg": "backlash_payload_kg"})

@@ -2,13 +2,13 @@
 
 When the measurements carry ``qw..qz`` (a 6-DOF probe), :func:`zrp.gap.diagnose` refits its
 final model (registration included) from positions and orientations together on the same
-fitting poses, each block weighted by its own noise (:mod:`zrp.gap.fullpose`, eqs. O1-O2),
+fitting poses, each block weighted by its own noise (:mod:`zrp.gap.fit.fullpose`, eqs. O1-O2),
 and judges both estimates on the diagnosis's own withheld poses:
 
 - effects only the orientations reveal are added by a score-test search on the fitting
-  poses (:mod:`zrp.gap.posesearch`), each confirmed on the withheld orientations;
+  poses (:mod:`zrp.gap.search.posesearch`), each confirmed on the withheld orientations;
 - orientation error before: the position-only final fit, with the probe rotation R_t0 that
-  fits it best on the fitting poses (:func:`zrp.gap.fullpose.probe_start`);
+  fits it best on the fitting poses (:func:`zrp.gap.fit.fullpose.probe_start`);
 - orientation error after: the full-pose fit with its identified probe rotation R_t;
 - the withheld position RMS of both (position-only: the final model refitted), and each
   parameter's standard error with and without orientations (normal theory of the weighted
@@ -28,17 +28,17 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.effects import Context, ParamSpec
-from zrp.gap.fullpose import (
+from zrp.gap.fit.fullpose import (
     FullPoseFit,
     fit_full_pose,
     orientation_residual,
     pose_rotations,
     probe_start,
 )
-from zrp.gap.leastsq import FitResult
-from zrp.gap.posesearch import OrientationStep, forward_search
-from zrp.gap.problem import Problem
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.problem import Problem
+from zrp.gap.search.posesearch import OrientationStep, forward_search
 from zrp.jsonio import dict_from_dataclass
 from zrp.rotations import er_from_matrix, er_to_rotvec
 
@@ -92,7 +92,7 @@ class FullPoseResult:
         withheld_rms_position_only, withheld_rms: 3-D position RMS on the withheld poses of
             the position-only and the full-pose estimates (length unit).
         parameters: the effect parameters' precision, with and without orientations.
-        added: groups the orientations revealed (:mod:`zrp.gap.posesearch`), in order; the
+        added: groups the orientations revealed (:mod:`zrp.gap.search.posesearch`), in order; the
             fit includes them, the position-only figures ("before") do not.
     """
 
@@ -162,7 +162,7 @@ def refit_full_pose(ctx: Context, final: FitResult, fitting: NDArray[np.int64],
                     candidates: dict[str, list[ParamSpec]] | None = None, alpha: float = 1e-3,
                     min_gain: float = 0.01, max_steps: int = 2) -> FullPoseResult:
     """Refit ``final``'s parameters with the measured orientations, add the effects only the
-    orientations reveal (:mod:`zrp.gap.posesearch`) and judge the estimates on the withheld
+    orientations reveal (:mod:`zrp.gap.search.posesearch`) and judge the estimates on the withheld
     poses (module doc).
 
     Args:

@@ -16,10 +16,10 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.gap.effects import Context, ParamSpec, effect_parameters
-from zrp.gap.excitation import excited_only
-from zrp.gap.identifiability import GEOMETRIC, geometric_overlap
-from zrp.gap.leastsq import (
+from zrp.gap.analysis.checks import GapWarning
+from zrp.gap.analysis.excitation import excited_only
+from zrp.gap.analysis.identifiability import GEOMETRIC, geometric_overlap
+from zrp.gap.fit.leastsq import (
     Aliased,
     FitResult,
     cv_rms,
@@ -29,17 +29,13 @@ from zrp.gap.leastsq import (
     identifiable_start,
     wald_groups,
 )
-from zrp.gap.metrics import Metrics
-from zrp.gap.problem import Problem
-from zrp.gap.profiles import switch_bands, with_backlash_switch
-from zrp.gap.progress import progress_bar
-from zrp.gap.results import (
-    BacklashSwitch,
-    Candidate,
-    GapWarning,
-    Step,
-    parameter_estimates,
-)
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.fit.profiles import switch_bands, with_backlash_switch
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.effects import effect_parameters
+from zrp.gap.model.problem import Problem
+from zrp.gap.search.progress import progress_bar
+from zrp.gap.search.steps import BacklashSwitch, Candidate, Step, parameter_estimates
 
 __all__ = ["TIE_TOL", "SearchResult", "SearchSettings", "backward_pass", "greedy_search",
            "withheld_residual"]

@@ -10,20 +10,25 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from functools import cached_property
+from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
-from zrp.gap.data import Measurements
-from zrp.gap.effects import Context, ParamSpec, effect_parameters
-from zrp.gap.leastsq import ALIAS_TOL, FitResult, check_identifiable, orthonormal_basis
-from zrp.gap.problem import Problem
-from zrp.gap.results import EffectIdentifiability, GapWarning
+from zrp.gap.analysis.checks import GapWarning
+from zrp.gap.data.measurements import Measurements
+from zrp.gap.fit.leastsq import ALIAS_TOL, Aliased, FitResult, check_identifiable, orthonormal_basis
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.effects import effect_parameters
+from zrp.gap.model.problem import Problem
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = [
     "GEOMETRIC",
+    "EffectIdentifiability",
     "ReferencePoses",
     "geometric_overlap",
     "registration_identifiable",
@@ -40,6 +45,24 @@ N_REFERENCE = 200
 #: 0 .. PRISMATIC_SHARE x the reach.
 REVOLUTE_RANGE = 2.5
 PRISMATIC_SHARE = 0.3
+
+
+@dataclass(frozen=True)
+class EffectIdentifiability:
+    """Which parameters of one effect these data cannot identify on top of the registration.
+
+    Attributes:
+        not_identifiable: parameters dropped (aliased with others).
+        weak: parameters kept but only weakly identifiable.
+        limited_by_data: names of the dropped ones that a rich pose set would identify.
+    """
+
+    not_identifiable: tuple[Aliased, ...]
+    weak: tuple[Aliased, ...]
+    limited_by_data: tuple[str, ...] = ()
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict_from_dataclass(self)
 
 
 class ReferencePoses:
