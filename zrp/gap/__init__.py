@@ -7,10 +7,11 @@ In-process use::
     meas = load_measurements("D.csv", model, deg=True)
     diag = diagnose(model, meas, seed=0)
     diag.top_effect, diag.final.rms, diag.to_dict()
+    zrp.gap.report.verdict_text(diag)  # the verdict in plain words
     write_outputs(diag, "DIR")  # diagnosis.json, report.md, residuals.csv, plots
 
-The engine (every module but :mod:`zrp.gap.report`) never imports the report; the report's
-wording of the verdict is installed into :class:`Diagnosis` here.
+The engine (every module but :mod:`zrp.gap.report`) never imports the report; the report is a
+plain function of the result (``zrp.gap.report.verdict_text(diag)``).
 """
 
 from zrp.gap.analysis.assessment import Assessment as Assessment
@@ -39,15 +40,11 @@ from zrp.gap.model.effects import effect_parameters as effect_parameters
 from zrp.gap.options import DiagnosisOptions as DiagnosisOptions
 from zrp.gap.pipeline import diagnose as diagnose
 from zrp.gap.report import write_outputs as write_outputs
-from zrp.gap.report.verdict import verdict_text as _verdict_text
 from zrp.gap.results import Diagnosis as Diagnosis
 from zrp.gap.results import Where as Where
-from zrp.gap.results import install_verdict_renderer as _install_verdict_renderer
 from zrp.gap.search.steps import Candidate as Candidate
 from zrp.gap.search.steps import ParameterEstimate as ParameterEstimate
 from zrp.gap.search.steps import Step as Step
-
-_install_verdict_renderer(_verdict_text)
 
 __all__ = [
     "EFFECTS",

@@ -2,16 +2,20 @@
 
 The results of each search step (:class:`ParameterEstimate`, :class:`Candidate`,
 :class:`Step`) live in :mod:`zrp.gap.search.steps` and are re-exported here. The JSON schema is
-documented in zrp/gap/README.md; :data:`SCHEMA_VERSION` names it. The plain-words verdict
-(:attr:`Diagnosis.verdict`) is prose, so it belongs to the report
-(:mod:`zrp.gap.report.verdict`); the engine only holds the slot the report fills
-(:func:`install_verdict_renderer`, wired in ``zrp/gap/__init__.py``) and never imports it.
+documented in zrp/gap/README.md; :data:`SCHEMA_VERSION` names it. The plain-words verdict is
+prose, so the report words it from the result (:func:`zrp.gap.report.verdict_text`) and adds it
+to diagnosis.json (:func:`zrp.gap.report.diagnosis_document`); nothing here refers to the
+report.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+import json
+import math
+import os
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -41,12 +45,14 @@ __all__ = [
     "BacklashSwitch",
     "Candidate",
     "Diagnosis",
+    "DiagnosisRecord",
     "EffectIdentifiability",
     "GapWarning",
     "ParameterEstimate",
     "Step",
+    "StepRecord",
     "Where",
-    "install_verdict_renderer",
+    "load_diagnosis",
     "parameter_estimates",
 ]
 
@@ -102,17 +108,6 @@ class Where(Mapping[str, Any]):
 
     def __len__(self) -> int:
         return len(self.to_dict())
-
-
-#: Renders :attr:`Diagnosis.verdict`; installed by the report (see zrp/gap/__init__.py).
-_verdict_renderer: Callable[[Diagnosis], str] | None = None
-
-
-def install_verdict_renderer(render: Callable[[Diagnosis], str]) -> None:
-    """Set the function that words :attr:`Diagnosis.verdict` (the report's
-    :func:`zrp.gap.report.verdict.verdict_text`; the engine does not import the report)."""
-    global _verdict_renderer
-    _verdict_renderer = render
 
 
 @dataclass(frozen=True, eq=False)
@@ -196,14 +191,6 @@ class Diagnosis(EffectsFound):
         return self.where.nominal if final is None else final
 
     @property
-    def verdict(self) -> str:
-        """One paragraph in plain words (worded by the report)."""
-        if _verdict_renderer is None:
-            raise RuntimeError("no verdict renderer installed; import zrp.gap (its __init__ "
-                               "installs zrp.gap.report.verdict.verdict_text)")
-        return _verdict_renderer(self)
-
-    @property
     def final_parameters(self) -> tuple[ParameterEstimate, ...]:
         """All effect parameters of the final model, estimated jointly (after the backward
         pass), with robust 95 % intervals (:mod:`zrp.gap.fit.uncertainty`). The per-step values
@@ -231,7 +218,9 @@ class Diagnosis(EffectsFound):
                          f"{', '.join(p.name for p in self.final_parameters)}")
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON document (schema in zrp/gap/README.md)."""
+        """The JSON document (schema in zrp/gap/README.md) without the verdict, which the
+        report words and inserts after ``unexplained``
+        (:func:`zrp.gap.report.diagnosis_document`)."""
         return {
             "schema_version": SCHEMA_VERSION,
             "model": self.model_name,
@@ -248,7 +237,6 @@ class Diagnosis(EffectsFound):
                       "ratio_to_noise_floor": self.ratio_to_noise_floor},
             "noise_floor": self.noise_floor.to_dict(),
             "unexplained": self.unexplained,
-            "verdict": self.verdict,
             "split": self.split,
             "where": self.where.to_dict(),
             "aliased": [a.to_dict() for a in self.aliased],
@@ -256,3 +244,82 @@ class Diagnosis(EffectsFound):
             **({} if self.assessment is None else self.assessment.to_dict()),
             "full_pose": None if self.full_pose is None else self.full_pose.to_dict(),
         }
+
+
+@dataclass(frozen=True)
+class StepRecord:
+    """One step of a stored diagnosis: the effect added, its joints and the candidates ranked
+    at that step."""
+
+    effect: str
+    joints: tuple[int, ...]
+    candidates: tuple[Candidate, ...] = ()
+
+
+@dataclass(frozen=True)
+class DiagnosisRecord(EffectsFound):
+    """A diagnosis read back from its JSON document (:func:`load_diagnosis`): the typed,
+    read-only part that readers of stored diagnoses (the blind benchmark's scorer) use.
+
+    Attributes:
+        steps: the effects added, in order (``effects``, ``top_effect`` as on
+            :class:`Diagnosis`).
+        nominal_rms, final_rms: withheld RMS after registration and with the final model
+            (NaN for a refusal).
+        unexplained: as in :class:`Diagnosis`.
+        final_parameters: the final model's effect parameters with their intervals.
+        error: why the diagnosis refused the data (a document written for a refusal), or None.
+    """
+
+    steps: tuple[StepRecord, ...]
+    nominal_rms: float
+    final_rms: float
+    unexplained: bool | None
+    final_parameters: tuple[ParameterEstimate, ...] = ()
+    error: str | None = None
+
+
+def _number(x: Any) -> float:
+    """A JSON number, null (NaN or an infinity written by :func:`zrp.jsonio.to_jsonable`) as
+    NaN."""
+    return math.nan if x is None else float(x)
+
+
+def _candidate(c: Mapping[str, Any]) -> Candidate:
+    return Candidate(c["effect"], tuple(int(j) for j in c["joints"]), int(c["n_params"]),
+                     _number(c["cv_rms"]), _number(c["bic_delta"]), float(c["p_value"]),
+                     bool(c["significant"]), str(c.get("note", "")))
+
+
+def _parameter(p: Mapping[str, Any]) -> ParameterEstimate:
+    ci = p.get("ci95_effect")
+    return ParameterEstimate(p["name"], p["effect"], int(p["joint"]), p["unit"],
+                             float(p["value"]), float(p["stderr"]),
+                             (_number(p["ci95"][0]), _number(p["ci95"][1])),
+                             None if ci is None else (_number(ci[0]), _number(ci[1])))
+
+
+def _step(s: Mapping[str, Any]) -> StepRecord:
+    return StepRecord(s["effect"], tuple(int(j) for j in s.get("joints", ())),
+                      tuple(_candidate(c) for c in s.get("candidates", ())))
+
+
+def load_diagnosis(source: str | os.PathLike[str] | Mapping[str, Any]) -> DiagnosisRecord:
+    """Read a diagnosis back from its JSON: a diagnosis.json path, or the document itself
+    (:meth:`Diagnosis.to_dict`, :func:`zrp.gap.report.diagnosis_document`, or a refusal
+    ``{"steps": [], "nominal": {"rms": NaN}, "final": {"rms": NaN}, "unexplained": None,
+    "error": ...}``). Keys a reader does not need may be missing (``candidates``,
+    ``final.parameters``, ``error``).
+
+    Raises:
+        InputError: a step, candidate or parameter the typed results refuse.
+        KeyError: the document lacks ``nominal.rms``, ``final.rms`` or a step's ``effect``.
+    """
+    doc = (source if isinstance(source, Mapping)
+           else json.loads(Path(source).read_text(encoding="utf-8")))
+    final = doc["final"]
+    return DiagnosisRecord(tuple(_step(s) for s in doc.get("steps", ())),
+                           _number(doc["nominal"]["rms"]), _number(final["rms"]),
+                           doc.get("unexplained"),
+                           tuple(_parameter(p) for p in final.get("parameters", ())),
+                           doc.get("error"))

@@ -20,7 +20,7 @@ from zrp.gap.data.csvfile import MAX_ROWS
 from zrp.gap.data.subsample import MAX_POINTS
 from zrp.gap.model.context import EFFECTS
 from zrp.gap.options import MAX_WITHHELD
-from zrp.gap.report import OUTPUT_FILES, write_outputs
+from zrp.gap.report import OUTPUT_FILES, diagnosis_document, verdict_text, write_outputs
 from zrp.model.files import load_model
 from zrp.output import OutputDir
 
@@ -146,6 +146,6 @@ def _run(args: argparse.Namespace) -> int:
             with contextlib.suppress(OSError):
                 out_dir.rmdir()
         raise
-    text = diag.verdict + "\n" + "\n".join(f"wrote {f}" for f in files)
-    emit(args, diag.to_dict(), text)
+    text = verdict_text(diag) + "\n" + "\n".join(f"wrote {f}" for f in files)
+    emit(args, diagnosis_document(diag), text)
     return 0

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from zrp.gap import diagnose, load_measurements
-from zrp.gap.report import write_outputs
+from zrp.gap.report import diagnosis_document, write_outputs
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["RobotTask", "diagnose_robot", "robot_row"]
@@ -70,4 +70,4 @@ def diagnose_robot(task: RobotTask) -> dict[str, Any]:
         warnings.simplefilter("always")
         diag = diagnose(task.model, meas, gravity_torque=tau, **task.options)
     write_outputs(diag, task.out, overwrite=True, plots=task.plots)
-    return robot_row(task.name, str(task.data), diag.to_dict())
+    return robot_row(task.name, str(task.data), diagnosis_document(diag))

@@ -1,4 +1,5 @@
-"""The verdict of a diagnosis in plain words (:attr:`zrp.gap.Diagnosis.verdict`)."""
+"""The verdict of a diagnosis in plain words (:func:`verdict_text`, a function of the
+:class:`~zrp.gap.Diagnosis`)."""
 
 from __future__ import annotations
 
