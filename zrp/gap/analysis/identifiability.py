@@ -145,13 +145,8 @@ def registration_identifiable(ctx: Context, specs: list[ParamSpec], poses: NDArr
     if not data_bad:
         return specs, theta0
     _, Jr = Problem(reference.context, specs, reference.poses, rb0).residual_and_jacobian(theta0)
-    structural = {i for i, _ in sequential_alias(Jr, names, fixed)}
-    limited = [(i, p) for i, p in data_bad if i not in structural or i < fixed]
-    if limited:
-        what = ", ".join(f"{names[i]} ~ {p or 'nothing'}" for i, p in limited)
-        raise InputError(
-            f"{ctx.meas.source}: the registration is not identifiable from these poses "
-            f"({what}); the joints must move enough to rotate the tool in several directions")
+    _refuse_data_limited(ctx, names, data_bad, {i for i, _ in sequential_alias(Jr, names, fixed)},
+                         fixed)
     drop = {i for i, _ in data_bad}
     warnings.warn(f"registration: {', '.join(names[i] for i in sorted(drop))} cannot be told "
                   "apart from the other registration parameters for this robot (structural); "
@@ -159,6 +154,18 @@ def registration_identifiable(ctx: Context, specs: list[ParamSpec], poses: NDArr
                   GapWarning, stacklevel=2)
     keep = [i for i in range(len(specs)) if i not in drop]
     return [specs[i] for i in keep], theta0[keep]
+
+
+def _refuse_data_limited(ctx: Context, names: list[str], data_bad: list[tuple[int, str]],
+                         structural: set[int], fixed: int) -> None:
+    """Raise when a registration parameter these data cannot identify is not structurally
+    aliased (richer poses would identify it), or is one of the ``fixed`` base-frame ones."""
+    limited = [(i, p) for i, p in data_bad if i not in structural or i < fixed]
+    if limited:
+        what = ", ".join(f"{names[i]} ~ {p or 'nothing'}" for i, p in limited)
+        raise InputError(
+            f"{ctx.meas.source}: the registration is not identifiable from these poses "
+            f"({what}); the joints must move enough to rotate the tool in several directions")
 
 
 def _warn_still_joints(ctx: Context, poses: NDArray[np.int64]) -> None:
@@ -180,21 +187,30 @@ def survey(ctx: Context, reg: FitResult,
     structure, are to blame: a warning names them)."""
     _warn_still_joints(ctx, reg.poses)
     ref_ctx = reference.context
-    reports: dict[str, list] = {}
+    reports: dict[str, list[Aliased]] = {}
     union: list[ParamSpec] = []
     ref_union: list[ParamSpec] = []
     for eff, (specs, _) in specs_of.items():
         if not specs:
             continue
-        _, rep = check_identifiable(ctx, reg, specs)
-        reports[eff] = rep
+        _, reports[eff] = check_identifiable(ctx, reg, specs)
         union += specs
         ref_union += effect_parameters(ref_ctx, eff)[0]
     # all effects together, on the data and on the rich reference poses
     _, rep = check_identifiable(ctx, reg, union)
     _, ref_rep = check_identifiable(ref_ctx, reference.fit_like(reg), ref_union)
-    structural = {a.name for a in ref_rep if a.dropped}
-    limited: dict[str, list[str]] = {eff: [] for eff in reports}
+    limited = _data_limited(rep, {a.name for a in ref_rep if a.dropped}, reports)
+    return {eff: EffectIdentifiability(tuple(a for a in rep if a.dropped),
+                                       tuple(a for a in rep if not a.dropped),
+                                       tuple(limited[eff]))
+            for eff, rep in reports.items()}
+
+
+def _data_limited(rep: list[Aliased], structural: set[str], effects: Mapping[str, object]
+                  ) -> dict[str, list[str]]:
+    """Per effect, the dropped parameters that are not ``structural`` (richer poses would
+    identify them), with one warning per effect (attributed to the caller of :func:`survey`)."""
+    limited: dict[str, list[str]] = {eff: [] for eff in effects}
     by_effect: dict[str, list[str]] = {}
     for a in rep:
         if a.dropped and a.name not in structural:
@@ -204,11 +220,8 @@ def survey(ctx: Context, reg: FitResult,
     for eff, items in by_effect.items():
         warnings.warn(f"rank-deficient data: {'; '.join(items)} ({eff}) cannot be identified "
                       "from these poses although richer poses would identify them; move the "
-                      "joints over wider ranges", GapWarning, stacklevel=2)
-    return {eff: EffectIdentifiability(tuple(a for a in rep if a.dropped),
-                                       tuple(a for a in rep if not a.dropped),
-                                       tuple(limited[eff]))
-            for eff, rep in reports.items()}
+                      "joints over wider ranges", GapWarning, stacklevel=3)
+    return limited
 
 
 def geometric_overlap(ctx: Context, current: FitResult, correction: F64) -> float:

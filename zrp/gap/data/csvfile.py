@@ -34,9 +34,7 @@ import csv
 import math
 import os
 import warnings
-from array import array
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -45,13 +43,8 @@ from tqdm import tqdm
 
 from zrp.arguments import check_int
 from zrp.errors import InputError
-from zrp.gap.data.measurements import (
-    FRAMES,
-    OPTIONAL_SCALARS,
-    QUAT_COLUMNS,
-    DataWarning,
-    Measurements,
-)
+from zrp.gap.data.csvrows import Accumulator, Columns, Header, check_header, parse_row
+from zrp.gap.data.measurements import FRAMES, DataWarning, Measurements
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["MAX_ROWS", "load_measurements"]
@@ -63,157 +56,6 @@ MAX_ROWS = 2_000_000
 F64 = NDArray[np.float64]
 #: plausible temperatures, deg C.
 TEMP_RANGE = (-60.0, 150.0)
-
-
-@dataclass(frozen=True)
-class _Header:
-    """The checked header: column positions and which optional groups are present."""
-
-    col: dict[str, int]
-    qcols: list[str]
-    dcols: list[str]
-    scalars: list[str]
-    quat: bool
-    dirs: bool
-
-    @property
-    def n_fields(self) -> int:
-        return len(self.col)
-
-
-@dataclass(frozen=True)
-class _Columns:
-    """The parsed values, one entry per data row."""
-
-    pose: NDArray
-    point: NDArray
-    q: F64
-    xyz: F64
-    scalars: dict[str, F64]
-    quat: F64 | None
-    dirs: F64 | None
-    lines: NDArray[np.int64]
-
-
-def _number(text: str, src: str, line: int, col: str) -> float:
-    s = text.strip()
-    if s == "":
-        raise InputError(f"{src} line {line}: column {col} is empty; expected a number")
-    try:
-        v = float(s)
-    except ValueError:
-        raise InputError(f"{src} line {line}: column {col} is {s!r}; expected a number") from None
-    if not math.isfinite(v):
-        raise InputError(f"{src} line {line}: column {col} is {s!r}; expected a finite number")
-    return v
-
-
-def _check_header(header: list[str], src: str, model: Manipulator) -> _Header:
-    n = model.n
-    qcols = [f"q{k}" for k in range(1, n + 1)]
-    dcols = [f"dir{k}" for k in range(1, n + 1)]
-    required = ["pose", *qcols, "x", "y", "z"]
-    allowed = [*required, "point", *QUAT_COLUMNS, *OPTIONAL_SCALARS, *dcols]
-    dup = sorted({c for c in header if header.count(c) > 1})
-    if dup:
-        raise InputError(f"{src} line 1: column(s) {', '.join(dup)} appear more than once")
-    unknown = [c for c in header if c not in allowed]
-    if unknown:
-        extra_q = [c for c in unknown if c.startswith("q") and c[1:].isdigit()]
-        hint = (f" (the model {model.name!r} has {n} joints: q1..q{n})" if extra_q else "")
-        raise InputError(f"{src} line 1: unknown column(s) {', '.join(unknown)}{hint}; valid "
-                         f"columns are {', '.join(allowed)}")
-    missing = [c for c in required if c not in header]
-    if missing:
-        raise InputError(f"{src} line 1: missing column(s) {', '.join(missing)}; required: "
-                         f"{', '.join(required)} (q in rad, or deg with deg=True; x, y, z in "
-                         f"{model.length_unit})")
-    quat_given = [c for c in QUAT_COLUMNS if c in header]
-    if quat_given and len(quat_given) != 4:
-        raise InputError(f"{src} line 1: orientation needs all of qw, qx, qy, qz; got only "
-                         f"{', '.join(quat_given)}")
-    dir_given = [c for c in dcols if c in header]
-    if dir_given and len(dir_given) != n:
-        raise InputError(f"{src} line 1: approach directions need all of {', '.join(dcols)}; "
-                         f"got only {', '.join(dir_given)}")
-    col = {c: i for i, c in enumerate(header)}
-    return _Header(col, qcols, dcols, [c for c in OPTIONAL_SCALARS if c in col],
-                   bool(quat_given), bool(dir_given))
-
-
-def _label(rec: list[str], i: int, name: str, what: str, src: str, lineno: int) -> str:
-    text = rec[i].strip()
-    if not text:
-        raise InputError(f"{src} line {lineno}: column {name} is empty; expected {what}")
-    return text
-
-
-def _quaternion(rec: list[str], h: _Header, src: str, lineno: int) -> list[float]:
-    quat = [_number(rec[h.col[c]], src, lineno, c) for c in QUAT_COLUMNS]
-    nq = float(np.linalg.norm(quat))
-    if abs(nq - 1.0) > 1e-3:
-        raise InputError(f"{src} line {lineno}: orientation (qw, qx, qy, qz) has norm "
-                         f"{nq:.6g}; expected a unit quaternion")
-    return quat
-
-
-def _direction(rec: list[str], h: _Header, src: str, lineno: int) -> list[float]:
-    out = []
-    for c in h.dcols:
-        v = _number(rec[h.col[c]], src, lineno, c)
-        if v not in (-1.0, 0.0, 1.0):
-            raise InputError(f"{src} line {lineno}: column {c} is {v:g}; expected -1, 0 or +1")
-        out.append(v)
-    return out
-
-
-def _parse_row(c: _Accumulator, lineno: int, rec: list[str], h: _Header, header: list[str],
-               src: str) -> None:
-    """Check one data record and append its values to ``c``."""
-    if len(rec) != h.n_fields:
-        raise InputError(f"{src} line {lineno}: {len(rec)} fields, but the header has "
-                         f"{h.n_fields} ({', '.join(header)})")
-    c.lines.append(lineno)
-    c.pose.append(_label(rec, h.col["pose"], "pose", "an id", src, lineno))
-    if "point" in h.col:
-        label = _label(rec, h.col["point"], "point", "a label", src, lineno)
-        c.point.append(c.labels.setdefault(label, label))  # one string object per label
-    c.q.extend([_number(rec[h.col[q]], src, lineno, q) for q in h.qcols])
-    c.xyz.extend([_number(rec[h.col[x]], src, lineno, x) for x in "xyz"])
-    for name in h.scalars:
-        c.scalars[name].append(_number(rec[h.col[name]], src, lineno, name))
-    if h.quat:
-        c.quat.extend(_quaternion(rec, h, src, lineno))
-    if h.dirs:
-        c.dirs.extend(_direction(rec, h, src, lineno))
-
-
-class _Accumulator:
-    """Parsed values, appended row by row into compact arrays (8 bytes a number), so that a
-    file of millions of rows is read in one pass with memory linear in its numbers."""
-
-    def __init__(self, h: _Header) -> None:
-        self.pose: list[str] = []
-        self.point: list[str] = []
-        self.labels: dict[str, str] = {}
-        self.q, self.xyz, self.quat, self.dirs = (array("d") for _ in range(4))
-        self.scalars = {name: array("d") for name in h.scalars}
-        self.lines = array("q")
-
-    def columns(self, h: _Header) -> _Columns:
-        r, n = len(self.lines), len(h.qcols)
-
-        def mat(a: array, width: int) -> F64:
-            return np.frombuffer(a, dtype=float).reshape(r, width).copy()
-
-        point = (np.array(self.point, dtype=object) if self.point
-                 else np.full(r, "p", dtype=object))
-        return _Columns(np.array(self.pose, dtype=object), point, mat(self.q, n),
-                        mat(self.xyz, 3),
-                        {k: np.frombuffer(v, dtype=float).copy() for k, v in self.scalars.items()},
-                        mat(self.quat, 4) if h.quat else None,
-                        mat(self.dirs, n) if h.dirs else None,
-                        np.frombuffer(self.lines, dtype=np.int64).copy())
 
 
 def _encoding(path: Path) -> str:
@@ -258,50 +100,75 @@ def _undecodable_line(src: str) -> int | None:
     return None
 
 
+class _Reader:
+    """One pass over the records: comments and blank records skipped, the header checked, then
+    each data row checked and appended."""
+
+    def __init__(self, src: str, model: Manipulator, max_rows: int | None) -> None:
+        self.src, self.model, self.max_rows = src, model, max_rows
+        self.header: list[str] | None = None
+        self.h: Header | None = None
+        self.acc: Accumulator | None = None
+        self.comments: list[int] = []
+        self.seen_text = False
+
+    def feed(self, lineno: int, rec: list[str]) -> bool:
+        """Take one record; True when it was a data row (appended)."""
+        if not rec or all(not c.strip() for c in rec):
+            self.seen_text = self.seen_text or bool(rec)
+            return False
+        self.seen_text = True
+        if rec[0].lstrip().startswith("#"):
+            if self.header is not None:
+                self.comments.append(lineno)
+            return False
+        if self.header is None or self.h is None or self.acc is None:
+            self.header = [c.strip() for c in rec]
+            self.h = check_header(self.header, self.src, self.model)
+            self.acc = Accumulator(self.h)
+            return False
+        if self.max_rows is not None and len(self.acc.lines) >= self.max_rows:
+            raise InputError(
+                f"{self.src} line {lineno}: more than max_rows={self.max_rows} data rows (about "
+                "0.7 GB of memory per million rows); split the file or thin it (every k-th "
+                "pose), or pass a larger max_rows (--max-rows on the command line)")
+        parse_row(self.acc, lineno, rec, self.h, self.header, self.src)
+        return True
+
+    @property
+    def rows(self) -> int:
+        """Data rows appended so far."""
+        return 0 if self.acc is None else len(self.acc.lines)
+
+    def parsed(self) -> tuple[list[str], Header, Accumulator]:
+        """The header and the rows, once the file has a header line."""
+        if self.header is None or self.h is None or self.acc is None:
+            required = ", ".join(["pose", *[f"q{k}" for k in range(1, self.model.n + 1)],
+                                  "x", "y", "z"])
+            if not self.seen_text:
+                raise InputError(f"{self.src}: the file is empty; expected a header line with "
+                                 f"the columns {required} (optional: point, t, temp, load, "
+                                 "qw..qz, dir1..)")
+            raise InputError(f"{self.src}: no header line (only comments or empty fields); "
+                             f"expected a header line with the columns {required}")
+        return self.header, self.h, self.acc
+
+
 def _read(path: Path, src: str, model: Manipulator, progress: bool, max_rows: int | None
-          ) -> tuple[list[str], _Header, _Columns]:
+          ) -> tuple[list[str], Header, Columns]:
     """Stream the file once: the header, then each data row checked and appended."""
-    required = ["pose", *[f"q{k}" for k in range(1, model.n + 1)], "x", "y", "z"]
-    header: list[str] | None = None
-    h: _Header | None = None
-    acc: _Accumulator | None = None
-    comments: list[int] = []
-    seen_text = False
+    reader = _Reader(src, model, max_rows)
     bar = tqdm(desc=f"reading {path.name}", unit=" rows", disable=not progress,
                mininterval=1.0, leave=False)
     with open(path, newline="", encoding=_encoding(path)) as fh, bar:
         for lineno, rec in _records(fh, src):
-            if not rec or all(not c.strip() for c in rec):
-                seen_text = seen_text or bool(rec)
-                continue
-            seen_text = True
-            if rec[0].lstrip().startswith("#"):
-                if header is not None:
-                    comments.append(lineno)
-                continue
-            if header is None:
-                header = [c.strip() for c in rec]
-                h = _check_header(header, src, model)
-                acc = _Accumulator(h)
-                continue
-            if max_rows is not None and len(acc.lines) >= max_rows:  # type: ignore[union-attr]
-                raise InputError(
-                    f"{src} line {lineno}: more than max_rows={max_rows} data rows (about 0.7 GB "
-                    "of memory per million rows); split the file or thin it (every k-th pose), "
-                    "or pass a larger max_rows (--max-rows on the command line)")
-            _parse_row(acc, lineno, rec, h, header, src)  # type: ignore[arg-type]
-            if len(acc.lines) % 10000 == 0:  # type: ignore[union-attr]
+            if reader.feed(lineno, rec) and reader.rows % 10000 == 0:
                 bar.update(10000)
-    if header is None or h is None or acc is None:
-        if not seen_text:
-            raise InputError(f"{src}: the file is empty; expected a header line with the "
-                             f"columns {', '.join(required)} (optional: point, t, temp, load, "
-                             "qw..qz, dir1..)")
-        raise InputError(f"{src}: no header line (only comments or empty fields); expected a "
-                         f"header line with the columns {', '.join(required)}")
-    if comments:
-        shown = ", ".join(map(str, comments[:10])) + (" ..." if len(comments) > 10 else "")
-        warnings.warn(f"{src}: {len(comments)} comment line(s) starting with # skipped (lines "
+    header, h, acc = reader.parsed()
+    if reader.comments:
+        c = reader.comments
+        shown = ", ".join(map(str, c[:10])) + (" ..." if len(c) > 10 else "")
+        warnings.warn(f"{src}: {len(c)} comment line(s) starting with # skipped (lines "
                       f"{shown})", DataWarning, stacklevel=3)
     if not acc.lines:
         raise InputError(f"{src}: no data rows after the header; expected one row per "

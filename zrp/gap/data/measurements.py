@@ -95,6 +95,25 @@ class Measurements:
     source: str = "measurements"
 
     def __post_init__(self) -> None:
+        q = self._checked_q()
+        r, n = q.shape
+        lines = self._set_labels(r)
+        if self.frame not in FRAMES:
+            raise InputError(f"frame: {self.frame!r} is not a frame; expected one of {FRAMES}")
+        for name, arr, shape in (("q", q, (r, n)), ("xyz", self.xyz, (r, 3))):
+            object.__setattr__(self, name, _freeze(self._bounded(name, arr, shape, lines)))
+        for name in OPTIONAL_SCALARS:
+            object.__setattr__(self, name, _opt(getattr(self, name), (r,), name))
+        object.__setattr__(self, "quat", _opt(self.quat, (r, 4), "quat"))
+        object.__setattr__(self, "direction", _opt(self.direction, (r, n), "direction"))
+        if self.direction is not None and not np.all(np.isin(self.direction, (-1.0, 0.0, 1.0))):
+            i = int(np.argwhere(~np.isin(self.direction, (-1.0, 0.0, 1.0)))[0][0])
+            raise InputError(f"{self.source} line {lines[i]}: dir columns must be -1, 0 or +1")
+        self._check_structure()
+
+    # ---- construction -------------------------------------------------------------------
+    def _checked_q(self) -> F64:
+        """q as numbers of shape (R, n), R >= 1 (xyz must be numbers too)."""
         try:
             q = np.array(self.q, dtype=float)
             np.array(self.xyz, dtype=float)
@@ -103,7 +122,11 @@ class Measurements:
         if q.ndim != 2 or q.shape[0] == 0:
             raise InputError(f"{self.source}: q: expected shape (R, n) with R >= 1 rows, got "
                              f"{q.shape}")
-        r, n = q.shape
+        return q
+
+    def _set_labels(self, r: int) -> NDArray[np.int64]:
+        """Freeze the pose ids, point labels and source lines of the ``r`` rows (point "p" and
+        lines 2.. when not given); returns the lines."""
         pose = np.array([str(p) for p in np.asarray(self.pose).ravel()], dtype=object)
         point = (np.array(["p"] * r, dtype=object) if self.point is None else
                  np.array([str(p) for p in np.asarray(self.point).ravel()], dtype=object))
@@ -117,27 +140,22 @@ class Measurements:
         object.__setattr__(self, "lines", _freeze(lines))
         object.__setattr__(self, "pose", _freeze(pose))
         object.__setattr__(self, "point", _freeze(point))
-        if self.frame not in FRAMES:
-            raise InputError(f"frame: {self.frame!r} is not a frame; expected one of {FRAMES}")
-        for name, arr, shape in (("q", q, (r, n)), ("xyz", self.xyz, (r, 3))):
-            a = np.array(arr, dtype=float)
-            if a.shape != shape:
-                raise InputError(f"{self.source}: {name}: expected shape {shape}, got {a.shape}")
-            bad = ~(np.abs(a) <= MAX_LENGTH)  # NaN fails the comparison too
-            if bad.any():
-                i, c = (int(v) for v in np.argwhere(bad)[0])
-                col = f"q{c + 1}" if name == "q" else "xyz"[c]
-                raise InputError(f"{self.source} line {lines[i]}: column {col} is {a[i, c]}; "
-                                 f"expected a finite number of magnitude up to {MAX_LENGTH:g}")
-            object.__setattr__(self, name, _freeze(a))
-        for name in OPTIONAL_SCALARS:
-            object.__setattr__(self, name, _opt(getattr(self, name), (r,), name))
-        object.__setattr__(self, "quat", _opt(self.quat, (r, 4), "quat"))
-        object.__setattr__(self, "direction", _opt(self.direction, (r, n), "direction"))
-        if self.direction is not None and not np.all(np.isin(self.direction, (-1.0, 0.0, 1.0))):
-            i = int(np.argwhere(~np.isin(self.direction, (-1.0, 0.0, 1.0)))[0][0])
-            raise InputError(f"{self.source} line {lines[i]}: dir columns must be -1, 0 or +1")
-        self._check_structure()
+        return lines
+
+    def _bounded(self, name: str, arr: ArrayLike, shape: tuple[int, int],
+                 lines: NDArray[np.int64]) -> F64:
+        """``q`` or ``xyz`` of the given shape, every value finite and at most MAX_LENGTH in
+        magnitude (the error names the first bad line and column)."""
+        a = np.array(arr, dtype=float)
+        if a.shape != shape:
+            raise InputError(f"{self.source}: {name}: expected shape {shape}, got {a.shape}")
+        bad = ~(np.abs(a) <= MAX_LENGTH)  # NaN fails the comparison too
+        if bad.any():
+            i, c = (int(v) for v in np.argwhere(bad)[0])
+            col = f"q{c + 1}" if name == "q" else "xyz"[c]
+            raise InputError(f"{self.source} line {lines[i]}: column {col} is {a[i, c]}; "
+                             f"expected a finite number of magnitude up to {MAX_LENGTH:g}")
+        return a
 
     # ---- structure ----------------------------------------------------------------------
     def _check_structure(self) -> None:

@@ -62,6 +62,15 @@ def _candidate_specs(eng: Engine, effect: str, start: dict[str, float]) -> list:
     return specs
 
 
+def _implausible_groups(eng: Engine, mf: ModelFit, first: int) -> set[str]:
+    """The joint groups of the parameters from ``first`` on whose values are not the effect: a
+    negative lag, friction, compliance or mode, a mode with zeta outside (0, 1) or a frequency
+    the sampling cannot see."""
+    rate = eng.traj.rate_hz
+    return {group_key(s) for s, v in zip(mf.specs[first:], mf.result.theta[first:], strict=True)
+            if v <= 0.0 or not plausible(s.name, float(v), rate)}
+
+
 def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                folds: Sequence[I64], alpha: float) -> Trial:
     """Fit ``effect`` on top of ``current``: identifiable parameters, Wald pruning of its
@@ -81,12 +90,8 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                  current.result.theta[:eng.nreg])
     pw = wald_groups(mf.result, first, tested)
     sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
-    if effect in POSITIVE:  # a negative lag, friction, compliance or mode is not that effect;
-        # nor is a mode with zeta outside (0, 1) or a frequency the sampling cannot see
-        rate = eng.traj.rate_hz
-        sig -= {group_key(s) for s, v in zip(mf.specs[first:], mf.result.theta[first:],
-                                             strict=True)
-                if v <= 0.0 or not plausible(s.name, float(v), rate)}
+    if effect in POSITIVE:
+        sig -= _implausible_groups(eng, mf, first)
     if not sig:
         return Trial(effect, None, note="no joint group significant", aliased=al)
     if len(sig) < len(pw):
