@@ -28,6 +28,7 @@ from zrp.gap.fit.uncertainty import robust_covariance
 from zrp.gap.model.context import Context
 from zrp.gap.model.effects import registration_parameters
 from zrp.gap.report import diagnosis_document, verdict_text
+from zrp.gap.results import load_diagnosis
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")
@@ -66,6 +67,15 @@ def test_verdict_tables_and_json_describe_the_final_model(tmp_path):
     assert {p["name"] for p in out["final"]["parameters"]} == {
         s.name for s in d.final_fit.specs[len(d.registration):]}
     write_outputs(d, tmp_path, plots=False)
+    # read back from diagnosis.json: the typed record of what the benchmark's scorer uses
+    rec = load_diagnosis(tmp_path / "diagnosis.json")
+    assert rec.effects == d.effects and rec.error is None
+    assert (rec.nominal_rms, rec.final_rms, rec.unexplained) == (
+        d.nominal.rms, d.final.rms, d.unexplained)
+    assert [s.joints for s in rec.steps] == [s.joints for s in d.steps]
+    assert [(c.effect, c.significant, c.p_value) for c in rec.steps[0].candidates] == [
+        (c.effect, c.significant, c.p_value) for c in d.steps[0].candidates]
+    assert [p.to_dict() for p in rec.final_parameters] == out["final"]["parameters"]
     md = (tmp_path / "report.md").read_text(encoding="utf-8")
     assert "added?" not in md and "| passes all tests | added at this step |" in md
     step1 = md.split("At step 1:")[1].split("\n\n")[1]
