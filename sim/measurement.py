@@ -37,7 +37,7 @@ from tqdm.auto import tqdm
 from sim.effects import HiddenEffects
 from sim.real_robot import RealRobot
 from zrp.errors import InputError, OutputExistsError
-from zrp.gap.data import Measurements
+from zrp.gap.data.measurements import Measurements
 from zrp.kinematics.ik import track_trajectory
 from zrp.model.manipulator import Manipulator
 from zrp.output import atomic_path, check_writable, write_json

@@ -14,11 +14,11 @@ from mjcf import MJCFOptions, build, inverse_dynamics_torques
 from sim.measurement import Instrument
 from sim.motion_measure import parse_motion_effects
 from sim.motion_robot import MotionEffects, execute_trajectory
+from zrp.gap.model.problem import Problem
 from zrp.gap.motion import Trajectory, diagnose_motion
 from zrp.gap.motion.effects import MotionContext, effect_columns, linearise, plausible
 from zrp.gap.motion.kernels import mode_response
 from zrp.gap.motion.paths import exercise_moves
-from zrp.gap.problem import Problem
 from zrp.rotations import matrix_from_rotvec
 
 SIGMA = 0.02  # mm per coordinate

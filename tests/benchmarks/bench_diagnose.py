@@ -21,8 +21,9 @@ from _report import Report, add_output_arguments, output_path
 
 import zrp
 from zrp.gap import Injection, diagnose, synthesize
-from zrp.gap.effects import Context, registration_parameters
-from zrp.gap.leastsq import fit, initial_registration
+from zrp.gap.fit.leastsq import fit, initial_registration
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import registration_parameters
 from zrp.kinematics import uniform_joint_values
 
 GOAL_S = 10.0

@@ -24,8 +24,9 @@ import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
 from sim.measurement import random_instrument
 from sim.motion_robot import MotionEffects, execute_trajectory
-from zrp.gap.effects import Context, registration_parameters
-from zrp.gap.leastsq import fit, initial_registration
+from zrp.gap.fit.leastsq import fit, initial_registration
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import registration_parameters
 from zrp.gap.motion import diagnose_motion
 from zrp.gap.motion.paths import exercise_moves
 

@@ -19,10 +19,10 @@ import numpy as np
 from _report import Report, add_output_arguments, output_path
 
 import zrp
+from zrp.kinematics.identification import apply_parameters, parameter_jacobian, parameter_space
 from zrp.manufacturing.deviation import trajectory_deviation
 from zrp.manufacturing.perturb import Perturbation
 from zrp.manufacturing.population import monte_carlo
-from zrp.manufacturing.sensitivity import apply_parameters, parameter_jacobian, parameter_space
 from zrp.manufacturing.study import PAPER_PARAMETERS, PAPER_XI
 from zrp.manufacturing.tolerance import Tolerances
 from zrp.paper.example import run_paper_example

@@ -18,7 +18,7 @@ figure, measured value, target, the baseline of the same run and the ratio:
 * the full diagnosis of the IRB 120 laser-tracker data in ../shared (2,946 points) and of its
   first 999 points; baselines: the registration fit alone, the same diagnosis with the
   Levenberg-Marquardt fits on the tall Jacobian (the former: MINPACK's own QR of it instead
-  of the QR-compressed problem, zrp.gap.problem.compressed) and on OpenBLAS's own threads
+  of the QR-compressed problem, zrp.gap.model.problem.compressed) and on OpenBLAS's own threads
   (the former; zrp/blas.py) (skipped without ../shared);
 * the blind benchmark's simulation of a 200-pose scenario; baselines: the same poses measured
   by forward kinematics only, and the former procedure (every move to a pre-pose simulated).
@@ -242,10 +242,12 @@ def diagnosis() -> None:
     import contextlib
 
     from zrp.blas import blas_threads
-    from zrp.gap import diagnose, leastsq, load_measurements, pipeline
-    from zrp.gap.effects import Context, registration_parameters
-    from zrp.gap.leastsq import fit, initial_registration
-    from zrp.gap.problem import compressed
+    from zrp.gap import diagnose, load_measurements, pipeline
+    from zrp.gap.fit import leastsq
+    from zrp.gap.fit.leastsq import fit, initial_registration
+    from zrp.gap.model.context import Context
+    from zrp.gap.model.effects import registration_parameters
+    from zrp.gap.model.problem import compressed
 
     model = zrp.load_model(str(SHARED / "irb120.toml"))
     lines = (SHARED / "measurements.csv").read_text(encoding="utf-8").splitlines()

@@ -1,6 +1,6 @@
 """The first-order error budget of given tolerances along a trajectory.
 
-From the identification Jacobian (:func:`zrp.manufacturing.sensitivity.parameter_jacobian`):
+From the identification Jacobian (:func:`zrp.kinematics.identification.parameter_jacobian`):
 the worst case over the tolerance box (:func:`worst_case_bound`), each parameter's share of the
 deviation variance (:func:`contributions`, ranked) and both together with an optional Monte
 Carlo comparison (:func:`tolerance_report`).
@@ -16,7 +16,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q
-from zrp.manufacturing.sensitivity import parameter_jacobian
+from zrp.kinematics.identification import parameter_jacobian
 from zrp.manufacturing.tolerance import Tolerances
 from zrp.model.manipulator import Manipulator
 

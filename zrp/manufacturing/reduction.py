@@ -29,13 +29,13 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.arguments import check_float
 from zrp.errors import InputError
+from zrp.kinematics.identification import parameter_jacobian
 from zrp.manufacturing._checks import check_percentile
 from zrp.manufacturing.budget import worst_case_bound
 from zrp.manufacturing.checkpoint import OrderedMerge, load_merge, run_identity, save_merge
 from zrp.manufacturing.chunks import ChunkResult, ChunkTask, run_chunk
 from zrp.manufacturing.histogram import Histogram, geometric_edges
 from zrp.manufacturing.population import DEFAULT_PERCENTILES, chunk_tasks
-from zrp.manufacturing.sensitivity import parameter_jacobian
 from zrp.manufacturing.tolerance import Tolerances, percentile_ci_ranks
 from zrp.model.manipulator import Manipulator
 from zrp.tasks import map_tasks
