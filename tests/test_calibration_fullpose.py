@@ -17,7 +17,7 @@ from zrp.cli.app import main
 from zrp.errors import InputError
 from zrp.gap import Measurements, diagnose, load_measurements
 from zrp.kinematics import uniform_joint_values
-from zrp.manufacturing.sensitivity import axis_tangents
+from zrp.kinematics.identification import axis_tangents
 
 PUMA = zrp.load_model("puma")
 TOOLS = np.array([(50.0, 0.0, 30.0), (-40.0, 60.0, 30.0), (0.0, -70.0, 40.0)])

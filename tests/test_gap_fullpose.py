@@ -1,4 +1,4 @@
-"""Full-pose identification (zrp.gap.fullpose, issue 11): measured orientations beside the
+"""Full-pose identification (zrp.gap.fit.fullpose, issue 11): measured orientations beside the
 positions, each weighted by its own noise.
 
 References: the synthetic robot is the nominal model with its axis tilted exactly
@@ -14,11 +14,12 @@ from scipy.spatial.transform import Rotation
 import zrp
 from zrp.errors import InputError
 from zrp.gap import Measurements
-from zrp.gap.effects import Context, effect_parameters, registration_parameters
-from zrp.gap.fullpose import fit_full_pose, orientation_residual, pose_rotations
-from zrp.gap.problem import Problem
+from zrp.gap.fit.fullpose import fit_full_pose, orientation_residual, pose_rotations
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
+from zrp.gap.model.problem import Problem
 from zrp.kinematics import uniform_joint_values
-from zrp.manufacturing.sensitivity import axis_tangents
+from zrp.kinematics.identification import axis_tangents
 
 PUMA = zrp.load_model("puma")
 TILT = 1.0e-3          # rad, axis 6 towards its first tangent

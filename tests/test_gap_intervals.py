@@ -11,14 +11,15 @@ import pytest
 import zrp
 from zrp.errors import InputError
 from zrp.gap import Injection, Measurements, diagnose, synthesize, write_outputs
-from zrp.gap.effects import Context, effect_parameters, registration_parameters
-from zrp.gap.leastsq import fit, initial_registration
-from zrp.gap.uncertainty import (
+from zrp.gap.fit.leastsq import fit, initial_registration
+from zrp.gap.fit.uncertainty import (
     interval_covariance,
     jackknife_covariance,
     robust_covariance,
     simultaneous_z,
 )
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")

@@ -14,11 +14,11 @@ from mjcf import MJCFOptions, build, inverse_dynamics_torques
 from sim.robot.instrument import Instrument
 from sim.robot.motion import MotionEffects, execute_trajectory
 from sim.robot.motion_measure import parse_motion_effects
+from zrp.gap.model.problem import Problem
 from zrp.gap.motion import Trajectory, diagnose_motion
 from zrp.gap.motion.effects import MotionContext, effect_columns, linearise, plausible
 from zrp.gap.motion.kernels import mode_response
 from zrp.gap.motion.paths import exercise_moves
-from zrp.gap.problem import Problem
 from zrp.rotations import matrix_from_rotvec
 
 SIGMA = 0.02  # mm per coordinate

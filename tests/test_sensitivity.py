@@ -7,7 +7,7 @@ import pytest
 
 from zrp import end_effector_pose, jacobian, load_model
 from zrp.errors import InputError
-from zrp.manufacturing.sensitivity import (
+from zrp.kinematics.identification import (
     apply_parameters,
     axis_tangents,
     parameter_jacobian,
@@ -134,7 +134,7 @@ def test_bad_input():
 
 def test_pose_error_is_first_order_in_dx():
     """pose_error - J dx shrinks quadratically with the step (second-order remainder)."""
-    from zrp.manufacturing.sensitivity import pose_error
+    from zrp.kinematics.identification import pose_error
 
     model = load_model("puma")
     q = np.random.default_rng(0).uniform(-2, 2, (5, 6))

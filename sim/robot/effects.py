@@ -28,8 +28,8 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
-from zrp.gap.effects import EFFECTS as GAP_EFFECTS
-from zrp.manufacturing.sensitivity import axis_tangents, tilt_axes
+from zrp.gap.model.context import EFFECTS as GAP_EFFECTS
+from zrp.kinematics.identification import axis_tangents, tilt_axes
 from zrp.model.manipulator import Manipulator
 
 __all__ = [
@@ -249,7 +249,7 @@ def motor_map(effects: HiddenEffects, q: ArrayLike) -> F64:
 
 def true_geometry(model: Manipulator, effects: HiddenEffects) -> Manipulator:
     """The real robot's geometry at t_ref: body vectors + link_length errors, axes tilted
-    exactly by axis_misalignment (:func:`zrp.manufacturing.sensitivity.tilt_axes`)."""
+    exactly by axis_misalignment (:func:`zrp.kinematics.identification.tilt_axes`)."""
     bodies = np.array(model.bodies, dtype=float)
     for k, db in effects.link_length.items():
         bodies[k - 1] += np.asarray(db)

@@ -37,7 +37,7 @@ from sim.robot.effects import HiddenEffects
 from sim.robot.instrument import Instrument, check_number
 from sim.robot.real import Reading, RealRobot, Session
 from zrp.errors import InputError, OutputExistsError
-from zrp.gap.data import Measurements
+from zrp.gap.data.measurements import Measurements
 from zrp.kinematics.ik import track_trajectory
 from zrp.kinematics.trajectory import Circle
 from zrp.model.manipulator import Manipulator

@@ -29,10 +29,10 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
-from zrp.gap.data import Measurements
-from zrp.gap.effects import Context
-from zrp.gap.leastsq import FitResult
-from zrp.gap.problem import Problem
+from zrp.gap.data.measurements import Measurements
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.model.context import Context
+from zrp.gap.model.problem import Problem
 from zrp.gap.results import Diagnosis
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import skew

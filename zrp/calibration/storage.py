@@ -18,7 +18,7 @@ import numpy as np
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.jointmap import Term
 from zrp.errors import InputError
-from zrp.gap.fullpose import FullPoseFit
+from zrp.gap.fit.fullpose import FullPoseFit
 from zrp.jsonio import dumps
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.output import check_writable, write_text
@@ -32,7 +32,7 @@ SCHEMA_VERSION = 1
 
 def full_pose_document(fp: FullPoseFit | None) -> dict[str, Any] | None:
     """The ``full_pose`` entry: the probe rotation R_t (probe frame in the hand frame) and the
-    noise weights of a full-pose fit (:mod:`zrp.gap.fullpose`); None without one."""
+    noise weights of a full-pose fit (:mod:`zrp.gap.fit.fullpose`); None without one."""
     if fp is None or not fp.orientation:
         return None
     rt = np.asarray(fp.probe_rotation)

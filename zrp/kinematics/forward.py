@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import all_in_range, joint_limits
-from zrp.model.manipulator import Manipulator, hand_frame
+from zrp.model.manipulator import Manipulator, derived, hand_frame
 from zrp.rotations.rodrigues import (
     er_from_axis_angle,
     er_identity,
@@ -147,20 +147,22 @@ def _range_error(model: Manipulator, q: ArrayLike) -> None:
     raise AssertionError("a batch kernel declined q, but check_q accepts it")  # pragma: no cover
 
 
+def _kernel_arrays(model: Manipulator) -> tuple:
+    return K.kernel_arrays(model.axes, model.bodies, model.prismatic)
+
+
+def _pack(model: Manipulator) -> F64:
+    return K.pack_model(model.axes, model.bodies, model.prismatic)
+
+
 def _karrays(model: Manipulator) -> tuple:
-    cache = model.__dict__.get("_kernel_arrays")
-    if cache is None:
-        cache = K.kernel_arrays(model.axes, model.bodies, model.prismatic)
-        model.__dict__["_kernel_arrays"] = cache
-    return cache
+    """The batch kernels' arrays of ``model`` (built once per model)."""
+    return derived(model, "_kernel_arrays", _kernel_arrays)
 
 
 def _packed(model: Manipulator) -> F64:
-    packed = model.__dict__.get("_kernel_packed")
-    if packed is None:
-        packed = K.pack_model(model.axes, model.bodies, model.prismatic)
-        model.__dict__["_kernel_packed"] = packed
-    return packed
+    """The single-pose kernels' packed model (built once per model)."""
+    return derived(model, "_kernel_packed", _pack)
 
 
 _F64 = np.dtype(np.float64)

@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
+from zrp.kinematics.identification import ParameterSpace, parameter_jacobian, parameter_space
 from zrp.manufacturing._checks import check_distribution, nonnegative, positive_int
 from zrp.manufacturing.budget import Contribution, contributions, worst_case_bound
 from zrp.manufacturing.population import (
@@ -36,7 +37,6 @@ from zrp.manufacturing.population import (
     nonlinear_maxima,
     trajectory_arrays,
 )
-from zrp.manufacturing.sensitivity import ParameterSpace, parameter_jacobian, parameter_space
 from zrp.manufacturing.tolerance import Tolerances, draw_parameters, percentile_ci
 from zrp.model.manipulator import Manipulator
 

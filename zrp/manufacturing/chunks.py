@@ -26,9 +26,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.errors import InputError
+from zrp.kinematics.identification import parameter_jacobian
 from zrp.manufacturing.histogram import Histogram
 from zrp.manufacturing.maxima import first_order_max, nonlinear_maxima
-from zrp.manufacturing.sensitivity import parameter_jacobian
 from zrp.manufacturing.tolerance import Tolerances, draw_parameters
 from zrp.model.manipulator import Manipulator
 

@@ -10,8 +10,8 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q, end_effector_pose
+from zrp.kinematics.identification import perturbed_arrays
 from zrp.manufacturing import _mc_kernels as MK
-from zrp.manufacturing.sensitivity import perturbed_arrays
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["first_order_max", "nonlinear_maxima", "trajectory_arrays"]

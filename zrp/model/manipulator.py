@@ -16,10 +16,10 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Literal
+from typing import Literal, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -35,9 +35,11 @@ __all__ = [
     "check_limits",
     "check_unit_vector",
     "check_vector3",
+    "derived",
     "hand_frame",
 ]
 
+T = TypeVar("T")
 JOINT_TYPES = ("revolute", "prismatic")
 JointType = Literal["revolute", "prismatic"]
 
@@ -384,3 +386,12 @@ class Manipulator:
     def __repr__(self) -> str:
         kinds = "".join("P" if p else "R" for p in self.prismatic)
         return f"Manipulator({self.name!r}, {self.n} joints {kinds}, unit={self.length_unit!r})"
+
+
+def derived(model: Manipulator, key: str, build: Callable[[Manipulator], T]) -> T:
+    """``build(model)``, computed once and kept on the model under ``key`` (the model is
+    immutable): for what the layers above derive from it, e.g. the kinematics kernels' arrays."""
+    value = model.__dict__.get(key)
+    if value is None:
+        value = model.__dict__[key] = build(model)
+    return value

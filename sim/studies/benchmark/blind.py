@@ -22,6 +22,7 @@ from sim.robot.real import RealRobot
 from sim.studies.benchmark.scenarios import BenchmarkConfig, Scenario, pose_limits
 from sim.studies.trajectories import circle_poses
 from zrp.gap import Diagnosis, diagnose, load_measurements
+from zrp.gap.report import diagnosis_document
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
@@ -56,7 +57,8 @@ def diagnose_blind(csv_path: str | Path, model: Manipulator, *, mjcf_path: str |
     nominal model and the nominal MJCF - nothing about the scenario. Warnings of the diagnosis
     are kept in the returned document, not printed.
     """
-    return diagnose_blind_result(csv_path, model, mjcf_path=mjcf_path, seed=seed).to_dict()
+    return diagnosis_document(diagnose_blind_result(csv_path, model, mjcf_path=mjcf_path,
+                                                    seed=seed))
 
 
 def diagnose_blind_result(csv_path: str | Path, model: Manipulator, *,

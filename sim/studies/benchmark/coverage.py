@@ -14,7 +14,7 @@ A scenario counts as covered when every compared parameter is. With each paramet
 interval that is a simultaneous statement the intervals are not built for: even exact
 intervals cover all 4 terms of a cyclic error together only 0.95^4 = 81 % of the time. So the
 scenario count is also given with ``ci95_effect``, the diagnosis's simultaneous 95 % intervals
-over all parameters of the effect (Sidak; :func:`zrp.gap.uncertainty.simultaneous_z`), which
+over all parameters of the effect (Sidak; :func:`zrp.gap.fit.uncertainty.simultaneous_z`), which
 are built for exactly that statement.
 """
 

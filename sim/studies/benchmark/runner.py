@@ -28,6 +28,8 @@ from sim.studies.benchmark.results import BenchmarkResult
 from sim.studies.benchmark.scenarios import BenchmarkConfig, Scenario, draw_scenarios
 from sim.studies.benchmark.scoring import ScenarioScore, score
 from zrp.errors import InputError
+from zrp.gap.report import diagnosis_document
+from zrp.gap.results import load_diagnosis
 from zrp.jsonio import dumps
 from zrp.model.manipulator import Manipulator
 from zrp.output import OutputDir, write_json
@@ -66,16 +68,16 @@ def run_scenario(task: ScenarioTask) -> ScenarioScore:
     try:
         result = diagnose_blind_result(csv_path, model, mjcf_path=task.mjcf_path,
                                        seed=scn.index)
-        diag = result.to_dict()
+        doc = diagnosis_document(result)
     except InputError as exc:  # the diagnosis refused the data: report, do not crash
-        diag = {"steps": [], "nominal": {"rms": math.nan}, "final": {"rms": math.nan},
-                "unexplained": None, "error": str(exc)}
+        doc = {"steps": [], "nominal": {"rms": math.nan}, "final": {"rms": math.nan},
+               "unexplained": None, "error": str(exc)}
     diag_s = time.perf_counter() - t1
-    write_json(work / "diagnoses" / f"{csv_path.stem}.diagnosis.json", diag, overwrite=True,
+    write_json(work / "diagnoses" / f"{csv_path.stem}.diagnosis.json", doc, overwrite=True,
                indent=None)
     # only now, after the diagnosis has answered, is the truth read
     truth = json.loads(truth_path.read_text(encoding="utf-8"))
-    sc = score(model, truth, diag, config)
+    sc = score(model, truth, load_diagnosis(doc), config)
     values = dict(sc.values)
     if config.compensate and result is not None:
         values.update(compensated_column(model, scn, truth, result, task.mjcf_path,
@@ -84,28 +86,25 @@ def run_scenario(task: ScenarioTask) -> ScenarioScore:
                             "values": values})
 
 
-_TUPLES = {"hidden", "expected", "found", "tied"}
-_FLOATS = {"noise_rms", "nominal_rms", "final_rms", "ratio", "shrink", "sim_s", "diag_s",
-           "payload"}
+def _nan_if_none(v: Any) -> float:
+    return math.nan if v is None else float(v)
+
+
+#: how each field of :class:`ScenarioScore` comes back from its JSON (the others as they are).
+_FROM_JSON: dict[str, Any] = {
+    **dict.fromkeys(("hidden", "expected", "found", "tied"), tuple),
+    **dict.fromkeys(("noise_rms", "nominal_rms", "final_rms", "ratio", "shrink", "sim_s",
+                     "diag_s", "payload"), _nan_if_none),
+    "found_joints": lambda v: tuple(tuple(j) for j in v),
+    "hidden_joints": lambda v: {e: tuple(j) for e, j in v.items()},
+    "snr": lambda v: {e: _nan_if_none(x) for e, x in v.items()},
+}
 
 
 def score_from_dict(d: dict[str, Any]) -> ScenarioScore:
     """The inverse of :meth:`ScenarioScore.to_dict` (JSON nulls back to NaN)."""
     names = {f.name for f in fields(ScenarioScore)} - {"values"}
-    kw: dict[str, Any] = {}
-    for k in names:
-        v = d[k]
-        if k in _TUPLES:
-            v = tuple(v)
-        elif k == "found_joints":
-            v = tuple(tuple(j) for j in v)
-        elif k == "hidden_joints":
-            v = {e: tuple(j) for e, j in v.items()}
-        elif k == "snr":
-            v = {e: math.nan if x is None else float(x) for e, x in v.items()}
-        elif k in _FLOATS:
-            v = math.nan if v is None else float(v)
-        kw[k] = v
+    kw = {k: _FROM_JSON.get(k, lambda v: v)(d[k]) for k in names}
     values = {k: v for k, v in d.items() if k not in names and k != "excited"}
     return ScenarioScore(**kw, values=values)
 

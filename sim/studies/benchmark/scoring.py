@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -23,6 +24,7 @@ from numpy.typing import NDArray
 from sim.robot.effects import HiddenEffects, motor_map, true_geometry
 from sim.studies.benchmark.coverage import interval_coverage
 from sim.studies.benchmark.scenarios import BenchmarkConfig
+from zrp.gap.results import DiagnosisRecord, load_diagnosis
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import Manipulator
 
@@ -190,81 +192,139 @@ class ScenarioScore:
                 "diag_s": self.diag_s, "note": self.note, **self.values}
 
 
-def score(model: Manipulator, truth: dict[str, Any], diagnosis: dict[str, Any],
-          config: BenchmarkConfig) -> ScenarioScore:
-    """Judge one diagnosis (its JSON) against the truth file's content."""
+@dataclass(frozen=True)
+class _Truth:
+    """What the scorer reads from the truth file: the hidden effects, their joints and how
+    visible each is (registered signature RMS over the noise RMS)."""
+
+    eff: HiddenEffects
+    index: int
+    kind: str
+    hidden: tuple[str, ...]
+    joints: dict[str, tuple[int, ...]]
+    noise_rms: float
+    snr: dict[str, float]
+    visible: tuple[str, ...]
+
+    @property
+    def expected(self) -> tuple[str, ...]:
+        """The visible hidden effects, or ("none",)."""
+        return self.visible or ("none",)
+
+    @property
+    def accept(self) -> tuple[str, ...]:
+        """Effects that are right to name first: the visible ones; with none visible,
+        "none" or a hidden effect (found below the excitation threshold: right, not
+        required)."""
+        return self.expected if self.visible else ("none", *self.hidden)
+
+
+def _truth(model: Manipulator, truth: dict[str, Any], config: BenchmarkConfig) -> _Truth:
     eff = HiddenEffects.from_dict(truth["effects"])
     scn = truth.get("scenario", {})
     hidden = tuple(scn.get("labels", eff.active))
-    sigma = float(truth["instrument"]["noise_sigma"])
-    noise_rms = math.sqrt(3.0) * sigma
-    sig = effect_signatures(model, truth)
-    snr = {k: v / noise_rms for k, v in sig.items()}
+    noise_rms = math.sqrt(3.0) * float(truth["instrument"]["noise_sigma"])
+    snr = {k: v / noise_rms for k, v in effect_signatures(model, truth).items()}
     visible = tuple(e for e in hidden if snr.get(e, 0.0) >= config.excitation_threshold)
-    expected = visible or ("none",)
-    steps = diagnosis.get("steps", [])
-    refused = diagnosis.get("error")
-    found = ("refused",) if refused else (tuple(s["effect"] for s in steps) or ("none",))
-    found_joints = tuple(tuple(int(j) for j in s.get("joints", [])) for s in steps)
-    # an effect hidden below the excitation threshold may still be found: naming it is right
-    # too (but not required)
-    accept = expected if expected != ("none",) else ("none", *hidden)
-    top_correct = found[0] in accept
-    tied: tuple[str, ...] = ()
-    if steps:
-        cands = [c for c in steps[0].get("candidates", []) if c.get("significant")
-                 and c.get("cv_rms") is not None]
-        if cands:
-            best = min(c["cv_rms"] for c in cands)
-            tied = tuple(c["effect"] for c in cands if c["cv_rms"] <= 1.01 * best
-                         and c["effect"] != found[0])
-    hj = {e: eff.joints(e) for e in hidden}
-    joints_ok = True
-    if found[0] not in ("none", "refused"):
-        joints_ok = False
-        for e in accept:
-            if e in found:
-                named = set(found_joints[found.index(e)])
-                joints_ok = set(hj[e]) <= named if hj[e] else True
-                break
-    if expected != ("none",):
-        all_found = all(e in found for e in expected)
-    else:  # nothing visible: nothing, or only hidden effects, may be named
-        all_found = set(found) <= {"none", *hidden}
-    nominal = float(diagnosis["nominal"]["rms"])
-    final = float(diagnosis["final"]["rms"])
-    ratio = final / noise_rms
+    return _Truth(eff, int(scn.get("index", -1)), str(scn.get("kind", "")), hidden,
+                  {e: eff.joints(e) for e in hidden}, noise_rms, snr, visible)
+
+
+def _found(diag: DiagnosisRecord) -> tuple[str, ...]:
+    """The effects named, in order ("none" alone if nothing; "refused" for a refusal)."""
+    return ("refused",) if diag.error else diag.effects
+
+
+def _tied(diag: DiagnosisRecord, first: str) -> tuple[str, ...]:
+    """Significant candidates of the first step within 1 % of the best cross-validated RMS,
+    other than the effect named first."""
+    if not diag.steps:
+        return ()
+    cands = [c for c in diag.steps[0].candidates if c.significant and not math.isnan(c.cv_rms)]
+    if not cands:
+        return ()
+    best = min(c.cv_rms for c in cands)
+    return tuple(c.effect for c in cands if c.cv_rms <= 1.01 * best and c.effect != first)
+
+
+def _joints_located(t: _Truth, found: tuple[str, ...],
+                    found_joints: tuple[tuple[int, ...], ...]) -> bool:
+    """The joints named for the first acceptable effect found include the injected ones (True
+    when nothing was named or the effect has no joints)."""
+    if found[0] in ("none", "refused"):
+        return True
+    for e in t.accept:
+        if e in found:
+            return set(t.joints[e]) <= set(found_joints[found.index(e)]) if t.joints[e] else True
+    return False
+
+
+def _all_found(t: _Truth, found: tuple[str, ...]) -> bool:
+    """Every visible effect was named; with none visible, nothing but hidden effects was."""
+    if t.visible:
+        return all(e in found for e in t.expected)
+    return set(found) <= {"none", *t.hidden}
+
+
+def _miss_note(t: _Truth, found: tuple[str, ...], tied: tuple[str, ...]) -> str:
+    """Why the first effect named is wrong."""
+    if found[0] == "none":
+        return "missed: nothing significant found"
+    lk = f"look-alike: named {found[0]}"
+    if any(e in tied for e in t.accept):
+        lk += " (the diagnosis reports the hidden effect as fitting equally well)"
+    return lk
+
+
+def _note(t: _Truth, diag: DiagnosisRecord, found: tuple[str, ...], tied: tuple[str, ...],
+          verdict: tuple[bool, bool, float], config: BenchmarkConfig) -> str:
+    """The scenario's remarks; ``verdict``: (top effect right, joints located, RMS ratio)."""
+    top_correct, joints_ok, ratio = verdict
     notes = []
-    if refused:
-        notes.append(f"the diagnosis refused the data: {str(refused).split(': ', 1)[-1]}")
-    hid = [e for e in hidden if e not in visible]
+    if diag.error:
+        notes.append(f"the diagnosis refused the data: {str(diag.error).split(': ', 1)[-1]}")
+    hid = [e for e in t.hidden if e not in t.visible]
     if hid:
         notes.append(f"{', '.join(hid)} not visible (SNR "
-                     f"{min(snr.get(e, 0.0) for e in hid):.2g})")
-    if not top_correct and not refused:
-        if found[0] == "none":
-            notes.append("missed: nothing significant found")
-        else:
-            lk = f"look-alike: named {found[0]}"
-            if any(e in tied for e in accept):
-                lk += " (the diagnosis reports the hidden effect as fitting equally well)"
-            notes.append(lk)
-    elif not joints_ok and not refused:
+                     f"{min(t.snr.get(e, 0.0) for e in hid):.2g})")
+    if not diag.error and not top_correct:
+        notes.append(_miss_note(t, found, tied))
+    elif not diag.error and not joints_ok:
         notes.append("joints not located")
     if ratio > config.ratio_target:
         notes.append(f"withheld RMS {ratio:.2f}x the noise"
-                     + (" (the diagnosis says unexplained)" if diagnosis.get("unexplained")
-                        else ""))
-    note = "; ".join(notes)
-    covered, compared, misses = interval_coverage(eff, hidden, diagnosis)
-    eff_cov, eff_cmp, _ = interval_coverage(eff, hidden, diagnosis, "ci95_effect")
+                     + (" (the diagnosis says unexplained)" if diag.unexplained else ""))
+    return "; ".join(notes)
+
+
+def _coverage(t: _Truth, diag: DiagnosisRecord) -> dict[str, Any]:
+    """The interval-coverage columns (:mod:`sim.studies.benchmark.coverage`)."""
+    doc = {"final": {"parameters": [p.to_dict() for p in diag.final_parameters]}}
+    covered, compared, misses = interval_coverage(t.eff, t.hidden, doc)
+    eff_cov, eff_cmp, _ = interval_coverage(t.eff, t.hidden, doc, "ci95_effect")
+    return {"ci_covered": covered, "ci_compared": compared, "ci_misses": misses,
+            "ci_effect_all": bool(eff_cmp and eff_cov == eff_cmp)}
+
+
+def score(model: Manipulator, truth: dict[str, Any],
+          diagnosis: DiagnosisRecord | Mapping[str, Any],
+          config: BenchmarkConfig) -> ScenarioScore:
+    """Judge one diagnosis (read back by :func:`zrp.gap.results.load_diagnosis`, or its JSON
+    document) against the truth file's content."""
+    diag = diagnosis if isinstance(diagnosis, DiagnosisRecord) else load_diagnosis(diagnosis)
+    t = _truth(model, truth, config)
+    found = _found(diag)
+    found_joints = tuple(s.joints for s in diag.steps)
+    tied = _tied(diag, found[0])
+    top_correct = found[0] in t.accept
+    joints_ok = _joints_located(t, found, found_joints)
+    ratio = diag.final_rms / t.noise_rms
+    note = _note(t, diag, found, tied, (top_correct, joints_ok, ratio), config)
     values = {"success": bool(top_correct and joints_ok and ratio <= config.ratio_target),
-              "ci_covered": covered, "ci_compared": compared, "ci_misses": misses,
-              "ci_effect_all": bool(eff_cmp and eff_cov == eff_cmp)}
-    return ScenarioScore(int(scn.get("index", -1)), str(scn.get("kind", "")), hidden, hj, snr,
-                         expected, found, found_joints, bool(top_correct), tied,
-                         bool(joints_ok),
-                         bool(all_found), noise_rms, nominal, final, ratio,
-                         final / nominal if nominal > 0 else 1.0,
-                         diagnosis.get("unexplained"), payload=eff.payload, note=note,
-                         values=values)
+              **_coverage(t, diag)}
+    nominal = diag.nominal_rms
+    return ScenarioScore(t.index, t.kind, t.hidden, t.joints, t.snr, t.expected, found,
+                         found_joints, bool(top_correct), tied, bool(joints_ok),
+                         bool(_all_found(t, found)), t.noise_rms, nominal, diag.final_rms,
+                         ratio, diag.final_rms / nominal if nominal > 0 else 1.0,
+                         diag.unexplained, payload=t.eff.payload, note=note, values=values)

@@ -8,7 +8,7 @@ from pathlib import Path
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
-from zrp.gap.effects import EFFECTS
+from zrp.gap.model.context import EFFECTS
 from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
 from zrp.jsonio import dumps
 from zrp.model.files import load_model

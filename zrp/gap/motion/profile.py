@@ -16,9 +16,9 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import minimize
 
+from zrp.gap.model.problem import Problem
 from zrp.gap.motion.effects import MotionParam, joint_mode, mode_band
 from zrp.gap.motion.fitting import Engine, ModelFit
-from zrp.gap.problem import Problem
 
 __all__ = ["ZETA_GRID", "vibration_start"]
 
