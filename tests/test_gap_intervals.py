@@ -127,10 +127,10 @@ def test_final_parameters_carry_effect_wide_intervals(tmp_path):
 
 
 def test_benchmark_coverage_counts_effect_wide_intervals():
-    """sim.benchmark.coverage: a truth outside one marginal interval but inside the
+    """sim.studies.benchmark.coverage: a truth outside one marginal interval but inside the
     effect-wide ones counts as a marginal miss only."""
-    from sim.benchmark.coverage import interval_coverage
-    from sim.effects import HiddenEffects
+    from sim.robot.effects import HiddenEffects
+    from sim.studies.benchmark.coverage import interval_coverage
 
     eff = HiddenEffects(cyclic_error={2: (1, 1e-4, 0.0)})
     doc = {"final": {"parameters": [

@@ -11,9 +11,9 @@ from scipy import signal
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques
-from sim.measurement import Instrument
-from sim.motion_measure import parse_motion_effects
-from sim.motion_robot import MotionEffects, execute_trajectory
+from sim.robot.instrument import Instrument
+from sim.robot.motion import MotionEffects, execute_trajectory
+from sim.robot.motion_measure import parse_motion_effects
 from zrp.gap.model.problem import Problem
 from zrp.gap.motion import Trajectory, diagnose_motion
 from zrp.gap.motion.effects import MotionContext, effect_columns, linearise, plausible

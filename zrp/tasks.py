@@ -1,7 +1,7 @@
 """Map independent tasks over any ``concurrent.futures``-style executor, or over none.
 
 The one scheduling loop of the toolkit: the Monte Carlo chunks (:mod:`zrp.manufacturing.chunks`),
-the blind benchmark's scenarios (:mod:`sim.benchmark.runner`) and the fleet diagnosis
+the blind benchmark's scenarios (:mod:`sim.studies.benchmark.runner`) and the fleet diagnosis
 (:mod:`zrp.cli.fleet`) all go through :func:`map_tasks`. The core never imports an executor
 library: the application passes one in (a Dask ``Client.get_executor()`` from
 :mod:`zrp.cli.cluster`, a ``ProcessPoolExecutor``, ...). Results come back in completion order,

@@ -22,8 +22,8 @@ from _report import Report, add_output_arguments, output_path
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
-from sim.measurement import random_instrument
-from sim.motion_robot import MotionEffects, execute_trajectory
+from sim.robot.instrument import random_instrument
+from sim.robot.motion import MotionEffects, execute_trajectory
 from zrp.gap.fit.leastsq import fit, initial_registration
 from zrp.gap.model.context import Context
 from zrp.gap.model.effects import registration_parameters

@@ -23,7 +23,7 @@ import numpy as np
 from _report import Report, add_output_arguments, check_outputs, output_path
 
 import zrp
-from sim.benchmark import (
+from sim.studies.benchmark import (
     BenchmarkConfig,
     draw_scenarios,
     render_text,
@@ -37,7 +37,7 @@ TARGET_S = 600.0
 
 def kinematic_baseline(model: zrp.Manipulator, cfg: BenchmarkConfig) -> float:
     """Seconds to compute the same sessions' tool points by forward kinematics only."""
-    from sim.effects import default_tool_points, true_geometry
+    from sim.robot.effects import default_tool_points, true_geometry
     from zrp.kinematics import reachable_poses
 
     tool = default_tool_points(model)

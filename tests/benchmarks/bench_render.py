@@ -43,9 +43,9 @@ def main() -> None:
         args.frames, args.skip_video = min(args.frames, 30), True
 
     # mujoco.Renderer reads MUJOCO_GL when mujoco is first imported: choose before importing.
-    import sim.gl
+    import sim.view.gl
 
-    backend = sim.gl.configure_backend(args.backend)
+    backend = sim.view.gl.configure_backend(args.backend)
     import mujoco
     import numpy as np
 

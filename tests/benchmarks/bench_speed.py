@@ -293,8 +293,8 @@ def diagnosis() -> None:
 
 
 def simulation(poses: int) -> None:
-    from sim.benchmark import BenchmarkConfig, draw_scenarios, simulate_scenario
-    from sim.effects import default_tool_points, true_geometry
+    from sim.robot.effects import default_tool_points, true_geometry
+    from sim.studies.benchmark import BenchmarkConfig, draw_scenarios, simulate_scenario
     from zrp.kinematics import reachable_poses
 
     model = zrp.load_model("puma")
@@ -304,8 +304,8 @@ def simulation(poses: int) -> None:
     tool = default_tool_points(model)
     import functools
 
-    import sim.benchmark.blind as blind
-    from sim.measurement import Procedure
+    import sim.studies.benchmark.blind as blind
+    from sim.robot.measurement import Procedure
 
     with tempfile.TemporaryDirectory() as tmp:
         times = [simulate_scenario(model, s, cfg, Path(tmp), Path(tmp))[2] for s in scns]

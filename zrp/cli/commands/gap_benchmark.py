@@ -79,7 +79,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo and the diagnosis (+0.2 s measured): only when this command runs.
-    from sim.benchmark import (
+    from sim.studies.benchmark import (
         BenchmarkConfig,
         output_names,
         render_text,

@@ -85,7 +85,7 @@ def _run(args: argparse.Namespace) -> int:
         folder.write_text("report_motion.md", _report(diag))
     if args.video:
         # sim loads MuJoCo and the renderer: only when a video is asked for.
-        from sim.motion_video import render_motion_video
+        from sim.view.motion_video import render_motion_video
 
         render_motion_video(model, traj, diag, args.video, magnify=args.magnify,
                             overwrite=args.force)
