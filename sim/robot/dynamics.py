@@ -12,10 +12,11 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from tqdm import tqdm
 
 from mjcf import MJCFOptions, build
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q, forward_kinematics
 from zrp.model.manipulator import Manipulator
@@ -24,7 +25,6 @@ from zrp.rotations import rotation_angle
 __all__ = ["DynamicPlayback", "check_timed_q", "default_dynamic_options",
            "dynamic_playback"]
 
-F64 = NDArray[np.float64]
 
 
 def check_timed_q(model: Manipulator, t: ArrayLike, q: ArrayLike) -> tuple[F64, F64]:

@@ -25,8 +25,9 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import EFFECTS as GAP_EFFECTS
 from zrp.kinematics.identification import axis_tangents, tilt_axes
@@ -40,7 +41,6 @@ __all__ = [
     "true_geometry",
 ]
 
-F64 = NDArray[np.float64]
 
 #: Effects the real robot can hide: exactly the diagnosis's candidates (one list for both).
 EFFECT_NAMES: tuple[str, ...] = GAP_EFFECTS

@@ -7,8 +7,8 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import matrix_from_rotvec
@@ -16,7 +16,6 @@ from zrp.units import units_per_mm
 
 __all__ = ["TRACKER_NOISE_RANGE_MM", "Instrument", "check_number", "random_instrument"]
 
-F64 = NDArray[np.float64]
 
 
 def check_number(v: object, name: str, unit: str, lo: float | None = None,

@@ -30,12 +30,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from tqdm.auto import tqdm
 
 from sim.robot.effects import HiddenEffects
 from sim.robot.instrument import Instrument, check_number
 from sim.robot.real import Reading, RealRobot, Session
+from zrp.arrays import F64
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap.data.measurements import Measurements
 from zrp.kinematics.ik import track_trajectory
@@ -55,7 +56,6 @@ __all__ = [
     "write_truth",
 ]
 
-F64 = NDArray[np.float64]
 APPROACHES = ("random", "order", "gravity")
 TRUTH_FORMAT = "zrp-real-robot-truth"
 TRANSFERS = ("jump", "simulate")

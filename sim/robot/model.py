@@ -17,17 +17,16 @@ from typing import Any
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
 from mjcf.inertia import BodyInertia
 from sim.robot.effects import HiddenEffects, finite
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.sampling import default_limits
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["PUMA560_LOAD_FRICTION", "RealRobotOptions", "build_robot_model"]
 
-F64 = NDArray[np.float64]
 
 #: Coulomb friction of the load side of each PUMA 560 joint against its parent, N m: 20 % of
 #: the drive's total Coulomb friction, i.e. of the motor-side values of Armstrong et al.

@@ -39,20 +39,19 @@ from typing import Any
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 from scipy import signal
 
 from sim.robot.effects import HiddenEffects
 from sim.robot.instrument import Instrument
 from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.motion.data import Trajectory
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["MOTION_HIDDEN", "MotionEffects", "MotionRun", "execute_trajectory"]
 
-F64 = NDArray[np.float64]
 MOTION_HIDDEN = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
                  "residual_vibration")
 

@@ -18,16 +18,16 @@ import re
 from collections.abc import Callable, Sequence
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.interpolate import CubicSpline
 
 from sim.robot.motion import MOTION_HIDDEN, MotionEffects
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["Command", "parse_motion_effects", "spline_command"]
 
-F64 = NDArray[np.float64]
 #: A commanded trajectory: ``command(t, order)`` -> joint values (order 0) or their time
 #: derivative of that order at the times ``t``, shape (..., n).
 Command = Callable[[F64, int], F64]

@@ -42,7 +42,7 @@ from typing import Any
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from mjcf.inertia import BodyInertia, puma560_inertias, rod_inertias
 from sim.robot.effects import (
@@ -54,6 +54,7 @@ from sim.robot.effects import (
     true_geometry,
 )
 from sim.robot.model import PUMA560_LOAD_FRICTION, RealRobotOptions, build_robot_model
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import Manipulator
@@ -61,7 +62,6 @@ from zrp.units import metres_per_unit
 
 __all__ = ["Reading", "RealRobot", "Session"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

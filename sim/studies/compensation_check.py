@@ -27,7 +27,6 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
 from mjcf import MJCFOptions, build, save_mjcf
 from mjcf.gravity import gravity_torques
@@ -36,6 +35,7 @@ from sim.robot.instrument import Instrument
 from sim.robot.measurement import Procedure, _nominal_static_torque, measure
 from sim.robot.real import RealRobot
 from sim.studies.trajectories import circle_poses
+from zrp.arrays import F64
 from zrp.calibration import CalibratedRobot, Compensation, PoseConditions, compensate
 from zrp.gap import Diagnosis, Measurements, diagnose
 from zrp.kinematics import reachable_poses
@@ -43,7 +43,6 @@ from zrp.model.manipulator import Manipulator
 
 __all__ = ["CompensationCheck", "compensate_and_measure", "run_compensation_check"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

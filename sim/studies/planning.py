@@ -31,7 +31,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from mjcf.gravity import gravity_torques
 from sim.robot.instrument import random_instrument
@@ -40,6 +39,7 @@ from sim.robot.real import RealRobot, default_tool_points
 from sim.studies.benchmark.runner import _nominal_mjcf
 from sim.studies.benchmark.scenarios import BenchmarkConfig, Scenario, draw_scenarios
 from sim.studies.benchmark.scoring import score
+from zrp.arrays import F64
 from zrp.calibration import CalibratedRobot, PoseConditions, plan_poses
 from zrp.calibration.planning import design_std
 from zrp.errors import InputError
@@ -58,7 +58,6 @@ __all__ = [
     "study_scenario",
 ]
 
-F64 = NDArray[np.float64]
 #: What the plan makes identifiable: every candidate effect the poses can excite.
 PLANNED_EFFECTS = tuple(e for e in EFFECTS if e != "thermal_expansion")
 

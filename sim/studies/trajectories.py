@@ -17,12 +17,12 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 import numpy as np
-from numpy.typing import NDArray
 
 from sim.robot.instrument import random_instrument
 from sim.robot.measurement import trajectory_poses
 from sim.robot.motion import MotionRun, execute_trajectory
 from sim.robot.motion_measure import Command, parse_motion_effects, spline_command
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.motion.paths import exercise_moves
 from zrp.kinematics.ik import track_trajectory
@@ -32,7 +32,6 @@ from zrp.paper.scenario import puma_circle
 __all__ = ["TRAJECTORIES", "circle_command", "circle_poses", "measure_stream",
            "named_command"]
 
-F64 = NDArray[np.float64]
 TRAJECTORIES = ("circle", "moves")
 
 

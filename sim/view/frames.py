@@ -29,7 +29,7 @@ from typing import NamedTuple
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from mjcf import BuiltArm, MJCFOptions, build
 from sim.robot.dynamics import check_timed_q
@@ -52,6 +52,7 @@ from sim.view.overlays import (
 )
 from sim.view.playback import kinematic_playback
 from sim.view.render import OffscreenRenderer
+from zrp.arrays import F64, U8
 from zrp.errors import InputError, ZRPError
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import rotation_angle
@@ -66,8 +67,6 @@ __all__ = [
     "video_frames",
 ]
 
-F64 = NDArray[np.float64]
-U8 = NDArray[np.uint8]
 FORMATS = ("auto", "mp4", "gif")
 
 class VideoSegment(NamedTuple):

@@ -15,14 +15,14 @@ import math
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from sim.view.render import OffscreenRenderer
+from zrp.arrays import F64
 from zrp.errors import InputError
 
 __all__ = ["frame_on_path", "framing_report", "path_normal", "projected_fractions"]
 
-F64 = NDArray[np.float64]
 
 
 def path_normal(path: ArrayLike) -> F64:

@@ -6,13 +6,13 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["exaggerated_model", "nice_factor"]
 
-F64 = NDArray[np.float64]
 
 
 def exaggerated_model(nominal: Manipulator, perturbed: Manipulator, factor: float

@@ -14,10 +14,10 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from numpy.typing import NDArray
 
 from mjcf import MJCFOptions, build
 from sim.view.render import OffscreenRenderer
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.motion import MotionDiagnosis, Trajectory
 from zrp.model.manipulator import Manipulator
@@ -26,7 +26,6 @@ from zrp.units import metres_per_unit
 
 __all__ = ["render_motion_video"]
 
-F64 = NDArray[np.float64]
 MEASURED = (0.1, 0.8, 0.2, 1.0)
 BEFORE = (0.9, 0.2, 0.2, 1.0)
 AFTER = (0.2, 0.4, 1.0, 1.0)

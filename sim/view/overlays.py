@@ -4,12 +4,11 @@ noise floor below which values print as 0, and the live delta_p(t) plot."""
 from __future__ import annotations
 
 import mujoco
-import numpy as np
-from numpy.typing import NDArray
+
+from zrp.arrays import F64
 
 __all__ = ["LEGEND", "NOISE_FLOOR", "PANEL_PX", "delta_p_figure", "shown_value"]
 
-F64 = NDArray[np.float64]
 
 DESIRED_RGBA = (0.2, 0.9, 0.3, 1.0)
 ACTUAL_RGBA = (1.0, 0.2, 0.85, 1.0)

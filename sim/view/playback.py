@@ -6,9 +6,10 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from mjcf import BuiltArm, MJCFOptions, build, metres_per_unit
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q, forward_kinematics
 from zrp.model.manipulator import Manipulator
@@ -22,7 +23,6 @@ __all__ = [
     "kinematic_playback",
 ]
 
-F64 = NDArray[np.float64]
 
 
 def as_built(arm: BuiltArm | Manipulator, options: MJCFOptions | None = None) -> BuiltArm:

@@ -13,14 +13,14 @@ from collections.abc import Sequence
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from sim.view.gl import create_context
+from zrp.arrays import U8
 from zrp.errors import InputError
 
 __all__ = ["OffscreenRenderer"]
 
-U8 = NDArray[np.uint8]
 _EYE = np.eye(3).ravel()
 _ZERO = np.zeros(3)
 

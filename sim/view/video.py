@@ -18,12 +18,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from tqdm import tqdm
 
 from sim.view.frames import VideoOptions, VideoSegment, _arm_points, _frames, _prepare
 from sim.view.framing import framing_report
 from sim.view.render import OffscreenRenderer
+from zrp.arrays import U8
 from zrp.errors import InputError, ZRPError
 from zrp.model.manipulator import Manipulator
 from zrp.output import atomic_path, check_writable
@@ -36,7 +37,6 @@ __all__ = [
     "video_path",
 ]
 
-U8 = NDArray[np.uint8]
 
 
 class VideoWriteError(ZRPError, OSError):

@@ -25,8 +25,9 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
@@ -39,7 +40,6 @@ from zrp.rotations import skew
 
 __all__ = ["CalibratedRobot", "PoseConditions", "chain"]
 
-F64 = NDArray[np.float64]
 
 
 def _rot(u: F64, q: F64) -> F64:

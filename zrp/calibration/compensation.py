@@ -24,15 +24,15 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.calibration.calibrated import CalibratedRobot, PoseConditions, chain
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import hand_frame
-from zrp.rotations import er_from_matrix, er_to_rotvec
+from zrp.rotations import er_from_matrix, rotvec_from_er
 
 __all__ = ["Compensation", "ThermalWarning", "compensate", "compensate_program"]
 
-F64 = NDArray[np.float64]
 GravityFn = Callable[[F64], F64]
 
 
@@ -134,7 +134,7 @@ def _errors(cal: CalibratedRobot, q: F64, cond: PoseConditions, tg: _Targets
     if tg.rot is not None:
         ee = cal.model.end_effector
         r = rn @ hand_frame(ee.axial, ee.transverse)
-        er = er_to_rotvec(er_from_matrix(r @ np.swapaxes(tg.rot, 1, 2)))
+        er = rotvec_from_er(er_from_matrix(r @ np.swapaxes(tg.rot, 1, 2)))
         e = np.concatenate([e, er * L], axis=1)
         J = np.concatenate([J, jw.transpose(0, 2, 1) * L], axis=1)
     return e, J, full

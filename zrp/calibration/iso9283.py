@@ -28,13 +28,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from zrp.arrays import F64
 from zrp.calibration.calibrated import CalibratedRobot, PoseConditions
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
 
 __all__ = ["PoseAccuracy", "pose_accuracy"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

@@ -16,15 +16,14 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import Context
 from zrp.gap.model.jointbases import JOINT_EFFECTS, joint_bases
 
 __all__ = ["NON_GEOMETRIC", "Term", "term_basis"]
 
-F64 = NDArray[np.float64]
 
 #: effects whose parameters are joint corrections with a pose-dependent basis.
 NON_GEOMETRIC = JOINT_EFFECTS

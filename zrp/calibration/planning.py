@@ -29,6 +29,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.arguments import check_float
+from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.model.context import Context, ParamSpec
@@ -41,7 +42,6 @@ from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
 __all__ = ["Plan", "PlanWarning", "design_std", "plan_poses"]
 
-F64 = NDArray[np.float64]
 ALIAS_TOL = 1e-6
 
 

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.arguments import check_float, check_instance, check_int, check_seed
+from zrp.arrays import F64
 from zrp.blas import blas_threads
 from zrp.errors import InputError
 from zrp.gap.analysis.assessment import Assessment, compliance_units, remainder_evidence
@@ -58,7 +59,6 @@ from zrp.model.manipulator import Manipulator
 
 __all__ = ["diagnose", "run_diagnosis"]
 
-F64 = NDArray[np.float64]
 #: numerical resolution of the fits as a fraction of the model's characteristic length.
 RESOLUTION = 1e-9
 
@@ -179,7 +179,7 @@ def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosi
 
 
 def _kept_rows(gravity_torque: ArrayLike, kept: NDArray[np.int64], n_poses: int
-               ) -> NDArray[np.float64]:
+               ) -> F64:
     """The rows of the kept poses of a per-pose torque array (its shape is checked later)."""
     tau = np.asarray(gravity_torque, dtype=float)
     if tau.ndim != 2 or tau.shape[0] != n_poses:

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.analysis.assessment import Assessment
 from zrp.gap.analysis.checks import GapWarning as GapWarning
@@ -56,7 +57,6 @@ __all__ = [
     "parameter_estimates",
 ]
 
-F64 = NDArray[np.float64]
 SCHEMA_VERSION = 1
 #: final withheld RMS above this multiple of the noise-floor RMS counts as unexplained.
 UNEXPLAINED_RATIO = 1.5

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.model.manipulator import MAX_LENGTH, Manipulator, derived
 
 __all__ = ["MAX_ANGLE", "all_in_range", "joint_limits"]
@@ -21,12 +21,12 @@ __all__ = ["MAX_ANGLE", "all_in_range", "joint_limits"]
 MAX_ANGLE = 1e6
 
 
-def joint_limits(model: Manipulator) -> NDArray[np.float64]:
+def joint_limits(model: Manipulator) -> F64:
     """Per joint the largest accepted |q|: :data:`MAX_ANGLE` rad or ``MAX_LENGTH``, shape (n,)."""
     return derived(model, "_joint_limits", _joint_limits)
 
 
-def _joint_limits(model: Manipulator) -> NDArray[np.float64]:
+def _joint_limits(model: Manipulator) -> F64:
     return np.where(np.asarray(model.prismatic), MAX_LENGTH, MAX_ANGLE)
 
 

@@ -15,8 +15,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import all_in_range, joint_limits
@@ -26,12 +27,11 @@ from zrp.rotations.rodrigues import (
     er_identity,
     er_multiply,
     er_rotate,
-    er_to_matrix,
+    matrix_from_er,
 )
 
 __all__ = ["FKResult", "check_q", "end_effector_pose", "forward_kinematics", "jacobian"]
 
-F64 = NDArray[np.float64]
 
 
 def check_q(model: Manipulator, q: ArrayLike, name: str = "q") -> F64:
@@ -94,7 +94,7 @@ class FKResult:
     @property
     def rotation(self) -> F64:
         """Hand rotation R_n relative to the zero reference position, shape (..., 3, 3)."""
-        return er_to_matrix(self.er)
+        return matrix_from_er(self.er)
 
     @property
     def hand_frame(self) -> F64:

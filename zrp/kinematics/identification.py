@@ -45,6 +45,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q, end_effector_pose
 from zrp.model.manipulator import Manipulator
@@ -53,8 +54,8 @@ from zrp.rotations.rodrigues import (
     er_from_axis_angle,
     er_identity,
     er_multiply,
-    er_to_matrix,
-    er_to_rotvec,
+    matrix_from_er,
+    rotvec_from_er,
 )
 
 __all__ = [
@@ -69,7 +70,6 @@ __all__ = [
     "tilt_axes",
 ]
 
-F64 = NDArray[np.float64]
 
 
 def axis_tangents(axes: ArrayLike) -> F64:
@@ -247,7 +247,7 @@ def parameter_jacobian(model: Manipulator, q: ArrayLike, *,
     rots = np.empty((*batch, n + 1, 3, 3))  # R_{k-1} for k = 1..n+1
     points = np.empty((*batch, n, 3))  # p_k, the point on joint k
     for k in range(n + 1):
-        r = er_to_matrix(e)
+        r = matrix_from_er(e)
         rots[..., k, :, :] = r
         jac[..., 3:6, 3 * k:3 * k + 3] = r  # d p / d b_{k,0} = R_{k-1}  (eq 2)
         pos = pos + r @ model.bodies[k]
@@ -297,5 +297,5 @@ def pose_error(nominal: Manipulator, actual: Manipulator, q: ArrayLike, *,
     qa = q if q_offset is None else q + check_q(nominal, q_offset, "q_offset")
     p_d, e_d = end_effector_pose(nominal, q)
     p_a, e_a = end_effector_pose(actual, qa)
-    rv = er_to_rotvec(er_multiply(e_a, er_conjugate(e_d)))
+    rv = rotvec_from_er(er_multiply(e_a, er_conjugate(e_d)))
     return np.concatenate([rv, p_a - p_d], axis=-1)

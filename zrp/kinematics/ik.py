@@ -22,6 +22,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import (
     IKError,
     InputError,
@@ -40,7 +41,6 @@ from zrp.output import write_text
 
 __all__ = ["CORRECTIONS", "TASKS", "IKResult", "track_trajectory"]
 
-F64 = NDArray[np.float64]
 CORRECTIONS = ("newton", "feedback", "none")
 TASKS = ("pose", "position")
 

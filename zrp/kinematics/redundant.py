@@ -16,8 +16,9 @@ import warnings
 from typing import Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import (
     InputError,
     JointLimitError,
@@ -30,11 +31,10 @@ from zrp.kinematics.ik import IKResult
 from zrp.kinematics.posture import Posture, _within_reach, check_limits_along, sqp
 from zrp.kinematics.trajectory import Trajectory
 from zrp.model.manipulator import Manipulator
-from zrp.rotations.rodrigues import er_conjugate, er_multiply, er_to_rotvec
+from zrp.rotations.rodrigues import er_conjugate, er_multiply, rotvec_from_er
 
 __all__ = ["LIMIT_MODES", "track_posture"]
 
-F64 = NDArray[np.float64]
 LIMIT_MODES = ("error", "warn", "ignore")
 
 
@@ -102,7 +102,7 @@ def _solve_sample(model: Manipulator, guess: F64, pd: F64, erd: F64 | None, post
     p_g, er_g = end_effector_pose(model, guess)
     out["drift_p"][i] = np.linalg.norm(pd - p_g)  # error of the extrapolated guess
     if erd is not None:
-        out["drift_o"][i] = np.linalg.norm(er_to_rotvec(er_multiply(erd, er_conjugate(er_g))))
+        out["drift_o"][i] = np.linalg.norm(rotvec_from_er(er_multiply(erd, er_conjugate(er_g))))
     qi, iters, e, js = sqp(model, guess, pd, erd, posture)
     out["err_p"][i] = np.linalg.norm(e[-3:])
     out["err_o"][i] = np.linalg.norm(e[:3]) if erd is not None else 0.0

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.identification import ParameterSpace, parameter_jacobian, parameter_space
 from zrp.manufacturing._checks import check_distribution, nonnegative, positive_int
@@ -42,7 +43,6 @@ from zrp.model.manipulator import Manipulator
 
 __all__ = ["Allocation", "allocate_tolerances"]
 
-F64 = NDArray[np.float64]
 Arrays = tuple[F64, F64, F64, F64, F64]
 
 

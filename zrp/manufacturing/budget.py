@@ -12,8 +12,9 @@ from dataclasses import dataclass
 from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q
 from zrp.kinematics.identification import parameter_jacobian
@@ -23,7 +24,6 @@ from zrp.model.manipulator import Manipulator
 __all__ = ["Contribution", "MonteCarloMaxima", "contributions", "tolerance_report",
            "worst_case_bound"]
 
-F64 = NDArray[np.float64]
 
 
 class MonteCarloMaxima(Protocol):

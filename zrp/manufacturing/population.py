@@ -15,8 +15,9 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.identification import parameter_space
 from zrp.manufacturing._checks import check_distribution, check_percentile, positive_int
@@ -39,7 +40,6 @@ __all__ = [
     "trajectory_arrays",
 ]
 
-F64 = NDArray[np.float64]
 #: Percentiles a :class:`MonteCarloResult` summary reports by default.
 DEFAULT_PERCENTILES = (50.0, 90.0, 95.0, 99.0, 99.9)
 

@@ -25,9 +25,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from zrp.arguments import check_float
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.identification import parameter_jacobian
 from zrp.manufacturing._checks import check_percentile
@@ -42,7 +43,6 @@ from zrp.tasks import map_tasks
 
 __all__ = ["BINS", "MonteCarloSummary", "histogram_edges", "monte_carlo_summary"]
 
-F64 = NDArray[np.float64]
 #: Bins per histogram and their span relative to the first-order worst case.
 BINS = 2048
 SPAN = (1e-4, 1e1)

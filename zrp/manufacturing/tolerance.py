@@ -21,8 +21,9 @@ from dataclasses import dataclass
 from statistics import NormalDist
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.identification import parameter_space
 from zrp.manufacturing._checks import (
@@ -36,7 +37,6 @@ from zrp.model.manipulator import MAX_LENGTH, Manipulator
 __all__ = ["DISTRIBUTIONS", "Tolerances", "draw_parameters", "percentile_ci",
            "percentile_ci_ranks"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

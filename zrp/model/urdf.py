@@ -23,15 +23,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import ModelFileError
 from zrp.model.manipulator import Manipulator
 from zrp.units import metres_per_unit
 
 __all__ = ["URDFImport", "URDFJoint", "URDFTree", "from_urdf", "import_urdf", "read_urdf"]
 
-F64 = NDArray[np.float64]
 _MOVING = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 _KNOWN = {*_MOVING, "fixed", "floating", "planar"}
 

@@ -14,12 +14,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from sim.robot.effects import EFFECT_NAMES, HiddenEffects, default_tool_points
 from sim.robot.instrument import TRACKER_NOISE_RANGE_MM
 from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.sampling import default_limits
 from zrp.model.manipulator import Manipulator
@@ -35,7 +35,6 @@ __all__ = [
     "typical_gravity_torque",
 ]
 
-F64 = NDArray[np.float64]
 KINDS = ("none", "single", "pair")
 #: The default range of the tracker noise sigma per coordinate, mm (a laser tracker's 10-30 um).
 DEFAULT_NOISE_MM = TRACKER_NOISE_RANGE_MM

@@ -19,11 +19,11 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
 from sim.robot.effects import HiddenEffects, motor_map, true_geometry
 from sim.studies.benchmark.coverage import interval_coverage
 from sim.studies.benchmark.scenarios import BenchmarkConfig
+from zrp.arrays import F64
 from zrp.gap.results import DiagnosisRecord, load_diagnosis
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import Manipulator
@@ -36,7 +36,6 @@ __all__ = [
     "score",
 ]
 
-F64 = NDArray[np.float64]
 JOINT_SPACE = ("joint_offset", "encoder_scale", "cyclic_error", "joint_compliance", "backlash")
 
 

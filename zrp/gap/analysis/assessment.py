@@ -24,8 +24,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.gap.analysis.baseline import GeometricBaseline
 from zrp.gap.analysis.fallback import FinalChoice
 from zrp.gap.analysis.where import WhereAnalysis
@@ -39,7 +39,6 @@ from zrp.units import metres_per_unit
 __all__ = ["TYPICAL_REPEATABILITY_MM", "Assessment", "Remainder", "compliance_units",
            "remainder_evidence"]
 
-F64 = NDArray[np.float64]
 #: upper end of the specified pose repeatability (ISO 9283) of industrial arms up to ~50 kg
 #: payload, mm (small arms such as the IRB 120: 0.01 mm; large ones 0.05-0.1 mm).
 TYPICAL_REPEATABILITY_MM = 0.1

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.gap.fit.leastsq import FitResult, cv_rms, fit, identifiable_start
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.model.context import Context, ParamSpec
@@ -79,7 +80,7 @@ def _withheld(ctx: Context, f: FitResult, withheld: NDArray[np.int64]) -> Metric
 
 
 def _on_top(ctx: Context, base: FitResult, extra: list[ParamSpec], fitting: NDArray[np.int64],
-            rb0: NDArray[np.float64]) -> tuple[FitResult, int, int]:
+            rb0: F64) -> tuple[FitResult, int, int]:
     keep, _, start = identifiable_start(ctx, base, extra)
     f = fit(ctx, list(base.specs) + keep, fitting,
             np.concatenate([base.theta, np.zeros(len(keep))]), rb0, start=start)
@@ -88,7 +89,7 @@ def _on_top(ctx: Context, base: FitResult, extra: list[ParamSpec], fitting: NDAr
 
 def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
                        fitting: NDArray[np.int64], withheld: NDArray[np.int64],
-                       folds: list[NDArray[np.int64]], rb0: NDArray[np.float64]
+                       folds: list[NDArray[np.int64]], rb0: F64
                        ) -> GeometricBaseline:
     """Fit the complete geometric calibration on top of the registration ``reg`` and then the
     final model's non-geometric parameters on top of it (see the module docstring)."""

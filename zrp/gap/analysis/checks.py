@@ -13,6 +13,7 @@ import warnings
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
 from zrp.gap.data.measurements import DataWarning, Measurements
 from zrp.gap.data.noise import noise_floor
@@ -30,7 +31,6 @@ __all__ = [
     "check_units",
 ]
 
-F64 = NDArray[np.float64]
 #: poses below which effects with many parameters are hard to identify.
 FEW_POSES = 50
 

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.analysis.baseline import GeometricBaseline
 from zrp.gap.fit.leastsq import FitResult
@@ -102,8 +103,8 @@ class FinalChoice:
                 "within_noise": self.within_noise}
 
 
-def _paired_z(ctx: Context, withheld: NDArray[np.int64], r_search: NDArray[np.float64],
-              r_base: NDArray[np.float64]) -> float:
+def _paired_z(ctx: Context, withheld: NDArray[np.int64], r_search: F64,
+              r_base: F64) -> float:
     """Paired z of the per-pose summed squared errors, search minus baseline (0 when the
     withheld poses are too few or the differences all equal)."""
     rows = np.flatnonzero(np.isin(ctx.meas.pose_index, withheld))
@@ -118,7 +119,7 @@ def _paired_z(ctx: Context, withheld: NDArray[np.int64], r_search: NDArray[np.fl
 
 
 def choose_final(ctx: Context, search_fit: FitResult, baseline: GeometricBaseline,
-                 withheld: NDArray[np.int64]) -> tuple[FitResult, NDArray[np.float64],
+                 withheld: NDArray[np.int64]) -> tuple[FitResult, F64,
                                                         FinalChoice]:
     """The final model (see the module docstring): its fit, its withheld residual (3 Rw,) and
     the choice. The baseline must carry its fit."""

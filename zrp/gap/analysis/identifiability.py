@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.analysis.checks import GapWarning
 from zrp.gap.data.measurements import Measurements
@@ -36,7 +37,6 @@ __all__ = [
     "survey",
 ]
 
-F64 = NDArray[np.float64]
 #: the geometric effects (offsets, scales, links, tilts).
 GEOMETRIC = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment")
 #: poses in the reference set.

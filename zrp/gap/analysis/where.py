@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.gap.fit.leastsq import FitResult, check_identifiable, orthonormal_basis
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.effects import effect_parameters
@@ -31,7 +32,6 @@ __all__ = [
     "where_analysis",
 ]
 
-F64 = NDArray[np.float64]
 #: geometric effects whose parameters the projection uses.
 PROJECTION_EFFECTS = ("joint_offset", "link_length", "axis_misalignment")
 N_BINS = 6

@@ -42,6 +42,7 @@ from numpy.typing import NDArray
 from tqdm import tqdm
 
 from zrp.arguments import check_int
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.csvrows import Accumulator, Columns, Header, check_header, parse_row
 from zrp.gap.data.measurements import FRAMES, DataWarning, Measurements
@@ -53,7 +54,6 @@ __all__ = ["MAX_ROWS", "load_measurements"]
 #: whole diagnosis, so two million stay within 2 GB.
 MAX_ROWS = 2_000_000
 
-F64 = NDArray[np.float64]
 #: plausible temperatures, deg C.
 TEMP_RANGE = (-60.0, 150.0)
 

@@ -12,13 +12,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import OPTIONAL_SCALARS, QUAT_COLUMNS
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["Accumulator", "Columns", "Header", "check_header", "parse_row"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

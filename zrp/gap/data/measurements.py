@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
 from zrp.model.manipulator import MAX_LENGTH
 from zrp.output import write_text
@@ -28,7 +29,6 @@ __all__ = [
     "Measurements",
 ]
 
-F64 = NDArray[np.float64]
 FRAMES = ("instrument", "base")
 OPTIONAL_SCALARS = ("t", "temp", "load")
 QUAT_COLUMNS = ("qw", "qx", "qy", "qz")

@@ -16,13 +16,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
 from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["CHI3_P95", "NOISE_METHODS", "NoiseFloor", "noise_floor"]
 
-F64 = NDArray[np.float64]
 #: 95th percentile of |r| for isotropic Gaussian noise, in units of sigma (chi, 3 dof).
 CHI3_P95 = 2.7954834829151074
 NOISE_METHODS = ("rigid_links", "repeats", "given", "none")

@@ -12,8 +12,9 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
 from zrp.kinematics.forward import check_q, forward_kinematics
@@ -24,7 +25,6 @@ from zrp.units import G_STANDARD, metres_per_unit
 
 __all__ = ["Injection", "synthesize"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -29,10 +29,11 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import FitResult, _covariance, fit, initial_registration
 from zrp.gap.model.context import Context, ParamSpec
@@ -42,7 +43,6 @@ from zrp.rotations import left_jacobian
 __all__ = ["FullPoseFit", "fit_full_pose", "orientation_residual", "pose_rotations",
            "probe_start"]
 
-F64 = NDArray[np.float64]
 
 
 def pose_rotations(ctx: Context) -> F64:

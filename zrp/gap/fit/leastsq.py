@@ -16,6 +16,7 @@ from scipy import (
 )
 from scipy.optimize import least_squares
 
+from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.problem import Evaluation, Problem, compressed
@@ -41,7 +42,6 @@ __all__ = [
     "wald_groups",
 ]
 
-F64 = NDArray[np.float64]
 
 #: A parameter whose Jacobian column keeps less than this fraction of its norm after
 #: projection on the other columns cannot be told apart from them (structural aliasing).

@@ -8,15 +8,14 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import point_errors
 from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["Metrics"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

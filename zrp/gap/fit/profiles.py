@@ -19,6 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.gap.fit.leastsq import (
     FitResult,
     check_identifiable,
@@ -34,7 +35,6 @@ from zrp.units import G_STANDARD, metres_per_unit
 
 __all__ = ["PAYLOAD_GRID_KG", "switch_bands", "with_backlash_switch", "with_gravity_side"]
 
-F64 = NDArray[np.float64]
 #: payloads at the tool profiled with MJCF torques, kg.
 PAYLOAD_GRID_KG = (0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0)
 #: a threshold (or payload) must remove this many residual variances more than the default.

@@ -17,16 +17,15 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import Z95, FitResult
 from zrp.jsonio import dict_from_dataclass
-from zrp.rotations import er_from_matrix, er_to_rotvec, matrix_from_rotvec
+from zrp.rotations import er_from_matrix, matrix_from_rotvec, rotvec_from_er
 
 __all__ = ["Quantity", "Registration", "registration_of"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -86,7 +85,7 @@ def _zyx(r: F64) -> F64:
 
 
 def _rotvec4(r: F64) -> F64:
-    rv = er_to_rotvec(er_from_matrix(r))
+    rv = rotvec_from_er(er_from_matrix(r))
     return np.append(rv, np.linalg.norm(rv))
 
 

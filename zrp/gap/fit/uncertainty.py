@@ -38,6 +38,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import special
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.model.context import Context
@@ -54,7 +55,6 @@ __all__ = [
     "simultaneous_z",
 ]
 
-F64 = NDArray[np.float64]
 #: |correlation| above which a pair of parameters is named as strongly correlated.
 STRONG_CORRELATION = 0.9
 

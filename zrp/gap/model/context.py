@@ -14,6 +14,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
 from zrp.kinematics.forward import forward_kinematics
@@ -30,7 +31,6 @@ __all__ = [
     "ParamSpec",
 ]
 
-F64 = NDArray[np.float64]
 
 #: Candidate effects, in the order they are tried (ties are broken by this order).
 EFFECTS = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment",

@@ -28,15 +28,14 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import EFFECTS, Context, ParamSpec
 from zrp.gap.model.jointbases import joint_bases
 
 __all__ = ["Built", "effect_parameters", "registration_parameters"]
 
-F64 = NDArray[np.float64]
 
 def registration_parameters(ctx: Context) -> list[ParamSpec]:
     """``base_frame`` (unless the data are in the base frame) and ``tool_offset`` specs."""

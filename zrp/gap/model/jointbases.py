@@ -27,15 +27,14 @@ parameter ``q{k}.{what}``   basis B_k per pose
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import Context
 from zrp.units import G_STANDARD, metres_per_unit
 
 __all__ = ["JOINT_EFFECTS", "joint_bases"]
 
-F64 = NDArray[np.float64]
 
 #: effects whose parameters are joint corrections with a pose-dependent basis.
 JOINT_EFFECTS = ("joint_offset", "encoder_scale", "cyclic_error", "backlash",

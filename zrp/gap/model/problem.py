@@ -25,13 +25,13 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.rotations import left_jacobian, matrix_from_rotvec, skew
 
 __all__ = ["Evaluation", "Problem", "compressed"]
 
-F64 = NDArray[np.float64]
 
 
 def _cross(a: F64, b: F64) -> F64:

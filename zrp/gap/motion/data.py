@@ -17,12 +17,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import FRAMES, Measurements
 
 __all__ = ["MIN_SAMPLES", "Trajectory"]
 
-F64 = NDArray[np.float64]
 #: fewest samples a trajectory diagnosis accepts.
 MIN_SAMPLES = 50
 

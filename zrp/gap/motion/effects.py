@@ -48,8 +48,8 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import KINDS, Context, ParamSpec
 from zrp.gap.motion.data import Trajectory
@@ -58,7 +58,6 @@ from zrp.gap.motion.kernels import first_order_lag, mode_response, play
 __all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
            "joint_mode", "limit_step", "linearise", "mode_band", "plausible", "tested"]
 
-F64 = NDArray[np.float64]
 MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
                   "residual_vibration")
 #: effects whose parameters are physically positive (a negative estimate is not that effect)

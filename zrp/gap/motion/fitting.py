@@ -9,8 +9,8 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64, I64
 from zrp.gap.fit.leastsq import FitResult, fit
 from zrp.gap.model.context import EFFECTS, Context, ParamSpec
 from zrp.gap.model.effects import effect_parameters
@@ -21,8 +21,6 @@ from zrp.model.manipulator import Manipulator
 
 __all__ = ["Engine", "ModelFit"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 NONLINEAR = ("sync_delay", "servo_lag", "reversal_friction", "residual_vibration")
 
 

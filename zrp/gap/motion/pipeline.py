@@ -13,6 +13,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64, I64
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import ALIAS_TOL, initial_registration, point_errors
 from zrp.gap.fit.metrics import Metrics
@@ -29,8 +30,6 @@ from zrp.model.manipulator import Manipulator
 
 __all__ = ["diagnose_motion"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 
 
 def _check(model: Manipulator, traj: Trajectory, torque: ArrayLike | None,

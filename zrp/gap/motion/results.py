@@ -6,9 +6,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-from numpy.typing import NDArray
-
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import Z95
 from zrp.gap.fit.metrics import Metrics
@@ -17,7 +15,6 @@ from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["MotionDiagnosis", "MotionEstimate", "MotionStep", "PhaseError"]
 
-F64 = NDArray[np.float64]
 #: 97.5 % quantile of the standard normal (95 % two-sided intervals).
 
 

@@ -9,8 +9,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import I64
 from zrp.gap.fit.leastsq import check_identifiable, cv_rms, f_test, group_key, wald_groups
 from zrp.gap.model.context import EFFECTS
 from zrp.gap.model.effects import effect_parameters
@@ -20,7 +20,6 @@ from zrp.gap.motion.profile import vibration_start
 
 __all__ = ["Trial", "backward_check", "drop_effects", "greedy"]
 
-I64 = NDArray[np.int64]
 
 
 @dataclass(frozen=True, eq=False)

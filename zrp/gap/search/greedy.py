@@ -16,6 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.gap.analysis.checks import GapWarning
 from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.identifiability import GEOMETRIC, geometric_overlap
@@ -40,7 +41,6 @@ from zrp.gap.search.steps import BacklashSwitch, Candidate, Step, parameter_esti
 __all__ = ["TIE_TOL", "SearchResult", "SearchSettings", "backward_pass", "greedy_search",
            "withheld_residual"]
 
-F64 = NDArray[np.float64]
 Folds = Sequence[NDArray[np.int64]]
 #: candidates whose cross-validated RMS is within this fraction of the winner's are reported
 #: as indistinguishable from it.

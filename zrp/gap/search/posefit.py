@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.fullpose import (
     FullPoseFit,
@@ -40,11 +41,10 @@ from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.problem import Problem
 from zrp.gap.search.posesearch import OrientationStep, forward_search
 from zrp.jsonio import dict_from_dataclass
-from zrp.rotations import er_from_matrix, er_to_rotvec
+from zrp.rotations import er_from_matrix, rotvec_from_er
 
 __all__ = ["FullPoseResult", "ParameterPrecision", "refit_full_pose"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True)
@@ -137,7 +137,7 @@ class FullPoseResult:
                                              else "estimated"),
                 "sigma_position": self.fit.sigma_position,
                 "probe_rotation": rt.tolist(),
-                "probe_rotvec_rad": er_to_rotvec(er_from_matrix(rt)).tolist(),
+                "probe_rotvec_rad": rotvec_from_er(er_from_matrix(rt)).tolist(),
                 "withheld_orientation_rms_rad": {"position_only": self.withheld_orientation_before,
                                                  "full_pose": self.withheld_orientation_after},
                 "withheld_rms": {"position_only": self.withheld_rms_position_only,

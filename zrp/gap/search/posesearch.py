@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy import stats
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.fullpose import FullPoseFit, orientation_residual
 from zrp.gap.model.context import Context, ParamSpec
@@ -38,7 +39,6 @@ from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["OrientationStep", "forward_search", "orientation_groups", "score_test"]
 
-F64 = NDArray[np.float64]
 #: kinds of parameters with orientation columns (eq. O2); the others turn no hand.
 TURNING = ("dq", "tilt")
 ALIASED = 1e-6

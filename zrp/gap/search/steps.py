@@ -11,9 +11,7 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-from numpy.typing import NDArray
-
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import Z95 as Z95
 from zrp.gap.fit.leastsq import Aliased, FitResult
@@ -31,7 +29,6 @@ __all__ = [
     "parameter_estimates",
 ]
 
-F64 = NDArray[np.float64]
 #: two-sided 95 % quantile of the standard normal distribution.
 
 
