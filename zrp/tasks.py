@@ -19,6 +19,7 @@ from itertools import islice
 from typing import Any, TypeVar
 
 from zrp.errors import InputError
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["WINDOW", "TaskFailure", "map_tasks"]
 
@@ -37,7 +38,7 @@ class TaskFailure:
     traceback: str
 
     def to_dict(self) -> dict[str, Any]:
-        return {"position": self.position, "task": self.task, "error": self.error}
+        return dict_from_dataclass(self, exclude=("traceback",))
 
 
 def _failure(position: int, task: Any, exc: BaseException,

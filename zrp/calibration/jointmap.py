@@ -21,6 +21,7 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import Context
 from zrp.gap.model.jointbases import JOINT_EFFECTS, joint_bases
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["NON_GEOMETRIC", "Term", "term_basis"]
 
@@ -64,8 +65,7 @@ class Term:
         return self.name.split(".", 1)[1]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "effect": self.effect, "joint": self.joint,
-                "unit": self.unit, "value": self.value, "stderr": self.stderr}
+        return dict_from_dataclass(self)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], where: str) -> Term:

@@ -35,6 +35,7 @@ from sim.studies.trajectories import named_command
 from zrp import jsonio
 from zrp.errors import InputError
 from zrp.gap.motion import diagnose_motion, load_trajectory, write_trajectory
+from zrp.jsonio import dict_from_dataclass
 from zrp.model.manipulator import Manipulator
 from zrp.output import OutputDir, write_text
 
@@ -110,7 +111,7 @@ class MotionScore:
         return self.top_correct and self.joints_correct and self.ratio <= 1.5
 
     def to_dict(self) -> dict[str, Any]:
-        return {**{k: v for k, v in self.__dict__.items()}, "success": self.success}
+        return {**dict_from_dataclass(self), "success": self.success}
 
 
 def _score(scn: MotionScenario, diag: Any, truth: dict[str, Any], sim_s: float,
