@@ -36,6 +36,7 @@ from mjcf.options import (
     RGBA,
     MJCFOptions,
 )
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 from zrp.units import metres_per_unit
@@ -48,7 +49,6 @@ __all__ = [
     "joint_name",
 ]
 
-F64 = NDArray[np.float64]
 
 @dataclass(frozen=True, eq=False)
 class BuiltArm:

@@ -9,14 +9,14 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from mjcf.gravity import joint_space_model
+from zrp.arrays import F64
 from zrp.errors import InputError
 
 __all__ = ["inverse_dynamics_torques", "mode_terms"]
 
-F64 = NDArray[np.float64]
 
 
 def _states(q: ArrayLike, qd: ArrayLike, qdd: ArrayLike) -> tuple[F64, F64, F64]:

@@ -6,13 +6,13 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 
 __all__ = ["gravity_torques", "joint_space_model"]
 
-F64 = NDArray[np.float64]
 
 
 def joint_space_model(source: str | Path | mujoco.MjModel, n: int,

@@ -96,32 +96,43 @@ def _branch_ends(m: mujoco.MjModel) -> list[int]:
     return list(chains.values())
 
 
-def _end_body(m: mujoco.MjModel, site: str | None, body: str | None) -> tuple[int, int]:
-    """(body id, site id or -1) of the end effector."""
-    if site is not None and body is not None:
-        raise InputError("site, body: give at most one of them (the end-effector frame)")
+def _named_end(m: mujoco.MjModel, site: str | None, body: str | None) -> tuple[int, int]:
+    """(body id, site id or -1) of the end effector named by ``site`` or ``body``."""
     if site is not None:
         sid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, site)
         if sid < 0:
             names = [_name(m, mujoco.mjtObj.mjOBJ_SITE, i) for i in range(m.nsite)]
             raise MJCFImportError(f"site: no site named {site!r}; the model has {names}")
         return int(m.site_bodyid[sid]), int(sid)
-    if body is not None:
-        bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
-        if bid < 0:
-            names = [_name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, m.nbody)]
-            raise MJCFImportError(f"body: no body named {body!r}; the model has {names}")
-        return int(bid), -1
-    # Default: the deepest body carrying joints; it must be unique (a single chain).
+    bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, body)
+    if bid < 0:
+        names = [_name(m, mujoco.mjtObj.mjOBJ_BODY, i) for i in range(1, m.nbody)]
+        raise MJCFImportError(f"body: no body named {body!r}; the model has {names}")
+    return int(bid), -1
+
+
+def _deepest_tips(m: mujoco.MjModel) -> list[int]:
+    """The bodies with the most joints on their path from the world and no child with as
+    many."""
     njoint_path = np.zeros(m.nbody, dtype=int)
     for b in range(1, m.nbody):
         njoint_path[b] = njoint_path[m.body_parentid[b]] + int(m.body_jntnum[b])
     deepest = int(njoint_path.max())
     if deepest == 0:
         raise MJCFImportError("the model has no hinge or slide joint: nothing to import")
-    tips = [b for b in range(1, m.nbody) if njoint_path[b] == deepest
+    return [b for b in range(1, m.nbody) if njoint_path[b] == deepest
             and not any(m.body_parentid[c] == b and njoint_path[c] == deepest
                         for c in range(1, m.nbody))]
+
+
+def _end_body(m: mujoco.MjModel, site: str | None, body: str | None) -> tuple[int, int]:
+    """(body id, site id or -1) of the end effector."""
+    if site is not None and body is not None:
+        raise InputError("site, body: give at most one of them (the end-effector frame)")
+    if site is not None or body is not None:
+        return _named_end(m, site, body)
+    # Default: the deepest body carrying joints; it must be unique (a single chain).
+    tips = _deepest_tips(m)
     ends = _branch_ends(m)
     if len(tips) > 1 or len(ends) > 1:
         names = sorted({_name(m, mujoco.mjtObj.mjOBJ_BODY, b) for b in [*tips, *ends]})
@@ -147,6 +158,52 @@ def _refuse_coupled(m: mujoco.MjModel, joints: list[int]) -> None:
                 f"coupled by a joint "
                 f"equality ({' ~ '.join(repr(n) for n in names)}); coupled joints are not "
                 f"modelled: choose an end body or site before it")
+
+
+def _chain_joints(m: mujoco.MjModel, bid: int) -> list[int]:
+    """The joints from the world to body ``bid``, in order; only hinges and slides, none
+    coupled, at least one."""
+    chain = []
+    b = bid
+    while b > 0:
+        chain.append(b)
+        b = int(m.body_parentid[b])
+    chain.reverse()
+    joints: list[int] = []
+    for b in chain:
+        for j in range(m.body_jntadr[b], m.body_jntadr[b] + m.body_jntnum[b]):
+            if int(m.jnt_type[j]) not in _CHAIN_JOINTS:
+                kind = mujoco.mjtJoint(m.jnt_type[j]).name.removeprefix("mjJNT_").lower()
+                raise MJCFImportError(
+                    f"joint {_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)!r} in body "
+                    f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, b)!r} is a {kind} joint; only hinge and "
+                    f"slide joints form a ZRP serial arm")
+            joints.append(j)
+    _refuse_coupled(m, joints)
+    if not joints:
+        raise MJCFImportError(f"no hinge or slide joint between the world and body "
+                              f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, bid)!r}")
+    return joints
+
+
+def _end_frame(d: mujoco.MjData, bid: int, sid: int) -> tuple[np.ndarray, np.ndarray]:
+    """(position, 3x3 frame) in the world of the end site ``sid``, or of body ``bid``."""
+    if sid >= 0:
+        return d.site_xpos[sid].copy(), d.site_xmat[sid].reshape(3, 3).copy()
+    return d.xpos[bid].copy(), d.xmat[bid].reshape(3, 3).copy()
+
+
+def _model_name(m: mujoco.MjModel) -> str:
+    """The MJCF model's name, or "imported arm"."""
+    return bytes(m.names).split(b"\0", 1)[0].decode(errors="replace") or "imported arm"
+
+
+def _limits(m: mujoco.MjModel, joints: list[int], scale: float
+            ) -> list[tuple[float, ...] | None]:
+    """Each joint's range (None when unlimited), slides in the model's length unit."""
+    return [None if not m.jnt_limited[j] else
+            tuple(m.jnt_range[j] / (scale if int(m.jnt_type[j]) == _SLIDE else 1.0))
+            for j in joints]
 
 
 def manipulator_from_mujoco(
@@ -179,44 +236,19 @@ def manipulator_from_mujoco(
     m = load_mujoco_model(source)
     scale = metres_per_unit(length_unit)
     bid, sid = _end_body(m, site, body)
-    chain = []
-    b = bid
-    while b > 0:
-        chain.append(b)
-        b = int(m.body_parentid[b])
-    chain.reverse()
-    joints: list[int] = []
-    for b in chain:
-        for j in range(m.body_jntadr[b], m.body_jntadr[b] + m.body_jntnum[b]):
-            if int(m.jnt_type[j]) not in _CHAIN_JOINTS:
-                kind = mujoco.mjtJoint(m.jnt_type[j]).name.removeprefix("mjJNT_").lower()
-                raise MJCFImportError(
-                    f"joint {_name(m, mujoco.mjtObj.mjOBJ_JOINT, j)!r} in body "
-                    f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, b)!r} is a {kind} joint; only hinge and "
-                    f"slide joints form a ZRP serial arm")
-            joints.append(j)
-    _refuse_coupled(m, joints)
-    if not joints:
-        raise MJCFImportError(f"no hinge or slide joint between the world and body "
-                              f"{_name(m, mujoco.mjtObj.mjOBJ_BODY, bid)!r}")
+    joints = _chain_joints(m, bid)
     d = mujoco.MjData(m)
     d.qpos[:] = 0.0
     mujoco.mj_kinematics(m, d)
     axes = np.array([d.xaxis[j] for j in joints])
     anchors = np.array([d.xanchor[j] for j in joints])
-    if sid >= 0:
-        p, frame = d.site_xpos[sid].copy(), d.site_xmat[sid].reshape(3, 3).copy()
-    else:
-        p, frame = d.xpos[bid].copy(), d.xmat[bid].reshape(3, 3).copy()
+    p, frame = _end_frame(d, bid, sid)
     bodies = np.vstack([anchors[:1], np.diff(anchors, axis=0), (p - anchors[-1])[None]]) / scale
     types = ["prismatic" if int(m.jnt_type[j]) == _SLIDE else "revolute"
              for j in joints]
     names = [_name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in joints]
-    model_name = name or bytes(m.names).split(b"\0", 1)[0].decode(errors="replace") \
-        or "imported arm"
-    limits = [None if not m.jnt_limited[j] else
-              tuple(m.jnt_range[j] / (scale if int(m.jnt_type[j]) == _SLIDE else 1.0))
-              for j in joints]
+    model_name = name or _model_name(m)
+    limits = _limits(m, joints, scale)
     return Manipulator.from_arrays(axes, bodies, axial=frame[:, 2], transverse=frame[:, 1],
                                    types=types, name=model_name, length_unit=length_unit,
                                    joint_names=[n if not n.startswith("#") else "" for n in names],

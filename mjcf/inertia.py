@@ -28,8 +28,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 
@@ -37,7 +37,6 @@ __all__ = ["INERTIA_MODELS", "BodyInertia", "puma560_inertias", "rod_inertias"]
 
 INERTIA_MODELS = ("none", "rods", "puma560")
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

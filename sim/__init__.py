@@ -1,15 +1,26 @@
-"""Simulation layer: MuJoCo playback and consistency checks against ZRP (:mod:`.playback`),
-servo dynamics (:mod:`.dynamics`), offscreen rendering (:mod:`.gl`, :mod:`.render`), comparison
-frames and videos (:mod:`.frames`, :mod:`.video`), the physics "real" robot (its hidden
-effects :mod:`.effects` and their text specs :mod:`.effect_specs`, its MuJoCo model
-:mod:`.robot_model`, the robot and its controller :mod:`.real_robot`), its measuring procedure
-(:mod:`.measurement`) and the blind benchmark of the gap diagnosis (the package
-:mod:`.benchmark`, imported by name: ``from sim.benchmark import run_benchmark``).
+"""Simulation layer, in sub-packages by job (see sim/README.md):
+
+* :mod:`sim.robot`: the physics "real" robot and its instrument - hidden effects
+  (:mod:`~sim.robot.effects`, text specs :mod:`~sim.robot.effect_specs`), its MuJoCo model
+  (:mod:`~sim.robot.model`), the robot and its controller at rest (:mod:`~sim.robot.real`) and
+  in motion (:mod:`~sim.robot.motion`), servo dynamics (:mod:`~sim.robot.dynamics`), the
+  laser tracker (:mod:`~sim.robot.instrument`) and the measuring procedures
+  (:mod:`~sim.robot.measurement`, :mod:`~sim.robot.motion_measure`);
+* :mod:`sim.view`: MuJoCo playback and its consistency check against ZRP
+  (:mod:`~sim.view.playback`), offscreen rendering (:mod:`~sim.view.gl`,
+  :mod:`~sim.view.render`), comparison frames and videos (:mod:`~sim.view.frames`,
+  :mod:`~sim.view.video`, :mod:`~sim.view.motion_video`) and the interactive viewer;
+* :mod:`sim.studies`: the blind benchmarks of the gap diagnosis (:mod:`sim.studies.benchmark`,
+  imported by name: ``from sim.studies.benchmark import run_benchmark``), the planned-poses
+  study and the compensation check;
+* :mod:`sim.lessons`: runnable lessons, one concept each.
 
 What a video shows is the caller's choice: the paper's scenes are assembled in the core
-(:mod:`zrp.paper.scenes`) and passed to :func:`render_video` as segments.
+(:mod:`zrp.paper.scenes`) and passed to :func:`render_video` as segments. Likewise the
+trajectories the robot is measured along are passed in: the studies and the command line build
+the paper's circle (:mod:`sim.studies.trajectories`), :mod:`sim.robot` never imports the paper.
 
-MuJoCo fixes its GL backend when it is first imported; :mod:`sim.gl` imports
+MuJoCo fixes its GL backend when it is first imported; :mod:`sim.view.gl` imports
 ``mujoco.egl``/``mujoco.osmesa`` directly, so :class:`OffscreenRenderer` works whatever was
 imported first.
 
@@ -31,40 +42,55 @@ from zrp.environment import check_mujoco_gl
 check_mujoco_gl()
 
 _EXPORTS = {
-    "dynamics": (
+    "robot.dynamics": (
         "DynamicPlayback",
         "default_dynamic_options",
         "dynamic_playback",
     ),
-    "effect_specs": (
+    "robot.effect_specs": (
         "parse_effects",
     ),
-    "effects": (
+    "robot.effects": (
         "EFFECT_NAMES",
         "HiddenEffects",
         "default_tool_points",
         "motor_map",
         "true_geometry",
     ),
-    "frames": (
+    "robot.instrument": (
+        "Instrument",
+        "random_instrument",
+    ),
+    "robot.measurement": (
+        "MeasurementRun",
+        "Procedure",
+        "measure",
+        "trajectory_poses",
+        "write_measurements",
+        "write_truth",
+    ),
+    "robot.model": (
+        "RealRobotOptions",
+    ),
+    "robot.real": (
+        "Reading",
+        "RealRobot",
+        "Session",
+    ),
+    "view.frames": (
         "VideoOptions",
         "VideoSegment",
         "comparison_frames",
         "nice_factor",
         "video_frames",
     ),
-    "framing": (
+    "view.framing": (
         "frame_on_path",
         "framing_report",
         "path_normal",
         "projected_fractions",
     ),
-    "viewer": (
-        "DisplayUnavailableError",
-        "display_status",
-        "view_path",
-    ),
-    "gl": (
+    "view.gl": (
         "BACKENDS",
         "GLBackendError",
         "GLUnavailableError",
@@ -73,39 +99,26 @@ _EXPORTS = {
         "probe_backend",
         "resolve_backend",
     ),
-    "measurement": (
-        "Instrument",
-        "MeasurementRun",
-        "Procedure",
-        "measure",
-        "random_instrument",
-        "trajectory_poses",
-        "write_measurements",
-        "write_truth",
-    ),
-    "playback": (
+    "view.playback": (
         "ConsistencyReport",
         "SitePoses",
         "consistency_check",
         "kinematic_playback",
     ),
-    "real_robot": (
-        "Reading",
-        "RealRobot",
-        "Session",
-    ),
-    "render": (
+    "view.render": (
         "OffscreenRenderer",
     ),
-    "robot_model": (
-        "RealRobotOptions",
-    ),
-    "video": (
+    "view.video": (
         "VideoResult",
         "VideoWriteError",
         "render_comparison_video",
         "render_video",
         "video_path",
+    ),
+    "view.viewer": (
+        "DisplayUnavailableError",
+        "display_status",
+        "view_path",
     ),
 }
 _WHERE = {name: mod for mod, names in _EXPORTS.items() for name in names}

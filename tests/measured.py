@@ -21,7 +21,7 @@ from scipy.spatial.transform import Rotation
 import zrp
 from zrp.gap import Measurements
 from zrp.kinematics import uniform_joint_values
-from zrp.manufacturing.sensitivity import axis_tangents
+from zrp.kinematics.identification import axis_tangents
 from zrp.rotations import matrix_from_rotvec
 
 #: The tracker's frame seen from the robot base: rotation and translation (mm).

@@ -17,6 +17,13 @@ from zrp.errors import (
 )
 from zrp.gap import Diagnosis, Measurements, diagnose, load_measurements, write_outputs
 from zrp.kinematics.forward import FKResult, end_effector_pose, forward_kinematics, jacobian
+from zrp.kinematics.identification import (
+    apply_parameters,
+    parameter_jacobian,
+    parameter_names,
+    parameter_space,
+    pose_error,
+)
 from zrp.kinematics.ik import IKResult, track_trajectory
 from zrp.kinematics.posture import PoseSolution, solve_pose
 from zrp.kinematics.redundant import track_posture
@@ -33,13 +40,6 @@ from zrp.manufacturing.allocation import Allocation, allocate_tolerances
 from zrp.manufacturing.deviation import Deviation, pose_deviation, trajectory_deviation
 from zrp.manufacturing.perturb import PAPER_SIGN_ZERO, Perturbation
 from zrp.manufacturing.population import MonteCarloResult, monte_carlo
-from zrp.manufacturing.sensitivity import (
-    apply_parameters,
-    parameter_jacobian,
-    parameter_names,
-    parameter_space,
-    pose_error,
-)
 from zrp.manufacturing.study import JointPath, StudyResult, load_joint_csv, one_at_a_time
 from zrp.manufacturing.tolerance import Tolerances
 from zrp.model.dh import DHRow, from_dh, from_mdh

@@ -5,19 +5,23 @@ strings, dataclasses with a ``to_dict()`` method are converted through it, and n
 (NaN, +-Infinity) become ``null``: the output is valid JSON (RFC 8259) that any parser reads,
 never Python's ``NaN`` extension. Anything else that JSON cannot hold is an error naming its
 type, not a silent ``str()``.
+
+:func:`dict_from_dataclass` is the one way a result dataclass writes its ``to_dict()``: its
+fields in declaration order, renamed or left out where the JSON schema says so.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from pathlib import PurePath
 from typing import Any
 
 import numpy as np
 
-__all__ = ["dumps", "to_jsonable"]
+__all__ = ["dict_from_dataclass", "dumps", "to_jsonable"]
 
 
 def to_jsonable(obj: Any) -> Any:
@@ -52,3 +56,53 @@ def to_jsonable(obj: Any) -> Any:
 def dumps(obj: Any, indent: int | None = 2) -> str:
     """Strict JSON text of ``obj`` (see :func:`to_jsonable`), with a trailing newline."""
     return json.dumps(to_jsonable(obj), indent=indent, allow_nan=False) + "\n"
+
+
+def _field_value(v: Any) -> Any:
+    """A field value in its ``to_dict`` form: objects with ``to_dict()`` (or dataclasses)
+    as dictionaries, tuples and lists as lists, mappings as dicts and arrays as nested
+    lists, each element converted the same way; anything else as it is."""
+    to_dict = getattr(v, "to_dict", None)
+    if callable(to_dict):
+        return to_dict()
+    if dataclasses.is_dataclass(v) and not isinstance(v, type):
+        return dict_from_dataclass(v)
+    if isinstance(v, (tuple, list)):
+        return [_field_value(x) for x in v]
+    if isinstance(v, Mapping):
+        return {k: _field_value(x) for k, x in v.items()}
+    if isinstance(v, np.ndarray):
+        return v.tolist()
+    return v
+
+
+def dict_from_dataclass(obj: Any, *, exclude: Collection[str] = (),
+                        rename: Mapping[str, str] | None = None,
+                        nan_to_none: Collection[str] = ()) -> dict[str, Any]:
+    """The fields of the dataclass instance ``obj`` as a dictionary, in declaration order.
+
+    Each value is converted as :func:`_field_value` says (nested results through their own
+    ``to_dict()``, tuples as lists). The result is ready for :func:`dumps`.
+
+    Args:
+        exclude: fields left out.
+        rename: field name -> JSON key, for the keys that differ from the field names.
+        nan_to_none: float fields written as None when they are NaN.
+
+    Raises:
+        TypeError: ``obj`` is not a dataclass instance.
+    """
+    if not dataclasses.is_dataclass(obj) or isinstance(obj, type):
+        raise TypeError(f"dict_from_dataclass: a {type(obj).__name__} is not a dataclass "
+                        "instance")
+    keys = rename or {}
+    out: dict[str, Any] = {}
+    for f in dataclasses.fields(obj):
+        if f.name in exclude:
+            continue
+        v = getattr(obj, f.name)
+        if f.name in nan_to_none and isinstance(v, float) and math.isnan(v):
+            out[keys.get(f.name, f.name)] = None
+        else:
+            out[keys.get(f.name, f.name)] = _field_value(v)
+    return out

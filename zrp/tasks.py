@@ -1,7 +1,7 @@
 """Map independent tasks over any ``concurrent.futures``-style executor, or over none.
 
 The one scheduling loop of the toolkit: the Monte Carlo chunks (:mod:`zrp.manufacturing.chunks`),
-the blind benchmark's scenarios (:mod:`sim.benchmark.runner`) and the fleet diagnosis
+the blind benchmark's scenarios (:mod:`sim.studies.benchmark.runner`) and the fleet diagnosis
 (:mod:`zrp.cli.fleet`) all go through :func:`map_tasks`. The core never imports an executor
 library: the application passes one in (a Dask ``Client.get_executor()`` from
 :mod:`zrp.cli.cluster`, a ``ProcessPoolExecutor``, ...). Results come back in completion order,
@@ -19,6 +19,7 @@ from itertools import islice
 from typing import Any, TypeVar
 
 from zrp.errors import InputError
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["WINDOW", "TaskFailure", "map_tasks"]
 
@@ -37,7 +38,7 @@ class TaskFailure:
     traceback: str
 
     def to_dict(self) -> dict[str, Any]:
-        return {"position": self.position, "task": self.task, "error": self.error}
+        return dict_from_dataclass(self, exclude=("traceback",))
 
 
 def _failure(position: int, task: Any, exc: BaseException,

@@ -7,12 +7,12 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.model.dh import from_mdh
 from zrp.model.manipulator import Manipulator
 from zrp.rotations.matrices import rotation_angle
-from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply, er_to_matrix
+from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply, matrix_from_er
 from zrp.units import canonical_length_unit
 
 __all__ = [
@@ -59,7 +59,7 @@ def random_arm(rng: np.random.Generator, n: int, p_prismatic: float = 0.0,
 
 
 # ---- assertions ------------------------------------------------------------------------------
-def _pose_parts(pose: Any, name: str) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+def _pose_parts(pose: Any, name: str) -> tuple[F64, F64]:
     """(positions (..., 3), rotations (..., 4) Euler-Rodrigues or (..., 3, 3) matrices) of a
     pose: a forward-kinematics result (``.position``, ``.er``), a pair (position, rotation) as
     :func:`zrp.end_effector_pose` returns, or homogeneous transforms (..., 4, 4)."""
@@ -79,13 +79,13 @@ def _pose_parts(pose: Any, name: str) -> tuple[NDArray[np.float64], NDArray[np.f
                          f"rotation) or (..., 4, 4) transforms, got {type(pose).__name__}")
 
 
-def _rotation_error(ra: NDArray[np.float64], rd: NDArray[np.float64]) -> NDArray[np.float64]:
+def _rotation_error(ra: F64, rd: F64) -> F64:
     """Angle (rad) of the rotation from ``rd`` to ``ra``: Euler-Rodrigues parameters composed
     when both are, else the matrices' relative rotation (accurate near zero either way)."""
     if ra.shape[-1] == 4 and rd.shape[-1] == 4:
         return er_angle(er_multiply(ra, er_conjugate(rd)))
-    ma = er_to_matrix(ra) if ra.shape[-1] == 4 else ra
-    md = er_to_matrix(rd) if rd.shape[-1] == 4 else rd
+    ma = matrix_from_er(ra) if ra.shape[-1] == 4 else ra
+    md = matrix_from_er(rd) if rd.shape[-1] == 4 else rd
     return rotation_angle(md, ma)
 
 

@@ -10,12 +10,13 @@
 
 Each lesson is a function ``lesson(out, small=False) -> Lesson`` that writes into an entered
 :class:`zrp.output.OutputDir` and returns its files, one sentence per file, and the numbers
-it measured. :func:`run_lessons` runs several into one folder.
+it measured (:mod:`.lesson`: :class:`Lesson` and the figure helper). The registry
+(:mod:`.registry`) imports the lessons; :func:`run_lessons` runs several into one folder.
 """
 
-from sim.lessons.gallery import LESSONS as LESSONS
-from sim.lessons.gallery import Lesson as Lesson
-from sim.lessons.gallery import lesson_file_names as lesson_file_names
-from sim.lessons.gallery import run_lessons as run_lessons
+from sim.lessons.lesson import Lesson as Lesson
+from sim.lessons.registry import LESSONS as LESSONS
+from sim.lessons.registry import lesson_file_names as lesson_file_names
+from sim.lessons.registry import run_lessons as run_lessons
 
 __all__ = ["LESSONS", "Lesson", "lesson_file_names", "run_lessons"]

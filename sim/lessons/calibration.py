@@ -5,10 +5,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.effect_specs import parse_effects
-from sim.lessons.gallery import Lesson, figure
-from sim.measurement import Procedure, measure, random_instrument
-from sim.real_robot import RealRobot
+from sim.lessons.lesson import Lesson, figure
+from sim.robot.effect_specs import parse_effects
+from sim.robot.instrument import random_instrument
+from sim.robot.measurement import Procedure, measure
+from sim.robot.real import RealRobot
 from zrp.gap.pipeline import diagnose
 from zrp.kinematics.sampling import reachable_poses
 from zrp.model.files import load_model

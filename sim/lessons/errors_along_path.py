@@ -7,9 +7,9 @@ from dataclasses import replace
 
 import numpy as np
 
-from sim.frames import VideoOptions
-from sim.lessons.gallery import Lesson, figure
-from sim.video import render_video
+from sim.lessons.lesson import Lesson, figure
+from sim.view.frames import VideoOptions
+from sim.view.video import render_video
 from zrp.manufacturing.perturb import Perturbation
 from zrp.manufacturing.study import one_at_a_time
 from zrp.output import OutputDir

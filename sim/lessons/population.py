@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.lessons.gallery import Lesson, figure
+from sim.lessons.lesson import Lesson, figure
 from zrp.manufacturing.population import monte_carlo
 from zrp.manufacturing.tolerance import Tolerances
 from zrp.output import OutputDir

@@ -7,15 +7,19 @@ baseline measured in the same run is one vectorised forward kinematics of the ca
 on the 1,000 targets (what every Newton iteration costs at least), so the printed ratio says
 how many such evaluations compensation needs, independent of the machine's load.
 
-Run: python tests/benchmarks/bench_compensate.py
+Run: python3 tests/benchmarks/bench_compensate.py [--quick] [--out FILE.md] [--force]
+(writes the table to renders/benchmarks/bench_compensate.md and .json; --quick: 500 points
+and 200 targets).
 """
 
 from __future__ import annotations
 
+import argparse
 import time
 import warnings
 
 import numpy as np
+from _report import Report, add_output_arguments, output_path
 
 import zrp
 from zrp.calibration import CalibratedRobot, compensate
@@ -36,14 +40,20 @@ def _best(fn, repeats=3):
 
 
 def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="500 points and 200 targets")
+    add_output_arguments(ap, "bench_compensate")
+    args = ap.parse_args()
+    out = output_path(args)
+    poses, targets = (250, 200) if args.quick else (500, 1000)
     rng = np.random.default_rng(2024)
     model = zrp.load_model("puma")
-    q = uniform_joint_values(model, 500, rng)
+    q = uniform_joint_values(model, poses, rng)
     inj = Injection(joint_offset={2: 1e-3}, compliance={2: 2e-5, 3: 3e-5}, backlash={1: 5e-4},
                     link={3: (0.3, 0.0, -0.2)})
     meas = synthesize(model, q, inj, rng=rng, noise_sigma=0.02,
                       tool_offsets=((50.0, 0.0, 30.0), (-40.0, 60.0, 30.0)))
-    qt = uniform_joint_values(model, 1000, rng, LIM * 0.8)
+    qt = uniform_joint_values(model, targets, rng, LIM * 0.8)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         diagnose(model, meas, seed=0, effects=("joint_offset",))  # warm-up (imports)
@@ -59,12 +69,27 @@ def main() -> None:
     t_comp, comp = _best(run)
     total = t_diag + t_comp
     s = comp.summary()
-    print(f"diagnosis (1,000 points) {t_diag:.3f} s ({', '.join(d.effects)}); calibrated robot + "
-          f"compensation of 1,000 targets {t_comp:.3f} s = {t_comp / t_fk:.0f} x one prediction "
-          f"({t_fk * 1e3:.1f} ms); total {total:.3f} s, goal {GOAL_S} s: "
-          f"{'PASS' if total <= GOAL_S else 'FAIL'}")
+    verdict = "PASS" if total <= GOAL_S else "FAIL"
+    print(f"diagnosis ({meas.n_rows:,} points) {t_diag:.3f} s ({', '.join(d.effects)}); "
+          f"calibrated robot + compensation of {targets:,} targets {t_comp:.3f} s = "
+          f"{t_comp / t_fk:.0f} x one prediction ({t_fk * 1e3:.1f} ms); total {total:.3f} s, "
+          f"goal {GOAL_S} s: {verdict}")
     print(f"predicted RMS {s['rms_before']:.3f} -> {s['rms_after']:.2e} mm, "
           f"{s['not_converged']} not converged, {s['near_singular']} near a singularity")
+    report = Report("bench_compensate", "diagnosis, calibrated robot and compensation of "
+                    "targets")
+    report.table(
+        f"PUMA, {meas.n_rows:,} measured points ({poses} poses x 2 reflectors), {targets:,} "
+        "position targets (best of 2-3 runs)", ["step", "measured", "goal"],
+        [(f"diagnosis, all candidate effects (found: {', '.join(d.effects)})",
+          f"{t_diag:.3f} s", ""),
+         ("calibrated robot + compensation", f"{t_comp:.3f} s",
+          f"{t_comp / t_fk:.0f} x one prediction ({t_fk * 1e3:.1f} ms)"),
+         ("total", f"{total:.3f} s", f"<= {GOAL_S:g} s: {verdict}"),
+         ("predicted RMS before -> after compensation",
+          f"{s['rms_before']:.3f} -> {s['rms_after']:.2e} mm",
+          f"{s['not_converged']} not converged, {s['near_singular']} near a singularity")])
+    report.write(out, args)
 
 
 if __name__ == "__main__":

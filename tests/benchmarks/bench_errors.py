@@ -1,9 +1,12 @@
-"""Benchmarks of the manufacturing-error analysis (run: python benchmarks/bench_errors.py).
+"""Benchmarks of the manufacturing-error analysis.
 
 Goals (issue 3): the whole numerical example in < 1 s of compute; the Monte Carlo of 1e5
 robots x 360 trajectory points in <= 5 s. Every timing is printed beside a baseline measured
 in the same run on the same machine, so the ratios stay meaningful on a loaded machine.
 Compilation (numba) is excluded: everything is warmed up first.
+
+Run: python3 tests/benchmarks/bench_errors.py [--robots N] [--quick] [--out FILE.md] [--force]
+(writes the tables to renders/benchmarks/bench_errors.md and .json; --quick: 1e4 robots).
 """
 
 from __future__ import annotations
@@ -13,12 +16,13 @@ import time
 
 import numba
 import numpy as np
+from _report import Report, add_output_arguments, output_path
 
 import zrp
+from zrp.kinematics.identification import apply_parameters, parameter_jacobian, parameter_space
 from zrp.manufacturing.deviation import trajectory_deviation
 from zrp.manufacturing.perturb import Perturbation
 from zrp.manufacturing.population import monte_carlo
-from zrp.manufacturing.sensitivity import apply_parameters, parameter_jacobian, parameter_space
 from zrp.manufacturing.study import PAPER_PARAMETERS, PAPER_XI
 from zrp.manufacturing.tolerance import Tolerances
 from zrp.paper.example import run_paper_example
@@ -34,7 +38,7 @@ def best_of(fn, repeat: int = 5) -> float:
     return min(times)
 
 
-def bench_paper() -> None:
+def bench_paper(report: Report) -> None:
     model = zrp.load_model("puma")
     run_paper_example(model)  # warm-up (numba caches, imports)
     t_all = best_of(lambda: run_paper_example(model), 5)
@@ -55,9 +59,16 @@ def bench_paper() -> None:
         print(f"    {k:24s} {v * 1e3:8.2f} ms")
     print(f"  baseline: the 90 study cells via Perturbation.apply + trajectory_deviation "
           f"{t_ref * 1e3:.1f} ms; study kernel path is x{t_ref / ex.timings_s['study']:.1f} faster")
+    report.table(
+        "The paper's numerical example (IK 360 steps, 10 x 9 study cells, alternative "
+        "conventions, comparison)", ["part", "time (ms)", "goal"],
+        [("whole example, best of 5", f"{t_all * 1e3:.1f}", "< 1000"),
+         *((f"of which {k}", f"{v * 1e3:.2f}", "") for k, v in ex.timings_s.items()),
+         ("baseline: the 90 cells via Perturbation.apply + trajectory_deviation",
+          f"{t_ref * 1e3:.1f}", f"study path x{t_ref / ex.timings_s['study']:.1f} faster")])
 
 
-def bench_monte_carlo(n_robots: int) -> None:
+def bench_monte_carlo(n_robots: int, report: Report) -> None:
     model = zrp.load_model("puma")
     path = circle_joint_path(model, steps=359)  # 360 trajectory points
     q = path.q
@@ -98,9 +109,22 @@ def bench_monte_carlo(n_robots: int) -> None:
           f"{loop_rate / 1e6:.3f} M poses/s -> x{mc.poses_per_s / loop_rate:.0f}")
     print(f"  P99 max delta_p = {mc.percentile(99)[0]:.4f} mm, P99 max angle = "
           f"{mc.percentile(99)[1]:.3e} rad")
+    report.table(
+        f"Monte Carlo: {n_robots} robots x {q.shape[0]} points (PUMA circle, 0.02 mm / 5e-5 rad "
+        f"uniform; numba threads: {numba.get_num_threads()})",
+        ["figure", "measured", "goal"],
+        [("kernel", f"{mc.elapsed_s:.3f} s, {mc.poses_per_s / 1e6:.2f} M poses/s", ""),
+         ("wall (incl. sampling, perturbed arrays)",
+          f"{wall:.3f} s, {poses / wall / 1e6:.2f} M poses/s", "<= 5 s for 1e5 robots"),
+         ("baseline zrp.end_effector_pose (one model, batched)",
+          f"{fk_rate / 1e6:.2f} M poses/s", f"kernel x{mc.poses_per_s / fk_rate:.1f}"),
+         ("baseline per-robot loop (Manipulator + end_effector_pose)",
+          f"{loop_rate / 1e6:.3f} M poses/s", f"kernel x{mc.poses_per_s / loop_rate:.0f}"),
+         ("P99 max delta_p, P99 max angle",
+          f"{mc.percentile(99)[0]:.4f} mm, {mc.percentile(99)[1]:.3e} rad", "")])
 
 
-def bench_sensitivity() -> None:
+def bench_sensitivity(report: Report) -> None:
     model = zrp.load_model("puma")
     path = circle_joint_path(model, steps=360)
     parameter_jacobian(model, path.q)
@@ -119,15 +143,27 @@ def bench_sensitivity() -> None:
     print(f"\nidentification Jacobian, {path.q.shape[0]} points x {space.size} parameters:")
     print(f"  analytic {t_an * 1e3:.2f} ms; baseline central finite differences "
           f"{t_fd * 1e3:.2f} ms -> x{t_fd / t_an:.1f}")
+    report.table(
+        f"Identification Jacobian, {path.q.shape[0]} points x {space.size} parameters",
+        ["method", "time (ms)", "ratio"],
+        [("analytic parameter_jacobian", f"{t_an * 1e3:.2f}", ""),
+         ("baseline: central finite differences", f"{t_fd * 1e3:.2f}",
+          f"analytic x{t_fd / t_an:.1f} faster")])
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--robots", type=int, default=100_000, help="Monte Carlo robots (1e5)")
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--robots", type=int, default=None, help="Monte Carlo robots (1e5)")
+    ap.add_argument("--quick", action="store_true", help="1e4 Monte Carlo robots")
+    add_output_arguments(ap, "bench_errors")
     args = ap.parse_args()
-    bench_paper()
-    bench_monte_carlo(args.robots)
-    bench_sensitivity()
+    out = output_path(args)
+    report = Report("bench_errors", "the manufacturing-error analysis: the paper's example, "
+                    "Monte Carlo, identification Jacobian")
+    bench_paper(report)
+    bench_monte_carlo(args.robots or (10_000 if args.quick else 100_000), report)
+    bench_sensitivity(report)
+    report.write(out, args)
 
 
 if __name__ == "__main__":

@@ -12,15 +12,20 @@ Prints, in one run:
 
 Targets on the 2-core machine: >= 20 M poses/s (>= 10x the MuJoCo loop), >= 5 M Jacobians/s,
 circle IK of 1,000 steps <= 20 ms. Timings are the best of several repeats.
+
+Run: python3 tests/benchmarks/bench_kinematics.py [--quick] [--out FILE.md] [--force]
+(writes the table to renders/benchmarks/bench_kinematics.md and .json; --quick: 1e5 poses).
 """
 
 from __future__ import annotations
 
+import argparse
 import os
 import time
 
 import mujoco
 import numpy as np
+from _report import Report, add_output_arguments, output_path
 
 import zrp
 from zrp.kinematics import _kernels as K
@@ -56,34 +61,44 @@ def mujoco_loop_rate(model: zrp.Manipulator, q: np.ndarray) -> float:
 
 
 def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true", help="1e5 poses instead of 1e6")
+    add_output_arguments(ap, "bench_kinematics")
+    args = ap.parse_args()
+    out_md = output_path(args)
     model = zrp.load_model("puma")
     rng = np.random.default_rng(0)
-    n = 1_000_000
+    n = 100_000 if args.quick else 1_000_000
     q = rng.uniform(-np.pi, np.pi, (n, 6))
     print(f"zrp forward kinematics, PUMA, N = {n:,} poses, one core")
+    rows: list[tuple[str, str, str]] = []
+
+    def show(label: str, value: str, target: str = "") -> None:
+        rows.append((label, value, target))
+        print(f"  {label:<36} {value}" + (f"  (target {target})" if target else ""))
 
     t_api = best(lambda: zrp.end_effector_pose(model, q))
     out = np.empty((n, 7))
     arrays = _karrays(model)
     lim = joint_limits(model)
     t_kernel = best(lambda: K.fk_pose_batch(q, *arrays, lim, out))
-    t_numpy = best(lambda: zrp.forward_kinematics(model, q[:100_000]), repeat=2) * 10
+    t_numpy = best(lambda: zrp.forward_kinematics(model, q[: n // 10]), repeat=2) * 10
     mj_rate = mujoco_loop_rate(model, q[:20_000])
     api, kern = n / t_api, n / t_kernel
-    print(f"  end_effector_pose (allocates output) {api / 1e6:8.2f} M poses/s")
-    print(f"  compiled kernel, preallocated output {kern / 1e6:8.2f} M poses/s  (target >= 20)")
-    print(f"  NumPy vectorised forward_kinematics  {n / t_numpy / 1e6:8.2f} M poses/s")
-    print(f"  MuJoCo mj_kinematics, Python loop    {mj_rate / 1e6:8.3f} M poses/s")
-    print(f"  ratio kernel / MuJoCo loop           {kern / mj_rate:8.1f}x  (target >= 10x)")
-    print(f"  ratio API / MuJoCo loop              {api / mj_rate:8.1f}x")
-    print(f"  ratio kernel / NumPy                 {kern * t_numpy / n:8.1f}x")
+    show("end_effector_pose (allocates output)", f"{api / 1e6:.2f} M poses/s")
+    show("compiled kernel, preallocated output", f"{kern / 1e6:.2f} M poses/s", ">= 20")
+    show("NumPy vectorised forward_kinematics", f"{n / t_numpy / 1e6:.2f} M poses/s")
+    show("MuJoCo mj_kinematics, Python loop", f"{mj_rate / 1e6:.3f} M poses/s")
+    show("ratio kernel / MuJoCo loop", f"{kern / mj_rate:.1f}x", ">= 10x")
+    show("ratio API / MuJoCo loop", f"{api / mj_rate:.1f}x")
+    show("ratio kernel / NumPy", f"{kern * t_numpy / n:.1f}x")
 
     t_jac = best(lambda: zrp.jacobian(model, q), repeat=3)
     jac = np.empty((n, 6, 6))
     t_jk = best(lambda: K.jac_batch(q, *arrays, lim, np.empty((0, 7)), jac), repeat=3)
-    print(f"  jacobian (allocates output)          {n / t_jac / 1e6:8.2f} M Jacobians/s")
-    print(f"  compiled kernel, preallocated output {n / t_jk / 1e6:8.2f} M Jacobians/s"
-          "  (target >= 5)")
+    show("jacobian (allocates output)", f"{n / t_jac / 1e6:.2f} M Jacobians/s")
+    show("compiled Jacobian kernel, preallocated", f"{n / t_jk / 1e6:.2f} M Jacobians/s",
+         ">= 5")
 
     setup = zrp.puma_circle()
     t_ik = best(lambda: zrp.track_trajectory(setup.model, setup.trajectory, setup.q0, 1000),
@@ -91,10 +106,15 @@ def main() -> None:
     t_ik_none = best(lambda: zrp.track_trajectory(setup.model, setup.trajectory, setup.q0,
                                                   1000, correction="none"), repeat=10)
     res = zrp.track_trajectory(setup.model, setup.trajectory, setup.q0, 1000)
-    print(f"  circle IK, 1,000 steps, Newton       {t_ik * 1e3:8.2f} ms  (target <= 20 ms; "
-          f"max error {res.position_error.max():.1e} mm)")
-    print(f"  circle IK, 1,000 steps, bare ABM4    {t_ik_none * 1e3:8.2f} ms  "
-          f"(ratio Newton / bare {t_ik / t_ik_none:.2f})")
+    show("circle IK, 1,000 steps, Newton", f"{t_ik * 1e3:.2f} ms (max error "
+         f"{res.position_error.max():.1e} mm)", "<= 20 ms")
+    show("circle IK, 1,000 steps, bare ABM4", f"{t_ik_none * 1e3:.2f} ms (Newton / bare "
+         f"{t_ik / t_ik_none:.2f})")
+    report = Report("bench_kinematics", "forward kinematics, Jacobians and the circle IK "
+                    "on one core")
+    report.table(f"PUMA, {n:,} random poses (best of several repeats)",
+                 ["figure", "measured", "target"], rows)
+    report.write(out_md, args)
 
 
 if __name__ == "__main__":

@@ -12,7 +12,9 @@ Measured in one run on the same model (the Table 1 PUMA built by ``mjcf.build``)
 
 Targets (issue 4): full frames >= 30 fps on the 2-core CPU; the 10 s video in <= 20 s.
 
-Run: ``python3 tests/benchmarks/bench_render.py [--frames 150] [--backend egl|osmesa]``
+Run: ``python3 tests/benchmarks/bench_render.py [--frames 150] [--backend egl|osmesa] [--quick]
+[--out FILE.md] [--force]`` (writes the table to renders/benchmarks/bench_render.md and .json;
+--quick: 30 frames and no video).
 """
 
 from __future__ import annotations
@@ -24,6 +26,8 @@ import tempfile
 import time
 from pathlib import Path
 
+from _report import Report, add_output_arguments, output_path
+
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -31,12 +35,17 @@ def main() -> None:
     ap.add_argument("--backend", default=None, help="egl or osmesa (default: MUJOCO_GL, else "
                     "the first that works)")
     ap.add_argument("--skip-video", action="store_true")
+    ap.add_argument("--quick", action="store_true", help="30 frames, no video")
+    add_output_arguments(ap, "bench_render")
     args = ap.parse_args()
+    out = output_path(args)
+    if args.quick:
+        args.frames, args.skip_video = min(args.frames, 30), True
 
     # mujoco.Renderer reads MUJOCO_GL when mujoco is first imported: choose before importing.
-    import sim.gl
+    import sim.view.gl
 
-    backend = sim.gl.configure_backend(args.backend)
+    backend = sim.view.gl.configure_backend(args.backend)
     import mujoco
     import numpy as np
 
@@ -71,6 +80,8 @@ def main() -> None:
             r.render()
         base = n / (time.perf_counter() - t0)
     print(f"mujoco.Renderer (defaults)          {base:7.1f} fps   1.00x")
+    rows = [("mujoco.Renderer (defaults: shadows, reflections, 4x MSAA)", f"{base:.1f} fps",
+             "1.00x", "")]
 
     with sim.OffscreenRenderer(arm.model, w, h, backend=backend) as r:
         r.update_scene(data)
@@ -83,6 +94,8 @@ def main() -> None:
             r.read()
         bare = n / (time.perf_counter() - t0)
     print(f"ours, bare (fast settings, read)    {bare:7.1f} fps   {bare / base:.2f}x")
+    rows.append(("ours, bare (fast settings, read back)", f"{bare:.1f} fps",
+                 f"{bare / base:.2f}x", ""))
 
     opts = sim.VideoOptions(width=w, height=h, fps=30, seconds=n / 30, backend=backend)
     gen = sim.comparison_frames(nominal, perturbed, ik.t, ik.q, label="JE2 +0.1 %",
@@ -95,6 +108,8 @@ def main() -> None:
     verdict = "meets" if full >= 30 else "MISSES"
     print(f"ours, full frame with overlays      {full:7.1f} fps   {full / base:.2f}x   "
           f"({verdict} the 30 fps target)")
+    rows.append(("ours, full video frame with overlays", f"{full:.1f} fps",
+                 f"{full / base:.2f}x", f">= 30 fps: {verdict}"))
 
     if not args.skip_video:
         with tempfile.TemporaryDirectory() as tmp:
@@ -107,6 +122,13 @@ def main() -> None:
         print(f"10 s 30 fps video end to end        {res.wall_seconds:7.2f} s     "
               f"{res.frames} frames, {size:.2f} MB ({verdict} the 20 s target; "
               f"{res.wall_seconds / 20:.2f} of the budget)")
+        rows.append(("10 s, 30 fps mp4 end to end (models, playback, rendering, libx264)",
+                     f"{res.wall_seconds:.2f} s", f"{res.frames} frames, {size:.2f} MB",
+                     f"<= 20 s: {verdict}"))
+    report = Report("bench_render", "offscreen rendering and video")
+    report.table(f"The Table 1 PUMA at {w}x{h}, {n} frames, backend {backend}",
+                 ["what", "measured", "vs mujoco.Renderer", "target"], rows)
+    report.write(out, args)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 """Speed against the issue-15 targets, every figure beside a baseline measured in the same run.
 
-Run: python tests/benchmarks/bench_speed.py [--quick] [--only diagnosis]   (from the
-repository root)
+Run: python3 tests/benchmarks/bench_speed.py [--quick] [--only diagnosis] [--out FILE.md]
+[--force]   (from the repository root; writes the table to renders/benchmarks/bench_speed.md
+and .json, bench_speed_diagnosis.md with --only diagnosis)
 
 One core for the kernels (NUMBA_NUM_THREADS=1, set before numba loads). Prints one table:
 figure, measured value, target, the baseline of the same run and the ratio:
@@ -17,7 +18,7 @@ figure, measured value, target, the baseline of the same run and the ratio:
 * the full diagnosis of the IRB 120 laser-tracker data in ../shared (2,946 points) and of its
   first 999 points; baselines: the registration fit alone, the same diagnosis with the
   Levenberg-Marquardt fits on the tall Jacobian (the former: MINPACK's own QR of it instead
-  of the QR-compressed problem, zrp.gap.problem.compressed) and on OpenBLAS's own threads
+  of the QR-compressed problem, zrp.gap.model.problem.compressed) and on OpenBLAS's own threads
   (the former; zrp/blas.py) (skipped without ../shared);
 * the blind benchmark's simulation of a 200-pose scenario; baselines: the same poses measured
   by forward kinematics only, and the former procedure (every move to a pre-pose simulated).
@@ -42,6 +43,8 @@ import numpy as np
 # measure the checkout this script is in, not whichever copy is installed (an editable
 # install of another checkout would otherwise be imported)
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+
+from _report import Report, add_output_arguments, output_path
 
 import zrp
 from zrp.kinematics import _kernels as K
@@ -239,10 +242,12 @@ def diagnosis() -> None:
     import contextlib
 
     from zrp.blas import blas_threads
-    from zrp.gap import diagnose, leastsq, load_measurements, pipeline
-    from zrp.gap.effects import Context, registration_parameters
-    from zrp.gap.leastsq import fit, initial_registration
-    from zrp.gap.problem import compressed
+    from zrp.gap import diagnose, load_measurements, pipeline
+    from zrp.gap.fit import leastsq
+    from zrp.gap.fit.leastsq import fit, initial_registration
+    from zrp.gap.model.context import Context
+    from zrp.gap.model.effects import registration_parameters
+    from zrp.gap.model.problem import compressed
 
     model = zrp.load_model(str(SHARED / "irb120.toml"))
     lines = (SHARED / "measurements.csv").read_text(encoding="utf-8").splitlines()
@@ -288,8 +293,8 @@ def diagnosis() -> None:
 
 
 def simulation(poses: int) -> None:
-    from sim.benchmark import BenchmarkConfig, draw_scenarios, simulate_scenario
-    from sim.effects import default_tool_points, true_geometry
+    from sim.robot.effects import default_tool_points, true_geometry
+    from sim.studies.benchmark import BenchmarkConfig, draw_scenarios, simulate_scenario
     from zrp.kinematics import reachable_poses
 
     model = zrp.load_model("puma")
@@ -299,8 +304,8 @@ def simulation(poses: int) -> None:
     tool = default_tool_points(model)
     import functools
 
-    import sim.benchmark.blind as blind
-    from sim.measurement import Procedure
+    import sim.studies.benchmark.blind as blind
+    from sim.robot.measurement import Procedure
 
     with tempfile.TemporaryDirectory() as tmp:
         times = [simulate_scenario(model, s, cfg, Path(tmp), Path(tmp))[2] for s in scns]
@@ -325,19 +330,29 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, no cluster")
     ap.add_argument("--only", choices=("diagnosis",), help="only this figure")
+    add_output_arguments(ap, "bench_speed")
     args = ap.parse_args()
+    if args.only:
+        args.report_name = f"bench_speed_{args.only}"
+    out = output_path(args)
     print(f"issue-15 speed figures (one core for the kernels; load {os.getloadavg()[0]:.1f})")
     if args.only == "diagnosis":
         diagnosis()
-        print(f"(load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
-        return
-    model = zrp.load_model("puma")
-    fk_rate = batched(model, 200_000 if args.quick else 1_000_000)
-    single_calls(model)
-    monte_carlo(10_000 if args.quick else 100_000, workers=not args.quick, fk_rate=fk_rate)
-    diagnosis()
-    simulation(50 if args.quick else 200)
+    else:
+        model = zrp.load_model("puma")
+        fk_rate = batched(model, 200_000 if args.quick else 1_000_000)
+        single_calls(model)
+        monte_carlo(10_000 if args.quick else 100_000, workers=not args.quick, fk_rate=fk_rate)
+        diagnosis()
+        simulation(50 if args.quick else 200)
     print(f"(load average at the end: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores)")
+    report = Report(args.report_name, "the issue-15 speed figures, each beside a baseline "
+                    "measured in the same run")
+    report.table("Kernels on one core (NUMBA_NUM_THREADS=1); best of interleaved repeats",
+                 ["figure", "measured", "target", "baseline (same run)", "ratio"],
+                 [(("... " + r[0].strip()) if r[0].startswith(" ") else r[0], *r[1:])
+                  for r in ROWS])
+    report.write(out, args)
 
 
 if __name__ == "__main__":

@@ -1,7 +1,7 @@
 """The calibrated robot out of a diagnosis, and compensation of targets (issue 11).
 
 References: the diagnosis's own withheld residual (round trip through the written files
-must reproduce it exactly); the synthetic "real robot" of zrp.gap.synthetic (forward
+must reproduce it exactly); the synthetic "real robot" of zrp.gap.data.synthetic (forward
 kinematics of a perturbed model, not the calibration code) for what the commands achieve.
 """
 
@@ -75,7 +75,7 @@ def test_offsets_are_folded_into_the_model(geometric):
     # of both through the toolkit's forward kinematics
     q = uniform_joint_values(PUMA, 20, np.random.default_rng(3), LIM)
     fit = geometric.final_fit
-    from zrp.gap.problem import Problem
+    from zrp.gap.model.problem import Problem
     u, _, bodies = Problem(geometric.context, fit.specs, geometric.fitting_poses[:1],
                            fit.base_rotation).geometry(fit.theta)
     corrected = PUMA.with_arrays(axes=u, bodies=bodies)

@@ -1,5 +1,5 @@
 """The calibrated robot's joint map takes its bases from the diagnosis's one definition
-(zrp.gap.jointbases, issue 11): every joint-correction parameter the effect builders make
+(zrp.gap.model.jointbases, issue 11): every joint-correction parameter the effect builders make
 has a term whose basis on the same poses is that parameter's column, MJCF and lumped-mass
 compliance, backlash with and without a switching torque."""
 
@@ -12,7 +12,8 @@ import zrp
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, term_basis
 from zrp.errors import InputError
 from zrp.gap import Measurements
-from zrp.gap.effects import Context, effect_parameters
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import effect_parameters
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")

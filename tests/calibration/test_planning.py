@@ -1,6 +1,6 @@
 """Measurement planning (zrp.calibration.plan_poses): the predicted standard deviations agree
 with the spread of identified values over repeated noisy simulations of the planned poses
-(the synthetic robot of zrp.gap.synthetic and the diagnosis's least squares)."""
+(the synthetic robot of zrp.gap.data.synthetic and the diagnosis's least squares)."""
 
 from __future__ import annotations
 
@@ -13,8 +13,9 @@ import zrp
 from zrp.calibration import PlanWarning, plan_poses
 from zrp.errors import InputError
 from zrp.gap import Injection, synthesize
-from zrp.gap.effects import Context, effect_parameters, registration_parameters
-from zrp.gap.leastsq import fit, initial_registration
+from zrp.gap.fit.leastsq import fit, initial_registration
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
 
 PUMA = zrp.load_model("puma")
 TOOLS = ((50.0, 0.0, 30.0), (-40.0, 60.0, 30.0), (0.0, -70.0, 40.0))

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import zrp
-from sim.benchmark import BenchmarkConfig, run_benchmark
+from sim.studies.benchmark import BenchmarkConfig, run_benchmark
 from zrp.cli import main
 from zrp.cli.cluster import LOCAL_CONFIG, local_cluster
 from zrp.gap import Injection, synthesize

@@ -11,6 +11,7 @@ import pytest
 import zrp
 from zrp.cli.app import main
 from zrp.gap import Injection, synthesize
+from zrp.gap.report import verdict_text
 from zrp.kinematics import uniform_joint_values
 
 
@@ -91,7 +92,7 @@ def test_real_irb120_report_is_believable(irb120_real):
     assert d.final.rms < 0.7 * d.nominal.rms  # the withheld gap shrinks substantially
     # but far from the instrument's floor: stated plainly, not hidden
     assert d.unexplained is True
-    assert "remains that no effect in the library explains" in d.verdict
+    assert "remains that no effect in the library explains" in verdict_text(d)
     # every reported interval is finite and contains its value
     for p in d.final_parameters:
         assert np.isfinite(p.stderr) and p.ci95[0] <= p.value <= p.ci95[1]

@@ -9,13 +9,14 @@ import os
 import subprocess
 import sys
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from zrp.errors import InputError, OutputBusyError, OutputExistsError
-from zrp.jsonio import dumps, to_jsonable
+from zrp.jsonio import dict_from_dataclass, dumps, to_jsonable
 from zrp.output import LOCK_NAME, OutputDir, atomic_path, check_writable, write_json, write_text
 
 # ---- JSON --------------------------------------------------------------------------------------
@@ -33,6 +34,38 @@ def test_json_is_strict():
 def test_json_refuses_what_it_cannot_hold():
     with pytest.raises(TypeError, match="complex"):
         to_jsonable({"z": 1j})
+
+
+@dataclass(frozen=True)
+class _Inner:
+    x: float
+    tags: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class _Outer:
+    name: str
+    inner: _Inner
+    items: tuple[_Inner, ...]
+    score: float
+    table: dict[str, tuple[int, int]]
+    matrix: np.ndarray
+    hidden: int = 0
+
+
+def test_dict_from_dataclass_keeps_field_order_renames_and_converts():
+    o = _Outer("a", _Inner(1.0, ("p", "q")), (_Inner(2.0, ()),), math.nan, {"k": (1, 2)},
+               np.eye(2))
+    d = dict_from_dataclass(o, exclude=("hidden",), rename={"score": "cv_rms"},
+                            nan_to_none=("score",))
+    assert list(d) == ["name", "inner", "items", "cv_rms", "table", "matrix"]
+    assert d == {"name": "a", "inner": {"x": 1.0, "tags": ["p", "q"]},
+                 "items": [{"x": 2.0, "tags": []}], "cv_rms": None, "table": {"k": [1, 2]},
+                 "matrix": [[1.0, 0.0], [0.0, 1.0]]}
+    assert math.isnan(dict_from_dataclass(o)["score"])  # NaN kept unless asked
+    assert dict_from_dataclass(o)["hidden"] == 0
+    with pytest.raises(TypeError, match="not a dataclass"):
+        dict_from_dataclass({"a": 1})
 
 
 # ---- single files ------------------------------------------------------------------------------

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.rotations.rodrigues import er_from_axis_angle, er_multiply, er_to_matrix
+from zrp.rotations.rodrigues import er_from_axis_angle, er_multiply, matrix_from_er
 from zrp.testing import assert_manipulator_close, assert_pose_close, panda_mdh
 
 
@@ -21,7 +21,7 @@ def poses(puma):
 
 def _transforms(p, e):
     t = np.zeros((*p.shape[:-1], 4, 4))
-    t[..., :3, :3] = er_to_matrix(e)
+    t[..., :3, :3] = matrix_from_er(e)
     t[..., :3, 3] = p
     t[..., 3, 3] = 1.0
     return t
@@ -32,7 +32,7 @@ def test_pose_forms_agree_with_each_other(puma, poses):
     p, e = zrp.end_effector_pose(puma, q)
     assert_pose_close(fk, (p, e))
     assert_pose_close((p, -e), fk)                      # e and -e: the same rotation
-    assert_pose_close((p, er_to_matrix(e)), (fk.position, fk.er))
+    assert_pose_close((p, matrix_from_er(e)), (fk.position, fk.er))
     assert_pose_close(_transforms(p, e), fk, atol_rotation_rad=1e-14)
     assert_pose_close(fk, fk, atol_position=0.0, atol_rotation_rad=0.0)
     one = zrp.end_effector_pose(puma, q[0])
@@ -51,7 +51,7 @@ def test_pose_names_the_first_pose_out_of_tolerance(poses):
     turned = er_multiply(fk.er, er_from_axis_angle([0.0, 0.0, 1.0], np.r_[0, 0, 3e-9, 0, 0]))
     with pytest.raises(AssertionError, match=r"pose 2: rotation differs by 3e-09 rad > "
                                              r"atol_rotation_rad 1e-12"):
-        assert_pose_close((fk.position, er_to_matrix(turned)), fk, err_msg="x")
+        assert_pose_close((fk.position, matrix_from_er(turned)), fk, err_msg="x")
     with pytest.raises(AssertionError, match=r"^x: pose 2: rotation"):
         assert_pose_close((fk.position, turned), fk, err_msg="x")
     assert_pose_close((fk.position, turned), fk, atol_rotation_rad=4e-9)

@@ -1,4 +1,4 @@
-"""The fits' QR-compressed least-squares problem (zrp.gap.problem.compressed) and the reuse of
+"""The fits' QR-compressed least-squares problem (zrp.gap.model.problem.compressed) and the reuse of
 the identifiability check's evaluation as a fit's start (issue 15: diagnosis speed)."""
 
 from __future__ import annotations
@@ -8,11 +8,12 @@ import pytest
 
 import zrp
 from zrp.errors import InputError
-from zrp.gap import leastsq
-from zrp.gap.effects import Context, effect_parameters, registration_parameters
-from zrp.gap.leastsq import fit, identifiable_start, initial_registration
-from zrp.gap.problem import Evaluation, compressed
-from zrp.gap.synthetic import Injection, synthesize
+from zrp.gap.data.synthetic import Injection, synthesize
+from zrp.gap.fit import leastsq
+from zrp.gap.fit.leastsq import fit, identifiable_start, initial_registration
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
+from zrp.gap.model.problem import Evaluation, compressed
 from zrp.kinematics import reachable_poses
 
 PUMA = zrp.load_model("puma")

@@ -16,8 +16,8 @@ import pytest
 import zrp
 from zrp.errors import InputError
 from zrp.gap import Injection, load_measurements, synthesize
-from zrp.gap.data import DataWarning
-from zrp.gap.subsample import subsample_poses
+from zrp.gap.data.measurements import DataWarning
+from zrp.gap.data.subsample import subsample_poses
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")

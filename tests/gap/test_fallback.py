@@ -13,6 +13,7 @@ import pytest
 
 import zrp
 from zrp.gap import Injection, Measurements, diagnose, synthesize, write_outputs
+from zrp.gap.report import verdict_text
 from zrp.kinematics import uniform_joint_values
 from zrp.testing import PANDA_LIMITS, panda_mdh
 
@@ -50,9 +51,9 @@ def test_falls_back_to_the_geometric_calibration_when_the_effects_do_not_beat_it
     assert d.final.rms == a.baseline.withheld.rms < 1.5 * d.noise_floor.rms
     _not_worse_than_baseline(d)
     assert set(d.final_joints) <= {"joint_offset", "link_length", "axis_misalignment"}
-    assert "does not beat a complete geometric calibration" in d.verdict
-    assert not a.choice.within_noise and "a clear difference" in d.verdict
-    assert "Final model: " in d.verdict
+    assert "does not beat a complete geometric calibration" in verdict_text(d)
+    assert not a.choice.within_noise and "a clear difference" in verdict_text(d)
+    assert "Final model: " in verdict_text(d)
     write_outputs(d, tmp_path)  # with the figures: they draw the fallback model
     md = (tmp_path / "report.md").read_text(encoding="utf-8")
     assert "| final | the geometric calibration (the search's model was worse" in md
@@ -92,7 +93,7 @@ def test_panda_single_reflector_optical_noise_and_payloads(tmp_path):
     m = Measurements.from_arrays(m.pose, m.q, m.xyz + noise, point=m.point, load=load)
     d = _quiet(panda, m, seed=0)
     assert d.noise_floor.rms is None and d.unexplained is None
-    assert "No noise floor can be estimated" in d.verdict
+    assert "No noise floor can be estimated" in verdict_text(d)
     _not_worse_than_baseline(d)
     assert np.all(np.isfinite([p.stderr for p in d.final_parameters]))
     write_outputs(d, tmp_path, plots=False)
@@ -127,7 +128,7 @@ def test_compliance_units_are_stated(with_mjcf, tmp_path):
     m = synthesize(PUMA, q, inj, rng=rng, noise_sigma=0.005)
     tau = None
     if with_mjcf:
-        from zrp.gap.synthetic import _gravity_torque  # the torques synthesize used
+        from zrp.gap.data.synthetic import _gravity_torque  # the torques synthesize used
 
         tau = _gravity_torque(PUMA, m.q_pose, inj.masses, np.array([0.0, 0.0, -1.0]))
     d = _quiet(PUMA, m, seed=0, gravity_torque=tau)
@@ -141,9 +142,9 @@ def test_compliance_units_are_stated(with_mjcf, tmp_path):
         assert all(p.unit == "rad/(N m)" for p in comp if p.name.endswith(".compliance"))
         k2 = d.parameter("q2.compliance")
         assert k2.ci95[0] <= 4e-5 <= k2.ci95[1]
-        assert "not in rad/(N m)" not in d.verdict
+        assert "not in rad/(N m)" not in verdict_text(d)
     else:
         assert not units["in_rad_per_newton_metre"] and units["unit"] == "rad/mm"
         assert all(p.unit in ("rad/mm", "rad/(mm kg)") for p in comp)
-        assert "not in rad/(N m): no MJCF supplied the masses" in d.verdict
+        assert "not in rad/(N m): no MJCF supplied the masses" in verdict_text(d)
         assert "compliance cannot be given in rad/(N m)" in md

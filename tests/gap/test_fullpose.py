@@ -1,4 +1,4 @@
-"""Full-pose identification (zrp.gap.fullpose, issue 11): measured orientations beside the
+"""Full-pose identification (zrp.gap.fit.fullpose, issue 11): measured orientations beside the
 positions, each weighted by its own noise.
 
 References: the synthetic robot is the nominal model with its axis tilted exactly
@@ -15,9 +15,10 @@ import zrp
 from tests.measured import BASE_ROTATION, full_pose_measurements
 from zrp.errors import InputError
 from zrp.gap import Measurements
-from zrp.gap.effects import Context, effect_parameters, registration_parameters
-from zrp.gap.fullpose import fit_full_pose, orientation_residual, pose_rotations
-from zrp.gap.problem import Problem
+from zrp.gap.fit.fullpose import fit_full_pose, orientation_residual, pose_rotations
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
+from zrp.gap.model.problem import Problem
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")

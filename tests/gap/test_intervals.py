@@ -11,14 +11,15 @@ import pytest
 import zrp
 from zrp.errors import InputError
 from zrp.gap import Injection, Measurements, diagnose, synthesize, write_outputs
-from zrp.gap.effects import Context, effect_parameters, registration_parameters
-from zrp.gap.leastsq import fit, initial_registration
-from zrp.gap.uncertainty import (
+from zrp.gap.fit.leastsq import fit, initial_registration
+from zrp.gap.fit.uncertainty import (
     interval_covariance,
     jackknife_covariance,
     robust_covariance,
     simultaneous_z,
 )
+from zrp.gap.model.context import Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")
@@ -126,10 +127,10 @@ def test_final_parameters_carry_effect_wide_intervals(tmp_path):
 
 
 def test_benchmark_coverage_counts_effect_wide_intervals():
-    """sim.benchmark.coverage: a truth outside one marginal interval but inside the
+    """sim.studies.benchmark.coverage: a truth outside one marginal interval but inside the
     effect-wide ones counts as a marginal miss only."""
-    from sim.benchmark.coverage import interval_coverage
-    from sim.effects import HiddenEffects
+    from sim.robot.effects import HiddenEffects
+    from sim.studies.benchmark.coverage import interval_coverage
 
     eff = HiddenEffects(cyclic_error={2: (1, 1e-4, 0.0)})
     doc = {"final": {"parameters": [

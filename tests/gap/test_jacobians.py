@@ -6,10 +6,11 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.gap.data import Measurements
-from zrp.gap.effects import EFFECTS, Context, effect_parameters, registration_parameters
-from zrp.gap.problem import Problem
-from zrp.manufacturing.sensitivity import parameter_jacobian
+from zrp.gap.data.measurements import Measurements
+from zrp.gap.model.context import EFFECTS, Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
+from zrp.gap.model.problem import Problem
+from zrp.kinematics.identification import parameter_jacobian
 from zrp.rotations import matrix_from_rotvec
 
 
@@ -58,9 +59,9 @@ def test_effect_jacobian_matches_finite_differences(name, effect):
     assert err.max() < 1e-5, [s.name for s, e in zip(specs, err, strict=False) if e >= 1e-5]
 
 
-def test_geometric_columns_agree_with_sensitivity_module():
+def test_geometric_columns_agree_with_identification_module():
     """At theta = 0 (flange point, no tool offset, base frame) the link and tilt columns equal
-    the position rows of zrp.manufacturing.sensitivity.parameter_jacobian."""
+    the position rows of zrp.kinematics.identification.parameter_jacobian."""
     rng = np.random.default_rng(3)
     model = zrp.load_model("puma")
     meas = _data(model, rng, frame="base", poses=5, points=1)

@@ -10,6 +10,7 @@ import pytest
 
 import zrp
 from zrp.gap import Injection, diagnose, synthesize
+from zrp.gap.report import verdict_text
 from zrp.kinematics import reachable_poses
 
 TOOLS_MM = np.array([[50.0, 0.0, 30.0], [-40.0, 60.0, 30.0], [0.0, -70.0, 40.0]])
@@ -58,7 +59,7 @@ def test_diagnosis_in_metres_equals_the_diagnosis_in_mm(inj):
         assert getattr(d_m, attr).rms * 1e3 == pytest.approx(getattr(d_mm, attr).rms, rel=1e-6)
     assert d_m.noise_floor.rms * 1e3 == pytest.approx(d_mm.noise_floor.rms, rel=1e-6)
     assert d_m.unexplained == d_mm.unexplained is False
-    assert " m " in d_m.verdict and " mm " in d_mm.verdict
+    assert " m " in verdict_text(d_m) and " mm " in verdict_text(d_mm)
 
 
 def test_small_arm_with_a_slide_in_metres_equals_the_same_arm_in_mm():

@@ -1,4 +1,4 @@
-"""``diagnose`` with measured orientations (zrp.gap.posefit, issue 11 "full-pose data"): the
+"""``diagnose`` with measured orientations (zrp.gap.search.posefit, issue 11 "full-pose data"): the
 final model refitted from positions and orientations, judged on the diagnosis's own withheld
 poses, shown in diagnosis.json, report.md and the verdict; the probe rotation and the noise
 recorded in compensation.json.
@@ -23,6 +23,7 @@ from tests.measured import full_pose_measurements, puma_full_pose
 from zrp.cli.app import main
 from zrp.errors import InputError
 from zrp.gap import Measurements, diagnose
+from zrp.gap.report import verdict_text
 
 PUMA = zrp.load_model("puma")
 SIGMA_O = 1e-4   # rad, the orientation noise of puma_full_pose
@@ -76,8 +77,8 @@ def test_orientation_results_in_json_report_and_verdict(both):
     assert set(fp["withheld_orientation_rms_rad"]) == {"position_only", "full_pose"}
     assert {p["name"] for p in fp["parameters"]} == {p.name for p in diag.full_pose.parameters}
     assert plain.to_dict()["full_pose"] is None
-    assert "Measured orientations (noise" in diag.verdict and "mrad" in diag.verdict
-    assert "Measured orientations" not in plain.verdict
+    assert "Measured orientations (noise" in verdict_text(diag) and "mrad" in verdict_text(diag)
+    assert "Measured orientations" not in verdict_text(plain)
     from zrp.gap.report.markdown import report_markdown  # the report layer, for its text
     md = report_markdown(diag)
     sec = md[md.index("## Full pose"):]
@@ -180,7 +181,7 @@ def test_an_effect_only_orientations_reveal_is_added(tilted_wrist):
     assert fp.sigma_orientation == pytest.approx(5e-5, rel=0.25)
     assert diag.to_dict()["full_pose"]["added_by_orientation"][0]["parameters"] == [
         "u6.t1", "u6.t2"]
-    assert "reveal" in diag.verdict
+    assert "reveal" in verdict_text(diag)
 
 
 def test_no_orientation_effect_is_added_to_a_complete_model(both):
@@ -196,7 +197,7 @@ def test_calibrated_robot_keeps_the_tilt_only_orientations_reveal(tilted_wrist, 
     from zrp.calibration import CalibratedRobot  # the calibration layer, for the round trip
     from zrp.calibration.fullpose import full_pose_calibration
     from zrp.calibration.storage import write_calibration
-    from zrp.gap.fullpose import pose_rotations
+    from zrp.gap.fit.fullpose import pose_rotations
 
     _, diag = tilted_wrist
     full = full_pose_calibration(diag)

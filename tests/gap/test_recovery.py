@@ -1,7 +1,7 @@
 """Injected-truth recovery: each effect alone (and pairs) on the PUMA and the IRB 120.
 
 The synthetic "real robot" is built with the toolkit's forward kinematics of a perturbed model
-(zrp.gap.synthetic), not with the diagnosis's own corrected-model code. Checks: the injected
+(zrp.gap.data.synthetic), not with the diagnosis's own corrected-model code. Checks: the injected
 effect comes out first with exactly the injected joints; every identified value lies within
 3.5 standard errors of the truth (a 99.95 % interval, so that a suite of ~150 comparisons does
 not fail by chance); the withheld RMS after correction is within 1.5x the injected noise
@@ -18,7 +18,8 @@ import pytest
 import zrp
 from mjcf.gravity import gravity_torques as gravity_torques_mjcf
 from zrp.gap import Injection, Measurements, diagnose, synthesize
-from zrp.gap.synthetic import _gravity_torque
+from zrp.gap.data.synthetic import _gravity_torque
+from zrp.gap.report import verdict_text
 from zrp.kinematics import uniform_joint_values
 
 SIGMA = 0.02  # mm, per coordinate
@@ -142,7 +143,7 @@ def test_equivalent_effects_are_reported_as_ties():
         d = diagnose(model, meas, seed=0)
     first = {d.steps[0].effect, *d.steps[0].ties}
     assert {"joint_offset", "link_length"} <= first
-    assert "equally well" in d.verdict
+    assert "equally well" in verdict_text(d)
     assert d.final.rms <= 1.5 * np.sqrt(3.0) * SIGMA
 
 
@@ -152,12 +153,12 @@ def test_no_effect_gives_none():
     assert d.effects == ("none",)
     assert d.unexplained is False
     # the final model is registration only, or the complete geometric calibration when that is
-    # (here by chance, within the noise) lower on the withheld poses (zrp/gap/fallback.py)
+    # (here by chance, within the noise) lower on the withheld poses (zrp/gap/analysis/fallback.py)
     ch = d.assessment.choice
     assert d.final.rms == min(d.nominal.rms, d.assessment.baseline.withheld.rms)
     if ch.fell_back:
-        assert ch.within_noise and "within the noise" in d.verdict
-    assert "at the noise floor" in d.verdict
+        assert ch.within_noise and "within the noise" in verdict_text(d)
+    assert "at the noise floor" in verdict_text(d)
 
 
 def test_gap_outside_the_library_is_reported_unexplained():
@@ -171,12 +172,12 @@ def test_gap_outside_the_library_is_reported_unexplained():
         warnings.simplefilter("ignore")
         d = diagnose(model, odd, seed=0)
     assert d.unexplained is True
-    assert "remains that no effect in the library explains" in d.verdict
+    assert "remains that no effect in the library explains" in verdict_text(d)
 
 
 def test_withheld_poses_never_influence_fitting_or_selection():
     """Corrupting the withheld measurements changes the withheld errors and nothing else but
-    the one choice they are for (zrp/gap/fallback.py): between the search's model and the
+    the one choice they are for (zrp/gap/analysis/fallback.py): between the search's model and the
     complete geometric calibration, both fitted without them and unchanged here."""
     injection, _, _ = SINGLE["joint_offset"]
     model, meas = _measure("puma", injection, seed=5, poses=120)

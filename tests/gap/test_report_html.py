@@ -15,6 +15,7 @@ import pytest
 
 import zrp
 from zrp.gap import Injection, diagnose, synthesize, write_outputs
+from zrp.gap.report import verdict_text
 from zrp.kinematics import uniform_joint_values
 
 BROWSER = next((b for b in ("chromium", "chromium-browser", "google-chrome")
@@ -120,7 +121,7 @@ def test_report_html_synthetic(tmp_path):
     meas = synthesize(model, q, Injection(joint_offset={2: 1e-3}), rng=rng, noise_sigma=0.02)
     d = diagnose(model, meas, seed=0)
     write_outputs(d, tmp_path / "out")
-    _check_page(tmp_path / "out", d.verdict, tmp_path)
+    _check_page(tmp_path / "out", verdict_text(d), tmp_path)
     _check_zoom(tmp_path / "out", tmp_path)
 
 
@@ -129,12 +130,12 @@ def test_report_html_real_irb120(irb120_real, tmp_path):
     d = irb120_real.diagnosis
     assert any(issubclass(w.category, zrp.gap.GapWarning) for w in irb120_real.warnings)
     write_outputs(d, tmp_path / "out")
-    _check_page(tmp_path / "out", d.verdict, tmp_path)
+    _check_page(tmp_path / "out", verdict_text(d), tmp_path)
     md = (tmp_path / "out" / "report.md").read_text(encoding="utf-8")
     assert "complete geometric calibration" in md
     a = d.assessment
     assert a is not None
     # no cause is stated that conflicts with the IRB 120's specified repeatability
-    assert "conflict with the specified repeatability" in d.verdict
+    assert "conflict with the specified repeatability" in verdict_text(d)
     # the final model is at or below the complete geometric calibration on withheld poses
     assert d.final.rms <= a.baseline.withheld.rms

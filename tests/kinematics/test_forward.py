@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 from scipy.spatial.transform import Rotation
 
 import zrp
-from zrp.rotations.rodrigues import er_to_matrix
+from zrp.rotations.rodrigues import matrix_from_er
 from zrp.testing import random_arm
 
 
@@ -86,8 +86,8 @@ def _orientation_fd(model, q, k, h):
     qp, qm = q.copy(), q.copy()
     qp[k] += h
     qm[k] -= h
-    rp = er_to_matrix(zrp.end_effector_pose(model, qp)[1])
-    rm = er_to_matrix(zrp.end_effector_pose(model, qm)[1])
+    rp = matrix_from_er(zrp.end_effector_pose(model, qp)[1])
+    rm = matrix_from_er(zrp.end_effector_pose(model, qm)[1])
     return Rotation.from_matrix(rp @ rm.T).as_rotvec() / (2 * h)
 
 

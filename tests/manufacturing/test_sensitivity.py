@@ -7,7 +7,7 @@ import pytest
 
 from zrp import end_effector_pose, jacobian, load_model
 from zrp.errors import InputError
-from zrp.manufacturing.sensitivity import (
+from zrp.kinematics.identification import (
     apply_parameters,
     axis_tangents,
     parameter_jacobian,
@@ -16,7 +16,7 @@ from zrp.manufacturing.sensitivity import (
     perturbed_arrays,
 )
 from zrp.model.manipulator import Manipulator
-from zrp.rotations.rodrigues import er_conjugate, er_multiply, er_to_rotvec
+from zrp.rotations.rodrigues import er_conjugate, er_multiply, rotvec_from_er
 
 
 def _pose_error(model, model_a, q, off=None):
@@ -24,7 +24,7 @@ def _pose_error(model, model_a, q, off=None):
     p_d, e_d = end_effector_pose(model, q)
     qa = q if off is None else q + off
     p_a, e_a = end_effector_pose(model_a, qa)
-    rv = er_to_rotvec(er_multiply(e_a, er_conjugate(e_d)))
+    rv = rotvec_from_er(er_multiply(e_a, er_conjugate(e_d)))
     return np.concatenate([rv, p_a - p_d], axis=-1)
 
 
@@ -134,7 +134,7 @@ def test_bad_input():
 
 def test_pose_error_is_first_order_in_dx():
     """pose_error - J dx shrinks quadratically with the step (second-order remainder)."""
-    from zrp.manufacturing.sensitivity import pose_error
+    from zrp.kinematics.identification import pose_error
 
     model = load_model("puma")
     q = np.random.default_rng(0).uniform(-2, 2, (5, 6))

@@ -26,7 +26,7 @@ def _random_rows(rng, n):
 
 def _tool(rng):
     t = np.eye(4)
-    t[:3, :3] = zrp.rotations.er_to_matrix(zrp.rotations.er_from_rotvec(rng.normal(size=3)))
+    t[:3, :3] = zrp.rotations.matrix_from_er(zrp.rotations.er_from_rotvec(rng.normal(size=3)))
     t[:3, 3] = rng.normal(size=3) * 100
     return t
 

@@ -10,9 +10,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-import sim.benchmark as gb
+import sim.studies.benchmark as gb
 import zrp
-from sim.benchmark import (
+from sim.robot.effects import HiddenEffects
+from sim.studies.benchmark import (
     BenchmarkConfig,
     confusion_matrix,
     draw_scenarios,
@@ -23,7 +24,6 @@ from sim.benchmark import (
     summary_rows,
     write_outputs,
 )
-from sim.effects import HiddenEffects
 from zrp.cli.app import main
 from zrp.errors import InputError
 
@@ -131,7 +131,7 @@ def test_scenarios_do_not_depend_on_how_many_are_drawn(puma):
 
 def _fake_truth(puma, effects, q, sigma=0.02):
     """A truth dict as the measuring procedure writes it, with exact joint values."""
-    from sim.effects import default_tool_points, motor_map
+    from sim.robot.effects import default_tool_points, motor_map
 
     qm = motor_map(effects, q)
     return {"effects": effects.to_dict(), "instrument": {"noise_sigma": sigma},
@@ -268,8 +268,9 @@ def test_blind_diagnosis_names_a_physical_backlash(puma, tmp_path):
     """End to end through files: a 1 mrad play on joint 1 (no gravity torque), 80 poses,
     measured and written; the blind diagnosis of the CSV alone names backlash on joint 1
     and ends at the noise floor."""
-    from sim.measurement import Instrument, measure, write_measurements
-    from sim.real_robot import RealRobot
+    from sim.robot.instrument import Instrument
+    from sim.robot.measurement import measure, write_measurements
+    from sim.robot.real import RealRobot
     from zrp.kinematics import reachable_poses
 
     rng = np.random.default_rng(21)

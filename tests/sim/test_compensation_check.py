@@ -1,14 +1,14 @@
-"""Compensation end to end on the physics robot (sim.compensation_check): measured, not
+"""Compensation end to end on the physics robot (sim.studies.compensation_check): measured, not
 predicted, errors of the program and of the compensated commands on fresh targets."""
 
 from __future__ import annotations
 
 import zrp
-from sim.benchmark import render_text, run_benchmark, write_outputs
-from sim.benchmark.report import compensated_summary
-from sim.benchmark.scenarios import BenchmarkConfig
-from sim.compensation_check import run_compensation_check
-from sim.effects import HiddenEffects
+from sim.robot.effects import HiddenEffects
+from sim.studies.benchmark import render_text, run_benchmark, write_outputs
+from sim.studies.benchmark.report import compensated_summary
+from sim.studies.benchmark.scenarios import BenchmarkConfig
+from sim.studies.compensation_check import run_compensation_check
 
 
 def test_compensated_targets_land_within_the_tracker_noise():

@@ -53,7 +53,7 @@ def test_video_frame_is_framed_on_the_circle(backend, tmp_path, which):
     assert fr["arm_height_fraction"] >= 0.4
     img = _last_frame(res.path).astype(int)
     r, g, b = img[..., 0], img[..., 1], img[..., 2]
-    # the desired path is the only saturated green on the frame (sim.overlays.DESIRED_RGBA)
+    # the desired path is the only saturated green on the frame (sim.view.overlays.DESIRED_RGBA)
     green = (g > 150) & (r < 120) & (b < 140)
     assert green.sum() > 100
     top, bottom, left, right = _bbox(green)
@@ -76,7 +76,7 @@ def test_one_magnification_per_parameter():
 
 
 def test_noise_floor_prints_zero():
-    from sim.overlays import NOISE_FLOOR, shown_value
+    from sim.view.overlays import NOISE_FLOOR, shown_value
 
     assert shown_value(1.59e-19, ".3e") == "0"
     assert shown_value(2 * NOISE_FLOOR, ".3e") == f"{2 * NOISE_FLOOR:.3e}"

@@ -1,4 +1,4 @@
-"""The MuJoCo real robot in motion (sim.motion_robot), its CLI and the motion benchmark:
+"""The MuJoCo real robot in motion (sim.robot.motion), its CLI and the motion benchmark:
 each hidden effect is checked against an independent reference (the command itself, an ODE
 solver, the friction bound F/kp, MuJoCo's own inverse dynamics)."""
 
@@ -11,10 +11,10 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mjcf import MJCFOptions, build, inverse_dynamics_torques
-from sim.benchmark.motion import draw_motion_scenarios, run_motion_benchmark
-from sim.measurement import Instrument
-from sim.motion_measure import parse_motion_effects
-from sim.motion_robot import MotionEffects, execute_trajectory
+from sim.robot.instrument import Instrument
+from sim.robot.motion import MotionEffects, execute_trajectory
+from sim.robot.motion_measure import parse_motion_effects
+from sim.studies.benchmark.motion import draw_motion_scenarios, run_motion_benchmark
 from zrp.cli.app import main
 from zrp.errors import InputError
 from zrp.gap.motion.paths import exercise_moves

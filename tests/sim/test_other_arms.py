@@ -11,12 +11,13 @@ import numpy as np
 import pytest
 
 import zrp
-from sim.benchmark import BenchmarkConfig
-from sim.benchmark.scenarios import DEFAULT_NOISE_MM, draw_scenarios, pose_limits
-from sim.effects import HiddenEffects
-from sim.measurement import Instrument, measure
-from sim.real_robot import RealRobot
-from sim.robot_model import _servo_inertias
+from sim.robot.effects import HiddenEffects
+from sim.robot.instrument import Instrument
+from sim.robot.measurement import measure
+from sim.robot.model import _servo_inertias
+from sim.robot.real import RealRobot
+from sim.studies.benchmark import BenchmarkConfig
+from sim.studies.benchmark.scenarios import DEFAULT_NOISE_MM, draw_scenarios, pose_limits
 from zrp.cli import main
 from zrp.kinematics import forward_kinematics, reachable_poses
 from zrp.testing import PANDA_LIMITS
@@ -158,7 +159,7 @@ def test_cli_plan_default_noise_is_20_um_in_any_length_unit(tmp_path, capsys):
 
 
 def test_random_instrument_noise_defaults_to_mm_in_the_model_unit():
-    from sim.measurement import TRACKER_NOISE_RANGE_MM, random_instrument
+    from sim.robot.instrument import TRACKER_NOISE_RANGE_MM, random_instrument
 
     puma = zrp.load_model("puma")
     in_m = dataclasses.replace(puma.with_arrays(bodies=puma.bodies * 1e-3), length_unit="m")

@@ -1,4 +1,4 @@
-"""The K-planned-poses study (sim/planning_study.py, ``zrp plan-benchmark``): its machinery
+"""The K-planned-poses study (sim/studies/planning.py, ``zrp plan-benchmark``): its machinery
 at a small size (the full study is in zrp/calibration/README.md)."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import zrp
-from sim.planning_study import DesignScore, design_rows, smallest_matching_k
+from sim.studies.planning import DesignScore, design_rows, smallest_matching_k
 from zrp.calibration import design_std, plan_poses
 from zrp.cli.app import main
 from zrp.errors import InputError
@@ -72,8 +72,9 @@ def test_plan_benchmark_command_end_to_end(tmp_path, capsys):
 
 
 def test_measure_refuses_directions_it_cannot_follow():
-    from sim.measurement import Instrument, Procedure, measure
-    from sim.real_robot import RealRobot
+    from sim.robot.instrument import Instrument
+    from sim.robot.measurement import Procedure, measure
+    from sim.robot.real import RealRobot
 
     robot = RealRobot(PUMA)
     q = np.zeros((3, 6))

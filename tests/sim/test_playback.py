@@ -85,10 +85,10 @@ def test_playback_bad_inputs():
 
 
 def test_rotation_angle_small_angles():
-    from zrp.rotations.rodrigues import er_from_axis_angle, er_to_matrix
+    from zrp.rotations.rodrigues import er_from_axis_angle, matrix_from_er
 
     for angle in (1e-14, 1e-9, 1e-3, 1.0, 3.0):
-        r = er_to_matrix(er_from_axis_angle([0.0, 0.6, 0.8], angle))
+        r = matrix_from_er(er_from_axis_angle([0.0, 0.6, 0.8], angle))
         assert zrp.rotations.rotation_angle(np.eye(3), r) == pytest.approx(angle, rel=1e-9,
                                                                             abs=1e-16)
 

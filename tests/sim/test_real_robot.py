@@ -9,19 +9,19 @@ import numpy as np
 import pytest
 
 import zrp
-from sim.effect_specs import parse_effects
-from sim.effects import HiddenEffects, motor_map, true_geometry
-from sim.measurement import (
-    Instrument,
+from sim.robot.effect_specs import parse_effects
+from sim.robot.effects import HiddenEffects, motor_map, true_geometry
+from sim.robot.instrument import Instrument, random_instrument
+from sim.robot.measurement import (
     Procedure,
     measure,
-    random_instrument,
     trajectory_poses,
     write_measurements,
     write_truth,
 )
-from sim.real_robot import RealRobot
-from sim.robot_model import RealRobotOptions
+from sim.robot.model import RealRobotOptions
+from sim.robot.real import RealRobot
+from sim.studies.trajectories import circle_poses
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap import load_measurements
 from zrp.kinematics import reachable_poses
@@ -262,15 +262,22 @@ def test_jumped_transfer_settles_where_the_simulated_move_does(puma, poses):
 
 
 def test_circle_poses_follow_the_paper_circle(puma):
-    q = trajectory_poses(puma, 24)
+    q = circle_poses(puma, 24)
     p, _ = zrp.end_effector_pose(puma, q)
-    centre = np.asarray(zrp.puma_circle().trajectory.center)
+    setup = zrp.puma_circle()
+    centre = np.asarray(setup.trajectory.center)
     assert np.linalg.norm(p - centre, axis=1) == pytest.approx(np.full(24, 125.0), abs=1e-6)
     # spread evenly round the circle: consecutive points about 2 pi r / 24 apart
     gaps = np.linalg.norm(np.diff(p, axis=0), axis=1)
     assert gaps == pytest.approx(np.full(23, 2 * np.pi * 125.0 / 24), rel=0.05)
+    # the robot's measurement takes the circle passed in: the same poses
+    assert np.array_equal(trajectory_poses(puma, 24, setup.trajectory, setup.q0), q)
     with pytest.raises(InputError, match="trajectory"):
-        trajectory_poses(puma, 24, "square")
+        trajectory_poses(puma, 24, "square", setup.q0)  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="at least 8"):
+        trajectory_poses(puma, 7, setup.trajectory, setup.q0)
+    with pytest.raises(InputError, match="PUMA"):
+        circle_poses(zrp.load_model("scara"), 24)
 
 
 def test_random_poses_respect_limits_and_floor(puma):

@@ -8,8 +8,8 @@ import pytest
 
 import mjcf
 import sim
-import sim.frames
-import sim.gl
+import sim.view.frames
+import sim.view.gl
 import zrp
 from tests.arms import perturbed_puma
 from zrp.errors import InputError, OutputExistsError
@@ -48,14 +48,14 @@ def test_unknown_backend_is_a_clear_error(monkeypatch):
 
 def test_no_working_backend_names_the_packages(monkeypatch):
     monkeypatch.delenv("MUJOCO_GL", raising=False)
-    monkeypatch.setattr(sim.gl, "probe_backend", lambda name, timeout=60.0: (False, "no lib"))
-    sim.gl.available_backend.cache_clear()
+    monkeypatch.setattr(sim.view.gl, "probe_backend", lambda name, timeout=60.0: (False, "no lib"))
+    sim.view.gl.available_backend.cache_clear()
     try:
         with pytest.raises(sim.GLUnavailableError, match="libegl1 libgl1") as info:
             sim.resolve_backend()
         assert "libosmesa6" in str(info.value)
     finally:
-        sim.gl.available_backend.cache_clear()
+        sim.view.gl.available_backend.cache_clear()
 
 
 def test_size_beyond_offscreen_buffer_is_rejected(puma_arm):
@@ -193,8 +193,8 @@ def test_lazy_import_and_configure_backend(monkeypatch):
     import subprocess
     import sys
 
-    code = ("import sys, sim.gl; assert 'mujoco' not in sys.modules; "
-            "print(sim.gl.configure_backend('osmesa'))")
+    code = ("import sys, sim.view.gl; assert 'mujoco' not in sys.modules; "
+            "print(sim.view.gl.configure_backend('osmesa'))")
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True, env={**__import__("os").environ, "MUJOCO_GL": ""})
     assert out.stdout.strip() == "osmesa"
@@ -205,7 +205,7 @@ def test_failed_render_leaves_no_partial_file(backend, circle, tmp_path, monkeyp
         yield np.zeros((240, 320, 3), np.uint8)
         raise RuntimeError("renderer exploded")
 
-    monkeypatch.setattr(sim.frames, "_segment_frames", broken)
+    monkeypatch.setattr(sim.view.frames, "_segment_frames", broken)
     t, q = circle
     out = tmp_path / "v.mp4"
     with pytest.raises(RuntimeError, match="exploded"):
@@ -217,7 +217,7 @@ def test_failed_render_leaves_no_partial_file(backend, circle, tmp_path, monkeyp
 def test_exaggerated_model_scales_the_errors():
     nominal = zrp.load_model("puma")
     perturbed = perturbed_puma()
-    big = sim.frames.exaggerated_model(nominal, perturbed, 10.0)
+    big = sim.view.frames.exaggerated_model(nominal, perturbed, 10.0)
     np.testing.assert_allclose(big.bodies - nominal.bodies,
                                10.0 * (perturbed.bodies - nominal.bodies), atol=1e-9)
     q = np.array([0.3, -0.5, 0.4, 0.2, 0.9, -0.3])
@@ -226,7 +226,7 @@ def test_exaggerated_model_scales_the_errors():
     p10 = zrp.forward_kinematics(big, q).position
     # first order: the tool point moves ~10 times as far (errors here are ~1e-3)
     assert np.linalg.norm(p10 - p0) == pytest.approx(10 * np.linalg.norm(p1 - p0), rel=0.05)
-    same = sim.frames.exaggerated_model(nominal, perturbed, 1.0)
+    same = sim.view.frames.exaggerated_model(nominal, perturbed, 1.0)
     np.testing.assert_allclose(same.axes, perturbed.axes, atol=1e-15)
 
 

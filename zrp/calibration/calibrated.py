@@ -25,21 +25,21 @@ import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
-from zrp.gap.data import Measurements
-from zrp.gap.effects import Context
-from zrp.gap.leastsq import FitResult
-from zrp.gap.problem import Problem
+from zrp.gap.data.measurements import Measurements
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.model.context import Context
+from zrp.gap.model.problem import Problem
 from zrp.gap.results import Diagnosis
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import skew
 
 __all__ = ["CalibratedRobot", "PoseConditions", "chain"]
 
-F64 = NDArray[np.float64]
 
 
 def _rot(u: F64, q: F64) -> F64:

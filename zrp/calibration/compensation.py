@@ -24,15 +24,15 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.calibration.calibrated import CalibratedRobot, PoseConditions, chain
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import hand_frame
-from zrp.rotations import er_from_matrix, er_to_rotvec
+from zrp.rotations import er_from_matrix, rotvec_from_er
 
 __all__ = ["Compensation", "ThermalWarning", "compensate", "compensate_program"]
 
-F64 = NDArray[np.float64]
 GravityFn = Callable[[F64], F64]
 
 
@@ -134,7 +134,7 @@ def _errors(cal: CalibratedRobot, q: F64, cond: PoseConditions, tg: _Targets
     if tg.rot is not None:
         ee = cal.model.end_effector
         r = rn @ hand_frame(ee.axial, ee.transverse)
-        er = er_to_rotvec(er_from_matrix(r @ np.swapaxes(tg.rot, 1, 2)))
+        er = rotvec_from_er(er_from_matrix(r @ np.swapaxes(tg.rot, 1, 2)))
         e = np.concatenate([e, er * L], axis=1)
         J = np.concatenate([J, jw.transpose(0, 2, 1) * L], axis=1)
     return e, J, full
@@ -193,6 +193,59 @@ class ThermalWarning(ZRPWarning):
     """Thermal expansion was identified but the targets' temperature is not known."""
 
 
+def _checked_targets(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike,
+                     orientations: ArrayLike | None, frame: str,
+                     target_ids: tuple[str, ...] | None
+                     ) -> tuple[F64, F64, tuple[str, ...], F64 | None]:
+    """(targets in the base frame (T, 3), seeds (T, n), target labels, orientations
+    (T, 3, 3) or None), shapes checked."""
+    y = np.atleast_2d(np.asarray(targets, dtype=float))
+    if y.ndim != 2 or y.shape[1] != 3:
+        raise InputError(f"targets: expected shape (T, 3), got {np.shape(targets)}")
+    T = len(y)
+    q0 = np.broadcast_to(np.asarray(seed, dtype=float), (T, cal.n)).copy()
+    ids = tuple(str(i) for i in range(1, T + 1)) if target_ids is None else tuple(target_ids)
+    if len(ids) != T:
+        raise InputError(f"target_ids: expected {T} labels, got {len(ids)}")
+    if frame == "instrument":
+        y = (y - np.asarray(cal.base_translation)) @ np.asarray(cal.base_rotation)
+    elif frame != "base":
+        raise InputError(f"frame: expected 'base' or 'instrument', got {frame!r}")
+    rot = None if orientations is None else np.asarray(orientations, dtype=float)
+    if rot is not None and rot.shape != (T, 3, 3):
+        raise InputError(f"orientations: expected shape ({T}, 3, 3), got {rot.shape}")
+    return y, q0, ids, rot
+
+
+def _warn_thermal(cal: CalibratedRobot, base: PoseConditions) -> None:
+    """Warn (at the caller of :func:`compensate`) when thermal expansion was identified but
+    the targets' temperature is not given."""
+    if cal.kappa != 0.0 and base.temp is None:
+        warnings.warn(f"the calibration found thermal expansion (kappa = {cal.kappa:.3g} "
+                      f"1/degC) but no temperature was given (conditions=PoseConditions("
+                      f"temp=...)): the commands are for the reference temperature "
+                      f"{cal.t_ref:.4g} degC", ThermalWarning, stacklevel=3)
+
+
+def _solve(cal: CalibratedRobot, q0: F64, cond: PoseConditions, base: PoseConditions,
+           gravity_torque: GravityFn | None, tg: _Targets, tol: float, max_iter: int,
+           max_rounds: int) -> tuple[F64, PoseConditions]:
+    """Newton solves from ``q0`` under ``cond`` (the conditions at ``q0``), repeated while
+    the approach directions and gravity torques, re-evaluated on the solution, leave an error;
+    (commands, their conditions)."""
+    q = q0
+    adaptive = gravity_torque is not None or base.direction is None
+    for _ in range(max_rounds):
+        q = _newton(cal, q, cond, tg, tol, max_iter)
+        if not adaptive:
+            break
+        cond = _conditions(base, gravity_torque, q)
+        e_new, _, _ = _errors(cal, q, cond, tg)
+        if np.all(np.linalg.norm(e_new, axis=1) < tol):
+            break
+    return q, cond
+
+
 def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
                orientations: ArrayLike | None = None, point: str | None = None,
                frame: str = "base", conditions: PoseConditions | None = None,
@@ -221,40 +274,13 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
     Raises:
         InputError: bad shapes or a command beyond a limit (naming the target and joint).
     """
-    y = np.atleast_2d(np.asarray(targets, dtype=float))
-    if y.ndim != 2 or y.shape[1] != 3:
-        raise InputError(f"targets: expected shape (T, 3), got {np.shape(targets)}")
-    T = len(y)
-    q0 = np.broadcast_to(np.asarray(seed, dtype=float), (T, cal.n)).copy()
-    ids = tuple(str(i) for i in range(1, T + 1)) if target_ids is None else tuple(target_ids)
-    if len(ids) != T:
-        raise InputError(f"target_ids: expected {T} labels, got {len(ids)}")
-    if frame == "instrument":
-        y = (y - np.asarray(cal.base_translation)) @ np.asarray(cal.base_rotation)
-    elif frame != "base":
-        raise InputError(f"frame: expected 'base' or 'instrument', got {frame!r}")
-    rot = None if orientations is None else np.asarray(orientations, dtype=float)
-    if rot is not None and rot.shape != (T, 3, 3):
-        raise InputError(f"orientations: expected shape ({T}, 3, 3), got {rot.shape}")
+    y, q0, ids, rot = _checked_targets(cal, targets, seed, orientations, frame, target_ids)
     tg = _Targets(y, rot, cal.tool_offset(point))
     base = conditions or PoseConditions()
-    if cal.kappa != 0.0 and base.temp is None:
-        warnings.warn(f"the calibration found thermal expansion (kappa = {cal.kappa:.3g} "
-                      f"1/degC) but no temperature was given (conditions=PoseConditions("
-                      f"temp=...)): the commands are for the reference temperature "
-                      f"{cal.t_ref:.4g} degC", ThermalWarning, stacklevel=2)
+    _warn_thermal(cal, base)
     cond = _conditions(base, gravity_torque, q0)
     e0, _, _ = _errors(cal, q0, cond, tg)
-    q = q0
-    adaptive = gravity_torque is not None or base.direction is None
-    for _ in range(max_rounds):
-        q = _newton(cal, q, cond, tg, tol, max_iter)
-        if not adaptive:
-            break
-        cond = _conditions(base, gravity_torque, q)
-        e_new, _, _ = _errors(cal, q, cond, tg)
-        if np.all(np.linalg.norm(e_new, axis=1) < tol):
-            break
+    q, cond = _solve(cal, q0, cond, base, gravity_torque, tg, tol, max_iter, max_rounds)
     e, _, full = _errors(cal, q, cond, tg)
     ok = np.linalg.norm(e, axis=1) < tol
     near_limit = _check_limits(q, limits, limit_margin, ids)

@@ -1,6 +1,6 @@
 """The calibrated robot from full-pose data: the diagnosis's final model refitted with the
 measured orientations (``qw..qz``), each block weighted by its own noise
-(:mod:`zrp.gap.fullpose`).
+(:mod:`zrp.gap.fit.fullpose`).
 
 The diagnosis chooses the effects from the positions (its stepwise search is unchanged); when
 the measurements carry orientations, the final model's parameters (registration included) are
@@ -16,9 +16,9 @@ import numpy as np
 
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.errors import InputError
-from zrp.gap.fullpose import FullPoseFit, fit_full_pose, orientation_residual, pose_rotations
-from zrp.gap.leastsq import FitResult
-from zrp.gap.problem import Problem
+from zrp.gap.fit.fullpose import FullPoseFit, fit_full_pose, orientation_residual, pose_rotations
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.model.problem import Problem
 from zrp.gap.results import Diagnosis
 
 __all__ = ["FullPoseCalibration", "full_pose_calibration"]
@@ -78,10 +78,10 @@ def full_pose_calibration(diag: Diagnosis, orientation_sigma: float | None = Non
     pose_rotations(ctx)  # refuses data without orientations, naming the columns
     same = (diag.full_pose is not None
             and diag.settings.get("orientation_sigma_rad") == orientation_sigma)
-    fp = (diag.full_pose.fit if same  # the diagnosis's own full-pose refit (zrp.gap.posefit)
+    fp = (diag.full_pose.fit if same  # the diagnosis's own full-pose refit (zrp.gap.search.posefit)
           else fit_full_pose(ctx, diag.final_fit.specs, diag.fitting_poses,
                              orientation_sigma=orientation_sigma))
-    specs = fp.specs  # with the groups the orientations revealed (zrp.gap.posesearch)
+    specs = fp.specs  # with the groups the orientations revealed (zrp.gap.search.posesearch)
     rb0 = fp.position.base_rotation
     fit = FitResult(tuple(specs), fp.theta, np.diag(fp.stderr ** 2), fp.position.residual,
                     fp.position.jac, rb0, np.asarray(diag.fitting_poses), True)

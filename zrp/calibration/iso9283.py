@@ -28,13 +28,13 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.spatial.transform import Rotation
 
+from zrp.arrays import F64
 from zrp.calibration.calibrated import CalibratedRobot, PoseConditions
 from zrp.errors import InputError
-from zrp.gap.data import Measurements
+from zrp.gap.data.measurements import Measurements
 
 __all__ = ["PoseAccuracy", "pose_accuracy"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)
@@ -91,7 +91,7 @@ def pose_accuracy(meas: Measurements, cal: CalibratedRobot, point: str, *,
         min_repeats: poses measured fewer times are skipped.
         probe_rotation: R_t, the measured frame on the hand (commanded orientation
             R_b R'_n R_t), shape (3, 3) (default identity: the hand frame is measured; e.g.
-            :attr:`zrp.gap.fullpose.FullPoseFit.probe_rotation`).
+            :attr:`zrp.gap.fit.fullpose.FullPoseFit.probe_rotation`).
 
     Raises:
         InputError: unknown point, or no pose repeated ``min_repeats`` times.

@@ -2,9 +2,9 @@
 
 Every non-geometric parameter of the gap diagnosis is a joint correction theta B(pose) with a
 basis B that depends on the commanded joint values and the pose's conditions
-(:mod:`zrp.gap.jointbases`). A calibrated robot keeps the parameter values (:class:`Term`)
+(:mod:`zrp.gap.model.jointbases`). A calibrated robot keeps the parameter values (:class:`Term`)
 and re-evaluates the bases on new poses with the diagnosis's own :class:`zrp.gap.Context` and
-the diagnosis's own definition of each basis (:func:`zrp.gap.jointbases.joint_bases`, the
+the diagnosis's own definition of each basis (:func:`zrp.gap.model.jointbases.joint_bases`, the
 table there), so the correction of a fresh target is computed exactly as the diagnosis
 computed it on the measured poses, and a change of a basis there changes both alike
 (revolute offsets are folded into the geometry; ``offset`` terms are prismatic joints').
@@ -16,15 +16,15 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
-from zrp.gap.effects import Context
-from zrp.gap.jointbases import JOINT_EFFECTS, joint_bases
+from zrp.gap.model.context import Context
+from zrp.gap.model.jointbases import JOINT_EFFECTS, joint_bases
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["NON_GEOMETRIC", "Term", "term_basis"]
 
-F64 = NDArray[np.float64]
 
 #: effects whose parameters are joint corrections with a pose-dependent basis.
 NON_GEOMETRIC = JOINT_EFFECTS
@@ -65,8 +65,7 @@ class Term:
         return self.name.split(".", 1)[1]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"name": self.name, "effect": self.effect, "joint": self.joint,
-                "unit": self.unit, "value": self.value, "stderr": self.stderr}
+        return dict_from_dataclass(self)
 
     @classmethod
     def from_dict(cls, d: dict[str, Any], where: str) -> Term:
@@ -80,7 +79,7 @@ class Term:
 
 def term_basis(term: Term, ctx: Context) -> F64:
     """The basis of ``term`` on the poses of ``ctx``, shape (P,) (joint ``term.joint``): the
-    diagnosis's own definition (:func:`zrp.gap.jointbases.joint_bases`).
+    diagnosis's own definition (:func:`zrp.gap.model.jointbases.joint_bases`).
 
     Raises:
         InputError: a term this library does not know, or missing pose conditions.

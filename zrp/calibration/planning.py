@@ -1,7 +1,7 @@
 """Measurement planning: which poses to measure so that the chosen effects are identifiable.
 
 Criterion: D-optimality of the identification Jacobian of the gap diagnosis's corrected model
-(:class:`zrp.gap.problem.Problem`: registration + the chosen effects, evaluated at the nominal
+(:class:`zrp.gap.model.problem.Problem`: registration + the chosen effects, evaluated at the nominal
 parameters), i.e. maximise log det(J^T J) over N poses drawn from a candidate set (uniform in
 the joint limits, above a floor keep-out). Selection: DETMAX-style exchange (Mitchell 1974):
 from a random start, add the candidate that raises log det most, then drop the design pose
@@ -29,10 +29,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.arguments import check_float
+from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
-from zrp.gap.data import Measurements
-from zrp.gap.effects import Context, ParamSpec, effect_parameters, registration_parameters
-from zrp.gap.problem import Problem
+from zrp.gap.data.measurements import Measurements
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.effects import effect_parameters, registration_parameters
+from zrp.gap.model.problem import Problem
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.sampling import uniform_joint_values
 from zrp.model.manipulator import Manipulator
@@ -40,7 +42,6 @@ from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
 __all__ = ["Plan", "PlanWarning", "design_std", "plan_poses"]
 
-F64 = NDArray[np.float64]
 ALIAS_TOL = 1e-6
 
 

@@ -18,11 +18,11 @@ import numpy as np
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.jointmap import Term
 from zrp.errors import InputError
-from zrp.gap.fullpose import FullPoseFit
+from zrp.gap.fit.fullpose import FullPoseFit
 from zrp.jsonio import dumps
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.output import check_writable, write_text
-from zrp.rotations import er_from_matrix, er_to_rotvec
+from zrp.rotations import er_from_matrix, rotvec_from_er
 
 __all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "read_calibration",
            "write_calibration"]
@@ -32,12 +32,12 @@ SCHEMA_VERSION = 1
 
 def full_pose_document(fp: FullPoseFit | None) -> dict[str, Any] | None:
     """The ``full_pose`` entry: the probe rotation R_t (probe frame in the hand frame) and the
-    noise weights of a full-pose fit (:mod:`zrp.gap.fullpose`); None without one."""
+    noise weights of a full-pose fit (:mod:`zrp.gap.fit.fullpose`); None without one."""
     if fp is None or not fp.orientation:
         return None
     rt = np.asarray(fp.probe_rotation)
     return {"probe_rotation": rt.tolist(),
-            "probe_rotvec_rad": er_to_rotvec(er_from_matrix(rt)).tolist(),
+            "probe_rotvec_rad": rotvec_from_er(er_from_matrix(rt)).tolist(),
             "sigma_orientation_rad": fp.sigma_orientation,
             "sigma_orientation_source": "given" if fp.sigma_orientation_given else "estimated",
             "sigma_position": fp.sigma_position,
@@ -56,7 +56,7 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "nominal_model": dumps_model(cal.nominal),
         "frame": cal.frame,
         "base_rotation": np.asarray(cal.base_rotation).tolist(),
-        "base_rotvec": er_to_rotvec(er_from_matrix(np.asarray(cal.base_rotation))).tolist(),
+        "base_rotvec": rotvec_from_er(er_from_matrix(np.asarray(cal.base_rotation))).tolist(),
         "base_translation": np.asarray(cal.base_translation).tolist(),
         "tool_points": {lab: np.asarray(t).tolist()
                         for lab, t in zip(cal.tool_labels, cal.tool_points, strict=True)},

@@ -16,16 +16,15 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.calibration.compensation import Compensation
 from zrp.errors import InputError
 from zrp.output import write_text
-from zrp.rotations import er_to_matrix
+from zrp.rotations import matrix_from_er
 
 __all__ = ["Targets", "load_targets", "write_commands"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)
@@ -107,7 +106,7 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
         if bad.size:
             raise InputError(f"{src}, line {bad[0] + 2}: qw..qz is not a unit quaternion "
                              f"(norm {norm[bad[0]]:.6g})")
-        rot = er_to_matrix(quat / norm[:, None])
+        rot = matrix_from_er(quat / norm[:, None])
     return Targets(tuple(ids), q, xyz, rot)
 
 

@@ -7,47 +7,44 @@ In-process use::
     meas = load_measurements("D.csv", model, deg=True)
     diag = diagnose(model, meas, seed=0)
     diag.top_effect, diag.final.rms, diag.to_dict()
+    zrp.gap.report.verdict_text(diag)  # the verdict in plain words
     write_outputs(diag, "DIR")  # diagnosis.json, report.md, residuals.csv, plots
 
-The engine (every module but :mod:`zrp.gap.report`) never imports the report; the report's
-wording of the verdict is installed into :class:`Diagnosis` here.
+The engine (every module but :mod:`zrp.gap.report`) never imports the report; the report is a
+plain function of the result (``zrp.gap.report.verdict_text(diag)``).
 """
 
-from zrp.gap.assessment import Assessment as Assessment
-from zrp.gap.assessment import Remainder as Remainder
-from zrp.gap.baseline import GeometricBaseline as GeometricBaseline
-from zrp.gap.csvfile import load_measurements as load_measurements
-from zrp.gap.data import DataWarning as DataWarning
-from zrp.gap.data import Measurements as Measurements
-from zrp.gap.effects import EFFECTS as EFFECTS
-from zrp.gap.effects import REGISTRATION as REGISTRATION
-from zrp.gap.effects import Context as Context
-from zrp.gap.effects import ParamSpec as ParamSpec
-from zrp.gap.effects import effect_parameters as effect_parameters
-from zrp.gap.leastsq import Aliased as Aliased
-from zrp.gap.leastsq import FitResult as FitResult
-from zrp.gap.leastsq import FitWarning as FitWarning
-from zrp.gap.metrics import Metrics as Metrics
-from zrp.gap.metrics import NoiseFloor as NoiseFloor
-from zrp.gap.noise import noise_floor as noise_floor
+from zrp.gap.analysis.assessment import Assessment as Assessment
+from zrp.gap.analysis.assessment import Remainder as Remainder
+from zrp.gap.analysis.baseline import GeometricBaseline as GeometricBaseline
+from zrp.gap.analysis.checks import GapWarning as GapWarning
+from zrp.gap.analysis.where import WhereAnalysis as WhereAnalysis
+from zrp.gap.data.csvfile import load_measurements as load_measurements
+from zrp.gap.data.measurements import DataWarning as DataWarning
+from zrp.gap.data.measurements import Measurements as Measurements
+from zrp.gap.data.noise import NoiseFloor as NoiseFloor
+from zrp.gap.data.noise import noise_floor as noise_floor
+from zrp.gap.data.split import split_poses as split_poses
+from zrp.gap.data.synthetic import Injection as Injection
+from zrp.gap.data.synthetic import synthesize as synthesize
+from zrp.gap.fit.leastsq import Aliased as Aliased
+from zrp.gap.fit.leastsq import FitResult as FitResult
+from zrp.gap.fit.leastsq import FitWarning as FitWarning
+from zrp.gap.fit.metrics import Metrics as Metrics
+from zrp.gap.fit.registration import Registration as Registration
+from zrp.gap.model.context import EFFECTS as EFFECTS
+from zrp.gap.model.context import REGISTRATION as REGISTRATION
+from zrp.gap.model.context import Context as Context
+from zrp.gap.model.context import ParamSpec as ParamSpec
+from zrp.gap.model.effects import effect_parameters as effect_parameters
 from zrp.gap.options import DiagnosisOptions as DiagnosisOptions
 from zrp.gap.pipeline import diagnose as diagnose
-from zrp.gap.registration import Registration as Registration
 from zrp.gap.report import write_outputs as write_outputs
-from zrp.gap.report.verdict import verdict_text as _verdict_text
-from zrp.gap.results import Candidate as Candidate
 from zrp.gap.results import Diagnosis as Diagnosis
-from zrp.gap.results import GapWarning as GapWarning
-from zrp.gap.results import ParameterEstimate as ParameterEstimate
-from zrp.gap.results import Step as Step
 from zrp.gap.results import Where as Where
-from zrp.gap.results import install_verdict_renderer as _install_verdict_renderer
-from zrp.gap.split import split_poses as split_poses
-from zrp.gap.synthetic import Injection as Injection
-from zrp.gap.synthetic import synthesize as synthesize
-from zrp.gap.where import WhereAnalysis as WhereAnalysis
-
-_install_verdict_renderer(_verdict_text)
+from zrp.gap.search.steps import Candidate as Candidate
+from zrp.gap.search.steps import ParameterEstimate as ParameterEstimate
+from zrp.gap.search.steps import Step as Step
 
 __all__ = [
     "EFFECTS",

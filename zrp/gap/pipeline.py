@@ -1,12 +1,13 @@
 """The sim-to-real gap diagnosis: where the gap lies, which effect causes it, how far it shrinks.
 
 Entry point: :func:`diagnose` (in-process; the ``zrp diagnose`` command and the blind benchmark
-call it). The stages, in order: check the data and split the poses (:mod:`zrp.gap.checks`,
-:mod:`zrp.gap.split`), register (base frame, tool offsets), estimate the noise floor
-(:mod:`zrp.gap.noise`), analyse where the residual lies (:mod:`zrp.gap.where`), survey what
-the data can identify (:mod:`zrp.gap.identifiability`), search the effects
-(:mod:`zrp.gap.search`), judge the final model on the withheld poses. The method and the JSON
-schema are documented in zrp/gap/README.md.
+call it). The stages, in order: check the data and split the poses
+(:mod:`zrp.gap.analysis.checks`, :mod:`zrp.gap.data.split`), register (base frame, tool
+offsets), estimate the noise floor (:mod:`zrp.gap.data.noise`), analyse where the residual lies
+(:mod:`zrp.gap.analysis.where`), survey what the data can identify
+(:mod:`zrp.gap.analysis.identifiability`), search the effects (:mod:`zrp.gap.search.greedy`),
+judge the final model on the withheld poses. The method and the JSON schema are documented in
+zrp/gap/README.md.
 """
 
 from __future__ import annotations
@@ -21,52 +22,43 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.arguments import check_float, check_instance, check_int, check_seed
+from zrp.arrays import F64
 from zrp.blas import blas_threads
 from zrp.errors import InputError
-from zrp.gap.assessment import Assessment, compliance_units, remainder_evidence
-from zrp.gap.baseline import GeometricBaseline, geometric_baseline
-from zrp.gap.checks import (
+from zrp.gap.analysis.assessment import Assessment, compliance_units, remainder_evidence
+from zrp.gap.analysis.baseline import GeometricBaseline, geometric_baseline
+from zrp.gap.analysis.checks import (
+    GapWarning,
     check_gravity_torque,
     check_points,
     check_poses,
     check_registration,
     check_units,
 )
-from zrp.gap.data import Measurements
-from zrp.gap.effects import (
-    EFFECTS,
-    MIN_EXCITATION_RAD,
-    Context,
-    effect_parameters,
-    registration_parameters,
-)
-from zrp.gap.excitation import excited_only
-from zrp.gap.fallback import FinalChoice, choose_final
-from zrp.gap.identifiability import ReferencePoses, registration_identifiable, survey
-from zrp.gap.leastsq import FitResult, fit, initial_registration
-from zrp.gap.metrics import Metrics
-from zrp.gap.noise import noise_floor
+from zrp.gap.analysis.excitation import excited_only
+from zrp.gap.analysis.fallback import FinalChoice, choose_final
+from zrp.gap.analysis.identifiability import ReferencePoses, registration_identifiable, survey
+from zrp.gap.analysis.where import WhereAnalysis, where_analysis
+from zrp.gap.data.measurements import Measurements
+from zrp.gap.data.noise import noise_floor
+from zrp.gap.data.split import split_poses
+from zrp.gap.data.subsample import MAX_POINTS, subsample_poses
+from zrp.gap.fit.leastsq import FitResult, fit, initial_registration
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.fit.profiles import with_gravity_side
+from zrp.gap.fit.registration import registration_of
+from zrp.gap.fit.uncertainty import correlations, interval_covariance, plausibility
+from zrp.gap.model.context import EFFECTS, MIN_EXCITATION_RAD, Context
+from zrp.gap.model.effects import effect_parameters, registration_parameters
 from zrp.gap.options import DiagnosisOptions
-from zrp.gap.posefit import refit_full_pose
-from zrp.gap.profiles import with_gravity_side
-from zrp.gap.registration import registration_of
-from zrp.gap.results import (
-    UNEXPLAINED_RATIO,
-    Diagnosis,
-    GapWarning,
-    Where,
-    parameter_estimates,
-)
-from zrp.gap.search import SearchSettings, greedy_search, withheld_residual
-from zrp.gap.split import split_poses
-from zrp.gap.subsample import MAX_POINTS, subsample_poses
-from zrp.gap.uncertainty import correlations, interval_covariance, plausibility
-from zrp.gap.where import WhereAnalysis, where_analysis
+from zrp.gap.results import UNEXPLAINED_RATIO, Diagnosis, Where
+from zrp.gap.search.greedy import SearchSettings, greedy_search, withheld_residual
+from zrp.gap.search.posefit import refit_full_pose
+from zrp.gap.search.steps import parameter_estimates
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["diagnose", "run_diagnosis"]
 
-F64 = NDArray[np.float64]
 #: numerical resolution of the fits as a fraction of the model's characteristic length.
 RESOLUTION = 1e-9
 
@@ -104,10 +96,10 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         withheld_fraction, folds, alpha, min_gain, max_steps, noise_sigma, harmonics,
             gravity_dir, progress: see :class:`~zrp.gap.options.DiagnosisOptions`.
         max_points: most measured points used; beyond it a seeded random subsample of whole
-            poses (the rule in :mod:`zrp.gap.subsample`, announced in a warning and in the
+            poses (the rule in :mod:`zrp.gap.data.subsample`, announced in a warning and in the
             diagnosis's ``warnings``); None uses every point.
         use_orientation: when the measurements carry ``qw..qz``, refit the final model
-            with positions and orientations together (:mod:`zrp.gap.posefit`; the result's
+            with positions and orientations together (:mod:`zrp.gap.search.posefit`; the result's
             ``full_pose``); False: positions only.
         orientation_sigma: orientation noise per component (rad) weighting the orientation
             residuals; None: estimated from them. Needs measured orientations.
@@ -171,7 +163,8 @@ def _check_orientation(meas: Measurements, use: object, sigma: object) -> None:
 
 def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosis:
     """``diag`` with its final model refitted from positions and orientations when the
-    measurements carry them and ``use`` (:mod:`zrp.gap.posefit`), recorded in its settings."""
+    measurements carry them and ``use`` (:mod:`zrp.gap.search.posefit`), recorded in its
+    settings."""
     used = use and diag.context.meas.quat is not None
     full = None
     if used:
@@ -186,7 +179,7 @@ def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosi
 
 
 def _kept_rows(gravity_torque: ArrayLike, kept: NDArray[np.int64], n_poses: int
-               ) -> NDArray[np.float64]:
+               ) -> F64:
     """The rows of the kept poses of a per-pose torque array (its shape is checked later)."""
     tau = np.asarray(gravity_torque, dtype=float)
     if tau.ndim != 2 or tau.shape[0] != n_poses:

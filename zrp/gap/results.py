@@ -1,36 +1,44 @@
 """What a diagnosis returns: typed, frozen results with their JSON form (``to_dict``).
 
 The results of each search step (:class:`ParameterEstimate`, :class:`Candidate`,
-:class:`Step`) live in :mod:`zrp.gap.steps` and are re-exported here. The JSON schema is
-documented in zrp/gap/README.md; :data:`SCHEMA_VERSION` names it. The plain-words verdict
-(:attr:`Diagnosis.verdict`) is prose, so it belongs to the report
-(:mod:`zrp.gap.report.verdict`); the engine only holds the slot the report fills
-(:func:`install_verdict_renderer`, wired in ``zrp/gap/__init__.py``) and never imports it.
+:class:`Step`) live in :mod:`zrp.gap.search.steps` and are re-exported here. The JSON schema is
+documented in zrp/gap/README.md; :data:`SCHEMA_VERSION` names it. The plain-words verdict is
+prose, so the report words it from the result (:func:`zrp.gap.report.verdict_text`) and adds it
+to diagnosis.json (:func:`zrp.gap.report.diagnosis_document`); nothing here refers to the
+report.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+import json
+import math
+import os
+from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
 
-from zrp.errors import InputError, ZRPWarning
-from zrp.gap.assessment import Assessment
-from zrp.gap.effects import Context
-from zrp.gap.leastsq import Aliased, FitResult
-from zrp.gap.metrics import Metrics, NoiseFloor
-from zrp.gap.posefit import FullPoseResult
-from zrp.gap.steps import Z95 as Z95
-from zrp.gap.steps import Candidate as Candidate
-from zrp.gap.steps import EffectsFound
-from zrp.gap.steps import ParameterEstimate as ParameterEstimate
-from zrp.gap.steps import Step as Step
-from zrp.gap.steps import alias_dict as alias_dict
-from zrp.gap.steps import parameter_estimates as parameter_estimates
-from zrp.gap.where import WhereAnalysis
+from zrp.arrays import F64
+from zrp.errors import InputError
+from zrp.gap.analysis.assessment import Assessment
+from zrp.gap.analysis.checks import GapWarning as GapWarning
+from zrp.gap.analysis.identifiability import EffectIdentifiability as EffectIdentifiability
+from zrp.gap.analysis.where import WhereAnalysis
+from zrp.gap.data.noise import NoiseFloor
+from zrp.gap.fit.leastsq import Aliased, FitResult
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.model.context import Context
+from zrp.gap.search.posefit import FullPoseResult
+from zrp.gap.search.steps import Z95 as Z95
+from zrp.gap.search.steps import BacklashSwitch as BacklashSwitch
+from zrp.gap.search.steps import Candidate as Candidate
+from zrp.gap.search.steps import EffectsFound
+from zrp.gap.search.steps import ParameterEstimate as ParameterEstimate
+from zrp.gap.search.steps import Step as Step
+from zrp.gap.search.steps import parameter_estimates as parameter_estimates
 
 __all__ = [
     "SCHEMA_VERSION",
@@ -38,65 +46,20 @@ __all__ = [
     "BacklashSwitch",
     "Candidate",
     "Diagnosis",
+    "DiagnosisRecord",
     "EffectIdentifiability",
     "GapWarning",
     "ParameterEstimate",
     "Step",
+    "StepRecord",
     "Where",
-    "alias_dict",
-    "install_verdict_renderer",
+    "load_diagnosis",
     "parameter_estimates",
 ]
 
-F64 = NDArray[np.float64]
 SCHEMA_VERSION = 1
 #: final withheld RMS above this multiple of the noise-floor RMS counts as unexplained.
 UNEXPLAINED_RATIO = 1.5
-
-
-class GapWarning(ZRPWarning):
-    """The diagnosis ran but something limits what it can say (aliasing, poor data...)."""
-
-
-@dataclass(frozen=True)
-class EffectIdentifiability:
-    """Which parameters of one effect these data cannot identify on top of the registration.
-
-    Attributes:
-        not_identifiable: parameters dropped (aliased with others).
-        weak: parameters kept but only weakly identifiable.
-        limited_by_data: names of the dropped ones that a rich pose set would identify.
-    """
-
-    not_identifiable: tuple[Aliased, ...]
-    weak: tuple[Aliased, ...]
-    limited_by_data: tuple[str, ...] = ()
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"not_identifiable": [alias_dict(a) for a in self.not_identifiable],
-                "weak": [alias_dict(a) for a in self.weak],
-                "limited_by_data": list(self.limited_by_data)}
-
-
-@dataclass(frozen=True)
-class BacklashSwitch:
-    """Where a joint with play rests (the ``backlash`` effect as added to the model).
-
-    Attributes:
-        switch: per joint, the gravity torque above which it rests on the loaded flank (None:
-            always against its approach direction).
-        band: per joint, the range of plausible switching torques (None where modelled by the
-            approach direction only).
-        payload_kg: the unknown payload at the tool profiled with MJCF torques, kg.
-    """
-
-    switch: tuple[float | None, ...]
-    band: tuple[list[float] | None, ...]
-    payload_kg: float
-
-    def to_dict(self) -> dict[str, Any]:
-        return {"backlash_switch": list(self.switch), "backlash_switch_band": list(self.band),
-                "backlash_payload_kg": self.payload_kg}
 
 
 @dataclass(frozen=True, eq=False)
@@ -147,17 +110,6 @@ class Where(Mapping[str, Any]):
         return len(self.to_dict())
 
 
-#: Renders :attr:`Diagnosis.verdict`; installed by the report (see zrp/gap/__init__.py).
-_verdict_renderer: Callable[[Diagnosis], str] | None = None
-
-
-def install_verdict_renderer(render: Callable[[Diagnosis], str]) -> None:
-    """Set the function that words :attr:`Diagnosis.verdict` (the report's
-    :func:`zrp.gap.report.verdict.verdict_text`; the engine does not import the report)."""
-    global _verdict_renderer
-    _verdict_renderer = render
-
-
 @dataclass(frozen=True, eq=False)
 class Diagnosis(EffectsFound):
     """The result of :func:`~zrp.gap.diagnose` (see zrp/gap/README.md for the JSON form).
@@ -183,8 +135,8 @@ class Diagnosis(EffectsFound):
         settings: the options of the run.
         assessment: the geometric baseline, robust intervals, correlations, plausibility,
             the full registration and the evidence on what remains
-            (:class:`~zrp.gap.assessment.Assessment`).
-        full_pose: the final model refitted with orientations (:mod:`zrp.gap.posefit`).
+            (:class:`~zrp.gap.analysis.assessment.Assessment`).
+        full_pose: the final model refitted with orientations (:mod:`zrp.gap.search.posefit`).
     """
 
     model_name: str
@@ -239,17 +191,9 @@ class Diagnosis(EffectsFound):
         return self.where.nominal if final is None else final
 
     @property
-    def verdict(self) -> str:
-        """One paragraph in plain words (worded by the report)."""
-        if _verdict_renderer is None:
-            raise RuntimeError("no verdict renderer installed; import zrp.gap (its __init__ "
-                               "installs zrp.gap.report.verdict.verdict_text)")
-        return _verdict_renderer(self)
-
-    @property
     def final_parameters(self) -> tuple[ParameterEstimate, ...]:
         """All effect parameters of the final model, estimated jointly (after the backward
-        pass), with robust 95 % intervals (:mod:`zrp.gap.uncertainty`). The per-step values
+        pass), with robust 95 % intervals (:mod:`zrp.gap.fit.uncertainty`). The per-step values
         are each estimated without the effects added later, so these are the ones to use."""
         se = None if self.assessment is None else self.assessment.stderr
         return parameter_estimates(self.final_fit, len(self.registration), stderr=se,
@@ -274,7 +218,9 @@ class Diagnosis(EffectsFound):
                          f"{', '.join(p.name for p in self.final_parameters)}")
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON document (schema in zrp/gap/README.md)."""
+        """The JSON document (schema in zrp/gap/README.md) without the verdict, which the
+        report words and inserts after ``unexplained``
+        (:func:`zrp.gap.report.diagnosis_document`)."""
         return {
             "schema_version": SCHEMA_VERSION,
             "model": self.model_name,
@@ -291,11 +237,89 @@ class Diagnosis(EffectsFound):
                       "ratio_to_noise_floor": self.ratio_to_noise_floor},
             "noise_floor": self.noise_floor.to_dict(),
             "unexplained": self.unexplained,
-            "verdict": self.verdict,
             "split": self.split,
             "where": self.where.to_dict(),
-            "aliased": [alias_dict(a) for a in self.aliased],
+            "aliased": [a.to_dict() for a in self.aliased],
             "warnings": list(self.warnings),
             **({} if self.assessment is None else self.assessment.to_dict()),
             "full_pose": None if self.full_pose is None else self.full_pose.to_dict(),
         }
+
+
+@dataclass(frozen=True)
+class StepRecord:
+    """One step of a stored diagnosis: the effect added, its joints and the candidates ranked
+    at that step."""
+
+    effect: str
+    joints: tuple[int, ...]
+    candidates: tuple[Candidate, ...] = ()
+
+
+@dataclass(frozen=True)
+class DiagnosisRecord(EffectsFound):
+    """A diagnosis read back from its JSON document (:func:`load_diagnosis`): the typed,
+    read-only part that readers of stored diagnoses (the blind benchmark's scorer) use.
+
+    Attributes:
+        steps: the effects added, in order (``effects``, ``top_effect`` as on
+            :class:`Diagnosis`).
+        nominal_rms, final_rms: withheld RMS after registration and with the final model
+            (NaN for a refusal).
+        unexplained: as in :class:`Diagnosis`.
+        final_parameters: the final model's effect parameters with their intervals.
+        error: why the diagnosis refused the data (a document written for a refusal), or None.
+    """
+
+    steps: tuple[StepRecord, ...]
+    nominal_rms: float
+    final_rms: float
+    unexplained: bool | None
+    final_parameters: tuple[ParameterEstimate, ...] = ()
+    error: str | None = None
+
+
+def _number(x: Any) -> float:
+    """A JSON number, null (NaN or an infinity written by :func:`zrp.jsonio.to_jsonable`) as
+    NaN."""
+    return math.nan if x is None else float(x)
+
+
+def _candidate(c: Mapping[str, Any]) -> Candidate:
+    return Candidate(c["effect"], tuple(int(j) for j in c["joints"]), int(c["n_params"]),
+                     _number(c["cv_rms"]), _number(c["bic_delta"]), float(c["p_value"]),
+                     bool(c["significant"]), str(c.get("note", "")))
+
+
+def _parameter(p: Mapping[str, Any]) -> ParameterEstimate:
+    ci = p.get("ci95_effect")
+    return ParameterEstimate(p["name"], p["effect"], int(p["joint"]), p["unit"],
+                             float(p["value"]), float(p["stderr"]),
+                             (_number(p["ci95"][0]), _number(p["ci95"][1])),
+                             None if ci is None else (_number(ci[0]), _number(ci[1])))
+
+
+def _step(s: Mapping[str, Any]) -> StepRecord:
+    return StepRecord(s["effect"], tuple(int(j) for j in s.get("joints", ())),
+                      tuple(_candidate(c) for c in s.get("candidates", ())))
+
+
+def load_diagnosis(source: str | os.PathLike[str] | Mapping[str, Any]) -> DiagnosisRecord:
+    """Read a diagnosis back from its JSON: a diagnosis.json path, or the document itself
+    (:meth:`Diagnosis.to_dict`, :func:`zrp.gap.report.diagnosis_document`, or a refusal
+    ``{"steps": [], "nominal": {"rms": NaN}, "final": {"rms": NaN}, "unexplained": None,
+    "error": ...}``). Keys a reader does not need may be missing (``candidates``,
+    ``final.parameters``, ``error``).
+
+    Raises:
+        InputError: a step, candidate or parameter the typed results refuse.
+        KeyError: the document lacks ``nominal.rms``, ``final.rms`` or a step's ``effect``.
+    """
+    doc = (source if isinstance(source, Mapping)
+           else json.loads(Path(source).read_text(encoding="utf-8")))
+    final = doc["final"]
+    return DiagnosisRecord(tuple(_step(s) for s in doc.get("steps", ())),
+                           _number(doc["nominal"]["rms"]), _number(final["rms"]),
+                           doc.get("unexplained"),
+                           tuple(_parameter(p) for p in final.get("parameters", ())),
+                           doc.get("error"))

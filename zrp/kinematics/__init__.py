@@ -1,7 +1,9 @@
 """Kinematics by the zero-reference-position method: forward kinematics and the eq (7)
 Jacobian (:mod:`.forward`, compiled in :mod:`._kernels`), trajectories (:mod:`.trajectory`),
-predictor-corrector inverse kinematics along them (:mod:`.ik`, compiled in :mod:`._ik_kernels`)
-and random joint values (:mod:`.sampling`). See README.md in this folder.
+predictor-corrector inverse kinematics along them (:mod:`.ik`, compiled in :mod:`._ik_kernels`),
+random joint values (:mod:`.sampling`) and the kinematic parameter vector with its
+identification Jacobian (:mod:`.identification`, used by calibration, the gap diagnosis and the
+tolerance analysis). See README.md in this folder.
 """
 
 from zrp.kinematics.forward import FKResult as FKResult

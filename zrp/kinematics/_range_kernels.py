@@ -11,9 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 from numba import njit
-from numpy.typing import NDArray
 
-from zrp.model.manipulator import MAX_LENGTH, Manipulator
+from zrp.arrays import F64
+from zrp.model.manipulator import MAX_LENGTH, Manipulator, derived
 
 __all__ = ["MAX_ANGLE", "all_in_range", "joint_limits"]
 
@@ -21,13 +21,13 @@ __all__ = ["MAX_ANGLE", "all_in_range", "joint_limits"]
 MAX_ANGLE = 1e6
 
 
-def joint_limits(model: Manipulator) -> NDArray[np.float64]:
+def joint_limits(model: Manipulator) -> F64:
     """Per joint the largest accepted |q|: :data:`MAX_ANGLE` rad or ``MAX_LENGTH``, shape (n,)."""
-    cache = model.__dict__.get("_joint_limits")
-    if cache is None:
-        cache = np.where(np.asarray(model.prismatic), MAX_LENGTH, MAX_ANGLE)
-        model.__dict__["_joint_limits"] = cache
-    return cache
+    return derived(model, "_joint_limits", _joint_limits)
+
+
+def _joint_limits(model: Manipulator) -> F64:
+    return np.where(np.asarray(model.prismatic), MAX_LENGTH, MAX_ANGLE)
 
 
 @njit(cache=True)

@@ -15,23 +15,23 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import all_in_range, joint_limits
-from zrp.model.manipulator import Manipulator, hand_frame
+from zrp.model.manipulator import Manipulator, derived, hand_frame
 from zrp.rotations.rodrigues import (
     er_from_axis_angle,
     er_identity,
     er_multiply,
     er_rotate,
-    er_to_matrix,
+    matrix_from_er,
 )
 
 __all__ = ["FKResult", "check_q", "end_effector_pose", "forward_kinematics", "jacobian"]
 
-F64 = NDArray[np.float64]
 
 
 def check_q(model: Manipulator, q: ArrayLike, name: str = "q") -> F64:
@@ -94,7 +94,7 @@ class FKResult:
     @property
     def rotation(self) -> F64:
         """Hand rotation R_n relative to the zero reference position, shape (..., 3, 3)."""
-        return er_to_matrix(self.er)
+        return matrix_from_er(self.er)
 
     @property
     def hand_frame(self) -> F64:
@@ -147,20 +147,22 @@ def _range_error(model: Manipulator, q: ArrayLike) -> None:
     raise AssertionError("a batch kernel declined q, but check_q accepts it")  # pragma: no cover
 
 
+def _kernel_arrays(model: Manipulator) -> tuple:
+    return K.kernel_arrays(model.axes, model.bodies, model.prismatic)
+
+
+def _pack(model: Manipulator) -> F64:
+    return K.pack_model(model.axes, model.bodies, model.prismatic)
+
+
 def _karrays(model: Manipulator) -> tuple:
-    cache = model.__dict__.get("_kernel_arrays")
-    if cache is None:
-        cache = K.kernel_arrays(model.axes, model.bodies, model.prismatic)
-        model.__dict__["_kernel_arrays"] = cache
-    return cache
+    """The batch kernels' arrays of ``model`` (built once per model)."""
+    return derived(model, "_kernel_arrays", _kernel_arrays)
 
 
 def _packed(model: Manipulator) -> F64:
-    packed = model.__dict__.get("_kernel_packed")
-    if packed is None:
-        packed = K.pack_model(model.axes, model.bodies, model.prismatic)
-        model.__dict__["_kernel_packed"] = packed
-    return packed
+    """The single-pose kernels' packed model (built once per model)."""
+    return derived(model, "_kernel_packed", _pack)
 
 
 _F64 = np.dtype(np.float64)

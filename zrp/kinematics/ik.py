@@ -22,6 +22,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import (
     IKError,
     InputError,
@@ -40,7 +41,6 @@ from zrp.output import write_text
 
 __all__ = ["CORRECTIONS", "TASKS", "IKResult", "track_trajectory"]
 
-F64 = NDArray[np.float64]
 CORRECTIONS = ("newton", "feedback", "none")
 TASKS = ("pose", "position")
 
@@ -156,6 +156,36 @@ def _reachability(model: Manipulator, t: F64, p: F64) -> None:
             f"beyond the arm's reach of {reach:.6g} {model.length_unit}")
 
 
+def _check_task(model: Manipulator, task: str | None, correction: str, gain: float | None
+                ) -> tuple[str, float]:
+    """Validated (task, gain): the task defaults by the number of joints, the gain by the
+    correction."""
+    if task is None:
+        task = "pose" if model.n >= 6 else "position"
+    if task not in TASKS:
+        raise InputError(f"task: {task!r} is unknown; expected one of {TASKS}")
+    if correction not in CORRECTIONS:
+        raise InputError(f"correction: {correction!r} is unknown; expected one of {CORRECTIONS}")
+    if gain is None:
+        gain = 50.0 if correction == "feedback" else 0.0
+    if not np.isfinite(gain) or gain < 0:
+        raise InputError(f"gain: expected a finite number >= 0 (1/s), got {gain!r}")
+    return task, gain
+
+
+def _warn_risky(model: Manipulator, trajectory: Trajectory, steps: int, task: str,
+                correction: str, gain: float) -> None:
+    """Warns (at the caller of the tracking function) about options that track badly."""
+    if correction == "feedback" and gain * trajectory.duration / steps > 0.3:
+        warnings.warn(f"gain * h = {gain * trajectory.duration / steps:.3g} exceeds 0.3: the "
+                      f"feedback is outside the predictor-corrector's stability region; use "
+                      f"more steps or a smaller gain", TrackingWarning, stacklevel=4)
+    if task == "pose" and model.n < 6:
+        warnings.warn(f"task='pose' with {model.n} joints: the orientation cannot be tracked "
+                      "independently; damped least squares will share the error",
+                      TrackingWarning, stacklevel=4)
+
+
 def _check_options(model: Manipulator, trajectory: Trajectory, q0: ArrayLike, steps: int,
                    task: str | None, correction: str, gain: float | None
                    ) -> tuple[F64, int, str, float]:
@@ -168,24 +198,8 @@ def _check_options(model: Manipulator, trajectory: Trajectory, q0: ArrayLike, st
         raise InputError(f"q0: expected shape ({model.n},), got {q0.shape}")
     if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 4:
         raise InputError(f"steps: expected an integer >= 4, got {steps!r}")
-    if task is None:
-        task = "pose" if model.n >= 6 else "position"
-    if task not in TASKS:
-        raise InputError(f"task: {task!r} is unknown; expected one of {TASKS}")
-    if correction not in CORRECTIONS:
-        raise InputError(f"correction: {correction!r} is unknown; expected one of {CORRECTIONS}")
-    if gain is None:
-        gain = 50.0 if correction == "feedback" else 0.0
-    if not np.isfinite(gain) or gain < 0:
-        raise InputError(f"gain: expected a finite number >= 0 (1/s), got {gain!r}")
-    if correction == "feedback" and gain * trajectory.duration / steps > 0.3:
-        warnings.warn(f"gain * h = {gain * trajectory.duration / steps:.3g} exceeds 0.3: the "
-                      f"feedback is outside the predictor-corrector's stability region; use "
-                      f"more steps or a smaller gain", TrackingWarning, stacklevel=3)
-    if task == "pose" and model.n < 6:
-        warnings.warn(f"task='pose' with {model.n} joints: the orientation cannot be tracked "
-                      "independently; damped least squares will share the error",
-                      TrackingWarning, stacklevel=3)
+    task, gain = _check_task(model, task, correction, gain)
+    _warn_risky(model, trajectory, steps, task, correction, gain)
     return q0, int(steps), task, float(gain)
 
 

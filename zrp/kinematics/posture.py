@@ -29,16 +29,16 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError, JointLimitError, SingularityError, UnreachableError
 from zrp.kinematics.forward import check_q, end_effector_pose, jacobian
 from zrp.model.manipulator import Manipulator
-from zrp.rotations.rodrigues import er_conjugate, er_multiply, er_to_rotvec
+from zrp.rotations.rodrigues import er_conjugate, er_multiply, rotvec_from_er
 
 __all__ = ["PoseSolution", "Posture", "check_limits_along", "pose_error", "solve_pose"]
 
-F64 = NDArray[np.float64]
 
 #: Penalty stiffness kappa in (P1), relative to the rest weights.
 KAPPA = 1e4
@@ -92,7 +92,7 @@ def pose_error(model: Manipulator, q: F64, pd: F64, erd: F64 | None) -> tuple[F6
     jac = jacobian(model, q)
     if erd is None:
         return pd - p, jac[3:]
-    rot = er_to_rotvec(er_multiply(erd, er_conjugate(er)))
+    rot = rotvec_from_er(er_multiply(erd, er_conjugate(er)))
     return np.concatenate([rot, pd - p]), jac
 
 

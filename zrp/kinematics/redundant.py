@@ -16,8 +16,9 @@ import warnings
 from typing import Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import (
     InputError,
     JointLimitError,
@@ -30,11 +31,10 @@ from zrp.kinematics.ik import IKResult
 from zrp.kinematics.posture import Posture, _within_reach, check_limits_along, sqp
 from zrp.kinematics.trajectory import Trajectory
 from zrp.model.manipulator import Manipulator
-from zrp.rotations.rodrigues import er_conjugate, er_multiply, er_to_rotvec
+from zrp.rotations.rodrigues import er_conjugate, er_multiply, rotvec_from_er
 
 __all__ = ["LIMIT_MODES", "track_posture"]
 
-F64 = NDArray[np.float64]
 LIMIT_MODES = ("error", "warn", "ignore")
 
 
@@ -71,6 +71,61 @@ def _stuck(model: Manipulator, t: float, pd: F64, err: float, js: F64, q: F64,
                            f"{model.length_unit})")
 
 
+def _check_options(model: Manipulator, trajectory: Trajectory, q0: ArrayLike, steps: int,
+                   task: str | None, limits: str) -> tuple[F64, str]:
+    """Validated (q0, task); the task defaults to the pose for six joints or more."""
+    if not isinstance(trajectory, Trajectory):
+        raise InputError(f"trajectory: expected a zrp Trajectory, got "
+                         f"{type(trajectory).__name__}")
+    q0 = np.array(check_q(model, q0, "q0"), dtype=float)
+    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 4:
+        raise InputError(f"steps: expected an integer >= 4, got {steps!r}")
+    if limits not in LIMIT_MODES:
+        raise InputError(f"limits: {limits!r} is unknown; expected one of {LIMIT_MODES}")
+    task = task or ("pose" if model.n >= 6 else "position")
+    if task not in ("pose", "position"):
+        raise InputError(f"task: {task!r} is unknown; expected 'pose' or 'position'")
+    return q0, task
+
+
+def _guess(q: F64, q0: F64, i: int) -> F64:
+    """The start of sample ``i``: ``q0``, then the previous solution extrapolated linearly."""
+    if i >= 2:
+        return 2 * q[i - 1] - q[i - 2]
+    return q[0] if i == 1 else q0
+
+
+def _solve_sample(model: Manipulator, guess: F64, pd: F64, erd: F64 | None, posture: Posture,
+                  out: dict[str, F64], i: int) -> tuple[F64, int, F64]:
+    """(P2) at one sample from ``guess``: (q, iterations, scaled Jacobian); the guess's drift,
+    the errors left, the correction and the manipulability go into row ``i`` of ``out``."""
+    p_g, er_g = end_effector_pose(model, guess)
+    out["drift_p"][i] = np.linalg.norm(pd - p_g)  # error of the extrapolated guess
+    if erd is not None:
+        out["drift_o"][i] = np.linalg.norm(rotvec_from_er(er_multiply(erd, er_conjugate(er_g))))
+    qi, iters, e, js = sqp(model, guess, pd, erd, posture)
+    out["err_p"][i] = np.linalg.norm(e[-3:])
+    out["err_o"][i] = np.linalg.norm(e[:3]) if erd is not None else 0.0
+    out["corr"][i] = np.linalg.norm(qi - guess)
+    out["manip"][i] = _manipulability(js)
+    return qi, iters, js
+
+
+def _limit_notes(model: Manipulator, t: F64, q: F64, limits: str) -> tuple[str, ...]:
+    """Check the joint limits along the result: raise, warn (at the caller of
+    :func:`track_posture`) and note, or ignore, as ``limits`` says."""
+    if limits == "ignore":
+        return ()
+    try:
+        check_limits_along(model, t, q)
+    except JointLimitError as exc:
+        if limits == "error":
+            raise
+        warnings.warn(str(exc), TrackingWarning, stacklevel=3)
+        return (str(exc),)
+    return ()
+
+
 def track_posture(
     model: Manipulator,
     trajectory: Trajectory,
@@ -100,17 +155,7 @@ def track_posture(
         SingularityError: a point within reach that the arm cannot follow at a singularity.
         UnreachableError: a point beyond reach.
     """
-    if not isinstance(trajectory, Trajectory):
-        raise InputError(f"trajectory: expected a zrp Trajectory, got "
-                         f"{type(trajectory).__name__}")
-    q0 = np.array(check_q(model, q0, "q0"), dtype=float)
-    if isinstance(steps, bool) or not isinstance(steps, (int, np.integer)) or steps < 4:
-        raise InputError(f"steps: expected an integer >= 4, got {steps!r}")
-    if limits not in LIMIT_MODES:
-        raise InputError(f"limits: {limits!r} is unknown; expected one of {LIMIT_MODES}")
-    task = task or ("pose" if model.n >= 6 else "position")
-    if task not in ("pose", "position"):
-        raise InputError(f"task: {task!r} is unknown; expected 'pose' or 'position'")
+    q0, task = _check_options(model, trajectory, q0, steps, task, limits)
     posture = Posture.build(model, q0 if rest is None else rest, weights, margin)
     started = time.perf_counter()
     t = np.linspace(0.0, trajectory.duration, steps + 1)
@@ -124,35 +169,15 @@ def track_posture(
                                          "manip")}
     iters = np.zeros(t.size, dtype=np.int64)
     tol_p = 1e-9 * model.characteristic_length
-    guess = q0
     for i in range(t.size):
-        if i >= 2:
-            guess = 2 * q[i - 1] - q[i - 2]
-        elif i == 1:
-            guess = q[0]
+        guess = _guess(q, q0, i)
         erd = erd_all[i] if task == "pose" else None
         pd = sample.position[i]
-        p_g, er_g = end_effector_pose(model, guess)
-        out["drift_p"][i] = np.linalg.norm(pd - p_g)  # error of the extrapolated guess
-        if erd is not None:
-            out["drift_o"][i] = np.linalg.norm(er_to_rotvec(er_multiply(erd, er_conjugate(er_g))))
-        qi, iters[i], e, js = sqp(model, guess, pd, erd, posture)
-        out["err_p"][i] = np.linalg.norm(e[-3:])
-        out["err_o"][i] = np.linalg.norm(e[:3]) if erd is not None else 0.0
-        out["corr"][i] = np.linalg.norm(qi - guess)
-        out["manip"][i] = _manipulability(js)
+        qi, iters[i], js = _solve_sample(model, guess, pd, erd, posture, out, i)
         if out["err_p"][i] > tol_p or out["err_o"][i] > 1e-9:
             _stuck(model, float(t[i]), pd, float(out["err_p"][i]), js, qi, posture)
         q[i] = qi
-    notes: tuple[str, ...] = ()
-    if limits != "ignore":
-        try:
-            check_limits_along(model, t, q)
-        except JointLimitError as exc:
-            if limits == "error":
-                raise
-            warnings.warn(str(exc), TrackingWarning, stacklevel=2)
-            notes = (str(exc),)
+    notes = _limit_notes(model, t, q, limits)
     qdot = np.gradient(q, t, axis=0)
     return IKResult(
         t=t, q=q, qdot=qdot, desired_position=sample.position, desired_er=erd_all,

@@ -8,16 +8,16 @@ below a floor height (what a real measuring run can reach).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from zrp.arguments import check_instance, check_int
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import end_effector_pose
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["SLIDE_TRAVEL", "default_limits", "reachable_poses", "uniform_joint_values"]
 
-F64 = NDArray[np.float64]
 
 #: A slide without limits moves +- this fraction of the arm's reach in random poses.
 SLIDE_TRAVEL = 0.1

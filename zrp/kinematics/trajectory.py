@@ -16,8 +16,9 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 
 __all__ = [
@@ -31,7 +32,6 @@ __all__ = [
     "TrajectorySample",
 ]
 
-F64 = NDArray[np.float64]
 OrientationLaw = Callable[[F64], tuple[F64, F64]]
 TIME_LAWS = ("quintic", "cycloidal")
 

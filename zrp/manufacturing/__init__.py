@@ -1,12 +1,22 @@
 """Manufacturing errors: perturbed link vectors and joint axes (eqs 8-12, :mod:`.perturb`),
 pose deviations along a trajectory (eqs 15-17, :mod:`.deviation`), the parameter vector and its
-identification Jacobian (:mod:`.sensitivity`), one-at-a-time studies (:mod:`.study`), and the
+identification Jacobian (re-exported from :mod:`zrp.kinematics.identification`), one-at-a-time
+studies (:mod:`.study`), and the
 tolerance analysis: tolerances and random draws (:mod:`.tolerance`), the nonlinear Monte Carlo
 (:mod:`.population`; reduced on the workers for any size: :mod:`.reduction`), the first-order
 budget (:mod:`.budget`), allocation (:mod:`.allocation`) and its figure (:mod:`.plots`). See
 README.md in this folder.
 """
 
+from zrp.kinematics.identification import ParameterSpace as ParameterSpace
+from zrp.kinematics.identification import apply_parameters as apply_parameters
+from zrp.kinematics.identification import axis_tangents as axis_tangents
+from zrp.kinematics.identification import parameter_jacobian as parameter_jacobian
+from zrp.kinematics.identification import parameter_names as parameter_names
+from zrp.kinematics.identification import parameter_space as parameter_space
+from zrp.kinematics.identification import perturbed_arrays as perturbed_arrays
+from zrp.kinematics.identification import pose_error as pose_error
+from zrp.kinematics.identification import tilt_axes as tilt_axes
 from zrp.manufacturing.allocation import Allocation as Allocation
 from zrp.manufacturing.allocation import allocate_tolerances as allocate_tolerances
 from zrp.manufacturing.budget import Contribution as Contribution
@@ -41,15 +51,6 @@ from zrp.manufacturing.population import gather_chunks as gather_chunks
 from zrp.manufacturing.population import monte_carlo as monte_carlo
 from zrp.manufacturing.reduction import MonteCarloSummary as MonteCarloSummary
 from zrp.manufacturing.reduction import monte_carlo_summary as monte_carlo_summary
-from zrp.manufacturing.sensitivity import ParameterSpace as ParameterSpace
-from zrp.manufacturing.sensitivity import apply_parameters as apply_parameters
-from zrp.manufacturing.sensitivity import axis_tangents as axis_tangents
-from zrp.manufacturing.sensitivity import parameter_jacobian as parameter_jacobian
-from zrp.manufacturing.sensitivity import parameter_names as parameter_names
-from zrp.manufacturing.sensitivity import parameter_space as parameter_space
-from zrp.manufacturing.sensitivity import perturbed_arrays as perturbed_arrays
-from zrp.manufacturing.sensitivity import pose_error as pose_error
-from zrp.manufacturing.sensitivity import tilt_axes as tilt_axes
 from zrp.manufacturing.study import PAPER_PARAMETERS as PAPER_PARAMETERS
 from zrp.manufacturing.study import PAPER_XI as PAPER_XI
 from zrp.manufacturing.study import JointPath as JointPath

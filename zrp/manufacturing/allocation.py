@@ -27,7 +27,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.kinematics.identification import ParameterSpace, parameter_jacobian, parameter_space
 from zrp.manufacturing._checks import check_distribution, nonnegative, positive_int
 from zrp.manufacturing.budget import Contribution, contributions, worst_case_bound
 from zrp.manufacturing.population import (
@@ -36,13 +38,11 @@ from zrp.manufacturing.population import (
     nonlinear_maxima,
     trajectory_arrays,
 )
-from zrp.manufacturing.sensitivity import ParameterSpace, parameter_jacobian, parameter_space
 from zrp.manufacturing.tolerance import Tolerances, draw_parameters, percentile_ci
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["Allocation", "allocate_tolerances"]
 
-F64 = NDArray[np.float64]
 Arrays = tuple[F64, F64, F64, F64, F64]
 
 

@@ -1,6 +1,6 @@
 """The first-order error budget of given tolerances along a trajectory.
 
-From the identification Jacobian (:func:`zrp.manufacturing.sensitivity.parameter_jacobian`):
+From the identification Jacobian (:func:`zrp.kinematics.identification.parameter_jacobian`):
 the worst case over the tolerance box (:func:`worst_case_bound`), each parameter's share of the
 deviation variance (:func:`contributions`, ranked) and both together with an optional Monte
 Carlo comparison (:func:`tolerance_report`).
@@ -9,24 +9,35 @@ Carlo comparison (:func:`tolerance_report`).
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q
-from zrp.manufacturing.sensitivity import parameter_jacobian
+from zrp.kinematics.identification import parameter_jacobian
 from zrp.manufacturing.tolerance import Tolerances
 from zrp.model.manipulator import Manipulator
 
-if TYPE_CHECKING:
-    from zrp.manufacturing.population import MonteCarloResult
-    from zrp.manufacturing.reduction import MonteCarloSummary
+__all__ = ["Contribution", "MonteCarloMaxima", "contributions", "tolerance_report",
+           "worst_case_bound"]
 
-__all__ = ["Contribution", "contributions", "tolerance_report", "worst_case_bound"]
 
-F64 = NDArray[np.float64]
+
+class MonteCarloMaxima(Protocol):
+    """What :func:`tolerance_report` reads of a Monte Carlo: its distribution and the largest
+    per-robot maxima. Both the gathered
+    :class:`~zrp.manufacturing.population.MonteCarloResult` and the reduced
+    :class:`~zrp.manufacturing.reduction.MonteCarloSummary` have them; the reduction's
+    histogram edges come from :func:`worst_case_bound`, so this module names neither type
+    (the imports go one way: reduction -> budget)."""
+
+    @property
+    def distribution(self) -> str: ...
+
+    def maxima(self) -> tuple[float, float]: ...
 
 
 def worst_case_bound(jac: ArrayLike, tolerances: ArrayLike) -> tuple[F64, F64]:
@@ -147,7 +158,7 @@ def contributions(jac: ArrayLike, tolerances: ArrayLike, names: tuple[str, ...],
 
 
 def tolerance_report(model: Manipulator, q: ArrayLike, tolerances: Tolerances,
-                     mc: MonteCarloResult | MonteCarloSummary | None = None) -> dict[str, Any]:
+                     mc: MonteCarloMaxima | None = None) -> dict[str, Any]:
     """First-order analysis of given tolerances: contributions, worst case, and (if ``mc`` is
     given, gathered or reduced on the workers) its comparison with the Monte Carlo maxima."""
     q = check_q(model, q)

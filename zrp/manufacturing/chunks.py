@@ -23,19 +23,18 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.kinematics.identification import parameter_jacobian
 from zrp.manufacturing.histogram import Histogram
 from zrp.manufacturing.maxima import first_order_max, nonlinear_maxima
-from zrp.manufacturing.sensitivity import parameter_jacobian
 from zrp.manufacturing.tolerance import Tolerances, draw_parameters
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["MAX_CHUNK", "TASK_POSES", "ChunkResult", "ChunkTask", "chunk_rng", "chunk_size",
            "run_chunk"]
 
-F64 = NDArray[np.float64]
 
 
 #: Poses (robots x trajectory points) per task when the chunk is chosen from the work: ~0.15 s

@@ -27,13 +27,14 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q, end_effector_pose
 from zrp.manufacturing.perturb import Perturbation
 from zrp.model.manipulator import Manipulator
-from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply, er_to_rotvec
+from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply, rotvec_from_er
 
 __all__ = [
     "Deviation",
@@ -44,7 +45,6 @@ __all__ = [
     "trajectory_deviation",
 ]
 
-F64 = NDArray[np.float64]
 
 
 def check_times(t: ArrayLike | None, n_points: int, name: str = "t") -> F64:
@@ -169,7 +169,7 @@ def pose_deviation(nominal: Manipulator, actual: Manipulator, q: ArrayLike,
     return Deviation(
         t=t,
         dp=dp,
-        rotvec=er_to_rotvec(e_err),
+        rotvec=rotvec_from_er(e_err),
         delta_p=np.linalg.norm(dp, axis=-1),  # eq (17)
         delta_r=delta_r_eq15(e_err),  # eqs (15)-(16)
         angle_rad=er_angle(e_err),

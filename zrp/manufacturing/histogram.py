@@ -15,15 +15,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64, I64
 from zrp.errors import InputError
 from zrp.manufacturing._checks import check_percentile
 
 __all__ = ["Histogram", "geometric_edges"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 
 
 def geometric_edges(lo: float, hi: float, bins: int) -> F64:

@@ -6,17 +6,17 @@ steps. The building blocks of :mod:`.population` and :mod:`.chunks`.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q, end_effector_pose
+from zrp.kinematics.identification import perturbed_arrays
 from zrp.manufacturing import _mc_kernels as MK
-from zrp.manufacturing.sensitivity import perturbed_arrays
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["first_order_max", "nonlinear_maxima", "trajectory_arrays"]
 
-F64 = NDArray[np.float64]
 
 
 def trajectory_arrays(model: Manipulator, q: ArrayLike) -> tuple[F64, F64, F64, F64, F64]:

@@ -29,8 +29,9 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 
@@ -46,7 +47,6 @@ __all__ = [
     "perturbation_names",
 ]
 
-F64 = NDArray[np.float64]
 SignZero = Literal[-1, 0, 1]
 
 #: sign(0) implied by the published tables: links 0, axes +1 (see the module docstring).

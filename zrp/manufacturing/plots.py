@@ -6,15 +6,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.manufacturing.histogram import Histogram
 from zrp.manufacturing.population import MonteCarloResult
 from zrp.manufacturing.reduction import MonteCarloSummary
 from zrp.output import atomic_path
-
-F64 = NDArray[np.float64]
 
 __all__ = ["check_png_path", "histogram_png"]
 

@@ -15,15 +15,16 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.kinematics.identification import parameter_space
 from zrp.manufacturing._checks import check_distribution, check_percentile, positive_int
 from zrp.manufacturing.chunks import ChunkResult, ChunkTask, chunk_size, run_chunk
 from zrp.manufacturing.maxima import first_order_max as first_order_max
 from zrp.manufacturing.maxima import nonlinear_maxima as nonlinear_maxima
 from zrp.manufacturing.maxima import trajectory_arrays as trajectory_arrays
-from zrp.manufacturing.sensitivity import parameter_space
 from zrp.manufacturing.tolerance import Tolerances, draw_parameters, percentile_ci
 from zrp.model.manipulator import Manipulator
 from zrp.tasks import map_tasks
@@ -39,7 +40,6 @@ __all__ = [
     "trajectory_arrays",
 ]
 
-F64 = NDArray[np.float64]
 #: Percentiles a :class:`MonteCarloResult` summary reports by default.
 DEFAULT_PERCENTILES = (50.0, 90.0, 95.0, 99.0, 99.9)
 

@@ -25,24 +25,24 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
 from zrp.arguments import check_float
+from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.kinematics.identification import parameter_jacobian
 from zrp.manufacturing._checks import check_percentile
 from zrp.manufacturing.budget import worst_case_bound
 from zrp.manufacturing.checkpoint import OrderedMerge, load_merge, run_identity, save_merge
-from zrp.manufacturing.chunks import ChunkResult, run_chunk
+from zrp.manufacturing.chunks import ChunkResult, ChunkTask, run_chunk
 from zrp.manufacturing.histogram import Histogram, geometric_edges
 from zrp.manufacturing.population import DEFAULT_PERCENTILES, chunk_tasks
-from zrp.manufacturing.sensitivity import parameter_jacobian
 from zrp.manufacturing.tolerance import Tolerances, percentile_ci_ranks
 from zrp.model.manipulator import Manipulator
 from zrp.tasks import map_tasks
 
 __all__ = ["BINS", "MonteCarloSummary", "histogram_edges", "monte_carlo_summary"]
 
-F64 = NDArray[np.float64]
 #: Bins per histogram and their span relative to the first-order worst case.
 BINS = 2048
 SPAN = (1e-4, 1e1)
@@ -148,6 +148,44 @@ class MonteCarloSummary:
         return out
 
 
+@dataclass
+class _Checkpoint:
+    """Where and how often the merge state is saved (``path`` None: never)."""
+
+    path: str | os.PathLike[str] | None
+    identity: dict[str, str]
+    every_s: float
+    last: float = field(default_factory=time.monotonic)
+
+    def save(self, state: OrderedMerge, *, now: bool = False) -> None:
+        """Save the state when ``now`` or when ``every_s`` seconds have passed since the last
+        save."""
+        if self.path is None:
+            return
+        if now or time.monotonic() - self.last >= self.every_s:
+            save_merge(self.path, self.identity, state)
+            self.last = time.monotonic()
+
+
+def _merge_chunks(todo: list[ChunkTask], state: OrderedMerge, executor: Executor | Any | None,
+                  n_robots: int, resumed: int, progress: bool, checkpoint: _Checkpoint
+                  ) -> None:
+    """Run the chunks ``todo`` and merge their histograms into ``state`` as they arrive,
+    saving the checkpoint on the way and when stopped (the chunks done so far are kept)."""
+    from tqdm import tqdm
+
+    with tqdm(total=n_robots, initial=resumed,
+              disable=not progress, unit="robot", desc="Monte Carlo") as bar:
+        try:
+            for i, res in map_tasks(run_chunk, todo, executor):
+                assert isinstance(res, ChunkResult)
+                state.add(res)
+                bar.update(todo[i].size)
+                checkpoint.save(state)
+        finally:  # also when stopped: the chunks done so far are kept
+            checkpoint.save(state, now=True)
+
+
 def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances,
                         n_robots: int, *, seed: int | None = None,
                         rng: np.random.Generator | None = None,
@@ -181,8 +219,6 @@ def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances
     tasks = chunk_tasks(model, q, tolerances, n_robots, rng=rng, seed=seed,
                         distribution=distribution, chunk=chunk, first_order=first_order,
                         edges=edges)
-    from tqdm import tqdm
-
     state = OrderedMerge([Histogram.of(np.empty(0), e) for e in edges * (1 + first_order)])
     identity: dict[str, str] = {}
     if checkpoint is not None:
@@ -192,20 +228,8 @@ def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances
         save_merge(checkpoint, identity, state)  # fails here, before any work, if unwritable
     todo = [t for t in tasks if not state.done(t.index)]
     resumed = n_robots - sum(t.size for t in todo)
-    last = time.monotonic()
-    with tqdm(total=n_robots, initial=resumed,
-              disable=not progress, unit="robot", desc="Monte Carlo") as bar:
-        try:
-            for i, res in map_tasks(run_chunk, todo, executor):
-                assert isinstance(res, ChunkResult)
-                state.add(res)
-                bar.update(todo[i].size)
-                if checkpoint is not None and time.monotonic() - last >= checkpoint_every_s:
-                    save_merge(checkpoint, identity, state)
-                    last = time.monotonic()
-        finally:  # also when stopped: the chunks done so far are kept
-            if checkpoint is not None:
-                save_merge(checkpoint, identity, state)
+    _merge_chunks(todo, state, executor, n_robots, resumed, progress,
+                  _Checkpoint(checkpoint, identity, checkpoint_every_s))
     assert not state.waiting and state.ready == len(tasks)  # map_tasks yields every task once
     m = state.merged
     fo = (m[2], m[3]) if first_order else (None, None)

@@ -22,8 +22,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError, ModelFileError, ZRPWarning
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import joint_limits
@@ -50,7 +51,6 @@ __all__ = [
     "one_at_a_time",
 ]
 
-F64 = NDArray[np.float64]
 
 #: The perturbation levels of the paper's study, in percent.
 PAPER_XI: tuple[float, ...] = (-0.1, -0.07, -0.05, -0.02, 0.0, 0.02, 0.05, 0.07, 0.1)
@@ -98,7 +98,7 @@ class JointPath:
                    float(ik.orientation_error.max()))
 
 
-def _check_radians(q: NDArray[np.float64], model: Manipulator, p: Path) -> None:
+def _check_radians(q: F64, model: Manipulator, p: Path) -> None:
     """Refuse revolute values beyond 2 pi: the file is most likely in degrees."""
     rev = ~np.asarray(model.prismatic)
     big = np.abs(q[:, rev]) > 2.0 * math.pi + 1e-6

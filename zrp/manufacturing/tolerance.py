@@ -1,6 +1,6 @@
 """Tolerances of the geometric parameters, and random robots drawn within them.
 
-Every geometric parameter of :mod:`zrp.manufacturing.sensitivity` (body-vector components
+Every geometric parameter of :mod:`zrp.kinematics.identification` (body-vector components
 b{k}.x/y/z in the model's length unit, axis tilts u{k}.t1/t2 in rad, optionally joint offsets)
 gets a tolerance ``tol_i`` (:class:`Tolerances`). A *robot* is one draw of all parameters
 (:func:`draw_parameters`):
@@ -21,22 +21,22 @@ from dataclasses import dataclass
 from statistics import NormalDist
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.kinematics.identification import parameter_space
 from zrp.manufacturing._checks import (
     DISTRIBUTIONS,
     check_distribution,
     check_percentile,
     nonnegative,
 )
-from zrp.manufacturing.sensitivity import parameter_space
 from zrp.model.manipulator import MAX_LENGTH, Manipulator
 
 __all__ = ["DISTRIBUTIONS", "Tolerances", "draw_parameters", "percentile_ci",
            "percentile_ci_ranks"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)
@@ -45,7 +45,7 @@ class Tolerances:
 
     Attributes:
         values: tol_i in parameter units, shape (P,), finite and >= 0.
-        names: P parameter names (:func:`zrp.manufacturing.sensitivity.parameter_names` order).
+        names: P parameter names (:func:`zrp.kinematics.identification.parameter_names` order).
         units: P units (length unit or "rad").
         joint_offsets: whether the joint-offset parameters are included.
     """

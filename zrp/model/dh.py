@@ -20,14 +20,14 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, fields
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator, check_limits
 
 __all__ = ["DHRow", "dh_forward", "from_dh", "from_mdh", "mdh_forward"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True)

@@ -36,8 +36,8 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError, ModelFileError
 from zrp.model.dh import DHRow, dh_forward, from_dh, from_mdh, mdh_forward
 from zrp.model.manipulator import Manipulator
@@ -49,7 +49,6 @@ else:  # pragma: no cover
 
 __all__ = ["CONVENTIONS", "DHTable", "dumps_dh", "loads_dh", "to_dh"]
 
-F64 = NDArray[np.float64]
 CONVENTIONS = ("standard", "modified")
 _EPS = 1e-12
 

@@ -16,14 +16,15 @@ from __future__ import annotations
 
 import dataclasses
 import warnings
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from functools import cached_property
-from typing import Literal
+from typing import Literal, TypeVar
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64
 from zrp.errors import ModelError, ZRPWarning
 from zrp.units import canonical_length_unit, units_per_mm
 
@@ -35,9 +36,11 @@ __all__ = [
     "check_limits",
     "check_unit_vector",
     "check_vector3",
+    "derived",
     "hand_frame",
 ]
 
+T = TypeVar("T")
 JOINT_TYPES = ("revolute", "prismatic")
 JointType = Literal["revolute", "prismatic"]
 
@@ -53,7 +56,7 @@ PERP_TOL = 1e-9
 MAX_LENGTH = 1e9
 
 
-def check_vector3(value: ArrayLike, where: str) -> NDArray[np.float64]:
+def check_vector3(value: ArrayLike, where: str) -> F64:
     """Coerce ``value`` to a finite float vector of shape (3,), or raise naming ``where``.
 
     Only real numbers are accepted (not strings, booleans or complex numbers), each of
@@ -88,7 +91,7 @@ def _short(value: object) -> str:
     return text if len(text) <= 80 else text[:77] + "..."
 
 
-def check_unit_vector(value: ArrayLike, where: str) -> NDArray[np.float64]:
+def check_unit_vector(value: ArrayLike, where: str) -> F64:
     """Coerce to a unit 3-vector: exact, normalised with a warning when off by a little, or an
     error when zero or far from unit length."""
     arr = check_vector3(value, where)
@@ -121,7 +124,7 @@ def check_limits(value: object, where: str) -> tuple[float, float] | None:
     return (lo, hi)
 
 
-def _frozen(arr: NDArray[np.float64]) -> NDArray[np.float64]:
+def _frozen(arr: F64) -> F64:
     arr = np.array(arr, dtype=float)
     arr.setflags(write=False)
     return arr
@@ -138,8 +141,8 @@ class Joint:
     """
 
     type: JointType
-    axis: NDArray[np.float64]
-    body: NDArray[np.float64]
+    axis: F64
+    body: F64
     name: str = ""
     index: int = field(default=0, compare=False)
     limits: tuple[float, float] | None = None
@@ -173,9 +176,9 @@ class Joint:
 class EndEffector:
     """End effector: b_{n+1,0}, the axial u_{a,0} and transverse u_{t,0} unit vectors."""
 
-    body: NDArray[np.float64]
-    axial: NDArray[np.float64]
-    transverse: NDArray[np.float64]
+    body: F64
+    axial: F64
+    transverse: F64
 
     def __post_init__(self) -> None:
         body = check_vector3(self.body, "end_effector body")
@@ -192,12 +195,12 @@ class EndEffector:
         object.__setattr__(self, "transverse", _frozen(ut))
 
     @property
-    def frame(self) -> NDArray[np.float64]:
+    def frame(self) -> F64:
         """Hand frame at q = 0, columns (u_t x u_a, u_t, u_a) (normal, sliding, approach)."""
         return hand_frame(self.axial, self.transverse)
 
 
-def hand_frame(axial: ArrayLike, transverse: ArrayLike) -> NDArray[np.float64]:
+def hand_frame(axial: ArrayLike, transverse: ArrayLike) -> F64:
     """Right-handed frame with columns (u_t x u_a, u_t, u_a): shapes (..., 3) -> (..., 3, 3).
 
     The approach (z) column is the axial vector and the sliding (y) column the transverse one,
@@ -309,12 +312,12 @@ class Manipulator:
         return len(self.joints)
 
     @cached_property
-    def axes(self) -> NDArray[np.float64]:
+    def axes(self) -> F64:
         """u_{k,0}, shape (n, 3)."""
         return _frozen(np.stack([j.axis for j in self.joints]))
 
     @cached_property
-    def bodies(self) -> NDArray[np.float64]:
+    def bodies(self) -> F64:
         """b_{k,0} for k = 1..n+1, shape (n + 1, 3) (last row: the end effector's)."""
         return _frozen(np.stack([*(j.body for j in self.joints), self.end_effector.body]))
 
@@ -368,12 +371,12 @@ class Manipulator:
         )
 
     @cached_property
-    def lower(self) -> NDArray[np.float64]:
+    def lower(self) -> F64:
         """Lower joint limits, shape (n,) (-inf where a joint has none)."""
         return _frozen(np.array([j.limits[0] if j.limits else -np.inf for j in self.joints]))
 
     @cached_property
-    def upper(self) -> NDArray[np.float64]:
+    def upper(self) -> F64:
         """Upper joint limits, shape (n,) (+inf where a joint has none)."""
         return _frozen(np.array([j.limits[1] if j.limits else np.inf for j in self.joints]))
 
@@ -384,3 +387,12 @@ class Manipulator:
     def __repr__(self) -> str:
         kinds = "".join("P" if p else "R" for p in self.prismatic)
         return f"Manipulator({self.name!r}, {self.n} joints {kinds}, unit={self.length_unit!r})"
+
+
+def derived(model: Manipulator, key: str, build: Callable[[Manipulator], T]) -> T:
+    """``build(model)``, computed once and kept on the model under ``key`` (the model is
+    immutable): for what the layers above derive from it, e.g. the kinematics kernels' arrays."""
+    value = model.__dict__.get(key)
+    if value is None:
+        value = model.__dict__[key] = build(model)
+    return value

@@ -23,15 +23,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import ModelFileError
 from zrp.model.manipulator import Manipulator
 from zrp.units import metres_per_unit
 
 __all__ = ["URDFImport", "URDFJoint", "URDFTree", "from_urdf", "import_urdf", "read_urdf"]
 
-F64 = NDArray[np.float64]
 _MOVING = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic"}
 _KNOWN = {*_MOVING, "fixed", "floating", "planar"}
 
@@ -236,6 +235,50 @@ def _check_chain(tree: URDFTree, chain: list[URDFJoint], base: str) -> None:
                 f"not modelled: choose an end_link before it")
 
 
+def _chain_ends(tree: URDFTree, base_link: str | None, end_link: str | None
+                ) -> tuple[str, str]:
+    """(base, end) links of the chain to import: the root and the default end when not given;
+    an unknown link is an error listing the links."""
+    base = tree.root if base_link is None else base_link
+    for arg, link in (("base_link", base), ("end_link", end_link)):
+        if link is not None and link not in tree.links:
+            raise ModelFileError(f"{tree.source}: {arg}: no link named {link!r}; the links are "
+                                 f"{list(tree.links)}")
+    end = _default_end(tree, base) if end_link is None else end_link
+    return base, end
+
+
+@dataclass
+class _Joints:
+    """The moving joints of a chain, in the base frame and the model's length unit."""
+
+    axes: list[F64] = field(default_factory=list)
+    points: list[F64] = field(default_factory=list)
+    types: list[str] = field(default_factory=list)
+    names: list[str] = field(default_factory=list)
+    limits: list[tuple[float, float] | None] = field(default_factory=list)
+    velocities: list[float | None] = field(default_factory=list)
+
+
+def _moving_joints(chain: list[URDFJoint], scale: float) -> tuple[F64, _Joints]:
+    """(transform base -> end of the chain, the moving joints); fixed joints only move the
+    frame. Prismatic limits and velocities are scaled to the length unit."""
+    t = np.eye(4)
+    js = _Joints()
+    for j in chain:
+        t = t @ j.origin
+        if j.type == "fixed":
+            continue
+        js.axes.append(t[:3, :3] @ j.axis)
+        js.points.append(t[:3, 3] * scale)
+        js.types.append(_MOVING[j.type])
+        js.names.append(j.name)
+        s = scale if j.type == "prismatic" else 1.0
+        js.limits.append(None if j.limits is None else (j.limits[0] * s, j.limits[1] * s))
+        js.velocities.append(None if j.velocity_limit is None else j.velocity_limit * s)
+    return t, js
+
+
 def import_urdf(source: str | Path, *, end_link: str | None = None,
                 base_link: str | None = None, length_unit: str = "mm",
                 name: str | None = None) -> URDFImport:
@@ -255,43 +298,26 @@ def import_urdf(source: str | Path, *, end_link: str | None = None,
             planar joint or a mimic joint on the chain, no moving joint.
     """
     tree = read_urdf(source)
-    base = tree.root if base_link is None else base_link
-    for arg, link in (("base_link", base), ("end_link", end_link)):
-        if link is not None and link not in tree.links:
-            raise ModelFileError(f"{tree.source}: {arg}: no link named {link!r}; the links are "
-                                 f"{list(tree.links)}")
-    end = _default_end(tree, base) if end_link is None else end_link
+    base, end = _chain_ends(tree, base_link, end_link)
     chain = tree.path(base, end)
     _check_chain(tree, chain, base)
     scale = 1.0 / metres_per_unit(length_unit)
-    t = np.eye(4)
-    axes, points, types, names, lims, vels = [], [], [], [], [], []
-    for j in chain:
-        t = t @ j.origin
-        if j.type == "fixed":
-            continue
-        axes.append(t[:3, :3] @ j.axis)
-        points.append(t[:3, 3] * scale)
-        types.append(_MOVING[j.type])
-        names.append(j.name)
-        s = scale if j.type == "prismatic" else 1.0
-        lims.append(None if j.limits is None else (j.limits[0] * s, j.limits[1] * s))
-        vels.append(None if j.velocity_limit is None else j.velocity_limit * s)
-    if not axes:
+    t, js = _moving_joints(chain, scale)
+    if not js.axes:
         raise ModelFileError(f"{tree.source}: no revolute, continuous or prismatic joint between "
                              f"{base!r} and {end!r}")
-    pts = np.array(points)
+    pts = np.array(js.points)
     bodies = np.vstack([pts[:1], np.diff(pts, axis=0), (t[:3, 3] * scale - pts[-1])[None]])
     model = Manipulator.from_arrays(
-        np.array(axes), bodies, axial=t[:3, 2], transverse=t[:3, 1], types=types,
-        name=name or tree.name, length_unit=length_unit, joint_names=names, limits=lims,
-        velocity_limits=vels)
+        np.array(js.axes), bodies, axial=t[:3, 2], transverse=t[:3, 1], types=js.types,
+        name=name or tree.name, length_unit=length_unit, joint_names=js.names, limits=js.limits,
+        velocity_limits=js.velocities)
     on_chain = {j.name for j in chain}
     others = sorted(j.name for j in tree.joints.values() if j.name not in on_chain
                     and j.type != "fixed")
     notes = [f"{len(others)} moving joints off the chain {base!r} -> {end!r} ignored: {others}"
              ] if others else []
-    return URDFImport(model, base, end, tuple(names), tuple(notes))
+    return URDFImport(model, base, end, tuple(js.names), tuple(notes))
 
 
 def from_urdf(source: str | Path, **kwargs: object) -> Manipulator:

@@ -24,14 +24,9 @@ from zrp.paper.published import (
 __all__ = ["check_claims"]
 
 
-def check_claims(study: StudyResult, path: JointPath, published: bool = True) -> dict[str, Any]:
-    """The paper's claims checked with numbers, on our study and (``published``) on the
-    published tables: linearity, joint-axis vs link errors at 0.1 %, link errors leaving the
-    orientation unchanged, the 0 % rows, and Table 3 as a closed form of the joint angles."""
-    le = kind_columns(study, "LE")
-    je = kind_columns(study, "JE")
-    out: dict[str, Any] = {}
-    # 1. linearity (fit and R^2 per column), ours and published (as printed / typos corrected)
+def _linearity(study: StudyResult, published: bool) -> dict[str, Any]:
+    """Claim 1: linearity (fit and R^2 per column), ours and published (as printed / typos
+    corrected)."""
     lin = {p: vars(v) for p, v in study.linearity("delta_p").items()}
     lin_r = {p: vars(v) for p, v in study.linearity("delta_r").items() if p.startswith("JE")}
     pub_lin: dict[str, Any] = {}
@@ -44,38 +39,40 @@ def check_claims(study: StudyResult, path: JointPath, published: bool = True) ->
                         "slope_mm_per_percent": fit_linearity(xs, fixed).slope}
     pub_lin3 = {col: {"r2": fit_linearity(xs, np.array((PUBLISHED_TABLE3_ZERO, *v))).r2}
                 for col, v in PUBLISHED_TABLE3.items()}
-    out["linearity"] = {"ours_delta_p": lin, "ours_delta_r": lin_r,
-                        "published_table2": pub_lin if published else {},
-                        "published_table3": pub_lin3 if published else {}}
-    # 2. joint-axis errors give larger positional deviations than link errors
-    j01 = int(np.argmin(np.abs(study.xi_percent - 0.1)))
+    return {"ours_delta_p": lin, "ours_delta_r": lin_r,
+            "published_table2": pub_lin if published else {},
+            "published_table3": pub_lin3 if published else {}}
+
+
+def _compare(le_v: dict[str, float], je_v: dict[str, float]) -> dict[str, Any]:
+    """Joint-axis (JE) against link (LE) deviations: means, their ratio, the pairs won."""
+    pairs = [(j, lk) for j in je_v for lk in le_v]
+    wins = sum(je_v[j] > le_v[lk] for j, lk in pairs)
+    return {"mean_JE": float(np.mean(list(je_v.values()))),
+            "mean_LE": float(np.mean(list(le_v.values()))),
+            "mean_ratio_JE_over_LE": float(np.mean(list(je_v.values()))
+                                           / np.mean(list(le_v.values()))),
+            "pairs_JE_greater": f"{wins}/{len(pairs)}",
+            "JE_below_max_LE": sorted(j for j in je_v if je_v[j] < max(le_v.values()))}
+
+
+def _je_over_le(study: StudyResult, le: list[str], je: list[str], j01: int,
+                published: bool) -> dict[str, Any]:
+    """Claim 2: joint-axis errors give larger positional deviations than link errors (0.1 %)."""
     ours_le = {p: float(study.max_delta_p[study.index(p), j01]) for p in le}
     ours_je = {p: float(study.max_delta_p[study.index(p), j01]) for p in je}
     pub_je = {c: LIKELY_TYPOS.get((2, c, 0.1), PUBLISHED_TABLE2[c][3]) for c in JE_PARAMS}
     pub_le = {c: PUBLISHED_TABLE2[c][3] for c in LE_PARAMS}
-
-    def _cmp(le_v: dict[str, float], je_v: dict[str, float]) -> dict[str, Any]:
-        pairs = [(j, lk) for j in je_v for lk in le_v]
-        wins = sum(je_v[j] > le_v[lk] for j, lk in pairs)
-        return {"mean_JE": float(np.mean(list(je_v.values()))),
-                "mean_LE": float(np.mean(list(le_v.values()))),
-                "mean_ratio_JE_over_LE": float(np.mean(list(je_v.values()))
-                                               / np.mean(list(le_v.values()))),
-                "pairs_JE_greater": f"{wins}/{len(pairs)}",
-                "JE_below_max_LE": sorted(j for j in je_v if je_v[j] < max(le_v.values()))}
-
-    out["je_greater_than_le_at_0.1pct"] = {
-        "ours": _cmp(ours_le, ours_je) if le and je else None,
-        "published_typos_corrected": _cmp(pub_le, pub_je) if published else None,
+    return {
+        "ours": _compare(ours_le, ours_je) if le and je else None,
+        "published_typos_corrected": _compare(pub_le, pub_je) if published else None,
     }
-    # 3. link errors leave the orientation unchanged
-    if le:
-        idx = [study.index(p) for p in le]
-        out["link_errors_max_angle_rad"] = float(study.max_angle_rad[idx].max())
-        out["link_errors_max_delta_r"] = float(study.max_delta_r[idx].max())
-    # 4. the 0 % rows
+
+
+def _zero_row(study: StudyResult, path: JointPath) -> dict[str, Any]:
+    """Claim 4: the 0 % rows."""
     j0 = np.flatnonzero(study.xi_percent == 0.0)
-    out["zero_row"] = {
+    return {
         "ours_max_delta_p": float(study.max_delta_p[:, j0].max()) if j0.size else None,
         "ours_max_delta_r": float(study.max_delta_r[:, j0].max()) if j0.size else None,
         "ik_max_position_error": path.ik_position_error,
@@ -85,7 +82,11 @@ def check_claims(study: StudyResult, path: JointPath, published: bool = True) ->
         "published_table3_is_2^-24": bool(abs(PUBLISHED_TABLE3_ZERO - 2.0**-24)
                                           <= half_ulp(PUBLISHED_TABLE3_ZERO)),
     }
-    # 5. Table 3 as a function of the joint angles alone: ours vs closed form
+
+
+def _table3_closed_form(study: StudyResult, path: JointPath, je: list[str], j01: int
+                        ) -> dict[str, Any]:
+    """Claim 5: Table 3 as a function of the joint angles alone: ours vs closed form."""
     closed = {}
     for p in je:
         k = int(p[2:])
@@ -96,6 +97,29 @@ def check_claims(study: StudyResult, path: JointPath, published: bool = True) ->
         closed[p] = {"max_abs_q_deg": float(np.degrees(np.abs(path.q[:, k - 1]).max())),
                      "closed_form_delta_r_0.1pct": float(np.sqrt(8.0) * np.sin(theta / 2.0)),
                      "ours_delta_r_0.1pct": float(study.max_delta_r[study.index(p), j01])}
-    out["table3_closed_form"] = closed
+    return closed
+
+
+def check_claims(study: StudyResult, path: JointPath, published: bool = True) -> dict[str, Any]:
+    """The paper's claims checked with numbers, on our study and (``published``) on the
+    published tables: linearity, joint-axis vs link errors at 0.1 %, link errors leaving the
+    orientation unchanged, the 0 % rows, and Table 3 as a closed form of the joint angles."""
+    le = kind_columns(study, "LE")
+    je = kind_columns(study, "JE")
+    out: dict[str, Any] = {}
+    # 1. linearity
+    out["linearity"] = _linearity(study, published)
+    # 2. joint-axis errors give larger positional deviations than link errors
+    j01 = int(np.argmin(np.abs(study.xi_percent - 0.1)))
+    out["je_greater_than_le_at_0.1pct"] = _je_over_le(study, le, je, j01, published)
+    # 3. link errors leave the orientation unchanged
+    if le:
+        idx = [study.index(p) for p in le]
+        out["link_errors_max_angle_rad"] = float(study.max_angle_rad[idx].max())
+        out["link_errors_max_delta_r"] = float(study.max_delta_r[idx].max())
+    # 4. the 0 % rows
+    out["zero_row"] = _zero_row(study, path)
+    # 5. Table 3 as a function of the joint angles alone
+    out["table3_closed_form"] = _table3_closed_form(study, path, je, j01)
     out["paper_implied_max_abs_q_deg"] = implied_joint_angles() if published else {}
     return out

@@ -6,8 +6,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.output import OutputDir
 from zrp.paper.comparison import kind_columns
 from zrp.paper.example import PaperExample
@@ -15,7 +15,6 @@ from zrp.paper.published import LIKELY_TYPOS, PUBLISHED_ROWS, PUBLISHED_TABLE2, 
 
 __all__ = ["FIGURES", "coincident_with", "figure_names", "paper_figures"]
 
-F64 = NDArray[np.float64]
 #: One line style and marker per series, so that no series hides another.
 LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1)))
 MARKERS = ("o", "s", "^", "v", "D", "P", "X", "*")

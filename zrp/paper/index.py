@@ -22,7 +22,8 @@ __all__ = ["CATALOGUE", "INDEX_NAME", "index_entries", "index_html", "write_inde
 
 INDEX_NAME = "index.html"
 DESCRIPTIONS = "descriptions.json"
-#: Known outputs: (pattern on the relative path, one sentence on what it shows).
+#: Known outputs: (pattern on the relative path, one sentence on what it shows). The first
+#: match wins, and ``*`` also matches ``/``: a folder's pattern comes before its files'.
 CATALOGUE: tuple[tuple[str, str], ...] = (
     ("*_joints.csv", "The joint trajectory of `zrp ik` with per-step diagnostics "
                      "(manipulability, damping, drift, correction)."),
@@ -63,6 +64,16 @@ CATALOGUE: tuple[tuple[str, str], ...] = (
     ("*index.html", "The index page of that folder's outputs."),
     ("gap_benchmark/*", "Output of the blind benchmark of the gap diagnosis (`zrp "
                         "gap-benchmark`)."),
+    ("motion_benchmark/*", "Output of the blind benchmark of the motion diagnosis (`zrp "
+                           "motion-benchmark`)."),
+    ("plan_benchmark/*", "Output of the planned-against-random measurement study (`zrp "
+                         "plan-benchmark`)."),
+    ("benchmarks/bench_*/*", "A benchmark script's detailed tables (tests/benchmarks/, the "
+                             "script of the folder's name)."),
+    ("benchmarks/bench_*.md", "Measured results of a benchmark script (tests/benchmarks/, "
+                              "the file of the same name): the date, machine, versions and "
+                              "exact command, then its tables."),
+    ("benchmarks/bench_*.json", "The same measured results as JSON."),
 )
 _FALLBACK = "Generated output of a zrp command (no description registered for this file)."
 

@@ -22,6 +22,7 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.optimize import differential_evolution, least_squares
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.paper.placement import (
     CELL_LABELS,
@@ -36,7 +37,6 @@ from zrp.paper.placement import (
 __all__ = ["BOUNDS", "CellFit", "RecoveryResult", "fit_cells", "local_pinning",
            "recover_circle"]
 
-F64 = NDArray[np.float64]
 #: Search box of the 9 unknowns (deg).
 BOUNDS = [(-180.0, 180.0)] * 6 + [(-180.0, 180.0), (-90.0, 90.0), (-180.0, 180.0)]
 _PENALTY = 1e3   # cost of a placement the arm cannot track (the fit's cost is O(1) or less)

@@ -23,8 +23,9 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError, ZRPError
 from zrp.kinematics.forward import end_effector_pose
 from zrp.kinematics.ik import track_trajectory
@@ -55,7 +56,6 @@ __all__ = [
     "placement_path",
 ]
 
-F64 = NDArray[np.float64]
 ORIENTATION_LAWS = ("held", "turning")
 #: Names and units of the 9 continuous unknowns, in the order of :meth:`CirclePlacement.vector`.
 UNKNOWNS = ("q1_0 (deg)", "q2_0 (deg)", "q3_0 (deg)", "q4_0 (deg)", "q5_0 (deg)", "q6_0 (deg)",

@@ -39,42 +39,30 @@ TABLES: tuple[tuple[str, str, str, bool], ...] = (
 REPORTS = ("comparison.md", "comparison.csv", "paper_example.json")
 
 
-def comparison_markdown(ex: PaperExample) -> str:
-    """The comparison report (Markdown); without published values for other models."""
-    st = ex.study
-    ch = ex.checks
-    pub = bool(ex.cells)
-    u = st.unit
-    lines = [
-        "# Numerical example: comparison with the published Tables 2 and 3" if pub else
-        "# One-at-a-time study (the paper's numerical example applied to another model)",
-        "",
-        f"Model: {ex.model.name}. Trajectory: {ex.path.label} ({st.t.size} samples).",
-        f"Sign convention: {st.convention} (the defaults the published numbers imply).",
-        "Table 2 quantities in mm (model length unit); Table 3 is delta_R of eq (15) as the paper "
-        "defines it (2 sqrt(2) sin(theta/2), ~ sqrt(2) x the error angle in rad).",
-        "",
-    ]
-    if pub:
-        lines += ["## Cells", "", "Ratio = ours / published.", "",
-                  "| table | column | xi (%) | ours | published | ratio | status | note |",
-                  "|---:|---|---:|---:|---:|---:|---|---|"]
-        for c in ex.cells:
-            lines.append(f"| {c.table} | {c.column} | {c.xi_percent:g} | {c.ours:.3E} | "
-                         f"{c.published:.2E} | {c.ratio:.3f} | {c.status} | {c.note} |")
-        counts: dict[str, int] = {}
-        for c in ex.cells:
-            counts[c.status] = counts.get(c.status, 0) + 1
-        lines += ["", "Status counts: " + ", ".join(f"{k} {v}" for k, v in
-                                                    sorted(counts.items())), ""]
-    else:
-        lines += ["The published Tables 2-3 belong to the paper's Table 1 PUMA; this model has "
-                  "no published values, so only the paper's checks are repeated.", ""]
-    z = ch["zero_row"]
-    ev = ch["sign_convention_evidence"]
+def _cells_section(ex: PaperExample, pub: bool) -> list[str]:
+    """Every compared cell with its ratio and status (or why there is none)."""
+    if not pub:
+        return ["The published Tables 2-3 belong to the paper's Table 1 PUMA; this model has "
+                "no published values, so only the paper's checks are repeated.", ""]
+    lines = ["## Cells", "", "Ratio = ours / published.", "",
+             "| table | column | xi (%) | ours | published | ratio | status | note |",
+             "|---:|---|---:|---:|---:|---:|---|---|"]
+    for c in ex.cells:
+        lines.append(f"| {c.table} | {c.column} | {c.xi_percent:g} | {c.ours:.3E} | "
+                     f"{c.published:.2E} | {c.ratio:.3f} | {c.status} | {c.note} |")
+    counts: dict[str, int] = {}
+    for c in ex.cells:
+        counts[c.status] = counts.get(c.status, 0) + 1
+    return [*lines, "", "Status counts: " + ", ".join(f"{k} {v}" for k, v in
+                                                      sorted(counts.items())), ""]
+
+
+def _zero_rows_section(ex: PaperExample, pub: bool) -> list[str]:
+    z = ex.checks["zero_row"]
+    u = ex.study.unit
     ik_p = z["ik_max_position_error"]
     ik_r = z["ik_max_orientation_error_rad"]
-    lines += [
+    lines = [
         "## The 0 % rows",
         "",
         f"- Ours: max delta_p = {z['ours_max_delta_p']:.3g} {u} and max delta_R = "
@@ -92,8 +80,15 @@ def comparison_markdown(ex: PaperExample) -> str:
             "literally, sqrt(4 (1 - e0^2 + e.e)) with e0^2 ~ 1. This toolkit evaluates the "
             "algebraically identical sqrt(8 e.e), which has no floor.",
         ]
+    return lines
+
+
+def _sign_section(ex: PaperExample, pub: bool) -> list[str]:
+    """Which sign of zero (eqs 10-11) the published numbers imply."""
+    ev = ex.checks["sign_convention_evidence"]
+    u = ex.study.unit
     lk = ev["link"]
-    lines += [
+    return [
         "",
         "## Sign of zero (eqs 10-11)",
         "",
@@ -107,6 +102,12 @@ def comparison_markdown(ex: PaperExample) -> str:
         "renormalised back to itself by eq 9)"
         + ("; the published JE values are nonzero. So axes use sign(0) = +1." if pub else "."),
         "",
+    ]
+
+
+def _linearity_section(ex: PaperExample) -> list[str]:
+    """The linearity fit per column, ours and published."""
+    lines = [
         "## The paper's claims, checked",
         "",
         "### Linear proportionality (fit max = slope |xi| + intercept over the 9 levels)",
@@ -115,9 +116,9 @@ def comparison_markdown(ex: PaperExample) -> str:
         " | published R^2 typos corrected |",
         "|---|---:|---:|---:|---:|---:|",
     ]
-    lin = ch["linearity"]
+    lin = ex.checks["linearity"]
     nan = float("nan")
-    for p in st.parameters:
+    for p in ex.study.parameters:
         o = lin["ours_delta_p"][p]
         pl = lin["published_table2"].get(p, {})
         lines.append(f"| {p} (delta_p) | {o['slope']:.5g} | {o['r2']:.8f} | "
@@ -132,8 +133,14 @@ def comparison_markdown(ex: PaperExample) -> str:
     lines += ["", "Link errors are exactly linear (a pure translation xi ||b_k||); axis errors are "
               "linear to first order; the small +/- slope asymmetry is the second-order term, "
               "from the 1/(1 + xi) of eq (9) and the curvature of the rotation.", ""]
-    jl = ch["je_greater_than_le_at_0.1pct"]
-    lines += ["### Joint-axis errors vs link errors (max delta_p at 0.1 %)", ""]
+    return lines
+
+
+def _je_le_section(ex: PaperExample) -> list[str]:
+    """Joint-axis against link errors at 0.1 %, in the paper's table and ours, with a verdict."""
+    u = ex.study.unit
+    jl = ex.checks["je_greater_than_le_at_0.1pct"]
+    lines = ["### Joint-axis errors vs link errors (max delta_p at 0.1 %)", ""]
     verdict = []
     for who, v in (("in the paper's own table (typos corrected)",
                     jl["published_typos_corrected"]), ("on our trajectory", jl["ours"])):
@@ -151,21 +158,32 @@ def comparison_markdown(ex: PaperExample) -> str:
         lines += ["", "; ".join(verdict).capitalize() + ". How large an axis error is depends "
                   "on the lever arm from the axis to the tool and on how far that joint turns "
                   "(below), so it is trajectory-dependent, while a link error is not.", ""]
-    if "link_errors_max_angle_rad" in ch:
-        lines += ["### Link errors leave the orientation unchanged", "",
-                  f"Max error angle over all LE cells: {ch['link_errors_max_angle_rad']:.3g} rad "
-                  f"(delta_R {ch['link_errors_max_delta_r']:.3g}). Exact: body vectors are "
-                  "rotated but never rotate anything (the identification Jacobian's orientation "
-                  "rows are identically zero for them).", ""]
+    return lines
+
+
+def _link_orientation_section(ch: dict[str, Any]) -> list[str]:
+    if "link_errors_max_angle_rad" not in ch:
+        return []
+    return ["### Link errors leave the orientation unchanged", "",
+            f"Max error angle over all LE cells: {ch['link_errors_max_angle_rad']:.3g} rad "
+            f"(delta_R {ch['link_errors_max_delta_r']:.3g}). Exact: body vectors are "
+            "rotated but never rotate anything (the identification Jacobian's orientation "
+            "rows are identically zero for them).", ""]
+
+
+def _joint_angles_section(ex: PaperExample, pub: bool) -> list[str]:
+    """The JE rotations from the joint angles alone: the paper's implied angles, ours and the
+    closed form."""
+    ch = ex.checks
     imp = ch["paper_implied_max_abs_q_deg"]
-    lines += ["## Joint angles decide the JE rotations", "",
-              "For JE_k only the joint's own angle matters for the rotation: with the sign(0) = +1"
-              " tilt alpha = atan(sqrt(2) xi / (1 + xi)), sin(theta/4) = |sin(q_k/2)| "
-              "sin(alpha/2)." + (" Inverting the published Table 3 gives how far each joint "
-                                 "turned in the paper's run:" if pub else ""), "",
-              "| column | paper: implied max abs(q_k) (deg) | ours: max abs(q_k) (deg) | ours "
-              "delta_R 0.1 % | closed form from max abs(q_k) |",
-              "|---|---:|---:|---:|---:|"]
+    lines = ["## Joint angles decide the JE rotations", "",
+             "For JE_k only the joint's own angle matters for the rotation: with the sign(0) = +1"
+             " tilt alpha = atan(sqrt(2) xi / (1 + xi)), sin(theta/4) = |sin(q_k/2)| "
+             "sin(alpha/2)." + (" Inverting the published Table 3 gives how far each joint "
+                                "turned in the paper's run:" if pub else ""), "",
+             "| column | paper: implied max abs(q_k) (deg) | ours: max abs(q_k) (deg) | ours "
+             "delta_R 0.1 % | closed form from max abs(q_k) |",
+             "|---|---:|---:|---:|---:|"]
     for p, v in ch["table3_closed_form"].items():
         rng = (f"{imp[p]['deg_min']:.1f} - {imp[p]['deg_max']:.1f}" if p in imp else "-")
         lines.append(f"| {p} | {rng} | {v['max_abs_q_deg']:.2f} | "
@@ -179,9 +197,33 @@ def comparison_markdown(ex: PaperExample) -> str:
                   "trajectory, not the model. The paper does not publish its circle's centre, "
                   "plane, orientation law or start configuration, so the JE cells are flagged as "
                   "trajectory-dependent rather than tuned."]
-    lines += ["", *circles_markdown(ex)]
-    lines += ["", "## Compute time", "",
-              *(f"- {k}: {v * 1e3:.1f} ms" for k, v in ex.timings_s.items()), ""]
+    return lines
+
+
+def comparison_markdown(ex: PaperExample) -> str:
+    """The comparison report (Markdown); without published values for other models."""
+    st = ex.study
+    pub = bool(ex.cells)
+    lines = [
+        "# Numerical example: comparison with the published Tables 2 and 3" if pub else
+        "# One-at-a-time study (the paper's numerical example applied to another model)",
+        "",
+        f"Model: {ex.model.name}. Trajectory: {ex.path.label} ({st.t.size} samples).",
+        f"Sign convention: {st.convention} (the defaults the published numbers imply).",
+        "Table 2 quantities in mm (model length unit); Table 3 is delta_R of eq (15) as the paper "
+        "defines it (2 sqrt(2) sin(theta/2), ~ sqrt(2) x the error angle in rad).",
+        "",
+        *_cells_section(ex, pub),
+        *_zero_rows_section(ex, pub),
+        *_sign_section(ex, pub),
+        *_linearity_section(ex),
+        *_je_le_section(ex),
+        *_link_orientation_section(ex.checks),
+        *_joint_angles_section(ex, pub),
+        "", *circles_markdown(ex),
+        "", "## Compute time", "",
+        *(f"- {k}: {v * 1e3:.1f} ms" for k, v in ex.timings_s.items()), "",
+    ]
     return "\n".join(lines)
 
 

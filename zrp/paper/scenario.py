@@ -24,8 +24,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import check_q, end_effector_pose, forward_kinematics
 from zrp.kinematics.ik import IKResult, track_trajectory
@@ -59,7 +60,7 @@ class CircleSetup:
 
     model: Manipulator
     trajectory: Circle
-    q0: NDArray[np.float64]
+    q0: F64
 
 
 def puma_circle(
@@ -93,7 +94,7 @@ def is_paper_model(model: Manipulator) -> bool:
             and np.allclose(model.bodies, puma.bodies, atol=1e-9))
 
 
-def paper_start(model: Manipulator) -> NDArray[np.float64]:
+def paper_start(model: Manipulator) -> F64:
     """The start configuration q0 (rad) chosen for the paper's PUMA, :data:`PUMA_Q0_DEG`.
 
     Raises:

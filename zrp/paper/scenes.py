@@ -23,8 +23,8 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.forward import end_effector_pose
 from zrp.manufacturing.perturb import Perturbation
@@ -45,7 +45,6 @@ __all__ = [
     "teaching_sweep_scene",
 ]
 
-F64 = NDArray[np.float64]
 
 #: The paper's perturbation levels, percent (the non-negative half of the study's xi).
 PAPER_LEVELS: tuple[float, ...] = tuple(x for x in PAPER_XI if x >= 0.0)

@@ -21,6 +21,6 @@ from zrp.rotations.rodrigues import er_from_scipy_quat as er_from_scipy_quat
 from zrp.rotations.rodrigues import er_identity as er_identity
 from zrp.rotations.rodrigues import er_multiply as er_multiply
 from zrp.rotations.rodrigues import er_rotate as er_rotate
-from zrp.rotations.rodrigues import er_to_matrix as er_to_matrix
-from zrp.rotations.rodrigues import er_to_rotvec as er_to_rotvec
-from zrp.rotations.rodrigues import er_to_scipy_quat as er_to_scipy_quat
+from zrp.rotations.rodrigues import matrix_from_er as matrix_from_er
+from zrp.rotations.rodrigues import rotvec_from_er as rotvec_from_er
+from zrp.rotations.rodrigues import scipy_quat_from_er as scipy_quat_from_er

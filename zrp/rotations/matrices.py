@@ -5,11 +5,12 @@ the angle between two frames. Shapes are given per function; angles are in rad.
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
+
+from zrp.arrays import F64
 
 __all__ = ["left_jacobian", "matrix_from_rotvec", "rotation_angle", "skew"]
 
-F64 = NDArray[np.float64]
 
 
 def skew(v: ArrayLike) -> F64:

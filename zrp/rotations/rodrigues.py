@@ -6,13 +6,15 @@ parameters (eq 6)::
     e0 = cos(theta/2),  (e1, e2, e3) = u sin(theta/2)
 
 stored here as arrays of shape (..., 4) in the order (e0, e1, e2, e3). Note that scipy's
-``Rotation.as_quat`` is scalar-last; use :func:`er_to_scipy_quat` / :func:`er_from_scipy_quat`.
+``Rotation.as_quat`` is scalar-last; use :func:`scipy_quat_from_er` / :func:`er_from_scipy_quat`.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
+
+from zrp.arrays import F64
 
 __all__ = [
     "er_angle",
@@ -25,12 +27,11 @@ __all__ = [
     "er_identity",
     "er_multiply",
     "er_rotate",
-    "er_to_matrix",
-    "er_to_rotvec",
-    "er_to_scipy_quat",
+    "matrix_from_er",
+    "rotvec_from_er",
+    "scipy_quat_from_er",
 ]
 
-F64 = NDArray[np.float64]
 
 
 def er_identity(shape: tuple[int, ...] = ()) -> F64:
@@ -104,7 +105,7 @@ def er_rotate(e: ArrayLike, v: ArrayLike) -> F64:
     )
 
 
-def er_to_matrix(e: ArrayLike) -> F64:
+def matrix_from_er(e: ArrayLike) -> F64:
     """Rotation matrices of unit parameters: shape (..., 4) -> (..., 3, 3)."""
     e = np.asarray(e, dtype=float)
     w, x, y, z = e[..., 0], e[..., 1], e[..., 2], e[..., 3]
@@ -161,7 +162,7 @@ def er_angle(e: ArrayLike) -> F64:
     return 2.0 * np.arctan2(np.linalg.norm(e[..., 1:], axis=-1), np.abs(e[..., 0]))
 
 
-def er_to_rotvec(e: ArrayLike) -> F64:
+def rotvec_from_er(e: ArrayLike) -> F64:
     """Rotation vector (axis times angle, rad), shape (..., 4) -> (..., 3)."""
     e = np.asarray(e, dtype=float)
     e = np.where(e[..., :1] < 0.0, -e, e)
@@ -208,7 +209,7 @@ def er_delta_r(e_err: ArrayLike) -> F64:
     return np.sqrt(8.0 * ee)
 
 
-def er_to_scipy_quat(e: ArrayLike) -> F64:
+def scipy_quat_from_er(e: ArrayLike) -> F64:
     """Scalar-first (e0, e1, e2, e3) -> scipy's scalar-last (x, y, z, w)."""
     e = np.asarray(e, dtype=float)
     return np.concatenate([e[..., 1:], e[..., :1]], axis=-1)

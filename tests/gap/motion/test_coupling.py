@@ -14,9 +14,9 @@ import pytest
 from scipy.integrate import solve_ivp
 
 from mjcf import MJCFOptions, build, inverse_dynamics_torques, mode_terms
-from sim.benchmark.motion import MotionScenario, _run_one
-from sim.measurement import Instrument
-from sim.motion_robot import MotionEffects, execute_trajectory
+from sim.robot.instrument import Instrument
+from sim.robot.motion import MotionEffects, execute_trajectory
+from sim.studies.benchmark.motion import MotionScenario, _run_one
 from zrp.gap.motion import Trajectory
 from zrp.gap.motion.effects import effect_columns, joint_mode, linearise
 from zrp.gap.motion.kernels import mode_response
@@ -137,7 +137,7 @@ def test_real_robot_slow_mode_follows_the_mode_with_the_arms_terms(puma, moves) 
 def test_friction_and_compliance_on_the_same_joint_both_named(puma) -> None:
     """A same-joint pair the additive model handles (joint 3, 10 N m of friction on a servo of
     stiffness 1/c, c = 20 urad/(N m): play F c = 0.2 mrad); on the gravity-loaded joint 2 with
-    15 N m and 30 urad/(N m) it does not (2.5x the noise, ``sim/README.md``)."""
+    15 N m and 30 urad/(N m) it does not (2.5x the noise; not asserted here)."""
     eff = MotionEffects(reversal_friction={3: 10.0}, dynamic_compliance={3: 2e-5})
     arm = build(puma, MJCFOptions(inertia="puma560")).model
     with tempfile.TemporaryDirectory() as tmp:

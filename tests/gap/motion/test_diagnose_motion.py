@@ -11,12 +11,12 @@ from scipy.integrate import solve_ivp
 import zrp
 from tests.measured import tracked_tool_point
 from zrp.errors import InputError
+from zrp.gap.model.problem import Problem
 from zrp.gap.motion import Trajectory, diagnose_motion, load_trajectory, write_trajectory
 from zrp.gap.motion.effects import MotionContext, effect_columns, linearise
 from zrp.gap.motion.kernels import first_order_lag, play
 from zrp.gap.motion.paths import exercise_moves
 from zrp.gap.motion.segments import phases, split_segments, stream_noise_sigma
-from zrp.gap.problem import Problem
 
 SIGMA = 0.02  # mm per coordinate
 

@@ -11,15 +11,15 @@ from scipy import signal
 
 import zrp
 from mjcf import MJCFOptions, build, inverse_dynamics_torques
-from sim.measurement import Instrument
-from sim.motion_measure import parse_motion_effects
-from sim.motion_robot import MotionEffects, execute_trajectory
+from sim.robot.instrument import Instrument
+from sim.robot.motion import MotionEffects, execute_trajectory
+from sim.robot.motion_measure import parse_motion_effects
 from tests.measured import tracked_tool_point
+from zrp.gap.model.problem import Problem
 from zrp.gap.motion import Trajectory, diagnose_motion
 from zrp.gap.motion.effects import MotionContext, effect_columns, linearise, plausible
 from zrp.gap.motion.kernels import mode_response
 from zrp.gap.motion.paths import exercise_moves
-from zrp.gap.problem import Problem
 
 SIGMA = 0.02  # mm per coordinate
 OMEGA, ZETA = 2 * np.pi * 8.0, 0.05

@@ -13,7 +13,7 @@ from zrp.calibration.storage import calibration_document
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.gap import diagnose, load_measurements
-from zrp.gap.effects import EFFECTS
+from zrp.gap.model.context import EFFECTS
 from zrp.gap.report import OUTPUT_FILES, write_outputs
 from zrp.model.files import load_model
 from zrp.output import OutputDir

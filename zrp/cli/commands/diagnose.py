@@ -16,11 +16,11 @@ from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
 from zrp.gap import diagnose as run_diagnosis
 from zrp.gap import load_measurements
-from zrp.gap.csvfile import MAX_ROWS
-from zrp.gap.effects import EFFECTS
+from zrp.gap.data.csvfile import MAX_ROWS
+from zrp.gap.data.subsample import MAX_POINTS
+from zrp.gap.model.context import EFFECTS
 from zrp.gap.options import MAX_WITHHELD
-from zrp.gap.report import OUTPUT_FILES, write_outputs
-from zrp.gap.subsample import MAX_POINTS
+from zrp.gap.report import OUTPUT_FILES, diagnosis_document, verdict_text, write_outputs
 from zrp.model.files import load_model
 from zrp.output import OutputDir
 
@@ -71,7 +71,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-points", type=whole(0), default=MAX_POINTS, metavar="N",
                    help=f"most measured points diagnosed (default {MAX_POINTS}); beyond it a "
                         "seeded random subsample of whole poses, announced and recorded in "
-                        "diagnosis.json (rule: zrp/gap/subsample.py); 0 uses every point")
+                        "diagnosis.json (rule: zrp/gap/data/subsample.py); 0 uses every point")
     p.add_argument("--max-rows", type=whole(1), default=MAX_ROWS, metavar="N",
                    help=f"most data rows read (default {MAX_ROWS:,}, about 1.4 GB at the peak);"
                         " a larger file is refused with guidance")
@@ -146,6 +146,6 @@ def _run(args: argparse.Namespace) -> int:
             with contextlib.suppress(OSError):
                 out_dir.rmdir()
         raise
-    text = diag.verdict + "\n" + "\n".join(f"wrote {f}" for f in files)
-    emit(args, diag.to_dict(), text)
+    text = verdict_text(diag) + "\n" + "\n".join(f"wrote {f}" for f in files)
+    emit(args, diagnosis_document(diag), text)
     return 0

@@ -16,7 +16,7 @@ DEFAULT_OUT = "renders/gap_benchmark"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from zrp.gap.effects import EFFECTS as EFFECT_NAMES  # light: no MuJoCo at parser build
+    from zrp.gap.model.context import EFFECTS as EFFECT_NAMES  # light: no MuJoCo at parser build
 
     p = sub.add_parser(
         "gap-benchmark", help="blind benchmark of the gap diagnosis on simulated robots",
@@ -79,7 +79,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo and the diagnosis (+0.2 s measured): only when this command runs.
-    from sim.benchmark import (
+    from sim.studies.benchmark import (
         BenchmarkConfig,
         output_names,
         render_text,

@@ -78,6 +78,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo (+0.1-0.2 s measured): only when this command runs, not for every `zrp`.
     import sim
+    from sim.studies.trajectories import circle_poses  # with sim, for the same reason
 
     if args.poses < 8:
         raise InputError(f"--poses: expected at least 8 poses, got {args.poses}")
@@ -99,7 +100,7 @@ def _run(args: argparse.Namespace) -> int:
     effects = sim.parse_effects(args.effect, model, args.payload, field="--effect")
     rng = np.random.default_rng(args.seed)
     q = (reachable_poses(model, args.poses, rng) if args.trajectory == "random"
-         else sim.trajectory_poses(model, args.poses, "circle"))
+         else circle_poses(model, args.poses))
     inst = sim.random_instrument(model, rng, args.noise)
     t0 = time.perf_counter()
     robot = sim.RealRobot(model, effects)
@@ -121,8 +122,8 @@ def _run(args: argparse.Namespace) -> int:
 
 
 def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> int:
-    """``--stream``: the real robot in motion (sim/motion_measure.py)."""
-    from sim.motion_measure import measure_stream  # MuJoCo: only when this command runs
+    """``--stream``: the real robot in motion (sim/studies/trajectories.py)."""
+    from sim.studies.trajectories import measure_stream  # MuJoCo: only when this command runs
 
     if args.effect:
         raise InputError("--effect: static effects are not simulated with --stream; use "

@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo: only when this command runs.
-    from sim.benchmark.motion import markdown, run_motion_benchmark
+    from sim.studies.benchmark.motion import markdown, run_motion_benchmark
 
     if args.moves < 2:
         raise InputError(f"--moves: expected at least 2 moves, got {args.moves}")

@@ -8,7 +8,7 @@ from pathlib import Path
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
-from zrp.gap.effects import EFFECTS
+from zrp.gap.model.context import EFFECTS
 from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
 from zrp.jsonio import dumps
 from zrp.model.files import load_model
@@ -85,7 +85,7 @@ def _run(args: argparse.Namespace) -> int:
         folder.write_text("report_motion.md", _report(diag))
     if args.video:
         # sim loads MuJoCo and the renderer: only when a video is asked for.
-        from sim.motion_video import render_motion_video
+        from sim.view.motion_video import render_motion_video
 
         render_motion_video(model, traj, diag, args.video, magnify=args.magnify,
                             overwrite=args.force)

@@ -120,12 +120,65 @@ def _compute(args: argparse.Namespace, model: Manipulator, out: OutputDir
     return ex, files, time.perf_counter() - t0
 
 
-def _paper(args: argparse.Namespace) -> int:
+def _output_folder(args: argparse.Namespace) -> tuple[Path, bool]:
+    """The output folder (renders/, renders/recovered/ with --circle recovered, or --out) and
+    whether its files may be replaced."""
     if args.out is None:
         args.out = DEFAULT_OUT + ("/recovered" if args.circle == "recovered" else "")
     out = Path(args.out)
     overwrite = args.force or (out in (Path(DEFAULT_OUT), Path(DEFAULT_OUT) / "recovered")
                                and claim_generated(out))
+    return out, overwrite
+
+
+def _comparison_lines(ex: PaperExample, counts: dict[str, int]) -> list[str]:
+    """The summary of the comparison with the published Tables 2-3."""
+    if not ex.cells:
+        return ["no published values for this model: the paper's checks only", ""]
+    le_ratio = [c.ratio for c in ex.cells if c.status == "match"]
+    le3 = [c.ratio for c in ex.cells if c.column == "LE3" and c.table == 2]
+    lines = [
+        f"comparison with the published Tables 2-3 on the {ex.circle} circle (ratio = ours "
+        "/ published):",
+        f"  match to the printed digits: {counts.get('match', 0)} cells (ratios "
+        f"{min(le_ratio):.4f}..{max(le_ratio):.4f})",
+        f"  LE3 discrepancy: ratios {min(le3):.3f}..{max(le3):.3f} (published values imply "
+        f"||b_3|| = 444.5 mm = 17.5 in vs 431.8 mm = 17 in in Table 1)",
+        f"  likely typos (Table 2, 0.1 %): JE1 7.88E+0, JE2 1.33E-1 -> "
+        f"{counts.get('typo', 0)} cells",
+    ]
+    if ex.circle == "recovered":
+        lines.append(f"  reproduced within 5 % (not to the printed digits): "
+                     f"{counts.get('reproduced', 0)} cells")
+    else:
+        lines.append(f"  trajectory-dependent JE cells: "
+                     f"{counts.get('trajectory-dependent', 0)} (on the circle recovered "
+                     "from the tables they are reproduced: `zrp paper --circle recovered`, "
+                     "comparison.md)")
+    lines.append("")
+    return lines
+
+
+def _claims_lines(ch: dict[str, Any]) -> list[str]:
+    """The summary of the paper's claims checked on our numbers."""
+    jl = ch["je_greater_than_le_at_0.1pct"]
+    lin = ch["linearity"]["ours_delta_p"]
+    ratio_pub = jl["published_typos_corrected"]
+    return [
+        "claims:",
+        f"  linearity: min R^2 over columns {min(v['r2'] for v in lin.values()):.6f}",
+        "  JE > LE at 0.1 %: "
+        + (f"paper mean ratio {ratio_pub['mean_ratio_JE_over_LE']:.3g}, " if ratio_pub else "")
+        + f"ours {jl['ours']['mean_ratio_JE_over_LE']:.3g} (pairs JE > LE: ours "
+        f"{jl['ours']['pairs_JE_greater']})",
+        f"  link errors change the orientation by at most {ch['link_errors_max_angle_rad']:.3g}"
+        " rad",
+        "",
+    ]
+
+
+def _paper(args: argparse.Namespace) -> int:
+    out, overwrite = _output_folder(args)
     model = load_model(args.model)
     check_path_options(args, model)
     _named_circle(args, model)
@@ -154,44 +207,8 @@ def _paper(args: argparse.Namespace) -> int:
         f"{ex.timings_s['inverse_kinematics'] * 1e3:.1f} ms, study "
         f"{ex.timings_s['study'] * 1e3:.1f} ms); writing {t_write:.2f} s",
         "",
-    ]
-    if ex.cells:
-        le_ratio = [c.ratio for c in ex.cells if c.status == "match"]
-        le3 = [c.ratio for c in ex.cells if c.column == "LE3" and c.table == 2]
-        lines += [
-            f"comparison with the published Tables 2-3 on the {ex.circle} circle (ratio = ours "
-            "/ published):",
-            f"  match to the printed digits: {counts.get('match', 0)} cells (ratios "
-            f"{min(le_ratio):.4f}..{max(le_ratio):.4f})",
-            f"  LE3 discrepancy: ratios {min(le3):.3f}..{max(le3):.3f} (published values imply "
-            f"||b_3|| = 444.5 mm = 17.5 in vs 431.8 mm = 17 in in Table 1)",
-            f"  likely typos (Table 2, 0.1 %): JE1 7.88E+0, JE2 1.33E-1 -> "
-            f"{counts.get('typo', 0)} cells",
-        ]
-        if ex.circle == "recovered":
-            lines.append(f"  reproduced within 5 % (not to the printed digits): "
-                         f"{counts.get('reproduced', 0)} cells")
-        else:
-            lines.append(f"  trajectory-dependent JE cells: "
-                         f"{counts.get('trajectory-dependent', 0)} (on the circle recovered "
-                         "from the tables they are reproduced: `zrp paper --circle recovered`, "
-                         "comparison.md)")
-        lines.append("")
-    else:
-        lines += ["no published values for this model: the paper's checks only", ""]
-    jl = ch["je_greater_than_le_at_0.1pct"]
-    lin = ch["linearity"]["ours_delta_p"]
-    ratio_pub = jl["published_typos_corrected"]
-    lines += [
-        "claims:",
-        f"  linearity: min R^2 over columns {min(v['r2'] for v in lin.values()):.6f}",
-        "  JE > LE at 0.1 %: "
-        + (f"paper mean ratio {ratio_pub['mean_ratio_JE_over_LE']:.3g}, " if ratio_pub else "")
-        + f"ours {jl['ours']['mean_ratio_JE_over_LE']:.3g} (pairs JE > LE: ours "
-        f"{jl['ours']['pairs_JE_greater']})",
-        f"  link errors change the orientation by at most {ch['link_errors_max_angle_rad']:.3g}"
-        " rad",
-        "",
+        *_comparison_lines(ex, counts),
+        *_claims_lines(ch),
         f"video: {video['status']}" + (f" -> {video['path']}" if "path" in video else ""),
         f"wrote {len(files)} files into {out}/ (tables, figures, comparison.md, "
         "paper_example.json); index of every output: " + str(index),

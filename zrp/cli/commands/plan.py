@@ -13,7 +13,7 @@ from zrp.calibration import plan_poses
 from zrp.cli.app import emit
 from zrp.cli.options import FINITE, LENGTH, SEED, whole
 from zrp.errors import InputError
-from zrp.gap.effects import EFFECTS
+from zrp.gap.model.context import EFFECTS
 from zrp.model.files import load_model
 from zrp.output import check_writable, write_text
 

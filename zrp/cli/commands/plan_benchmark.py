@@ -49,10 +49,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo and the diagnosis: only when this command runs
-    from sim.benchmark import BenchmarkConfig
+    from sim.studies.benchmark import BenchmarkConfig
 
     # (the same reason: MuJoCo is loaded only when this command runs)
-    from sim.planning_study import design_rows, render_k_study, run_k_study
+    from sim.studies.planning import design_rows, render_k_study, run_k_study
 
     out = Path(args.out or DEFAULT_OUT)
     overwrite = args.force or (args.out is None and claim_generated(out))

@@ -5,12 +5,15 @@ from __future__ import annotations
 import argparse
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from zrp.cli.app import emit
 from zrp.cli.options import MAX_FPS, MAX_HEIGHT, MAX_SECONDS, MAX_WIDTH, PERCENT, real, whole
 from zrp.output import OutputDir, claim_generated
 from zrp.paper.scenes import PAPER_LEVELS, Scene, paper_video_scene, teaching_sweep_scene
+
+if TYPE_CHECKING:
+    from sim import VideoOptions
 
 DEFAULT_OUT = "renders"
 
@@ -68,31 +71,24 @@ def _result(r: Any) -> dict[str, Any]:
                                                     r.max_theta, strict=True)]}
 
 
-def _run(args: argparse.Namespace) -> int:
-    # sim loads MuJoCo (+0.1 s measured) and must see --backend before it creates a GL
-    # context: imported when this command runs, not for every `zrp`.
-    import sim
-
-    opts = sim.VideoOptions(width=args.width, height=args.height, fps=args.fps,
-                            seconds=args.seconds, magnify=args.magnify, format=args.format,
-                            backend=args.backend)
+def _videos(args: argparse.Namespace, video_options: type[VideoOptions]
+            ) -> list[tuple[Scene, VideoOptions]]:
+    """The paper video's scene and options, and the teaching sweep's under ``--sweep``."""
+    opts = video_options(width=args.width, height=args.height, fps=args.fps,
+                         seconds=args.seconds, magnify=args.magnify, format=args.format,
+                         backend=args.backend)
     scene = paper_video_scene(args.parameter, args.xi, steps=args.steps)
     # one magnification for every video of the parameter (the scene's), unless --magnify
     opts = replace(opts, magnify=args.magnify or scene.magnify)
-    videos: list[tuple[Scene, sim.VideoOptions]] = [(scene, opts)]
+    videos: list[tuple[Scene, VideoOptions]] = [(scene, opts)]
     if args.sweep:
         levels = tuple(args.levels) if args.levels else PAPER_LEVELS
         videos.append((teaching_sweep_scene(args.parameter, levels, steps=args.steps),
                        replace(opts, seconds=args.seconds or 3.0)))
-    names = [sim.video_path(scene.file_name, o).name for scene, o in videos]
-    overwrite = args.force or (args.out_dir is None and claim_generated(DEFAULT_OUT))
-    with OutputDir(Path(args.out_dir or DEFAULT_OUT), overwrite=overwrite, names=names) as out:
-        seg = videos[0][0].segments[0]
-        checks = [sim.consistency_check(m, seg.q) for m in (seg.nominal, seg.perturbed)]
-        dyn = None if args.no_dynamics else sim.dynamic_playback(seg.perturbed, seg.t, seg.q)
-        results = [sim.render_video(scene.segments, out.root / name, title=scene.title,
-                                    options=o, overwrite=overwrite, progress=not args.quiet)
-                   for (scene, o), name in zip(videos, names, strict=True)]
+    return videos
+
+
+def _payload(results: list[Any], checks: list[Any], dyn: Any, seg: Any) -> dict[str, Any]:
     payload: dict[str, Any] = {
         "videos": [_result(r) for r in results],
         "consistency": [{"model": c.model_name, "max_position_error_mm": c.max_position_error_mm,
@@ -105,9 +101,32 @@ def _run(args: argparse.Namespace) -> int:
             "kv": dyn.options.kv, "max_tracking_error_mm": dyn.max_tracking_error,
             "rms_tracking_error_mm": dyn.rms_tracking_error,
             "max_geometric_delta_p_mm": results[0].max_delta_p[0]}
-    text = "\n".join([r.summary() for r in results]
-                     + ["MuJoCo vs ZRP direct kinematics: " + c.summary() for c in checks]
-                     + ([f"perturbed arm, {dyn.summary()} (geometric delta_p max "
-                         f"{results[0].max_delta_p[0]:.4g} mm)"] if dyn is not None else []))
-    emit(args, payload, text)
+    return payload
+
+
+def _text(results: list[Any], checks: list[Any], dyn: Any) -> str:
+    lines = [r.summary() for r in results]
+    lines += ["MuJoCo vs ZRP direct kinematics: " + c.summary() for c in checks]
+    if dyn is not None:
+        lines.append(f"perturbed arm, {dyn.summary()} (geometric delta_p max "
+                     f"{results[0].max_delta_p[0]:.4g} mm)")
+    return "\n".join(lines)
+
+
+def _run(args: argparse.Namespace) -> int:
+    # sim loads MuJoCo (+0.1 s measured) and must see --backend before it creates a GL
+    # context: imported when this command runs, not for every `zrp`.
+    import sim
+
+    videos = _videos(args, sim.VideoOptions)
+    names = [sim.video_path(scene.file_name, o).name for scene, o in videos]
+    overwrite = args.force or (args.out_dir is None and claim_generated(DEFAULT_OUT))
+    with OutputDir(Path(args.out_dir or DEFAULT_OUT), overwrite=overwrite, names=names) as out:
+        seg = videos[0][0].segments[0]
+        checks = [sim.consistency_check(m, seg.q) for m in (seg.nominal, seg.perturbed)]
+        dyn = None if args.no_dynamics else sim.dynamic_playback(seg.perturbed, seg.t, seg.q)
+        results = [sim.render_video(scene.segments, out.root / name, title=scene.title,
+                                    options=o, overwrite=overwrite, progress=not args.quiet)
+                   for (scene, o), name in zip(videos, names, strict=True)]
+    emit(args, _payload(results, checks, dyn, seg), _text(results, checks, dyn))
     return 0

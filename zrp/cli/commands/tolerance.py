@@ -30,7 +30,8 @@ from zrp.output import check_writable
 #: Above this many robots `zrp tolerance` reduces on the workers (gathering costs 32 bytes a
 #: robot with the first-order maxima: 320 MB here); --allocate verifies with at most this many.
 GATHER_LIMIT = 10_000_000
-#: Largest --robots: 1e10 robots x 360 points is ~3e4 core-hours (zrp/cli/README.md).
+#: Largest --robots: 1e10 robots x 360 points is ~3e4 core-hours (the per-pose rate of one core:
+#: tests/benchmarks/bench_speed.py).
 MAX_ROBOTS = 10**10
 
 

@@ -101,21 +101,40 @@ def _diagnose_all(args: argparse.Namespace, todo: list[RobotTask]
     return rows, failures
 
 
-def run_fleet(args: argparse.Namespace) -> int:
-    """The fleet run; exit code 1 when some robot could not be diagnosed (the rest was)."""
+def _fleet_files(args: argparse.Namespace) -> list[Path]:
+    """The robots' data files, after checking the cluster options and the tolerance."""
     check_cluster_options(args)
     if not args.tolerance > 0:
         raise InputError(f"--tolerance: expected a positive length, got {args.tolerance}")
     files = sorted(Path(f) for f in glob.glob(args.data) if Path(f).is_file())
     if not files:
         raise InputError(f"--data: no file matches {args.data!r}")
+    return files
+
+
+def _wanted(args: argparse.Namespace, names: tuple[str, ...]) -> list[str]:
+    """``names`` less the plots under ``--no-plots``."""
+    return [n for n in names if not (args.no_plots and n.endswith(".png"))]
+
+
+def _write_fleet(folder: OutputDir, args: argparse.Namespace, doc: dict[str, Any]) -> None:
+    folder.write_json("fleet.json", doc)
+    folder.write_text("fleet.csv", fleet_csv(doc))
+    if not args.no_plots and doc["rows"]:
+        folder.savefig("fleet.png", fleet_figure(doc), dpi=110)
+    folder.write_text("fleet.md", fleet_markdown(doc))
+
+
+def run_fleet(args: argparse.Namespace) -> int:
+    """The fleet run; exit code 1 when some robot could not be diagnosed (the rest was)."""
+    files = _fleet_files(args)
     out = Path(args.out)
     tasks = _tasks(args, files, out)
     done = _previous(tasks) if args.resume else {}
     todo = [t for t in tasks if t.name not in done]
     overwrite = args.force or args.resume
-    names = [n for n in FLEET_FILES if not (args.no_plots and n.endswith(".png"))]
-    per_robot = [n for n in OUTPUT_FILES if not (args.no_plots and n.endswith(".png"))]
+    names = _wanted(args, FLEET_FILES)
+    per_robot = _wanted(args, OUTPUT_FILES)
     # every file this run writes is checked before the first diagnosis
     check_writable([t.out / n for t in todo for n in per_robot], overwrite)
     with OutputDir(out, overwrite=overwrite, names=names) as folder:
@@ -123,11 +142,7 @@ def run_fleet(args: argparse.Namespace) -> int:
         unit = tasks[0].model.length_unit
         doc = fleet_summary(rows + list(done.values()), failures, args.tolerance, unit,
                             resumed=len(done))
-        folder.write_json("fleet.json", doc)
-        folder.write_text("fleet.csv", fleet_csv(doc))
-        if not args.no_plots and doc["rows"]:
-            folder.savefig("fleet.png", fleet_figure(doc), dpi=110)
-        folder.write_text("fleet.md", fleet_markdown(doc))
+        _write_fleet(folder, args, doc)
         files_written = list(folder.written)
     text = fleet_markdown(doc) + "\n".join(f"wrote {f}" for f in files_written)
     emit(args, doc, text)

@@ -22,6 +22,24 @@ def _num(x: Any) -> float:
     return math.nan if x is None else float(x)
 
 
+def _marked(rows: list[dict[str, Any]], tolerance: float) -> list[dict[str, Any]]:
+    """The rows sorted by robot, each marked out of tolerance / within after correction."""
+    rows = sorted(rows, key=lambda r: r["robot"])
+    for r in rows:
+        r["out_of_tolerance"] = bool(_num(r["error_max"]) > tolerance)
+        r["within_after_correction"] = bool(_num(r["corrected_max"]) <= tolerance)
+    return rows
+
+
+def _effect_counts(rows: list[dict[str, Any]]) -> tuple[Counter, Counter, Counter]:
+    """How often each effect is named first, named at all, and (effect, joint) named first."""
+    first = Counter(r["top_effect"] for r in rows if r["top_effect"] != "none")
+    named = Counter(e for r in rows for e in set(r["effects"]) if e != "none")
+    joints = Counter((r["top_effect"], j) for r in rows if r["top_effect"] != "none"
+                     for j in r["top_joints"])
+    return first, named, joints
+
+
 def fleet_summary(rows: list[dict[str, Any]], failures: list[TaskFailure], tolerance: float,
                   unit: str, resumed: int = 0) -> dict[str, Any]:
     """The fleet document (fleet.json).
@@ -31,14 +49,8 @@ def fleet_summary(rows: list[dict[str, Any]], failures: list[TaskFailure], toler
     when the diagnosed model's largest withheld error (``corrected_max``) does not. The
     dominant effect is the one named first for the most robots (``none`` not counted).
     """
-    rows = sorted(rows, key=lambda r: r["robot"])
-    for r in rows:
-        r["out_of_tolerance"] = bool(_num(r["error_max"]) > tolerance)
-        r["within_after_correction"] = bool(_num(r["corrected_max"]) <= tolerance)
-    first = Counter(r["top_effect"] for r in rows if r["top_effect"] != "none")
-    named = Counter(e for r in rows for e in set(r["effects"]) if e != "none")
-    joints = Counter((r["top_effect"], j) for r in rows if r["top_effect"] != "none"
-                     for j in r["top_joints"])
+    rows = _marked(rows, tolerance)
+    first, named, joints = _effect_counts(rows)
     dominant = first.most_common(1)[0][0] if first else "none"
     return {
         "robots": len(rows) + len(failures), "diagnosed": len(rows), "failed": len(failures),

@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from zrp.gap import diagnose, load_measurements
-from zrp.gap.report import write_outputs
+from zrp.gap.report import diagnosis_document, write_outputs
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["RobotTask", "diagnose_robot", "robot_row"]
@@ -49,7 +49,7 @@ def robot_row(name: str, data: str, d: dict[str, Any]) -> dict[str, Any]:
     top = d["effects"][0] if d.get("effects") else "none"
     if (d.get("final_model") or {}).get("fell_back") and steps:
         joints = {top: steps[0].get("joints", [])}  # final = the geometric calibration: the
-        # joints the search named (zrp/gap/fallback.py)
+        # joints the search named (zrp/gap/analysis/fallback.py)
     return {"robot": name, "data": data, "points": d["nominal"]["n_points"],
             "error_rms": d["nominal"]["rms"], "error_p95": d["nominal"]["p95"],
             "error_max": d["nominal"]["max"], "corrected_rms": d["final"]["rms"],
@@ -70,4 +70,4 @@ def diagnose_robot(task: RobotTask) -> dict[str, Any]:
         warnings.simplefilter("always")
         diag = diagnose(task.model, meas, gravity_torque=tau, **task.options)
     write_outputs(diag, task.out, overwrite=True, plots=task.plots)
-    return robot_row(task.name, str(task.data), diag.to_dict())
+    return robot_row(task.name, str(task.data), diagnosis_document(diag))

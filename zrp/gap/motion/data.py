@@ -3,9 +3,9 @@
 :class:`Trajectory` holds S samples (time stamps of the tracker, s), the controller's commanded
 joint values at those times, and the M tool points measured at each sample. Each sample is a
 "pose" of the static engine (:class:`zrp.gap.Measurements`, pose id ``s<i>``), so the static
-fitting (:mod:`zrp.gap.problem`, :mod:`zrp.gap.leastsq`) and the static effects run unchanged
-on the same data. The commanded joint values are interpolated by a cubic spline (eq. M0) for
-the velocities, accelerations and time shifts the motion effects need.
+fitting (:mod:`zrp.gap.model.problem`, :mod:`zrp.gap.fit.leastsq`) and the static effects run
+unchanged on the same data. The commanded joint values are interpolated by a cubic spline
+(eq. M0) for the velocities, accelerations and time shifts the motion effects need.
 """
 
 from __future__ import annotations
@@ -17,12 +17,12 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 from scipy.interpolate import CubicSpline
 
+from zrp.arrays import F64
 from zrp.errors import InputError
-from zrp.gap.data import FRAMES, Measurements
+from zrp.gap.data.measurements import FRAMES, Measurements
 
 __all__ = ["MIN_SAMPLES", "Trajectory"]
 
-F64 = NDArray[np.float64]
 #: fewest samples a trajectory diagnosis accepts.
 MIN_SAMPLES = 50
 
@@ -56,6 +56,24 @@ class Trajectory:
     source: str = "trajectory"
 
     def __post_init__(self) -> None:
+        t, q, xyz = self._shaped()
+        s = t.shape[0]
+        lines = (np.arange(s, dtype=np.int64) + 2 if self.lines is None
+                 else np.asarray(self.lines, dtype=np.int64))
+        self._check_values(t, q, xyz, lines)
+        if len(self.point_labels) != xyz.shape[1]:
+            raise InputError(f"{self.source}: {xyz.shape[1]} points per sample but "
+                             f"{len(self.point_labels)} point labels")
+        if self.frame not in FRAMES:
+            raise InputError(f"frame: {self.frame!r} is not a frame; expected one of {FRAMES}")
+        object.__setattr__(self, "t", _frozen(t))
+        object.__setattr__(self, "q", _frozen(q))
+        object.__setattr__(self, "xyz", _frozen(xyz))
+        object.__setattr__(self, "lines", lines)
+        object.__setattr__(self, "point_labels", tuple(str(p) for p in self.point_labels))
+
+    def _shaped(self) -> tuple[F64, F64, F64]:
+        """t (S,), q (S, n) and xyz (S, M, 3) (one point: (S, 3) allowed), S >= MIN_SAMPLES."""
         t = np.asarray(self.t, dtype=float)
         q = np.asarray(self.q, dtype=float)
         xyz = np.asarray(self.xyz, dtype=float)
@@ -69,8 +87,11 @@ class Trajectory:
         if s < MIN_SAMPLES:
             raise InputError(f"{self.source}: {s} samples; a trajectory diagnosis needs at "
                              f"least {MIN_SAMPLES}")
-        lines = (np.arange(s, dtype=np.int64) + 2 if self.lines is None
-                 else np.asarray(self.lines, dtype=np.int64))
+        return t, q, xyz
+
+    def _check_values(self, t: F64, q: F64, xyz: F64, lines: NDArray[np.int64]) -> None:
+        """Every value finite, the times strictly increasing (errors name the line)."""
+        s = t.shape[0]
         for name, a in (("t", t), ("q", q), ("xyz", xyz)):
             bad = ~np.isfinite(a.reshape(s, -1)).all(axis=1)
             if bad.any():
@@ -82,16 +103,6 @@ class Trajectory:
             raise InputError(f"{self.source} line {lines[i]}: t = {float(t[i])!r} s does not "
                              f"increase (previous sample t = {float(t[i - 1])!r} s); samples "
                              "must be in time order")
-        if len(self.point_labels) != xyz.shape[1]:
-            raise InputError(f"{self.source}: {xyz.shape[1]} points per sample but "
-                             f"{len(self.point_labels)} point labels")
-        if self.frame not in FRAMES:
-            raise InputError(f"frame: {self.frame!r} is not a frame; expected one of {FRAMES}")
-        object.__setattr__(self, "t", _frozen(t))
-        object.__setattr__(self, "q", _frozen(q))
-        object.__setattr__(self, "xyz", _frozen(xyz))
-        object.__setattr__(self, "lines", lines)
-        object.__setattr__(self, "point_labels", tuple(str(p) for p in self.point_labels))
 
     @property
     def n_samples(self) -> int:

@@ -35,7 +35,7 @@ parameters' columns (:attr:`Column.via`, merged by :func:`linearise`).
 The nonlinear ones (delay, lag, play, the mode's omega and zeta) are linearised at the current
 estimate theta0: q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the
 *shift*) goes into the joint values of :class:`MotionContext` and D into a ``dq`` basis, so the
-static :class:`~zrp.gap.problem.Problem` and its analytic Jacobian apply unchanged; the search
+static :class:`~zrp.gap.model.problem.Problem` and its analytic Jacobian apply unchanged; the search
 re-linearises until theta stops moving (Gauss-Newton on the exact model; the mode's omega and
 zeta start from the profile search of :mod:`zrp.gap.motion.profile`, within a trust region,
 :func:`limit_step`).
@@ -48,17 +48,16 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from numpy.typing import NDArray
 
+from zrp.arrays import F64
 from zrp.errors import InputError
-from zrp.gap.effects import KINDS, Context, ParamSpec
+from zrp.gap.model.context import KINDS, Context, ParamSpec
 from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.kernels import first_order_lag, mode_response, play
 
 __all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
            "joint_mode", "limit_step", "linearise", "mode_band", "plausible", "tested"]
 
-F64 = NDArray[np.float64]
 MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
                   "residual_vibration")
 #: effects whose parameters are physically positive (a negative estimate is not that effect)
@@ -70,7 +69,7 @@ MIN_TRAVEL = 1e-4
 
 
 class MotionParam(ParamSpec):
-    """A :class:`~zrp.gap.effects.ParamSpec` of a motion effect (kind ``dq``)."""
+    """A :class:`~zrp.gap.model.context.ParamSpec` of a motion effect (kind ``dq``)."""
 
     def __post_init__(self) -> None:
         if self.effect not in MOTION_EFFECTS or self.kind not in KINDS or self.kind != "dq":
@@ -84,7 +83,7 @@ class MotionParam(ParamSpec):
 
 @dataclass(frozen=True, eq=False)
 class MotionContext(Context):
-    """A :class:`~zrp.gap.effects.Context` whose joint values carry the linearisation shift of
+    """A :class:`~zrp.gap.model.context.Context` whose joint values carry the linearisation shift of
     the nonlinear motion effects: q = commanded + shift, shape (S, n)."""
 
     shift: F64 | None = None
@@ -100,7 +99,7 @@ class Column:
     """One motion parameter evaluated at a value.
 
     Attributes:
-        name, unit, effect: as in :class:`~zrp.gap.effects.ParamSpec`.
+        name, unit, effect: as in :class:`~zrp.gap.model.context.ParamSpec`.
         joint: 1-based joint, 0 for a parameter acting on all joints.
         value: the value at which d and D are evaluated.
         d: the joint deviation d(theta), shape (S, n).

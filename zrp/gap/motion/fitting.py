@@ -1,6 +1,6 @@
 """Fitting a model of motion effects on top of the registration, re-linearising the
 nonlinear effects (Gauss-Newton on the exact model): the static engine's least squares
-(:func:`zrp.gap.leastsq.fit`, analytic Jacobian of :class:`zrp.gap.problem.Problem`) does
+(:func:`zrp.gap.fit.leastsq.fit`, analytic Jacobian of :class:`zrp.gap.model.problem.Problem`) does
 each linear step."""
 
 from __future__ import annotations
@@ -9,19 +9,18 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import NDArray
 
-from zrp.gap.effects import EFFECTS, Context, ParamSpec, effect_parameters
-from zrp.gap.leastsq import FitResult, fit
+from zrp.arrays import F64, I64
+from zrp.gap.fit.leastsq import FitResult, fit
+from zrp.gap.model.context import EFFECTS, Context, ParamSpec
+from zrp.gap.model.effects import effect_parameters
+from zrp.gap.model.problem import Problem
 from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.effects import MotionContext, effect_columns, limit_step, linearise
-from zrp.gap.problem import Problem
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["Engine", "ModelFit"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 NONLINEAR = ("sync_delay", "servo_lag", "reversal_friction", "residual_vibration")
 
 

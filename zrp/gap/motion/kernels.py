@@ -29,9 +29,10 @@ import numpy as np
 from numpy.typing import NDArray
 from scipy.linalg import expm
 
+from zrp.arrays import F64
+
 __all__ = ["first_order_lag", "mode_response", "play"]
 
-F64 = NDArray[np.float64]
 
 
 @numba.njit(cache=True)

@@ -10,13 +10,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike, NDArray
+from numpy.typing import ArrayLike
 
+from zrp.arrays import F64
 from zrp.errors import InputError
 
 __all__ = ["JointMoves", "exercise_moves"]
 
-F64 = NDArray[np.float64]
 
 
 @dataclass(frozen=True, eq=False)

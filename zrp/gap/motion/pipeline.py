@@ -13,23 +13,23 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arrays import F64, I64
 from zrp.errors import InputError
-from zrp.gap.effects import EFFECTS, Context, registration_parameters
-from zrp.gap.leastsq import ALIAS_TOL, initial_registration, point_errors
-from zrp.gap.metrics import Metrics
+from zrp.gap.fit.leastsq import ALIAS_TOL, initial_registration, point_errors
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.model.context import EFFECTS, Context
+from zrp.gap.model.effects import registration_parameters
+from zrp.gap.model.problem import Problem
 from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.effects import MOTION_EFFECTS
 from zrp.gap.motion.fitting import Engine, ModelFit
 from zrp.gap.motion.results import MotionDiagnosis, MotionEstimate, MotionStep, PhaseError
 from zrp.gap.motion.search import backward_check, drop_effects, greedy
 from zrp.gap.motion.segments import PHASES, phases, split_segments, stream_noise_sigma
-from zrp.gap.problem import Problem
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["diagnose_motion"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 
 
 def _check(model: Manipulator, traj: Trajectory, torque: ArrayLike | None,
@@ -66,7 +66,7 @@ def _check_terms(traj: Trajectory, terms: ArrayLike | None) -> F64 | None:
 
 def _registration(ctx: Context, poses: I64) -> tuple[list, F64, F64]:
     """Registration parameters these samples can identify (Gram-Schmidt on the normalised
-    Jacobian columns, as :func:`zrp.gap.leastsq.check_identifiable`), starting values, R_b0."""
+    Jacobian columns, as :func:`zrp.gap.fit.leastsq.check_identifiable`), starting values, R_b0."""
     specs = registration_parameters(ctx)
     theta0, rb0 = initial_registration(ctx, specs, poses)
     _, J = Problem(ctx, specs, poses, rb0).residual_and_jacobian(theta0)

@@ -13,17 +13,15 @@ search decide afterwards).
 from __future__ import annotations
 
 import numpy as np
-from numpy.typing import NDArray
 from scipy.optimize import minimize
 
+from zrp.arrays import F64, I64
+from zrp.gap.model.problem import Problem
 from zrp.gap.motion.effects import MotionParam, joint_mode, mode_band
 from zrp.gap.motion.fitting import Engine, ModelFit
-from zrp.gap.problem import Problem
 
 __all__ = ["ZETA_GRID", "vibration_start"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 #: damping ratios tried (a lightly damped mode: well below 1)
 ZETA_GRID = (0.01, 0.03, 0.1, 0.3)
 

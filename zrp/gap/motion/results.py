@@ -6,17 +6,15 @@ import math
 from dataclasses import dataclass
 from typing import Any
 
-import numpy as np
-from numpy.typing import NDArray
-
+from zrp.arrays import F64
 from zrp.errors import InputError
-from zrp.gap.leastsq import Z95
-from zrp.gap.metrics import Metrics
-from zrp.gap.steps import EffectsFound
+from zrp.gap.fit.leastsq import Z95
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.search.steps import EffectsFound
+from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["MotionDiagnosis", "MotionEstimate", "MotionStep", "PhaseError"]
 
-F64 = NDArray[np.float64]
 #: 97.5 % quantile of the standard normal (95 % two-sided intervals).
 
 
@@ -75,10 +73,7 @@ class MotionStep:
     ties: tuple[str, ...]
 
     def to_dict(self) -> dict[str, Any]:
-        return {"effect": self.effect, "joints": list(self.joints), "cv_rms": self.cv_rms,
-                "p_value": self.p_value, "bic_delta": self.bic_delta,
-                "withheld": self.withheld.to_dict(), "candidates": list(self.candidates),
-                "ties": list(self.ties)}
+        return dict_from_dataclass(self)
 
 
 @dataclass(frozen=True)
@@ -94,7 +89,7 @@ class PhaseError:
     withheld_after: float | None
 
     def to_dict(self) -> dict[str, Any]:
-        return dict(self.__dict__)
+        return dict_from_dataclass(self)
 
 
 @dataclass(frozen=True, eq=False)

@@ -1,7 +1,7 @@
 """The greedy search over motion effects (forward steps, then a backward check), on the
-static engine's statistics: identifiability (:func:`~zrp.gap.leastsq.check_identifiable`),
+static engine's statistics: identifiability (:func:`~zrp.gap.fit.leastsq.check_identifiable`),
 Wald tests per joint group, F test and BIC against the current model, and cross-validated RMS
-over folds of whole time segments (:func:`~zrp.gap.leastsq.cv_rms`)."""
+over folds of whole time segments (:func:`~zrp.gap.fit.leastsq.cv_rms`)."""
 
 from __future__ import annotations
 
@@ -9,17 +9,17 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from numpy.typing import NDArray
 
-from zrp.gap.effects import EFFECTS, effect_parameters
-from zrp.gap.leastsq import check_identifiable, cv_rms, f_test, group_key, wald_groups
+from zrp.arrays import I64
+from zrp.gap.fit.leastsq import check_identifiable, cv_rms, f_test, group_key, wald_groups
+from zrp.gap.model.context import EFFECTS
+from zrp.gap.model.effects import effect_parameters
 from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise, plausible, tested
 from zrp.gap.motion.fitting import Engine, ModelFit
 from zrp.gap.motion.profile import vibration_start
 
 __all__ = ["Trial", "backward_check", "drop_effects", "greedy"]
 
-I64 = NDArray[np.int64]
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +61,15 @@ def _candidate_specs(eng: Engine, effect: str, start: dict[str, float]) -> list:
     return specs
 
 
+def _implausible_groups(eng: Engine, mf: ModelFit, first: int) -> set[str]:
+    """The joint groups of the parameters from ``first`` on whose values are not the effect: a
+    negative lag, friction, compliance or mode, a mode with zeta outside (0, 1) or a frequency
+    the sampling cannot see."""
+    rate = eng.traj.rate_hz
+    return {group_key(s) for s, v in zip(mf.specs[first:], mf.result.theta[first:], strict=True)
+            if v <= 0.0 or not plausible(s.name, float(v), rate)}
+
+
 def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                folds: Sequence[I64], alpha: float) -> Trial:
     """Fit ``effect`` on top of ``current``: identifiable parameters, Wald pruning of its
@@ -80,12 +89,8 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                  current.result.theta[:eng.nreg])
     pw = wald_groups(mf.result, first, tested)
     sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
-    if effect in POSITIVE:  # a negative lag, friction, compliance or mode is not that effect;
-        # nor is a mode with zeta outside (0, 1) or a frequency the sampling cannot see
-        rate = eng.traj.rate_hz
-        sig -= {group_key(s) for s, v in zip(mf.specs[first:], mf.result.theta[first:],
-                                             strict=True)
-                if v <= 0.0 or not plausible(s.name, float(v), rate)}
+    if effect in POSITIVE:
+        sig -= _implausible_groups(eng, mf, first)
     if not sig:
         return Trial(effect, None, note="no joint group significant", aliased=al)
     if len(sig) < len(pw):

@@ -14,13 +14,12 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
+from zrp.arrays import F64, I64
 from zrp.errors import InputError
 from zrp.gap.motion.data import Trajectory
 
 __all__ = ["PHASES", "Phases", "TimeSplit", "phases", "split_segments", "stream_noise_sigma"]
 
-F64 = NDArray[np.float64]
-I64 = NDArray[np.int64]
 PHASES = ("reversal", "high_speed", "acceleration", "after_stop", "other")
 
 

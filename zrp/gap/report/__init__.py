@@ -1,15 +1,19 @@
-"""The report of a diagnosis: the verdict in plain words, report.md, the plots, and the
-writer of the output folder. It reads the engine's results; the engine never imports it."""
+"""The report of a diagnosis, plain functions of the result: the verdict in plain words
+(:func:`verdict_text`), the diagnosis.json document with it (:func:`diagnosis_document`),
+report.md (:func:`report_markdown`), the plots, and the writer of the output folder
+(:func:`write_outputs`). It reads the engine's results; the engine never imports it."""
 
 from zrp.gap.report.markdown import report_markdown as report_markdown
 from zrp.gap.report.plots import implicated_joint as implicated_joint
 from zrp.gap.report.verdict import verdict_text as verdict_text
 from zrp.gap.report.write import OUTPUT_FILES as OUTPUT_FILES
+from zrp.gap.report.write import diagnosis_document as diagnosis_document
 from zrp.gap.report.write import residuals_csv as residuals_csv
 from zrp.gap.report.write import write_outputs as write_outputs
 
 __all__ = [
     "OUTPUT_FILES",
+    "diagnosis_document",
     "implicated_joint",
     "report_markdown",
     "residuals_csv",

@@ -20,7 +20,7 @@ from __future__ import annotations
 import base64
 import html
 import re
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 
 __all__ = ["report_html"]
 
@@ -109,55 +109,56 @@ def _figure(alt: str, name: str, svgs: Mapping[str, bytes]) -> str:
             "</figure>")
 
 
+def _run_end(lines: list[str], i: int, keep: Callable[[str], bool]) -> int:
+    """The first line from ``i`` on that ``keep`` rejects (or the end)."""
+    while i < len(lines) and keep(lines[i]):
+        i += 1
+    return i
+
+
+def _verdict(lines: list[str], i: int) -> tuple[str, int]:
+    """The verdict paragraph: the non-blank lines from ``i`` to the next heading, as one."""
+    j = _run_end(lines, i, lambda s: not s.startswith("#"))
+    para = [s for s in lines[i:j] if s.strip()]
+    return f'<div id="verdict">{_inline(" ".join(para))}</div>', j
+
+
+def _block(lines: list[str], i: int, svgs: Mapping[str, bytes]) -> tuple[str, int]:
+    """The HTML of the block (table, figure, list or paragraph) at line ``i`` and the line
+    after it."""
+    ln = lines[i]
+    if ln.startswith("|"):
+        j = _run_end(lines, i, lambda s: s.startswith("|"))
+        return _table(lines[i:j]), j
+    fm = re.match(r"^!\[(.*)\]\((.*)\)\s*$", ln)
+    if fm:
+        return _figure(fm.group(1), fm.group(2), svgs), i + 1
+    if ln.lstrip().startswith("- "):
+        j = _run_end(lines, i, lambda s: s.lstrip().startswith("- "))
+        items = "".join(f"<li>{_inline(s.lstrip()[2:])}</li>" for s in lines[i:j])
+        return "<ul>" + items + "</ul>", j
+    return f"<p>{_inline(ln)}</p>", i + 1
+
+
 def _blocks(md: str, svgs: Mapping[str, bytes]) -> list[str]:
     out: list[str] = []
     lines = md.splitlines()
-    i, first_h2 = 0, True
+    i, verdict_done = 0, False
     while i < len(lines):
-        ln = lines[i]
-        if not ln.strip():
+        m = re.match(r"^(#{1,3}) (.*)$", lines[i])
+        if not lines[i].strip():
             i += 1
-            continue
-        m = re.match(r"^(#{1,3}) (.*)$", ln)
-        if m:
+        elif m is None:
+            block, i = _block(lines, i, svgs)
+            out.append(block)
+        else:
             lvl = len(m.group(1))
             out.append(f"<h{lvl}>{_inline(m.group(2))}</h{lvl}>")
-            if lvl == 2 and first_h2 and m.group(2).strip() == "Verdict":
-                first_h2 = False
-                j = i + 1
-                para = []
-                while j < len(lines) and not lines[j].startswith("#"):
-                    if lines[j].strip():
-                        para.append(lines[j])
-                    j += 1
-                out.append(f'<div id="verdict">{_inline(" ".join(para))}</div>')
-                i = j
-                continue
             i += 1
-            continue
-        if ln.startswith("|"):
-            j = i
-            while j < len(lines) and lines[j].startswith("|"):
-                j += 1
-            out.append(_table(lines[i:j]))
-            i = j
-            continue
-        fm = re.match(r"^!\[(.*)\]\((.*)\)\s*$", ln)
-        if fm:
-            out.append(_figure(fm.group(1), fm.group(2), svgs))
-            i += 1
-            continue
-        if ln.lstrip().startswith("- "):
-            j = i
-            items = []
-            while j < len(lines) and lines[j].lstrip().startswith("- "):
-                items.append(f"<li>{_inline(lines[j].lstrip()[2:])}</li>")
-                j += 1
-            out.append("<ul>" + "".join(items) + "</ul>")
-            i = j
-            continue
-        out.append(f"<p>{_inline(ln)}</p>")
-        i += 1
+            if lvl == 2 and not verdict_done and m.group(2).strip() == "Verdict":
+                verdict_done = True
+                block, i = _verdict(lines, i)
+                out.append(block)
     return out
 
 

@@ -8,9 +8,14 @@ from collections.abc import Sequence
 
 from scipy.spatial.transform import Rotation
 
-from zrp.gap.report.verdict import baseline_text, final_effects_text, full_pose_text
+from zrp.gap.analysis.where import Region, WhereAnalysis
+from zrp.gap.report.verdict import (
+    baseline_text,
+    final_effects_text,
+    full_pose_text,
+    verdict_text,
+)
 from zrp.gap.results import Candidate, Diagnosis, ParameterEstimate
-from zrp.gap.where import Region, WhereAnalysis
 
 __all__ = ["decimals", "report_markdown", "value_ci"]
 
@@ -76,7 +81,7 @@ def _header(diag: Diagnosis) -> list[str]:
     s = diag.settings
     return [f"# Sim-to-real gap diagnosis: {diag.model_name}\n",
             "## Verdict\n",
-            diag.verdict + "\n",
+            verdict_text(diag) + "\n",
             "## Data\n",
             f"Data: {diag.context.meas.source}: {s['n_poses']} poses, {s['n_points']} measured "
             f"points ({', '.join(s['point_labels'])}), frame `{s['frame']}`. Fitting set "

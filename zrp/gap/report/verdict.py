@@ -1,11 +1,12 @@
-"""The verdict of a diagnosis in plain words (:attr:`zrp.gap.Diagnosis.verdict`)."""
+"""The verdict of a diagnosis in plain words (:func:`verdict_text`, a function of the
+:class:`~zrp.gap.Diagnosis`)."""
 
 from __future__ import annotations
 
 import numpy as np
 
+from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.results import Diagnosis
-from zrp.gap.where import WhereAnalysis
 
 __all__ = ["baseline_text", "final_effects_text", "full_pose_text", "remains_text",
            "verdict_text"]
@@ -21,29 +22,46 @@ def _fmt(x: float | None, unit: str) -> str:
     return "n/a" if x is None else f"{x:.4g} {unit}"
 
 
-def remains_text(w: WhereAnalysis, unit: str) -> str:
-    """Plain words on the structure of what remains (from a where analysis)."""
+def _trend_r2(w: WhereAnalysis) -> tuple[float, float]:
+    """The largest R^2 of the residual against one joint angle, and against the measurement
+    order, time or temperature."""
     r2_joint = max((j.r2 for j in w.joints), default=0.0)
     r2_other = max([w.order_r2] + [r for r in (w.time_r2, w.temperature_r2) if r is not None])
+    return r2_joint, r2_other
+
+
+def _trend_text(w: WhereAnalysis, r2_joint: float, r2_other: float) -> str:
+    """What the residual still depends on, or that it depends on nothing in particular."""
+    if r2_joint < NO_TREND_R2 and r2_other < NO_TREND_R2:
+        return (f"it depends on no single joint angle, the measurement order, time or "
+                f"temperature (R^2 <= {max(r2_joint, r2_other):.2f})")
+    j = max(w.joints, key=lambda j: j.r2)
+    return (f"it still depends on q{j.joint} (R^2 {j.r2:.2f})" if j.r2 >= r2_other else
+            f"it still depends on measurement order/time/temperature (R^2 {r2_other:.2f})")
+
+
+def _reach_text(w: WhereAnalysis, unit: str) -> str | None:
+    """RMS in the inner and the outer third of the reach (None without regions)."""
     regions = w.regions
     inner = [g.rms for g in regions if g is regions[0] or g.radius == regions[0].radius]
     outer = [g.rms for g in regions if g.radius == regions[-1].radius]
+    if not (inner and outer):
+        return None
+    return (f"RMS {np.mean(inner):.3g} {unit} in the inner and {np.mean(outer):.3g} "
+            f"{unit} in the outer third of the reach")
+
+
+def remains_text(w: WhereAnalysis, unit: str) -> str:
+    """Plain words on the structure of what remains (from a where analysis)."""
+    r2_joint, r2_other = _trend_r2(w)
     no_trend = r2_joint < NO_TREND_R2 and r2_other < NO_TREND_R2
-    txt = []
     common = w.common_share
-    if common is not None:
-        txt.append(f"{100 * common:.0f} % of what remains moves all points of a pose together")
-    if no_trend:
-        txt.append(f"it depends on no single joint angle, the measurement order, time or "
-                   f"temperature (R^2 <= {max(r2_joint, r2_other):.2f})")
-    else:
-        j = max(w.joints, key=lambda j: j.r2)
-        txt.append(f"it still depends on q{j.joint} (R^2 {j.r2:.2f})" if j.r2 >= r2_other else
-                   f"it still depends on measurement order/time/temperature (R^2 "
-                   f"{r2_other:.2f})")
-    if inner and outer:
-        txt.append(f"RMS {np.mean(inner):.3g} {unit} in the inner and {np.mean(outer):.3g} "
-                   f"{unit} in the outer third of the reach")
+    txt = [] if common is None else [
+        f"{100 * common:.0f} % of what remains moves all points of a pose together"]
+    txt.append(_trend_text(w, r2_joint, r2_other))
+    reach = _reach_text(w, unit)
+    if reach is not None:
+        txt.append(reach)
     out = "What remains: " + "; ".join(txt) + "."
     if common is not None and common > POSE_ERROR_SHARE and no_trend:
         out += (" No correction of the joint angles or geometry in the library reproduces a "

@@ -1,6 +1,6 @@
-"""Write a :class:`~zrp.gap.Diagnosis` to a folder: diagnosis.json, residuals.csv, the PNG
-plots, report.md and report.html (the same text with the figures embedded), through the one
-output policy (:mod:`zrp.output`)."""
+"""Write a :class:`~zrp.gap.Diagnosis` to a folder: diagnosis.json (:func:`diagnosis_document`:
+the result's JSON with the verdict), residuals.csv, the PNG plots, report.md and report.html (the
+same text with the figures embedded), through the one output policy (:mod:`zrp.output`)."""
 
 from __future__ import annotations
 
@@ -8,20 +8,33 @@ import csv
 import io
 import os
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 from zrp.gap.report.html import report_html
 from zrp.gap.report.markdown import report_markdown
 from zrp.gap.report.plots import DPI, PLOT_FILES, figures, withheld_rows
+from zrp.gap.report.verdict import verdict_text
 from zrp.gap.results import Diagnosis
 from zrp.output import OutputDir
 
-__all__ = ["OUTPUT_FILES", "residuals_csv", "write_outputs"]
+__all__ = ["OUTPUT_FILES", "diagnosis_document", "residuals_csv", "write_outputs"]
 
 #: every file :func:`write_outputs` writes (all are checked, even without plots, so that no
 #: plot of an earlier run is left beside the new results).
 OUTPUT_FILES = ("diagnosis.json", "report.md", "report.html", "residuals.csv", *PLOT_FILES)
+
+
+def diagnosis_document(diag: Diagnosis) -> dict[str, Any]:
+    """The diagnosis.json document: :meth:`Diagnosis.to_dict` with the verdict in plain words
+    (:func:`verdict_text`) after ``unexplained``."""
+    out: dict[str, Any] = {}
+    for key, value in diag.to_dict().items():
+        out[key] = value
+        if key == "unexplained":
+            out["verdict"] = verdict_text(diag)
+    return out
 
 
 def residuals_csv(diag: Diagnosis) -> str:
@@ -43,7 +56,7 @@ def residuals_csv(diag: Diagnosis) -> str:
 
 def _write(diag: Diagnosis, out: OutputDir, plots: bool) -> list[Path]:
     first = len(out.written)
-    out.write_json("diagnosis.json", diag.to_dict())
+    out.write_json("diagnosis.json", diagnosis_document(diag))
     out.write_text("residuals.csv", residuals_csv(diag))
     svgs: dict[str, bytes] = {}
     if plots:

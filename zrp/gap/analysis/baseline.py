@@ -1,0 +1,108 @@
+"""The standard complete geometric calibration, always fitted beside the chosen effects.
+
+A calibration engineer's reference: all kinematic parameters (joint offsets, body vectors,
+axis tilts: :data:`KINEMATIC`) on top of the registration, reduced to a base set that these
+poses identify (column-pivoted Gram-Schmidt on the normalised Jacobian, :func:`~zrp.gap.fit.leastsq.
+check_identifiable`: a QR reduction), fitted on the fitting poses and judged on the withheld
+ones. Then the non-geometric effects of the final model are added on top of it, which answers
+the question "what do the non-geometric effects add beyond a full geometric calibration, on
+withheld poses?".
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.arrays import F64
+from zrp.gap.fit.leastsq import FitResult, cv_rms, fit, identifiable_start
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.effects import effect_parameters
+from zrp.gap.model.problem import Problem
+
+__all__ = ["KINEMATIC", "GeometricBaseline", "geometric_baseline"]
+
+#: The effects of a standard complete kinematic calibration (an encoder scale is a drive
+#: property and counts as non-geometric here).
+KINEMATIC = ("joint_offset", "link_length", "axis_misalignment")
+
+
+@dataclass(frozen=True)
+class GeometricBaseline:
+    """The complete geometric calibration and what the non-geometric effects add to it.
+
+    Attributes:
+        n_parameters: base-set size (identifiable geometric parameters, registration excluded).
+        n_dropped: geometric parameters the reduction dropped (aliased).
+        withheld: withheld errors of the geometric calibration.
+        cv_rms: its cross-validated RMS on the fitting poses.
+        non_geometric: the non-geometric effects of the final model added on top ("" none).
+        n_non_geometric: their parameters identifiable on top of the base set.
+        combined: withheld errors of geometric + non-geometric, or None when the final model
+            has no non-geometric effect.
+        fit: the geometric calibration's fit (registration + base set; the final model when
+            the search's model does not beat it on the withheld poses, see
+            :mod:`zrp.gap.analysis.fallback`).
+    """
+
+    n_parameters: int
+    n_dropped: int
+    withheld: Metrics
+    cv_rms: float
+    non_geometric: tuple[str, ...]
+    n_non_geometric: int
+    combined: Metrics | None
+    fit: FitResult | None = field(default=None, compare=False, repr=False)
+
+    @property
+    def increment(self) -> float | None:
+        """Share by which the non-geometric effects lower the baseline's withheld RMS (negative
+        when they make it worse), or None."""
+        if self.combined is None or self.withheld.rms <= 0:
+            return None
+        return 1.0 - self.combined.rms / self.withheld.rms
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"n_parameters": self.n_parameters, "n_dropped": self.n_dropped,
+                "withheld": self.withheld.to_dict(), "rms": self.withheld.rms,
+                "cv_rms": self.cv_rms, "non_geometric": list(self.non_geometric),
+                "n_non_geometric": self.n_non_geometric,
+                "combined": None if self.combined is None else self.combined.to_dict(),
+                "increment": self.increment}
+
+
+def _withheld(ctx: Context, f: FitResult, withheld: NDArray[np.int64]) -> Metrics:
+    return Metrics.of(Problem(ctx, f.specs, withheld, f.base_rotation).residual(f.theta))
+
+
+def _on_top(ctx: Context, base: FitResult, extra: list[ParamSpec], fitting: NDArray[np.int64],
+            rb0: F64) -> tuple[FitResult, int, int]:
+    keep, _, start = identifiable_start(ctx, base, extra)
+    f = fit(ctx, list(base.specs) + keep, fitting,
+            np.concatenate([base.theta, np.zeros(len(keep))]), rb0, start=start)
+    return f, len(keep), len(extra) - len(keep)
+
+
+def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
+                       fitting: NDArray[np.int64], withheld: NDArray[np.int64],
+                       folds: list[NDArray[np.int64]], rb0: F64
+                       ) -> GeometricBaseline:
+    """Fit the complete geometric calibration on top of the registration ``reg`` and then the
+    final model's non-geometric parameters on top of it (see the module docstring)."""
+    geo: list[ParamSpec] = []
+    for e in KINEMATIC:
+        geo += effect_parameters(ctx, e)[0]
+    base, n_geo, n_drop = _on_top(ctx, reg, geo, fitting, rb0)
+    nreg = len(reg.specs)
+    non_geo = [s for s in final.specs[nreg:] if s.effect not in KINEMATIC]
+    effects = tuple(dict.fromkeys(s.effect for s in non_geo))
+    combined, n_ng = None, 0
+    if non_geo:
+        both, n_ng, _ = _on_top(ctx, base, non_geo, fitting, rb0)
+        combined = _withheld(ctx, both, withheld)
+    return GeometricBaseline(n_geo, n_drop, _withheld(ctx, base, withheld),
+                             cv_rms(ctx, base, folds), effects, n_ng, combined, base)

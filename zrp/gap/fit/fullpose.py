@@ -1,0 +1,224 @@
+"""Full-pose identification: measured orientations (``qw, qx, qy, qz``) beside the positions.
+
+A 6-DOF probe (e.g. a laser tracker's T-Mac) reports the orientation of its own frame in the
+instrument frame (base frame for base-frame data). With R_t the constant rotation of the probe
+on the hand (registered like the tool offsets), the corrected model predicts
+
+    R_i = R_b R_n(q'_i) R_t,        R_t = exp([psi]) R_t0                               (O1)
+
+(R_b, R_n, q' as in :mod:`zrp.gap.model.problem`). The orientation residual of pose i is the
+rotation vector e_i = log(R_i R_meas,i^T) (rad, instrument frame), and for a left
+perturbation delta of R_i, de = J_l(e)^-1 delta (J_l: left Jacobian of SO(3)). The perturbation
+columns (instrument frame) are
+
+    base rotation phi: J_l(phi);   revolute joint k (dq): R_b u_k B[i, k];                  (O2)
+    axis tilt of joint k: R_b omega_k (the omega of the position columns);
+    probe rotation psi: R_b R_n J_l(psi);   translations, tool offsets, bodies, thermal: 0.
+
+Identification minimises sum |r_p / sigma_p|^2 + sum |e / sigma_o|^2 (positions per
+coordinate, length unit; orientations per component, rad): each block weighted by its own
+noise. sigma_p is the position-only fit's residual sigma; sigma_o is given, or estimated from
+the orientation residuals (the fit repeated until the estimate settles, 3 passes). The
+standard errors are the normal-theory ones of the weighted problem, comparable with the
+position-only fit's (the same formula, :func:`zrp.gap.fit.leastsq.fit`).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.optimize import least_squares
+from scipy.spatial.transform import Rotation
+
+from zrp.arrays import F64
+from zrp.errors import InputError
+from zrp.gap.fit.leastsq import FitResult, _covariance, fit, initial_registration
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.problem import Problem
+from zrp.rotations import left_jacobian
+
+__all__ = ["FullPoseFit", "fit_full_pose", "orientation_residual", "pose_rotations",
+           "probe_start"]
+
+
+
+def pose_rotations(ctx: Context) -> F64:
+    """Measured orientation per pose (its first row's quaternion, scalar first), shape
+    (P, 3, 3).
+
+    Raises:
+        InputError: the measurements carry no ``qw, qx, qy, qz`` columns.
+    """
+    quat = ctx.meas.quat
+    if quat is None:
+        raise InputError("measurements: no qw, qx, qy, qz columns; full-pose identification "
+                         "needs measured orientations")
+    q = np.asarray(quat, dtype=float)[ctx.meas.first_row]
+    return Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()
+
+
+def _left_jacobians(e: F64) -> F64:
+    return np.stack([left_jacobian(v) for v in e])
+
+
+def orientation_residual(prob: Problem, theta: ArrayLike, psi: ArrayLike, rt0: ArrayLike,
+                         measured: ArrayLike) -> tuple[F64, F64]:
+    """Orientation residuals (O1) and their Jacobian (O2) on the poses of ``prob``.
+
+    Args:
+        prob: the position problem (its parameters and poses).
+        theta: its parameters, shape (p,); psi: probe rotation correction, rad, shape (3,).
+        rt0: R_t0, shape (3, 3); measured: R_meas per pose of ``prob``, shape (S, 3, 3).
+
+    Returns:
+        e, shape (S, 3) (rad), and d e / d(theta, psi), shape (S, 3, p + 3).
+    """
+    theta = np.asarray(theta, dtype=float)
+    psi = np.asarray(psi, dtype=float)
+    ch = prob._chain(theta)
+    n = prob.ctx.model.n
+    rn = ch.rprev[:, n]
+    rb, _ = prob.base(theta)
+    rt = Rotation.from_rotvec(psi).as_matrix() @ np.asarray(rt0, dtype=float)
+    pred = rb @ rn @ rt
+    e = Rotation.from_matrix(pred @ np.swapaxes(np.asarray(measured), 1, 2)).as_rotvec()
+    S = len(e)
+    cols = np.zeros((S, 3, prob.size + 3))
+    if prob.instrument:
+        cols[:, :, prob.idx["rot"]] = left_jacobian(theta[prob.idx["rot"]])
+    rev = ~np.asarray(prob.ctx.model.prismatic)
+    if prob.idx["dq"].size:
+        cols[:, :, prob.idx["dq"]] = np.einsum("ij,skj,skp->sip", rb, ch.ucur * rev[None, :,
+                                                                                    None], prob.B)
+    tang = prob.ctx.tangents
+    for i in prob.idx["tilt"]:
+        s = prob.specs[i]
+        k = s.joint - 1
+        if not rev[k]:
+            continue
+        uk = ch.u[k]
+        du = (tang[k, s.comp] - uk * (uk @ tang[k, s.comp])) / np.linalg.norm(ch.v[k])
+        loc = (np.sin(ch.q[:, k])[:, None] * du
+               + (1.0 - np.cos(ch.q[:, k]))[:, None] * np.cross(uk, du))
+        cols[:, :, i] = np.einsum("ij,sjk,sk->si", rb, ch.rprev[:, k], loc)
+    cols[:, :, prob.size:] = rb @ rn @ left_jacobian(psi)
+    jinv = np.linalg.inv(_left_jacobians(e))
+    return e, jinv @ cols
+
+
+@dataclass(frozen=True, eq=False)
+class FullPoseFit:
+    """A full-pose (or, with ``orientation=False``, position-only) fit.
+
+    Attributes:
+        specs: the parameters (p); theta: their values (p,); stderr: standard errors (p,).
+        probe_rotation: R_t, shape (3, 3) (identity without orientations).
+        sigma_position: position noise per coordinate used as weight (length unit).
+        sigma_orientation: orientation noise per component (rad; nan without orientations).
+        orientation_rms: RMS rotation angle of the orientation residuals (rad; nan without).
+        position: the position-only fit (the start).
+        orientation: orientations were used.
+        sigma_orientation_given: sigma_orientation was given (False: estimated).
+    """
+
+    specs: tuple[ParamSpec, ...]
+    theta: F64
+    stderr: F64
+    probe_rotation: F64
+    sigma_position: float
+    sigma_orientation: float
+    orientation_rms: float
+    position: FitResult
+    orientation: bool
+    sigma_orientation_given: bool = False
+
+    def __post_init__(self) -> None:
+        p = len(self.specs)
+        if self.theta.shape != (p,) or self.stderr.shape != (p,):
+            raise InputError("FullPoseFit: theta/stderr do not match the parameters")
+
+    def value(self, name: str) -> float:
+        return float(self.theta[self._index(name)])
+
+    def std(self, name: str) -> float:
+        return float(self.stderr[self._index(name)])
+
+    def _index(self, name: str) -> int:
+        names = [s.name for s in self.specs]
+        if name not in names:
+            raise InputError(f"name: no parameter {name!r}; fitted: {', '.join(names)}")
+        return names.index(name)
+
+
+def probe_start(prob: Problem, theta: F64, measured: F64) -> F64:
+    """R_t0: the rotation closest to the mean of (R_b R_n)^T R_meas over the poses."""
+    n = prob.ctx.model.n
+    rb, _ = prob.base(theta)
+    a = np.swapaxes(rb @ prob._chain(theta).rprev[:, n], 1, 2) @ measured
+    u, _, vt = np.linalg.svd(a.mean(axis=0))
+    return u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
+
+
+def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
+                  orientation: bool = True, orientation_sigma: float | None = None,
+                  passes: int = 3) -> FullPoseFit:
+    """Identify ``specs`` on ``poses`` from positions and, with ``orientation``, the measured
+    orientations, each weighted by its own noise (module doc).
+
+    Args:
+        ctx: the data context (its measurements need ``qw..qz`` for ``orientation``).
+        specs: registration + effect parameters, as for :func:`zrp.gap.fit.leastsq.fit`.
+        poses: pose indices, shape (S,).
+        orientation: use the orientations (False: the position-only fit, for comparison).
+        orientation_sigma: the orientation noise per component (rad); None: estimated.
+        passes: fits with the re-estimated sigma_o (when it is estimated).
+
+    Raises:
+        InputError: no orientations, a non-positive sigma, too few poses.
+    """
+    poses = np.asarray(poses, dtype=np.int64)
+    theta0, rb0 = initial_registration(ctx, specs, poses)
+    pos = fit(ctx, specs, poses, theta0, rb0)
+    sp = pos.sigma
+    nan = float("nan")
+    if not orientation:
+        return FullPoseFit(tuple(specs), pos.theta, pos.stderr, np.eye(3), sp, nan, nan, pos,
+                           False)
+    if orientation_sigma is not None and not (np.isfinite(orientation_sigma)
+                                              and orientation_sigma > 0):
+        raise InputError(f"orientation_sigma: expected a positive angle (rad), got "
+                         f"{orientation_sigma!r}")
+    measured = pose_rotations(ctx)[poses]
+    prob = Problem(ctx, specs, poses, rb0)
+    rt0 = probe_start(prob, pos.theta, measured)
+    p = prob.size
+    x = np.concatenate([pos.theta, np.zeros(3)])
+    e, _ = orientation_residual(prob, pos.theta, np.zeros(3), rt0, measured)
+    so = (float(orientation_sigma) if orientation_sigma is not None
+          else float(np.sqrt(np.mean(e ** 2))) or 1e-9)
+
+    def both(v: F64, so: float) -> tuple[F64, F64]:
+        rp, jp = prob.residual_and_jacobian(v[:p])
+        eo, jo = orientation_residual(prob, v[:p], v[p:], rt0, measured)
+        jp = np.hstack([jp, np.zeros((jp.shape[0], 3))])
+        return (np.concatenate([rp / sp, eo.ravel() / so]),
+                np.vstack([jp / sp, jo.reshape(-1, p + 3) / so]))
+
+    for _ in range(1 if orientation_sigma is not None else passes):
+        res = least_squares(lambda v, s=so: both(v, s)[0], x, jac=lambda v, s=so: both(v, s)[1],
+                            method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12,
+                            max_nfev=100)
+        x = res.x
+        e, _ = orientation_residual(prob, x[:p], x[p:], rt0, measured)
+        if orientation_sigma is None:
+            so = float(np.sqrt(np.sum(e ** 2) / max(e.size - 3, 1))) or 1e-9
+    r, J = both(x, so)
+    cov = _covariance(J, r)
+    se = np.sqrt(np.clip(np.diag(cov), 0.0, None))[:p]
+    rt = Rotation.from_rotvec(x[p:]).as_matrix() @ rt0
+    ang = float(np.sqrt(np.mean(np.sum(e ** 2, axis=1))))
+    return FullPoseFit(tuple(specs), x[:p], se, rt, sp, so, ang, pos, True,
+                       orientation_sigma is not None)

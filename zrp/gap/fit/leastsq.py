@@ -1,0 +1,426 @@
+"""Registration, nonlinear least squares with the analytic Jacobians, identifiability and
+statistics (covariance, Wald and F tests, information criteria, linearised cross-validation).
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike, NDArray
+from scipy import (
+    special,  # chdtrc/fdtrc: the chi2/F survival functions without scipy.stats (1 s import)
+)
+from scipy.optimize import least_squares
+
+from zrp.arrays import F64
+from zrp.errors import InputError, ZRPWarning
+from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.problem import Evaluation, Problem, compressed
+from zrp.jsonio import dict_from_dataclass
+
+#: Two-sided 95 % quantile of the standard normal (the one home of the constant in zrp.gap).
+Z95 = 1.959963984540054
+
+__all__ = [
+    "Z95",
+    "Aliased",
+    "FitResult",
+    "FitWarning",
+    "check_identifiable",
+    "cv_rms",
+    "f_test",
+    "fit",
+    "group_key",
+    "identifiable_start",
+    "initial_registration",
+    "orthonormal_basis",
+    "point_errors",
+    "wald_groups",
+]
+
+
+#: A parameter whose Jacobian column keeps less than this fraction of its norm after
+#: projection on the other columns cannot be told apart from them (structural aliasing).
+ALIAS_TOL = 1e-6
+#: Below this fraction it is identifiable only weakly (reported, kept).
+WEAK_TOL = 1e-2
+
+
+class FitWarning(ZRPWarning):
+    """A fit is poorly conditioned, did not converge, or the data hide some parameter."""
+
+
+@dataclass(frozen=True, eq=False)
+class FitResult:
+    """A least-squares fit of the corrected model on a set of poses.
+
+    Attributes:
+        specs: the parameters (p).
+        theta: values, shape (p,), in the units of the specs.
+        cov: covariance, shape (p, p) (from sigma^2 (J^T J)^-1 at the solution).
+        residual: predicted minus measured, shape (3R,).
+        jac: Jacobian at the solution, shape (3R, p).
+        base_rotation: R_b0 used by the problem, shape (3, 3).
+        poses: pose indices fitted, shape (S,).
+        converged: the solver reported success.
+    """
+
+    specs: tuple[ParamSpec, ...]
+    theta: F64
+    cov: F64
+    residual: F64
+    jac: F64
+    base_rotation: F64
+    poses: NDArray[np.int64]
+    converged: bool
+
+    def __post_init__(self) -> None:
+        p = len(self.specs)
+        if self.theta.shape != (p,) or self.cov.shape != (p, p):
+            raise InputError(f"FitResult: theta/cov shapes {self.theta.shape}/{self.cov.shape} "
+                             f"do not match {p} parameters")
+
+    @property
+    def rss(self) -> float:
+        """Residual sum of squares, length unit^2."""
+        return float(self.residual @ self.residual)
+
+    @property
+    def n_res(self) -> int:
+        return int(self.residual.size)
+
+    @property
+    def dof(self) -> int:
+        return max(self.n_res - len(self.specs), 1)
+
+    @property
+    def sigma(self) -> float:
+        """Residual standard deviation per coordinate, length unit."""
+        return float(np.sqrt(self.rss / self.dof))
+
+    @property
+    def stderr(self) -> F64:
+        """Standard errors, shape (p,)."""
+        return np.sqrt(np.clip(np.diag(self.cov), 0.0, None))
+
+    @property
+    def bic(self) -> float:
+        """Bayesian information criterion (Gaussian errors, unknown variance)."""
+        return float(self.n_res * np.log(self.rss / self.n_res) + len(self.specs)
+                     * np.log(self.n_res))
+
+    def value(self, name: str) -> float:
+        """The value of the parameter called ``name``."""
+        for s, v in zip(self.specs, self.theta, strict=False):
+            if s.name == name:
+                return float(v)
+        raise InputError(f"no parameter {name!r}; fitted: {', '.join(s.name for s in self.specs)}")
+
+
+def point_errors(residual: F64) -> F64:
+    """3-D error per measured point |r|, shape (R,), from a residual of shape (3R,)."""
+    return np.linalg.norm(np.asarray(residual).reshape(-1, 3), axis=1)
+
+
+def _kabsch(a: F64, b: F64) -> tuple[F64, F64]:
+    """R, t minimising |R a + t - b| (a, b shape (N, 3))."""
+    ca, cb = a.mean(0), b.mean(0)
+    h = (a - ca).T @ (b - cb)
+    u, _, vt = np.linalg.svd(h)
+    d = np.sign(np.linalg.det(vt.T @ u.T)) or 1.0
+    r = vt.T @ np.diag([1.0, 1.0, d]) @ u.T
+    return r, cb - r @ ca
+
+
+def initial_registration(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike,
+                         iterations: int = 60) -> tuple[F64, F64]:
+    """Starting values for the registration parameters (other parameters 0) and R_b0.
+
+    Alternates a Kabsch fit of the base frame with a linear solve of the tool offsets (the
+    nominal model is used for p and R_n).
+
+    Returns:
+        theta0 shape (p,), R_b0 shape (3, 3).
+    """
+    poses = np.asarray(poses, dtype=np.int64)
+    prob = Problem(ctx, specs, poses)
+    fk = ctx.nominal_fk
+    p = fk.position[poses][prob.row_pose]
+    rn = fk.rotation[poses][prob.row_pose]
+    m = prob.measured
+    M = len(ctx.meas.point_labels)
+    t = np.zeros((M, 3))
+    rb, tb = np.eye(3), np.zeros(3)
+    for _ in range(iterations if prob.instrument else 1):
+        x = p + np.einsum("rij,rj->ri", rn, t[prob.row_point])
+        if prob.instrument:
+            rb, tb = _kabsch(x, m)
+        local = (m - tb) @ rb  # = R_b^T (m - t_b)
+        for j in range(M):
+            sel = prob.row_point == j
+            t[j] = np.linalg.lstsq(rn[sel].reshape(-1, 3), (local[sel] - p[sel]).ravel(),
+                                   rcond=None)[0]
+    theta = np.zeros(len(specs))
+    for i, s in enumerate(specs):
+        if s.kind == "trans":
+            theta[i] = tb[s.comp]
+        elif s.kind == "tool":
+            theta[i] = t[s.comp // 3, s.comp % 3]
+    return theta, rb
+
+
+def orthonormal_basis(a: F64, rtol: float = 1e-10) -> F64:
+    """An orthonormal basis of the column span of a (m, k) -> (m, r), via the Gram matrix
+    (much faster than a QR for tall matrices; columns should be normalised)."""
+    if a.shape[1] == 0:
+        return np.zeros((a.shape[0], 0))
+    w, v = np.linalg.eigh(a.T @ a)
+    keep = w > max(w.max(), 1e-300) * rtol
+    q = (a @ v[:, keep]) / np.sqrt(w[keep])
+    # one re-orthogonalisation pass for accuracy
+    w2, v2 = np.linalg.eigh(q.T @ q)
+    return (q @ v2) / np.sqrt(w2)
+
+
+def _covariance(jac: F64, residual: F64) -> F64:
+    """sigma^2 (J^T J)^-1 with column scaling; inf where J^T J is singular."""
+    p = jac.shape[1]
+    dof = max(jac.shape[0] - p, 1)
+    s2 = float(residual @ residual) / dof
+    d = np.linalg.norm(jac, axis=0)
+    d = np.where(d > 0, d, 1.0)
+    js = jac / d
+    w, v = np.linalg.eigh(js.T @ js)
+    with np.errstate(divide="ignore"):
+        inv = np.where(w > max(w.max(), 1e-300) * 1e-12, 1.0 / w, np.inf)
+    cov = (v * np.where(np.isfinite(inv), inv, 0.0)) @ v.T
+    if not np.all(np.isfinite(inv)):
+        # parameters touching the null space get an infinite variance
+        null = v[:, ~np.isfinite(inv)]
+        touched = np.abs(null).max(axis=1) > 1e-6
+        cov[touched, :] = np.inf
+        cov[:, touched] = np.inf
+    return s2 * cov / np.outer(d, d)
+
+
+def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: ArrayLike,
+        base_rotation: ArrayLike, *, max_nfev: int = 100,
+        start: Evaluation | None = None) -> FitResult:
+    """Least squares (scipy ``least_squares``, Levenberg-Marquardt) with the analytic
+    Jacobian of :class:`~zrp.gap.model.problem.Problem`.
+
+    Args:
+        specs: parameters (p).
+        poses: pose indices, shape (S,).
+        theta0: starting values, shape (p,).
+        base_rotation: R_b0, shape (3, 3).
+        start: the evaluation at theta0 when already known (used only when its poses and
+            theta equal ``poses`` and ``theta0``).
+    """
+    prob = Problem(ctx, specs, poses, base_rotation)
+    theta0 = np.asarray(theta0, dtype=float)
+    if prob.n_residuals <= prob.size:
+        raise InputError(f"{prob.n_residuals // 3} measured points give {prob.n_residuals} "
+                         f"coordinates, not enough for {prob.size} parameters; measure more "
+                         "poses")
+    cache: dict[bytes, tuple[F64, F64, F64, F64]] = {}  # the last two points evaluated
+
+    def evaluated(th: F64) -> tuple[F64, F64, F64, F64]:
+        key = th.tobytes()
+        if key not in cache:
+            if len(cache) > 1:
+                del cache[next(iter(cache))]
+            r, J = prob.residual_and_jacobian(th)
+            cache[key] = (*compressed(r, J), r, J)
+        return cache[key]
+
+    def both(th: F64) -> tuple[F64, F64]:
+        return evaluated(th)[:2]
+
+    if (start is not None and np.array_equal(start.poses, prob.poses)
+            and np.array_equal(start.theta, theta0) and start.jac.shape[1] == prob.size):
+        cache[theta0.tobytes()] = (*compressed(start.residual, start.jac), start.residual,
+                                   start.jac)
+
+    res = least_squares(lambda th: both(th)[0], theta0, jac=lambda th: both(th)[1],
+                        method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12,
+                        max_nfev=max_nfev)
+    r, J = evaluated(res.x)[2:]  # the solution is one of the last two points evaluated
+    ok = bool(res.status > 0)
+    if not ok:
+        warnings.warn(f"least squares did not converge ({res.message}) with "
+                      f"{len(specs)} parameters", FitWarning, stacklevel=2)
+    return FitResult(tuple(specs), res.x, _covariance(J, r), r, J, np.asarray(base_rotation),
+                     np.asarray(poses, dtype=np.int64), ok)
+
+
+@dataclass(frozen=True)
+class Aliased:
+    """A parameter that the data cannot tell apart from others.
+
+    Attributes:
+        name: the parameter.
+        effect: its effect.
+        partners: the parameters it trades against (largest share first).
+        fraction: share of its Jacobian column outside the span of the others (0: identical).
+        dropped: True when it was left out of the fit (structural), False when only weak.
+    """
+
+    name: str
+    effect: str
+    partners: tuple[str, ...]
+    fraction: float
+    dropped: bool
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict_from_dataclass(self)
+
+
+def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[ParamSpec],
+                       poses: ArrayLike | None = None) -> tuple[list[ParamSpec], list[Aliased]]:
+    """Which candidate parameters the data can identify on top of ``base``.
+
+    The Jacobian of base + candidates is evaluated at the base solution; each candidate column
+    (normalised) is projected on the span of the base columns and of the candidates accepted
+    before it. A column that keeps less than ``ALIAS_TOL`` of its norm is dropped and reported
+    with the parameters it is aliased with; one that keeps less than ``WEAK_TOL`` is kept and
+    reported as weakly identifiable.
+
+    Returns:
+        the identifiable candidates, and the aliasing report.
+    """
+    keep, report, _ = identifiable_start(ctx, base, candidates, poses)
+    return keep, report
+
+
+def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[ParamSpec],
+                       poses: ArrayLike | None = None
+                       ) -> tuple[list[ParamSpec], list[Aliased], Evaluation]:
+    """:func:`check_identifiable`, and the evaluation of base + the kept candidates at
+    (base.theta, 0) that it computed (the start of the fit that usually follows)."""
+    poses = base.poses if poses is None else np.asarray(poses, dtype=np.int64)
+    specs = list(base.specs) + list(candidates)
+    prob = Problem(ctx, specs, poses, base.base_rotation)
+    theta = np.concatenate([base.theta, np.zeros(len(candidates))])
+    r, J = prob.residual_and_jacobian(theta)
+    norms = np.linalg.norm(J, axis=0)
+    nb = len(base.specs)
+    A = J[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
+    Q = orthonormal_basis(A)
+    names = [s.name for s in specs]
+    accepted_cols = list(range(nb))
+    keep: list[ParamSpec] = []
+    report: list[Aliased] = []
+    # every candidate projected off the base span at once (two passes, one matrix product each
+    # instead of one matrix-vector product per candidate), then, in order, off the candidates
+    # accepted before it: the same projection onto span(base, accepted)
+    C = J[:, nb:] / np.where(norms[nb:] > 0, norms[nb:], 1.0)
+    P = C - Q @ (Q.T @ C)
+    P = P - Q @ (Q.T @ P)
+    Qa = np.empty((J.shape[0], len(candidates)))  # the accepted candidates' directions
+    na = 0
+    for i, spec in enumerate(candidates):
+        nrm = norms[nb + i]
+        if nrm <= 1e-12 * max(norms.max(), 1.0):
+            report.append(Aliased(spec.name, spec.effect, (), 0.0, True))
+            continue
+        c = C[:, i]
+        rr = P[:, i]
+        if na:
+            qa = Qa[:, :na]
+            rr = rr - qa @ (qa.T @ rr)
+            rr = rr - qa @ (qa.T @ rr)
+        frac = float(np.linalg.norm(rr))
+        if frac < WEAK_TOL:
+            acc = J[:, accepted_cols] / np.where(norms[accepted_cols] > 0,
+                                                 norms[accepted_cols], 1.0)
+            corr = np.abs(acc.T @ c)  # cosines between normalised columns
+            order = np.argsort(-corr)
+            partners = tuple(names[accepted_cols[o]] for o in order[:3]
+                             if corr[o] >= 0.5 * corr.max())
+            report.append(Aliased(spec.name, spec.effect, partners, frac, frac < ALIAS_TOL))
+            if frac < ALIAS_TOL:
+                continue
+        keep.append(spec)
+        accepted_cols.append(nb + i)
+        Qa[:, na] = rr / frac
+        na += 1
+    return keep, report, Evaluation(prob.poses, theta[accepted_cols], r, J[:, accepted_cols])
+
+
+def group_key(spec: ParamSpec) -> str:
+    """The significance group of a parameter, unique across effects ("effect:group")."""
+    return f"{spec.effect}:{spec.group}"
+
+
+def wald_groups(result: FitResult, first: int,
+                tested: Callable[[ParamSpec], bool] | None = None) -> dict[str, float]:
+    """p-value of the Wald test (all parameters of a group zero) per :func:`group_key`, for
+    the parameters from index ``first`` on; with ``tested``, only the parameters it accepts
+    enter the test (e.g. a mode's amplitude, not its frequency, whose null is not zero)."""
+    groups: dict[str, list[int]] = {}
+    for i in range(first, len(result.specs)):
+        if tested is None or tested(result.specs[i]):
+            groups.setdefault(group_key(result.specs[i]), []).append(i)
+    out: dict[str, float] = {}
+    for g, idx in groups.items():
+        th = result.theta[idx]
+        C = result.cov[np.ix_(idx, idx)]
+        if not np.all(np.isfinite(C)):
+            out[g] = 1.0
+            continue
+        try:
+            chi2 = float(th @ np.linalg.solve(C, th))
+        except np.linalg.LinAlgError:
+            out[g] = 1.0
+            continue
+        out[g] = float(special.chdtrc(len(idx), chi2))
+    return out
+
+
+def f_test(small: FitResult, big: FitResult) -> float:
+    """p-value of the F test that the extra parameters of ``big`` do not help."""
+    dp = len(big.specs) - len(small.specs)
+    if dp <= 0 or big.rss <= 0:
+        return 1.0
+    f = ((small.rss - big.rss) / dp) / (big.rss / big.dof)
+    return float(special.fdtrc(dp, big.dof, f)) if f > 0 else 1.0
+
+
+def cv_rms(ctx: Context, result: FitResult, folds: Sequence[NDArray[np.int64]]) -> float:
+    """Cross-validated 3-D RMS error (length unit) over the folds of the fitted poses.
+
+    For each fold, the parameters are refitted without it by one Gauss-Newton step from the
+    full solution (exact for parameters that enter linearly, second-order accurate for the
+    registration), and the error is evaluated on the fold. The folds' squared errors are pooled.
+    """
+    rows = np.flatnonzero(np.isin(ctx.meas.pose_index, result.poses))  # Problem's row order
+    prob_rows_pose = ctx.meas.pose_index[rows]
+    r = result.residual.reshape(-1, 3)
+    J = result.jac.reshape(r.shape[0], 3, -1)
+    d = np.linalg.norm(result.jac, axis=0)
+    d = np.where(d > 0, d, 1.0)
+    Js = J / d
+    A = np.einsum("rcp,rcq->pq", Js, Js)
+    b = np.einsum("rcp,rc->p", Js, r)
+    sq = 0.0
+    cnt = 0
+    for f in folds:
+        held = np.isin(prob_rows_pose, f)
+        if not held.any():
+            continue
+        Jh = Js[held]
+        Ah = A - np.einsum("rcp,rcq->pq", Jh, Jh)
+        bh = b - np.einsum("rcp,rc->p", Jh, r[held])
+        try:
+            step = -np.linalg.solve(Ah, bh)
+        except np.linalg.LinAlgError:
+            step = -np.linalg.lstsq(Ah, bh, rcond=None)[0]
+        rh = r[held] + np.einsum("rcp,p->rc", Jh, step)
+        sq += float(np.sum(rh**2))
+        cnt += int(held.sum())
+    return float(np.sqrt(sq / max(cnt, 1)))
