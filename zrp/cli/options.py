@@ -2,7 +2,7 @@
 checked here, once, with its range, so a bad value is one line naming the option
 (``argument --seed: expected a whole number >= 0, got -1``) before any work starts.
 
-The limits are stated where the options are declared; ``tests/test_hostile_inputs.py`` checks
+The limits are stated where the options are declared; ``tests/cli/test_option_checks.py`` checks
 that no command declares a bare ``type=int`` or ``type=float``.
 """
 
