@@ -87,7 +87,7 @@ class Procedure:
             are simulated as before and decide the backlash flank and the trims); "simulate"
             steps the whole quintic move (3.4x the physics steps on 200 random poses; the
             settled tool points of both agree far below the tracker's noise, backlash
-            included: tests/test_real_robot.py).
+            included: tests/sim/test_real_robot.py).
     """
 
     approach: str = "gravity"
