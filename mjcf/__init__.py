@@ -13,6 +13,10 @@ from mjcf.gravity import gravity_torques
 from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
 from mjcf.inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
 from mjcf.writer import mjcf_xml, save_mjcf
+from zrp.packages import DISTRIBUTION
+
+#: The distribution this ``mjcf`` belongs to (a generic name: see :mod:`zrp.packages`).
+__distribution__ = DISTRIBUTION
 from zrp.units import LENGTH_UNITS, metres_per_unit
 
 __all__ = [

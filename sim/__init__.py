@@ -36,6 +36,11 @@ import importlib
 from typing import Any
 
 from zrp.environment import check_mujoco_gl
+from zrp.packages import DISTRIBUTION, check_own_packages
+
+#: The distribution this ``sim`` belongs to (a generic name: see :mod:`zrp.packages`).
+__distribution__ = DISTRIBUTION
+check_own_packages(("mjcf",))  # a clear error if another 'mjcf' shadows ours
 
 # MuJoCo fails at import on an unknown MUJOCO_GL: say so as a named error first (no mujoco
 # import here; zrp.environment is plain Python).

@@ -50,8 +50,7 @@ from zrp.model.urdf_writer import save_urdf, urdf_xml
 from zrp.paper.example import run_paper_example
 from zrp.paper.report import write_paper_outputs
 from zrp.paper.scenario import circle_joint_path, puma_circle, puma_circle_ik
-
-__version__ = "0.1.0"
+from zrp.version import __version__
 
 __all__ = [
     "PAPER_SIGN_ZERO",
@@ -91,6 +90,7 @@ __all__ = [
     "UnreachableError",
     "ZRPError",
     "ZRPWarning",
+    "__version__",
     "allocate_tolerances",
     "apply_parameters",
     "builtin_models",

@@ -7,6 +7,7 @@ kinematics of a perturbed model, not the calibration code) for what the commands
 
 from __future__ import annotations
 
+import json
 import warnings
 
 import numpy as np
@@ -64,6 +65,9 @@ def test_round_trip_reproduces_withheld_error(which, request, withheld_residual,
         diag.final.rms, rel=1e-9)
     with pytest.raises(OutputExistsError):
         write_calibration(cal, m, c)
+    # both files record the toolkit version that wrote them
+    assert m.read_text().splitlines()[0] == f"# written by zrp-accuracy {zrp.__version__}"
+    assert json.loads(c.read_text())["zrp_version"] == zrp.__version__
 
 
 def test_offsets_are_folded_into_the_model(geometric):

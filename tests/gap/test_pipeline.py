@@ -63,7 +63,8 @@ def test_verdict_tables_and_json_describe_the_final_model(tmp_path):
     assert "verdict" not in out and doc["verdict"] == verdict_text(d)
     keys = list(doc)
     assert keys[keys.index("unexplained") + 1] == "verdict"
-    assert [k for k in keys if k != "verdict"] == list(out)
+    assert keys[0] == "zrp_version" and doc["zrp_version"] == zrp.__version__
+    assert [k for k in keys[1:] if k != "verdict"] == list(out)
     assert {p["name"] for p in out["final"]["parameters"]} == {
         s.name for s in d.final_fit.specs[len(d.registration):]}
     write_outputs(d, tmp_path, plots=False)

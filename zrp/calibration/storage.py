@@ -23,6 +23,7 @@ from zrp.jsonio import dumps
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.output import check_writable, write_text
 from zrp.rotations import er_from_matrix, rotvec_from_er
+from zrp.version import __version__
 
 __all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "read_calibration",
            "write_calibration"]
@@ -50,6 +51,7 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
     full-pose fit the calibration came from (its probe rotation and noise are recorded)."""
     return {
         "schema_version": SCHEMA_VERSION,
+        "zrp_version": __version__,
         "kind": "zrp calibration (non-geometric part and registration)",
         "model_file": model_file,
         "length_unit": cal.model.length_unit,
@@ -90,7 +92,8 @@ def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: s
     """
     check_writable([model_path, comp_path], overwrite)
     doc = calibration_document(cal, Path(model_path).name, full_pose)
-    m = write_text(model_path, dumps_model(cal.model), overwrite=overwrite)
+    m = write_text(model_path, f"# written by zrp-accuracy {__version__}\n"
+                   + dumps_model(cal.model), overwrite=overwrite)
     c = write_text(comp_path, dumps(doc), overwrite=overwrite)
     return m, c
 

@@ -21,6 +21,7 @@ from zrp.cli import commands
 from zrp.cli.signals import handling
 from zrp.errors import OutputExistsError, ZRPError
 from zrp.jsonio import dumps
+from zrp.packages import PackageShadowedError, check_own_packages
 
 __all__ = ["API_TO_CLI", "build_parser", "cli_message", "emit", "main"]
 
@@ -79,6 +80,11 @@ def _interrupt(signum: int, frame: object) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    try:  # the commands import mjcf and sim: another package of either name must not shadow them
+        check_own_packages()
+    except PackageShadowedError as exc:
+        print(f"zrp: error: {exc}", file=sys.stderr)
+        return 2
     parser = build_parser()
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):

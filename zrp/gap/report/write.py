@@ -18,6 +18,7 @@ from zrp.gap.report.plots import DPI, PLOT_FILES, figures, withheld_rows
 from zrp.gap.report.verdict import verdict_text
 from zrp.gap.results import Diagnosis
 from zrp.output import OutputDir
+from zrp.version import __version__
 
 __all__ = ["OUTPUT_FILES", "diagnosis_document", "residuals_csv", "write_outputs"]
 
@@ -27,9 +28,10 @@ OUTPUT_FILES = ("diagnosis.json", "report.md", "report.html", "residuals.csv", *
 
 
 def diagnosis_document(diag: Diagnosis) -> dict[str, Any]:
-    """The diagnosis.json document: :meth:`Diagnosis.to_dict` with the verdict in plain words
-    (:func:`verdict_text`) after ``unexplained``."""
-    out: dict[str, Any] = {}
+    """The diagnosis.json document: the toolkit's version (``zrp_version``), then
+    :meth:`Diagnosis.to_dict` with the verdict in plain words (:func:`verdict_text`) after
+    ``unexplained``."""
+    out: dict[str, Any] = {"zrp_version": __version__}
     for key, value in diag.to_dict().items():
         out[key] = value
         if key == "unexplained":
