@@ -131,13 +131,13 @@ def test_benchmark_coverage_counts_effect_wide_intervals():
     effect-wide ones counts as a marginal miss only."""
     from sim.robot.effects import HiddenEffects
     from sim.studies.benchmark.coverage import interval_coverage
+    from zrp.gap.results import ParameterEstimate
 
     eff = HiddenEffects(cyclic_error={2: (1, 1e-4, 0.0)})
-    doc = {"final": {"parameters": [
-        {"name": "q2.sin1", "effect": "cyclic_error", "value": 1.0e-4, "ci95": [0.9e-4, 1.1e-4],
-         "ci95_effect": [0.85e-4, 1.15e-4]},
-        {"name": "q2.cos1", "effect": "cyclic_error", "value": 1.2e-5, "ci95": [2e-6, 2.2e-5],
-         "ci95_effect": [-1e-6, 2.5e-5]}]}}
+    doc = (ParameterEstimate("q2.sin1", "cyclic_error", 2, "rad", 1.0e-4, 1e-5,
+                             (0.9e-4, 1.1e-4), (0.85e-4, 1.15e-4)),
+           ParameterEstimate("q2.cos1", "cyclic_error", 2, "rad", 1.2e-5, 5e-6,
+                             (2e-6, 2.2e-5), (-1e-6, 2.5e-5)))
     c, n, miss = interval_coverage(eff, ("cyclic_error",), doc)
     assert (c, n) == (1, 2) and miss[0].startswith("q2.cos1: true 0 not in")
     c, n, miss = interval_coverage(eff, ("cyclic_error",), doc, "ci95_effect")

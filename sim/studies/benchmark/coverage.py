@@ -20,9 +20,10 @@ are built for exactly that statement.
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Sequence
 
 from sim.robot.effects import HiddenEffects
+from zrp.gap.results import ParameterEstimate
 
 __all__ = ["COMPARABLE", "interval_coverage", "true_values"]
 
@@ -56,28 +57,28 @@ def true_values(eff: HiddenEffects, effect: str) -> dict[str, float]:
 
 
 def interval_coverage(eff: HiddenEffects, hidden: tuple[str, ...],
-                      diagnosis: dict[str, Any], key: str = "ci95"
+                      parameters: Sequence[ParameterEstimate], key: str = "ci95"
                       ) -> tuple[int, int, list[str]]:
-    """(covered, compared, misses) over the final parameters of the hidden effects; a miss
-    reads "name: true x not in [lo, hi]". ``key``: ``"ci95"`` (each parameter's 95 %
-    interval) or ``"ci95_effect"`` (the simultaneous 95 % intervals of the whole effect)."""
+    """(covered, compared, misses) over ``parameters``, the final model's (a diagnosis's
+    ``final_parameters``), for the hidden effects; a miss reads "name: true x not in [lo, hi]".
+    ``key``: ``"ci95"`` (each parameter's 95 % interval) or ``"ci95_effect"`` (the
+    simultaneous 95 % intervals of the whole effect)."""
     covered, total, misses = 0, 0, []
-    params = diagnosis.get("final", {}).get("parameters", [])
     for effect in hidden:
         if effect not in COMPARABLE:
             continue
         truth = true_values(eff, effect)
-        for p in params:
-            if p.get("effect") != effect or p.get(key) is None:
+        for p in parameters:
+            interval = getattr(p, key)
+            if p.effect != effect or interval is None:
                 continue
-            name = p["name"]
-            if effect == "joint_compliance" and not name.endswith(".compliance"):
+            if effect == "joint_compliance" and not p.name.endswith(".compliance"):
                 continue  # the payload terms: their truth depends on the unknown payload
-            lo, hi = p[key]
-            t = truth.get(name, 0.0)
+            lo, hi = interval
+            t = truth.get(p.name, 0.0)
             total += 1
             if lo <= t <= hi:
                 covered += 1
             else:
-                misses.append(f"{name}: true {t:.3g} not in [{lo:.3g}, {hi:.3g}]")
+                misses.append(f"{p.name}: true {t:.3g} not in [{lo:.3g}, {hi:.3g}]")
     return covered, total, misses

@@ -298,9 +298,9 @@ def _note(t: _Truth, diag: DiagnosisRecord, found: tuple[str, ...], tied: tuple[
 
 def _coverage(t: _Truth, diag: DiagnosisRecord) -> dict[str, Any]:
     """The interval-coverage columns (:mod:`sim.studies.benchmark.coverage`)."""
-    doc = {"final": {"parameters": [p.to_dict() for p in diag.final_parameters]}}
-    covered, compared, misses = interval_coverage(t.eff, t.hidden, doc)
-    eff_cov, eff_cmp, _ = interval_coverage(t.eff, t.hidden, doc, "ci95_effect")
+    params = diag.final_parameters
+    covered, compared, misses = interval_coverage(t.eff, t.hidden, params)
+    eff_cov, eff_cmp, _ = interval_coverage(t.eff, t.hidden, params, "ci95_effect")
     return {"ci_covered": covered, "ci_compared": compared, "ci_misses": misses,
             "ci_effect_all": bool(eff_cmp and eff_cov == eff_cmp)}
 
