@@ -7,15 +7,15 @@ import ast
 import re
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[2]
-PACKAGES = ("zrp", "mjcf", "sim")
+from tests.contracts.test_architecture import ROOT, project_modules
+
 ALIASES = {"F64", "I64", "U8"}
 # a conversion written the other way round: <thing>_to_<thing>, e.g. er_to_matrix, deg_to_rad
 TO_STYLE = re.compile(r"^[a-z0-9]+_to_(matrix|rotvec|er|quat|scipy_quat|rad|deg|mm|m|axis_angle)$")
 
 
 def _modules() -> list[Path]:
-    return sorted(p for pkg in PACKAGES for p in (ROOT / pkg).rglob("*.py"))
+    return [path for _, path in project_modules()]
 
 
 def alias_definitions(source: str) -> list[str]:
