@@ -249,7 +249,8 @@ def write_outputs(result: BenchmarkResult, out: str | os.PathLike[str] | OutputD
     if isinstance(out, OutputDir):
         return _write_all(result, out, plots)
     try:
-        with OutputDir(out, overwrite=overwrite, names=output_names(plots)) as folder:
+        # every file it may write is checked, and an earlier run's plot removed without plots
+        with OutputDir(out, overwrite=overwrite, names=output_names(True), prune=True) as folder:
             return _write_all(result, folder, plots)
     except OutputExistsError as exc:
         if not exc.paths:

@@ -64,7 +64,8 @@ def _run(args: argparse.Namespace) -> int:
     out_dir = Path(args.out)
     created = not out_dir.exists()
     try:
-        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES + FILES) as out:
+        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES + FILES,
+                       prune=True) as out:
             diag = diagnose(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, max_steps=args.max_steps, noise_sigma=args.noise,
                             use_orientation=not args.no_orientation,
@@ -75,9 +76,11 @@ def _run(args: argparse.Namespace) -> int:
                 full = full_pose_calibration(diag, args.orientation_sigma)
                 cal = full.robot
             files = write_outputs(diag, out, plots=False)
-            files += list(write_calibration(cal, out_dir / FILES[0], out_dir / FILES[1],
-                                            overwrite=True,
-                                            full_pose=None if full is None else full.fit))
+            cal_files = list(write_calibration(cal, out_dir / FILES[0], out_dir / FILES[1],
+                                               overwrite=True,
+                                               full_pose=None if full is None else full.fit))
+            out.written += cal_files  # this run's (the folder's prune keeps them)
+            files += cal_files
     except BaseException:
         if created:
             with contextlib.suppress(OSError):

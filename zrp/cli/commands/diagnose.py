@@ -132,7 +132,7 @@ def _run(args: argparse.Namespace) -> int:
     try:
         # the folder is this run's from here on: existing outputs are refused before the
         # computation, and a concurrent run into the same folder is refused, never mixed in
-        with (OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES) as out,
+        with (OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES, prune=True) as out,
               one_line_warnings("zrp diagnose")):
             diag = run_diagnosis(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, withheld_fraction=args.withheld, folds=args.folds,

@@ -102,7 +102,7 @@ def _run(args: argparse.Namespace) -> int:
                           reflectors=args.reflectors)
     model = load_model(args.model)
     # the folder is locked and its files checked before the (long) run
-    with OutputDir(out, overwrite=overwrite, names=output_names(not args.no_plots)) as folder:
+    with OutputDir(out, overwrite=overwrite, names=output_names(True), prune=True) as folder:
         # the work folder must be visible to the workers (same path on a remote cluster)
         with executor_from_args(args) as ex:
             result = run_benchmark(model, cfg, work, progress=not args.no_progress, executor=ex,

@@ -90,7 +90,13 @@ def _header(diag: Diagnosis) -> list[str]:
             f"geometric calibration), {s['folds']} cross-validation folds.\n"]
 
 
-def _shrink(diag: Diagnosis) -> list[str]:
+#: the figures report.md shows (file, alt text), when the plots are written beside it
+FIGURES = (("shrink.png", "shrink"), ("residuals_before_after.png", "residuals"),
+           ("residual_vs_joint.png", "residual vs joint"), ("residual_map.png", "workspace"),
+           ("correlation.png", "correlation"))
+
+
+def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
     u, nf, nom = diag.length_unit, diag.noise_floor, diag.nominal
     L = ["## How far the gap shrinks (withheld poses)\n",
          f"| step | effect | joints | RMS ({u}) | p95 ({u}) | max ({u}) | CV RMS ({u}) "
@@ -136,9 +142,9 @@ def _shrink(diag: Diagnosis) -> list[str]:
                  + (" Distances between rigidly linked points measure the instrument's noise "
                     "only; the robot's repeatability adds to it, so the attainable floor is "
                     "somewhat higher." if nf.method == "rigid_links" else ""))
-    L += ["\n![shrink](shrink.png)\n", "![residuals](residuals_before_after.png)\n",
-          "![residual vs joint](residual_vs_joint.png)\n", "![workspace](residual_map.png)\n",
-          "![correlation](correlation.png)\n"]
+    if figures:
+        L.append("")
+        L += [f"![{alt}]({name})\n" for name, alt in FIGURES]
     return L
 
 
@@ -364,11 +370,11 @@ def _full_pose(diag: Diagnosis) -> list[str]:
     return L
 
 
-def report_markdown(diag: Diagnosis) -> str:
-    """The text of report.md."""
+def report_markdown(diag: Diagnosis, *, figures: bool = True) -> str:
+    """The text of report.md (linking the plots beside it when ``figures``)."""
     u = diag.length_unit
-    L = (_header(diag) + _shrink(diag) + _parameters(diag) + _full_pose(diag) + _trust(diag)
-         + _ranking(diag) + _aliasing(diag) + _where(diag.where.nominal, u))
+    L = (_header(diag) + _shrink(diag, figures) + _parameters(diag) + _full_pose(diag)
+         + _trust(diag) + _ranking(diag) + _aliasing(diag) + _where(diag.where.nominal, u))
     if diag.where.after_final_model is not None:
         L += _remains(diag.where.after_final_model, u)
     if diag.warnings:

@@ -67,7 +67,7 @@ def _write(diag: Diagnosis, out: OutputDir, plots: bool) -> list[Path]:
             buf = io.BytesIO()
             fig.savefig(buf, format="svg", dpi=DPI)
             svgs[name] = buf.getvalue()
-    md = report_markdown(diag)
+    md = report_markdown(diag, figures=plots)
     out.write_text("report.md", md)
     out.write_text("report.html", report_html(md, svgs, f"Gap diagnosis: {diag.model_name}"))
     return out.written[first:]
@@ -82,7 +82,8 @@ def write_outputs(diag: Diagnosis, out_dir: str | os.PathLike[str] | OutputDir, 
         out_dir: the folder, or an :class:`~zrp.output.OutputDir` the caller has entered
             (then its own ``overwrite`` policy applies, and it should have checked
             :data:`OUTPUT_FILES` on entry).
-        overwrite: replace files that exist (for a folder path).
+        overwrite: replace files that exist (for a folder path); the plots of an earlier
+            run are removed when this one makes none (``prune``, :class:`~zrp.output.OutputDir`).
 
     Returns:
         the paths written, in order.
@@ -94,5 +95,5 @@ def write_outputs(diag: Diagnosis, out_dir: str | os.PathLike[str] | OutputDir, 
     """
     if isinstance(out_dir, OutputDir):
         return _write(diag, out_dir, plots)
-    with OutputDir(out_dir, overwrite=overwrite, names=OUTPUT_FILES) as out:
+    with OutputDir(out_dir, overwrite=overwrite, names=OUTPUT_FILES, prune=True) as out:
         return _write(diag, out, plots)
