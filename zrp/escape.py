@@ -32,9 +32,13 @@ __all__ = ["csv_cell", "file_href", "html_text", "md_text", "md_unescape", "one_
 
 #: control characters (C0, DEL, C1) and the Unicode line and paragraph separators
 _CONTROL = re.compile(r"[\x00-\x1f\x7f-\x9f\u2028\u2029]")
-#: characters with a meaning in Markdown (CommonMark's ASCII punctuation that can start or
-#: end structure) or HTML; each is backslash-escaped by :func:`md_text`
-_MD_SPECIAL = re.compile(r"([\\`*_{}\[\]<>()#+\-!|~&$])")
+#: characters with a meaning in Markdown anywhere in a line (emphasis, code, links, tables,
+#: strikethrough, raw HTML, entities); each is backslash-escaped by :func:`md_text`
+_MD_SPECIAL = re.compile(r"([\\`*\[\]<>|~#&{}])")
+#: an underscore that can open or close emphasis (one inside a word, snake_case, cannot)
+_MD_UNDERSCORE = re.compile(r"(?<![A-Za-z0-9])_|_(?![A-Za-z0-9])")
+#: what starts a block when it begins a line: a list item, a numbered item, a setext line
+_MD_LINE_START = re.compile(r"^([-+=]|\d+(?=[.)]))")
 _MD_ESCAPED = re.compile(r"\\([!-/:-@\[-`{-~])")
 #: first characters that make a spreadsheet run a cell as a formula
 _FORMULA_START = ("=", "+", "-", "@", "\t", "\r")
@@ -47,8 +51,15 @@ def one_line(text: object) -> str:
 
 
 def md_text(text: object) -> str:
-    """``text`` as inert Markdown inline text (one line, punctuation backslash-escaped)."""
-    return _MD_SPECIAL.sub(r"\\\1", one_line(text))
+    """``text`` as inert Markdown inline text: one line, each character with a meaning in
+    Markdown or HTML backslash-escaped (``snake_case`` and ``q6.offset`` read as written)."""
+    s = _MD_UNDERSCORE.sub(r"\\_", _MD_SPECIAL.sub(r"\\\1", one_line(text)))
+    m = _MD_LINE_START.match(s)
+    if m is None:
+        return s
+    if m.group(1).isdigit():  # "1." would start a numbered list: escape the full stop
+        return s[:m.end()] + "\\" + s[m.end():]
+    return "\\" + s
 
 
 def md_unescape(text: str) -> str:
@@ -85,7 +96,7 @@ def csv_cell(value: object) -> object:
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         return value
     text = str(value).replace("\r\n", " ").replace("\n", " ").replace("\r", " ")
-    if text.startswith(_FORMULA_START):
+    if len(text) > 1 and text.startswith(_FORMULA_START):  # a lone "-" is no formula
         try:
             if math.isfinite(float(text)):
                 return text

@@ -10,7 +10,7 @@ import numpy as np
 
 from zrp.arguments import check_float, check_int
 from zrp.errors import InputError
-from zrp.gap.model.context import EFFECTS
+from zrp.gap.model.choices import EFFECTS
 
 __all__ = ["MAX_WITHHELD", "DiagnosisOptions"]
 

@@ -8,6 +8,7 @@ from pathlib import Path
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
+from zrp.escape import md_text
 from zrp.gap.model.context import EFFECTS
 from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
 from zrp.jsonio import dumps
@@ -97,7 +98,7 @@ def _run(args: argparse.Namespace) -> int:
 def _report(diag: object) -> str:
     d = diag  # MotionDiagnosis
     u = d.length_unit  # type: ignore[attr-defined]
-    lines = ["# Motion diagnosis", "", d.verdict, "",  # type: ignore[attr-defined]
+    lines = ["# Motion diagnosis", "", " ".join(d.verdict.split()), "",  # type: ignore[attr-defined]
              f"| phase | samples | RMS before ({u}) | after | withheld before | after |",
              "|---|---|---|---|---|---|"]
     for p in d.phases:  # type: ignore[attr-defined]
@@ -108,5 +109,5 @@ def _report(diag: object) -> str:
     lines += ["", "| parameter | value | 95 % interval |", "|---|---|---|"]
     for e in d.parameters:  # type: ignore[attr-defined]
         lo, hi = e.ci95
-        lines.append(f"| {e.name} | {e.value:.4g} {e.unit} | [{lo:.4g}, {hi:.4g}] |")
+        lines.append(f"| {md_text(e.name)} | {e.value:.4g} {e.unit} | [{lo:.4g}, {hi:.4g}] |")
     return "\n".join(lines) + "\n"

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from zrp.escape import csv_cell
 from zrp.gap.report.html import report_html
 from zrp.gap.report.markdown import report_markdown
 from zrp.gap.report.plots import DPI, PLOT_FILES, figures, withheld_rows
@@ -50,7 +51,7 @@ def residuals_csv(diag: Diagnosis) -> str:
     w.writerow(["line", "pose", "point", "before_x", "before_y", "before_z", "before_norm",
                 "after_x", "after_y", "after_z", "after_norm"])
     for i, r in enumerate(withheld_rows(diag)):
-        w.writerow([int(meas.lines[r]), meas.pose[r], meas.point[r],
+        w.writerow([int(meas.lines[r]), csv_cell(meas.pose[r]), csv_cell(meas.point[r]),
                     *(f"{v:.6g}" for v in rb[i]), f"{np.linalg.norm(rb[i]):.6g}",
                     *(f"{v:.6g}" for v in ra[i]), f"{np.linalg.norm(ra[i]):.6g}"])
     return buf.getvalue()
