@@ -6,15 +6,13 @@ from __future__ import annotations
 import argparse
 import contextlib
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from zrp.calibration import CalibratedRobot, write_calibration
-from zrp.calibration.fullpose import FullPoseCalibration, full_pose_calibration
-from zrp.calibration.storage import calibration_document
+if TYPE_CHECKING:
+    from zrp.calibration.fullpose import FullPoseCalibration
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, real, whole
-from zrp.gap import diagnose, load_measurements
-from zrp.gap.model.context import EFFECTS
-from zrp.gap.report import OUTPUT_FILES, write_outputs
+from zrp.gap.model.choices import EFFECTS
 from zrp.model.files import load_model
 from zrp.output import OutputDir
 
@@ -57,6 +55,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s): only when this command runs
     from mjcf.gravity import gravity_torques
+    from zrp.calibration import CalibratedRobot, write_calibration
+    from zrp.calibration.fullpose import full_pose_calibration
+    from zrp.calibration.storage import calibration_document
+    from zrp.gap import diagnose, load_measurements
+    from zrp.gap.report import OUTPUT_FILES, write_outputs
 
     model = load_model(args.model)
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)

@@ -6,9 +6,6 @@ import argparse
 
 import numpy as np
 
-from zrp.calibration import PoseConditions, compensate_program, read_calibration
-from zrp.calibration import compensate as compensate_targets
-from zrp.calibration.targets import load_targets, write_commands
 from zrp.cli.app import emit
 from zrp.cli.options import real
 from zrp.errors import InputError
@@ -63,6 +60,10 @@ def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.calibration import PoseConditions, compensate_program, read_calibration
+    from zrp.calibration import compensate as compensate_targets
+    from zrp.calibration.targets import load_targets, write_commands
+
     check_writable([args.out], args.force)
     cal = read_calibration(args.calibration)
     tg = load_targets(args.targets, cal.n, deg=args.deg)

@@ -14,13 +14,10 @@ from zrp.cli.app import emit
 from zrp.cli.fleet import add_fleet_options, is_fleet, refuse_fleet_options, run_fleet
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
-from zrp.gap import diagnose as run_diagnosis
-from zrp.gap import load_measurements
 from zrp.gap.data.csvfile import MAX_ROWS
 from zrp.gap.data.subsample import MAX_POINTS
-from zrp.gap.model.context import EFFECTS
+from zrp.gap.model.choices import EFFECTS
 from zrp.gap.options import MAX_WITHHELD
-from zrp.gap.report import OUTPUT_FILES, diagnosis_document, verdict_text, write_outputs
 from zrp.model.files import load_model
 from zrp.output import OutputDir
 
@@ -114,6 +111,9 @@ def one_line_warnings(prog: str) -> Iterator[None]:
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s measured): only when this command runs, not for every `zrp`.
     from mjcf.gravity import gravity_torques
+    from zrp.gap import diagnose as run_diagnosis
+    from zrp.gap import load_measurements
+    from zrp.gap.report import OUTPUT_FILES, diagnosis_document, verdict_text, write_outputs
 
     if args.max_steps < 1:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")

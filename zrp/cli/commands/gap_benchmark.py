@@ -16,7 +16,7 @@ DEFAULT_OUT = "renders/gap_benchmark"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from zrp.gap.model.context import EFFECTS as EFFECT_NAMES  # light: no MuJoCo at parser build
+    from zrp.gap.model.choices import EFFECTS as EFFECT_NAMES  # light: no SciPy, numba
 
     p = sub.add_parser(
         "gap-benchmark", help="blind benchmark of the gap diagnosis on simulated robots",

@@ -11,16 +11,12 @@ import numpy as np
 from zrp.cli.app import emit
 from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, real, whole
 from zrp.errors import InputError, ZRPWarning
-from zrp.kinematics.forward import forward_kinematics
-from zrp.kinematics.ik import CORRECTIONS, track_trajectory
-from zrp.kinematics.posture import solve_pose
-from zrp.kinematics.redundant import track_posture
+from zrp.kinematics.choices import CORRECTIONS
 from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
 from zrp.model.files import builtin_models, load_model
 from zrp.model.manipulator import MAX_LENGTH, Manipulator
 from zrp.output import check_writable, claim_generated
-from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM, is_paper_model
-from zrp.rotations.rodrigues import er_angle
+from zrp.paper.choices import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM
 
 
 def _joint_values(model: Manipulator, values: list[float], rad: bool, name: str) -> np.ndarray:
@@ -106,6 +102,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _fk(args: argparse.Namespace) -> int:
+    from zrp.kinematics.forward import forward_kinematics
+    from zrp.rotations.rodrigues import er_angle
+
     model = load_model(args.model)
     q = _joint_values(model, args.q, args.rad, "--q")
     fk = forward_kinematics(model, q)
@@ -128,6 +127,11 @@ def _fk(args: argparse.Namespace) -> int:
 
 
 def _ik(args: argparse.Namespace) -> int:
+    from zrp.kinematics.forward import forward_kinematics
+    from zrp.kinematics.ik import track_trajectory
+    from zrp.kinematics.redundant import track_posture
+    from zrp.paper.scenario import is_paper_model
+
     model = load_model(args.model)
     if args.q0 is None:
         if not is_paper_model(model):
@@ -186,6 +190,8 @@ def _ik(args: argparse.Namespace) -> int:
 
 
 def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> int:
+    from zrp.kinematics.posture import solve_pose
+
     sol = solve_pose(model, np.array(args.target), args.target_er, q0=q0)
     s = sol.summary()
     s["joint_names"] = list(model.joint_names)

@@ -11,9 +11,7 @@ import numpy as np
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, real, whole
 from zrp.errors import InputError
-from zrp.gap.motion import write_trajectory
 from zrp.jsonio import dumps
-from zrp.kinematics import reachable_poses
 from zrp.model.files import builtin_models, load_model
 from zrp.output import check_writable, write_text
 from zrp.units import TRACKER_NOISE_MM, units_per_mm
@@ -79,6 +77,7 @@ def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo (+0.1-0.2 s measured): only when this command runs, not for every `zrp`.
     import sim
     from sim.studies.trajectories import circle_poses  # with sim, for the same reason
+    from zrp.kinematics import reachable_poses
 
     if args.poses < 8:
         raise InputError(f"--poses: expected at least 8 poses, got {args.poses}")
@@ -124,6 +123,7 @@ def _run(args: argparse.Namespace) -> int:
 def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> int:
     """``--stream``: the real robot in motion (sim/studies/trajectories.py)."""
     from sim.studies.trajectories import measure_stream  # MuJoCo: only when this command runs
+    from zrp.gap.motion import write_trajectory
 
     if args.effect:
         raise InputError("--effect: static effects are not simulated with --stream; use "

@@ -9,8 +9,8 @@ from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
 from zrp.escape import md_text
-from zrp.gap.model.context import EFFECTS
-from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
+from zrp.gap.model.choices import EFFECTS
+from zrp.gap.motion.choices import MOTION_EFFECTS
 from zrp.jsonio import dumps
 from zrp.model.files import load_model
 from zrp.output import OutputDir, check_writable
@@ -72,6 +72,8 @@ def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[obje
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.gap.motion import diagnose_motion, load_trajectory
+
     model = load_model(args.model)
     if args.video:
         check_writable([args.video], args.force)  # before the work

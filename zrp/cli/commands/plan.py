@@ -9,11 +9,10 @@ import warnings
 
 import numpy as np
 
-from zrp.calibration import plan_poses
 from zrp.cli.app import emit
 from zrp.cli.options import FINITE, LENGTH, SEED, whole
 from zrp.errors import InputError
-from zrp.gap.model.context import EFFECTS
+from zrp.gap.model.choices import EFFECTS
 from zrp.model.files import load_model
 from zrp.output import check_writable, write_text
 
@@ -65,6 +64,8 @@ def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.calibration import plan_poses
+
     check_writable([args.out], args.force)
     model = load_model(args.model)
     with warnings.catch_warnings(record=True) as wl:

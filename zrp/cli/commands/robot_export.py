@@ -10,7 +10,6 @@ from zrp.cli.app import emit
 from zrp.model.dh_table import dumps_dh, to_dh
 from zrp.model.files import builtin_models, dumps_model, load_model
 from zrp.model.manipulator import Manipulator
-from zrp.model.urdf_writer import urdf_xml
 from zrp.output import check_writable, write_text
 
 FORMATS = {"urdf": ".urdf", "mjcf": ".xml", "dh": ".dh.toml", "mdh": ".mdh.toml",
@@ -37,6 +36,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _text(model: Manipulator, fmt: str) -> str:
+    from zrp.model.urdf_writer import urdf_xml
+
     if fmt == "urdf":
         return urdf_xml(model)
     if fmt in ("dh", "mdh"):
