@@ -5,10 +5,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
-import warnings
-from collections.abc import Iterator
 from pathlib import Path
-from typing import TextIO
 
 from zrp.cli.app import emit
 from zrp.cli.fleet import add_fleet_options, is_fleet, refuse_fleet_options, run_fleet
@@ -89,25 +86,6 @@ def register(sub: argparse._SubParsersAction) -> None:
     })
 
 
-@contextlib.contextmanager
-def one_line_warnings(prog: str) -> Iterator[None]:
-    """Print each warning as one clean line ``prog: warning: message`` on stderr (not Python's
-    file:line plus source line), each distinct message once."""
-    seen: set[str] = set()
-
-    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
-             file: TextIO | None = None, line: str | None = None) -> None:
-        text = " ".join(str(message).split())
-        if text not in seen:
-            seen.add(text)
-            print(f"{prog}: warning: {text}", file=sys.stderr if file is None else file)
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("always")
-        warnings.showwarning = show
-        yield
-
-
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s measured): only when this command runs, not for every `zrp`.
     from mjcf.gravity import gravity_torques
@@ -132,8 +110,7 @@ def _run(args: argparse.Namespace) -> int:
     try:
         # the folder is this run's from here on: existing outputs are refused before the
         # computation, and a concurrent run into the same folder is refused, never mixed in
-        with (OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES, prune=True) as out,
-              one_line_warnings("zrp diagnose")):
+        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES, prune=True) as out:
             diag = run_diagnosis(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, withheld_fraction=args.withheld, folds=args.folds,
                             alpha=args.alpha, max_steps=args.max_steps, noise_sigma=args.noise,
