@@ -55,11 +55,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s): only when this command runs
     from mjcf.gravity import gravity_torques
-    from zrp.calibration import CalibratedRobot, write_calibration
-    from zrp.calibration.fullpose import full_pose_calibration
-    from zrp.calibration.storage import calibration_document
-    from zrp.gap import diagnose, load_measurements
-    from zrp.gap.report import OUTPUT_FILES, write_outputs
+    from zrp.calibration import CalibratedRobot, write_calibration  # on use: keeps --help quick
+    from zrp.calibration.fullpose import full_pose_calibration  # on use: keeps --help quick
+    from zrp.calibration.storage import calibration_document  # on use: keeps --help quick
+    from zrp.gap import diagnose, load_measurements  # on use: keeps --help quick
+    from zrp.gap.report import OUTPUT_FILES, write_outputs  # on use: keeps --help quick
 
     model = load_model(args.model)
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)

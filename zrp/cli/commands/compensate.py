@@ -60,9 +60,13 @@ def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from zrp.calibration import PoseConditions, compensate_program, read_calibration
-    from zrp.calibration import compensate as compensate_targets
-    from zrp.calibration.targets import load_targets, write_commands
+    from zrp.calibration import (  # on use: keeps --help quick
+        PoseConditions,
+        compensate_program,
+        read_calibration,
+    )
+    from zrp.calibration import compensate as compensate_targets  # on use: keeps --help quick
+    from zrp.calibration.targets import load_targets, write_commands  # on use: keeps --help quick
 
     check_writable([args.out], args.force)
     cal = read_calibration(args.calibration)

@@ -89,9 +89,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s measured): only when this command runs, not for every `zrp`.
     from mjcf.gravity import gravity_torques
-    from zrp.gap import diagnose as run_diagnosis
-    from zrp.gap import load_measurements
-    from zrp.gap.report import OUTPUT_FILES, diagnosis_document, verdict_text, write_outputs
+    from zrp.gap import diagnose as run_diagnosis  # on use: keeps --help quick
+    from zrp.gap import load_measurements  # on use: keeps --help quick
+    from zrp.gap.report import (  # on use: keeps --help quick
+        OUTPUT_FILES,
+        diagnosis_document,
+        verdict_text,
+        write_outputs,
+    )
 
     if args.max_steps < 1:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")

@@ -102,8 +102,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _fk(args: argparse.Namespace) -> int:
-    from zrp.kinematics.forward import forward_kinematics
-    from zrp.rotations.rodrigues import er_angle
+    from zrp.kinematics.forward import forward_kinematics  # on use: keeps --help quick
+    from zrp.rotations.rodrigues import er_angle  # on use: keeps --help quick
 
     model = load_model(args.model)
     q = _joint_values(model, args.q, args.rad, "--q")
@@ -127,10 +127,10 @@ def _fk(args: argparse.Namespace) -> int:
 
 
 def _ik(args: argparse.Namespace) -> int:
-    from zrp.kinematics.forward import forward_kinematics
-    from zrp.kinematics.ik import track_trajectory
-    from zrp.kinematics.redundant import track_posture
-    from zrp.paper.scenario import is_paper_model
+    from zrp.kinematics.forward import forward_kinematics  # on use: keeps --help quick
+    from zrp.kinematics.ik import track_trajectory  # on use: keeps --help quick
+    from zrp.kinematics.redundant import track_posture  # on use: keeps --help quick
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
 
     model = load_model(args.model)
     if args.q0 is None:
@@ -190,7 +190,7 @@ def _ik(args: argparse.Namespace) -> int:
 
 
 def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> int:
-    from zrp.kinematics.posture import solve_pose
+    from zrp.kinematics.posture import solve_pose  # on use: keeps --help quick
 
     sol = solve_pose(model, np.array(args.target), args.target_er, q0=q0)
     s = sol.summary()

@@ -72,7 +72,7 @@ def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[obje
 
 
 def _run(args: argparse.Namespace) -> int:
-    from zrp.gap.motion import diagnose_motion, load_trajectory
+    from zrp.gap.motion import diagnose_motion, load_trajectory  # on use: keeps --help quick
 
     model = load_model(args.model)
     if args.video:

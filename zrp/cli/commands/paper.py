@@ -60,7 +60,7 @@ _TRAJECTORY_DEFAULTS = {"joints": None, "q0": None, "radius": 125.0, "normal": N
 def _named_circle(args: argparse.Namespace, model: Manipulator) -> str | None:
     """The named circle to run ("default" / "recovered"), or None for a custom trajectory;
     --circle with trajectory options or another model is an error naming them."""
-    from zrp.paper.scenario import is_paper_model
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
 
     custom = [f"--{k.replace('_', '-')}" for k, v in _TRAJECTORY_DEFAULTS.items()
               if getattr(args, k) != v]
@@ -75,8 +75,8 @@ def _named_circle(args: argparse.Namespace, model: Manipulator) -> str | None:
 
 def _video_name(args: argparse.Namespace, model: Manipulator) -> str | None:
     """The video's file name (.mp4, or .gif without ffmpeg), or None when none is made."""
-    from zrp.paper.scenario import is_paper_model
-    from zrp.paper.scenes import paper_video_file_name
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
+    from zrp.paper.scenes import paper_video_file_name  # on use: keeps --help quick
 
     if args.no_video or not is_paper_model(model):
         return None
@@ -89,7 +89,7 @@ def _video_name(args: argparse.Namespace, model: Manipulator) -> str | None:
 def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
            model: Manipulator, circle: str) -> dict[str, Any]:
     """Render the nominal-vs-perturbed video of the paper's circle into the locked folder."""
-    from zrp.paper.scenes import paper_video_scene
+    from zrp.paper.scenes import paper_video_scene  # on use: keeps --help quick
 
     if args.no_video:
         return {"status": "skipped (--no-video)"}
@@ -113,8 +113,8 @@ def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
 def _compute(args: argparse.Namespace, model: Manipulator, out: OutputDir
              ) -> tuple[PaperExample, list[Path], float]:
     """IK, study, comparison and claims, written into the (checked and locked) folder."""
-    from zrp.paper.example import run_paper_example
-    from zrp.paper.report import write_paper_outputs
+    from zrp.paper.example import run_paper_example  # on use: keeps --help quick
+    from zrp.paper.report import write_paper_outputs  # on use: keeps --help quick
 
     t0 = time.perf_counter()
     circle = _named_circle(args, model)
@@ -188,7 +188,7 @@ def _claims_lines(ch: dict[str, Any]) -> list[str]:
 
 
 def _paper(args: argparse.Namespace) -> int:
-    from zrp.paper.report import output_names
+    from zrp.paper.report import output_names  # on use: keeps --help quick
 
     out, overwrite = _output_folder(args)
     model = load_model(args.model)

@@ -64,7 +64,7 @@ def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from zrp.calibration import plan_poses
+    from zrp.calibration import plan_poses  # on use: keeps --help quick
 
     check_writable([args.out], args.force)
     model = load_model(args.model)

@@ -32,8 +32,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from zrp.paper.inverse import local_pinning, recover_circle
-    from zrp.paper.placement import CELL_LABELS
+    from zrp.paper.inverse import local_pinning, recover_circle  # on use: keeps --help quick
+    from zrp.paper.placement import CELL_LABELS  # on use: keeps --help quick
 
     for name in ("popsize", "maxiter", "starts"):
         if getattr(args, name) < 1:

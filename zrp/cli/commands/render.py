@@ -74,7 +74,11 @@ def _result(r: Any) -> dict[str, Any]:
 def _videos(args: argparse.Namespace, video_options: type[VideoOptions]
             ) -> list[tuple[Scene, VideoOptions]]:
     """The paper video's scene and options, and the teaching sweep's under ``--sweep``."""
-    from zrp.paper.scenes import PAPER_LEVELS, paper_video_scene, teaching_sweep_scene
+    from zrp.paper.scenes import (  # on use: keeps --help quick
+        PAPER_LEVELS,
+        paper_video_scene,
+        teaching_sweep_scene,
+    )
 
     opts = video_options(width=args.width, height=args.height, fps=args.fps,
                          seconds=args.seconds, magnify=args.magnify, format=args.format,

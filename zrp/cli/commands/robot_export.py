@@ -36,7 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _text(model: Manipulator, fmt: str) -> str:
-    from zrp.model.urdf_writer import urdf_xml
+    from zrp.model.urdf_writer import urdf_xml  # on use: keeps --help quick
 
     if fmt == "urdf":
         return urdf_xml(model)

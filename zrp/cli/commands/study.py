@@ -59,7 +59,7 @@ def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
 def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
     """Check the trajectory options against ``model`` before any work: --q0 has one value per
     joint, and is given for every model but the paper's PUMA (which has a default start)."""
-    from zrp.paper.scenario import is_paper_model
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
 
     if args.joints:
         return
@@ -77,8 +77,8 @@ def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
 
 def path_from_args(args: argparse.Namespace, model: Manipulator) -> JointPath:
     """The nominal joint trajectory the options describe."""
-    from zrp.manufacturing.study import load_joint_csv
-    from zrp.paper.scenario import circle_joint_path
+    from zrp.manufacturing.study import load_joint_csv  # on use: keeps --help quick
+    from zrp.paper.scenario import circle_joint_path  # on use: keeps --help quick
 
     check_path_options(args, model)
     if args.joints:
@@ -129,7 +129,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run_study(args: argparse.Namespace, model: Manipulator,
                out: OutputDir | None) -> tuple[JointPath, StudyResult]:
-    from zrp.manufacturing.study import one_at_a_time
+    from zrp.manufacturing.study import one_at_a_time  # on use: keeps --help quick
 
     path = path_from_args(args, model)
     st = one_at_a_time(model, path, args.params, args.xi, sign_zero_links=args.sign0_links,

@@ -115,7 +115,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _tolerance(args: argparse.Namespace) -> int:
-    from zrp.manufacturing.plots import check_png_path
+    from zrp.manufacturing.plots import check_png_path  # on use: keeps --help quick
 
     model = load_model(args.model)
     check_path_options(args, model)
@@ -163,8 +163,8 @@ def _allocate(args: argparse.Namespace, model: Manipulator, path: JointPath,
               ex: Executor | None) -> int:
     """--allocate: the loosest tolerances meeting the requirement, verified (the verification
     Monte Carlo runs on the executor)."""
-    from zrp.manufacturing.allocation import allocate_tolerances
-    from zrp.manufacturing.plots import histogram_png
+    from zrp.manufacturing.allocation import allocate_tolerances  # on use: keeps --help quick
+    from zrp.manufacturing.plots import histogram_png  # on use: keeps --help quick
 
     rng = np.random.default_rng(args.seed)
     u = model.length_unit
@@ -215,11 +215,17 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
     draws its robots from (--seed, i), so the result is the same in this process and on any
     number of workers. With --reduce (implied above GATHER_LIMIT robots) each chunk comes back
     as histograms: percentiles are known to their bin, extremes exactly."""
-    from zrp.manufacturing.budget import tolerance_report
-    from zrp.manufacturing.plots import histogram_png
-    from zrp.manufacturing.population import MonteCarloResult, monte_carlo
-    from zrp.manufacturing.reduction import MonteCarloSummary, monte_carlo_summary
-    from zrp.manufacturing.tolerance import Tolerances
+    from zrp.manufacturing.budget import tolerance_report  # on use: keeps --help quick
+    from zrp.manufacturing.plots import histogram_png  # on use: keeps --help quick
+    from zrp.manufacturing.population import (  # on use: keeps --help quick
+        MonteCarloResult,
+        monte_carlo,
+    )
+    from zrp.manufacturing.reduction import (  # on use: keeps --help quick
+        MonteCarloSummary,
+        monte_carlo_summary,
+    )
+    from zrp.manufacturing.tolerance import Tolerances  # on use: keeps --help quick
 
     u = model.length_unit
     offsets = args.offsets is not None

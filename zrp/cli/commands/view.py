@@ -29,7 +29,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo (and the viewer GLFW): only when this command runs
     import sim
-    from zrp.paper.scenes import paper_video_scene
+    from zrp.paper.scenes import paper_video_scene  # on use: keeps --help quick
 
     ok, why = sim.display_status()
     if not ok:

@@ -55,7 +55,7 @@ def add_fleet_options(p: argparse.ArgumentParser) -> None:
 
 
 def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[RobotTask]:
-    from zrp.cli.fleet.tasks import RobotTask
+    from zrp.cli.fleet.tasks import RobotTask  # on use: keeps --help quick
 
     model = load_model(args.model)
     names = [f.stem for f in files]
@@ -77,7 +77,7 @@ def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[Robot
 
 def _previous(tasks: list[RobotTask]) -> dict[str, dict[str, Any]]:
     """Rows of the robots an interrupted run finished."""
-    from zrp.cli.fleet.tasks import robot_row
+    from zrp.cli.fleet.tasks import robot_row  # on use: keeps --help quick
 
     done = {}
     for t in tasks:
@@ -91,7 +91,7 @@ def _diagnose_all(args: argparse.Namespace, todo: list[RobotTask]
                   ) -> tuple[list[dict[str, Any]], list[TaskFailure]]:
     from tqdm.auto import tqdm  # ~0.1 s (asyncio): only when a fleet runs
 
-    from zrp.cli.fleet.tasks import diagnose_robot
+    from zrp.cli.fleet.tasks import diagnose_robot  # on use: keeps --help quick
 
     rows: list[dict[str, Any]] = []
     failures: list[TaskFailure] = []
@@ -134,7 +134,7 @@ def _write_fleet(folder: OutputDir, args: argparse.Namespace, doc: dict[str, Any
 
 def run_fleet(args: argparse.Namespace) -> int:
     """The fleet run; exit code 1 when some robot could not be diagnosed (the rest was)."""
-    from zrp.gap.report import OUTPUT_FILES
+    from zrp.gap.report import OUTPUT_FILES  # on use: keeps --help quick
 
     files = _fleet_files(args)
     out = Path(args.out)
