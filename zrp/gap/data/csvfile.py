@@ -39,7 +39,6 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from tqdm import tqdm
 
 from zrp.arguments import check_int
 from zrp.arrays import F64
@@ -157,6 +156,8 @@ class _Reader:
 def _read(path: Path, src: str, model: Manipulator, progress: bool, max_rows: int | None
           ) -> tuple[list[str], Header, Columns]:
     """Stream the file once: the header, then each data row checked and appended."""
+    from tqdm import tqdm  # ~0.03 s: on use, so that `zrp diagnose --help` stays quick
+
     reader = _Reader(src, model, max_rows)
     bar = tqdm(desc=f"reading {path.name}", unit=" rows", disable=not progress,
                mininterval=1.0, leave=False)
