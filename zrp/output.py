@@ -42,7 +42,6 @@ from pathlib import Path
 from typing import Any
 
 from zrp.errors import InputError, OutputBusyError, OutputExistsError, OutputKindError
-from zrp.jsonio import dumps
 
 __all__ = [
     "GENERATED_MARK",
@@ -215,6 +214,8 @@ def write_bytes(path: str | os.PathLike[str], data: bytes, *, overwrite: bool = 
 def write_json(path: str | os.PathLike[str], obj: Any, *, overwrite: bool = False,
                indent: int | None = 2) -> Path:
     """Write ``obj`` as strict JSON (:func:`zrp.jsonio.dumps`: no NaN) atomically."""
+    from zrp.jsonio import dumps  # NumPy: on use, so that `zrp --help` does not load it
+
     return write_text(path, dumps(obj, indent), overwrite=overwrite)
 
 

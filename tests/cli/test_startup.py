@@ -1,6 +1,6 @@
 """The command line starts without the heavy modules: building the parser (``zrp --help``,
-``zrp <cmd> --help``) and ``import zrp`` import neither SciPy, numba, MuJoCo, Matplotlib nor
-Dask; each command imports them when it runs. Checked in a fresh interpreter from
+``zrp <cmd> --help``) and ``import zrp`` import neither NumPy, SciPy, numba, MuJoCo, Matplotlib
+nor Dask; each command imports them when it runs. Checked in a fresh interpreter from
 ``sys.modules`` (deterministic; the time itself is measured in
 tests/benchmarks/bench_cli_startup.py)."""
 
@@ -14,7 +14,8 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
-HEAVY = ("scipy", "numba", "mujoco", "matplotlib", "dask", "distributed", "sim", "mjcf")
+HEAVY = ("numpy", "scipy", "numba", "mujoco", "matplotlib", "dask", "distributed", "sim",
+         "mjcf")
 
 
 def _loaded(code: str) -> list[str]:

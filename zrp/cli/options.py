@@ -12,8 +12,7 @@ import argparse
 import math
 from collections.abc import Callable
 
-from zrp.arguments import MAX_SEED
-from zrp.model.manipulator import MAX_LENGTH
+from zrp.limits import MAX_LENGTH, MAX_SEED
 
 __all__ = [
     "DURATION",

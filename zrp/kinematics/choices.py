@@ -6,7 +6,9 @@ without importing the numerical code that uses them (``zrp --help`` stays quick)
 
 from __future__ import annotations
 
-__all__ = ["CORRECTIONS", "TASKS"]
+__all__ = ["CORRECTIONS", "TASKS", "TIME_LAWS"]
 
 CORRECTIONS = ("newton", "feedback", "none")
+#: Time laws of a trajectory (:mod:`.trajectory`).
+TIME_LAWS = ("quintic", "cycloidal")
 TASKS = ("pose", "position")

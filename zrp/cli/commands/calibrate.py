@@ -13,7 +13,6 @@ if TYPE_CHECKING:
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.gap.model.choices import EFFECTS
-from zrp.model.files import load_model
 from zrp.output import OutputDir
 
 FILES = ("calibrated.toml", "compensation.json")
@@ -60,6 +59,7 @@ def _run(args: argparse.Namespace) -> int:
     from zrp.calibration.storage import calibration_document  # on use: keeps --help quick
     from zrp.gap import diagnose, load_measurements  # on use: keeps --help quick
     from zrp.gap.report import OUTPUT_FILES, write_outputs  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     model = load_model(args.model)
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)

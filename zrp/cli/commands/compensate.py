@@ -3,13 +3,15 @@
 from __future__ import annotations
 
 import argparse
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from zrp.cli.app import emit
 from zrp.cli.options import real
 from zrp.errors import InputError
 from zrp.output import check_writable
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -45,6 +47,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
+    import numpy as np  # on use: keeps --help quick
+
     if args.limits is None:
         return None
     pairs = args.limits.split(",")
@@ -60,6 +64,8 @@ def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
     from zrp.calibration import (  # on use: keeps --help quick
         PoseConditions,
         compensate_program,

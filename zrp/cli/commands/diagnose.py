@@ -11,11 +11,8 @@ from zrp.cli.app import emit
 from zrp.cli.fleet import add_fleet_options, is_fleet, refuse_fleet_options, run_fleet
 from zrp.cli.options import LENGTH, SEED, real, whole
 from zrp.errors import InputError
-from zrp.gap.data.csvfile import MAX_ROWS
-from zrp.gap.data.subsample import MAX_POINTS
+from zrp.gap.data.choices import MAX_POINTS, MAX_ROWS, MAX_WITHHELD
 from zrp.gap.model.choices import EFFECTS
-from zrp.gap.options import MAX_WITHHELD
-from zrp.model.files import load_model
 from zrp.output import OutputDir
 
 
@@ -97,6 +94,7 @@ def _run(args: argparse.Namespace) -> int:
         verdict_text,
         write_outputs,
     )
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     if args.max_steps < 1:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")

@@ -9,7 +9,7 @@ from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.options import FRACTION, SEED, real, whole
 from zrp.errors import InputError
-from zrp.model.files import builtin_models, load_model
+from zrp.model.builtin import builtin_models
 from zrp.output import OutputDir, claim_generated
 
 DEFAULT_OUT = "renders/gap_benchmark"
@@ -86,6 +86,7 @@ def _run(args: argparse.Namespace) -> int:
         run_benchmark,
         write_outputs,
     )
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     out = Path(args.out or DEFAULT_OUT)
     overwrite = args.force or (args.out is None and claim_generated(out))

@@ -5,21 +5,26 @@ from __future__ import annotations
 import argparse
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
+
+    from zrp.model.manipulator import Manipulator
 
 from zrp.cli.app import emit
 from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, real, whole
 from zrp.errors import InputError, ZRPWarning
-from zrp.kinematics.choices import CORRECTIONS
-from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
-from zrp.model.files import builtin_models, load_model
-from zrp.model.manipulator import MAX_LENGTH, Manipulator
+from zrp.kinematics.choices import CORRECTIONS, TIME_LAWS
+from zrp.limits import MAX_LENGTH
+from zrp.model.builtin import builtin_models
 from zrp.output import check_writable, claim_generated
 from zrp.paper.choices import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM
 
 
 def _joint_values(model: Manipulator, values: list[float], rad: bool, name: str) -> np.ndarray:
+    import numpy as np  # on use: keeps --help quick
+
     if len(values) != model.n:
         raise InputError(f"{name}: expected {model.n} values for {model.name!r} "
                          f"({', '.join(model.joint_names)}), got {len(values)}")
@@ -102,7 +107,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _fk(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
     from zrp.kinematics.forward import forward_kinematics  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
     from zrp.rotations.rodrigues import er_angle  # on use: keeps --help quick
 
     model = load_model(args.model)
@@ -127,9 +135,13 @@ def _fk(args: argparse.Namespace) -> int:
 
 
 def _ik(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
     from zrp.kinematics.forward import forward_kinematics  # on use: keeps --help quick
     from zrp.kinematics.ik import track_trajectory  # on use: keeps --help quick
     from zrp.kinematics.redundant import track_posture  # on use: keeps --help quick
+    from zrp.kinematics.trajectory import Circle, Line  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
     from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
 
     model = load_model(args.model)
@@ -190,6 +202,8 @@ def _ik(args: argparse.Namespace) -> int:
 
 
 def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> int:
+    import numpy as np  # on use: keeps --help quick
+
     from zrp.kinematics.posture import solve_pose  # on use: keeps --help quick
 
     sol = solve_pose(model, np.array(args.target), args.target_er, q0=q0)
@@ -211,6 +225,8 @@ def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> 
 
 
 def _models(args: argparse.Namespace) -> int:
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     models = {name: str(path) for name, path in sorted(builtin_models().items())}
     text = "\n".join(f"{k:10s} {load_model(v).name}  ({v})" for k, v in models.items())
     emit(args, models, text)

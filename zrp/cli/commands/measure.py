@@ -6,13 +6,10 @@ import argparse
 import time
 from pathlib import Path
 
-import numpy as np
-
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, real, whole
 from zrp.errors import InputError
-from zrp.jsonio import dumps
-from zrp.model.files import builtin_models, load_model
+from zrp.model.builtin import builtin_models
 from zrp.output import check_writable, write_text
 from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
@@ -75,9 +72,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo (+0.1-0.2 s measured): only when this command runs, not for every `zrp`.
+    import numpy as np  # on use: keeps --help quick
+
     import sim
     from sim.studies.trajectories import circle_poses  # with sim, for the same reason
     from zrp.kinematics import reachable_poses
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     if args.poses < 8:
         raise InputError(f"--poses: expected at least 8 poses, got {args.poses}")
@@ -124,6 +124,7 @@ def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> 
     """``--stream``: the real robot in motion (sim/studies/trajectories.py)."""
     from sim.studies.trajectories import measure_stream  # MuJoCo: only when this command runs
     from zrp.gap.motion import write_trajectory
+    from zrp.jsonio import dumps  # on use: keeps --help quick
 
     if args.effect:
         raise InputError("--effect: static effects are not simulated with --stream; use "

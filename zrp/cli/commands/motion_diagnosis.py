@@ -11,8 +11,6 @@ from zrp.errors import InputError
 from zrp.escape import md_text
 from zrp.gap.model.choices import EFFECTS
 from zrp.gap.motion.choices import MOTION_EFFECTS
-from zrp.jsonio import dumps
-from zrp.model.files import load_model
 from zrp.output import OutputDir, check_writable
 
 OUTPUT_FILES = ("diagnosis_motion.json", "report_motion.md")
@@ -73,6 +71,8 @@ def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[obje
 
 def _run(args: argparse.Namespace) -> int:
     from zrp.gap.motion import diagnose_motion, load_trajectory  # on use: keeps --help quick
+    from zrp.jsonio import dumps  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     model = load_model(args.model)
     if args.video:

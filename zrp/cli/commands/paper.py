@@ -14,8 +14,9 @@ from typing import TYPE_CHECKING, Any
 from zrp.cli.app import emit
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
 from zrp.errors import InputError
-from zrp.model.files import load_model
-from zrp.model.manipulator import Manipulator
+
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 from zrp.output import OutputDir, claim_generated
 from zrp.paper.choices import CIRCLES
 
@@ -188,6 +189,7 @@ def _claims_lines(ch: dict[str, Any]) -> list[str]:
 
 
 def _paper(args: argparse.Namespace) -> int:
+    from zrp.model.files import load_model  # on use: keeps --help quick
     from zrp.paper.report import output_names  # on use: keeps --help quick
 
     out, overwrite = _output_folder(args)

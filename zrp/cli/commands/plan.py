@@ -6,15 +6,16 @@ import argparse
 import csv
 import io
 import warnings
-
-import numpy as np
+from typing import TYPE_CHECKING
 
 from zrp.cli.app import emit
 from zrp.cli.options import FINITE, LENGTH, SEED, whole
 from zrp.errors import InputError
 from zrp.gap.model.choices import EFFECTS
-from zrp.model.files import load_model
 from zrp.output import check_writable, write_text
+
+if TYPE_CHECKING:
+    import numpy as np
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -51,6 +52,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
+    import numpy as np  # on use: keeps --help quick
+
     if text is None:
         return None
     pairs = text.split(",")
@@ -64,7 +67,10 @@ def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
     from zrp.calibration import plan_poses  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     check_writable([args.out], args.force)
     model = load_model(args.model)

@@ -5,11 +5,13 @@ from __future__ import annotations
 import argparse
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from zrp.cli.app import emit
-from zrp.model.dh_table import dumps_dh, to_dh
-from zrp.model.files import builtin_models, dumps_model, load_model
-from zrp.model.manipulator import Manipulator
+from zrp.model.builtin import builtin_models
+
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
 
 FORMATS = {"urdf": ".urdf", "mjcf": ".xml", "dh": ".dh.toml", "mdh": ".mdh.toml",
@@ -36,6 +38,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _text(model: Manipulator, fmt: str) -> str:
+    from zrp.model.dh_table import dumps_dh, to_dh  # on use: keeps --help quick
+    from zrp.model.files import dumps_model  # on use: keeps --help quick
     from zrp.model.urdf_writer import urdf_xml  # on use: keeps --help quick
 
     if fmt == "urdf":
@@ -51,6 +55,8 @@ def _text(model: Manipulator, fmt: str) -> str:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     stem = re.sub(r"[^A-Za-z0-9]+", "_", Path(args.model).stem).strip("_").lower() or "model"
     out = Path(args.out or f"renders/{stem}{FORMATS[args.to]}")
     check_writable([out], args.force)

@@ -9,19 +9,18 @@ import argparse
 import warnings
 from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 
 from zrp.cli.app import emit
 from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, PERCENT, whole
 from zrp.errors import InputError, ZRPWarning
-from zrp.kinematics.trajectory import TIME_LAWS
-from zrp.manufacturing.choices import PAPER_PARAMETERS, PAPER_XI
-from zrp.manufacturing.perturb import PAPER_SIGN_ZERO
+from zrp.kinematics.choices import TIME_LAWS
+from zrp.manufacturing.choices import PAPER_PARAMETERS, PAPER_SIGN_ZERO, PAPER_XI
 
 if TYPE_CHECKING:
     from zrp.manufacturing.study import JointPath, StudyResult
-from zrp.model.files import builtin_models, load_model
-from zrp.model.manipulator import Manipulator
+from zrp.model.builtin import builtin_models
 from zrp.output import OutputDir
 from zrp.paper.choices import PUMA_Q0_DEG
 
@@ -77,6 +76,8 @@ def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
 
 def path_from_args(args: argparse.Namespace, model: Manipulator) -> JointPath:
     """The nominal joint trajectory the options describe."""
+    import numpy as np  # on use: keeps --help quick
+
     from zrp.manufacturing.study import load_joint_csv  # on use: keeps --help quick
     from zrp.paper.scenario import circle_joint_path  # on use: keeps --help quick
 
@@ -142,6 +143,10 @@ def _run_study(args: argparse.Namespace, model: Manipulator,
 
 
 def _study(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     check_path_options(args, model)
     files: list[str] = []

@@ -9,7 +9,8 @@ from concurrent.futures import Executor
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 
 from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
@@ -20,8 +21,6 @@ from zrp.errors import InputError
 if TYPE_CHECKING:
     from zrp.manufacturing.study import JointPath
 from zrp.manufacturing.choices import DISTRIBUTIONS
-from zrp.model.files import load_model
-from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable
 
 #: Above this many robots `zrp tolerance` reduces on the workers (gathering costs 32 bytes a
@@ -116,6 +115,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _tolerance(args: argparse.Namespace) -> int:
     from zrp.manufacturing.plots import check_png_path  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     model = load_model(args.model)
     check_path_options(args, model)
@@ -163,6 +163,8 @@ def _allocate(args: argparse.Namespace, model: Manipulator, path: JointPath,
               ex: Executor | None) -> int:
     """--allocate: the loosest tolerances meeting the requirement, verified (the verification
     Monte Carlo runs on the executor)."""
+    import numpy as np  # on use: keeps --help quick
+
     from zrp.manufacturing.allocation import allocate_tolerances  # on use: keeps --help quick
     from zrp.manufacturing.plots import histogram_png  # on use: keeps --help quick
 

@@ -15,7 +15,6 @@ from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor
 from zrp.cli.fleet.summary import fleet_csv, fleet_figure, fleet_markdown, fleet_summary
 from zrp.cli.options import LENGTH
 from zrp.errors import InputError
-from zrp.model.files import load_model
 from zrp.output import OutputDir, check_writable
 from zrp.tasks import TaskFailure, map_tasks
 
@@ -56,6 +55,7 @@ def add_fleet_options(p: argparse.ArgumentParser) -> None:
 
 def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[RobotTask]:
     from zrp.cli.fleet.tasks import RobotTask  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     model = load_model(args.model)
     names = [f.stem for f in files]

@@ -43,15 +43,13 @@ from numpy.typing import NDArray
 from zrp.arguments import check_int
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.data.choices import MAX_ROWS
 from zrp.gap.data.csvrows import Accumulator, Columns, Header, check_header, parse_row
 from zrp.gap.data.measurements import FRAMES, DataWarning, Measurements
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["MAX_ROWS", "load_measurements"]
 
-#: Most data rows read by default: about 0.7 GB of memory per million rows at the peak of a
-#: whole diagnosis, so two million stay within 2 GB.
-MAX_ROWS = 2_000_000
 
 #: plausible temperatures, deg C.
 TEMP_RANGE = (-60.0, 150.0)
