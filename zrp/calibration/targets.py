@@ -4,7 +4,9 @@ Targets CSV, one row per target, in program order: ``target`` (id), ``q1``..``qn
 program's joint values, rad or deg with ``deg=True``; the seed of the solve), and optionally
 ``x, y, z`` (desired tool-point position; without them the target is the nominal model's pose
 at q: a joint program) and ``qw, qx, qy, qz`` (desired hand orientation in the base frame, a
-unit quaternion, with x, y, z). Errors name the file, line and column.
+unit quaternion, with x, y, z). A joint or position column may declare its unit
+(``q1[deg]``, ``x[m]``; the rule and checks of :mod:`zrp.units`: seeds in degrees read as
+radians are refused). Errors name the file, line and column.
 """
 
 from __future__ import annotations
@@ -20,8 +22,16 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.calibration.compensation import Compensation
 from zrp.errors import InputError
+from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.rotations import matrix_from_er
+from zrp.units import (
+    angle_bounds,
+    joint_column_units,
+    joint_values_to_rad,
+    length_scale,
+    split_unit,
+)
 
 __all__ = ["Targets", "load_targets", "write_commands"]
 
@@ -70,8 +80,11 @@ def _columns(header: list[str], n: int, src: str) -> tuple[list[str], bool, bool
     return cols, has_xyz, has_quat
 
 
-def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
-    """Read a targets CSV for a robot with ``n`` joints (see the module doc).
+def load_targets(path: str | Path, n: int, *, deg: bool = False,
+                 model: Manipulator | None = None) -> Targets:
+    """Read a targets CSV for a robot with ``n`` joints (see the module doc); ``model`` (with
+    n joints) tells the prismatic joints, the joint limits and the length unit (None: all
+    revolute, positions in the model's unit, unit-less).
 
     Raises:
         InputError: unreadable file, bad header, field count, non-numbers (file, line, column).
@@ -84,7 +97,9 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
     rows = [r for r in rows if r]
     if len(rows) < 2:
         raise InputError(f"{src}: no targets (a header and at least one row expected)")
-    header = [h.strip() for h in rows[0]]
+    parsed = [split_unit(h, f"{src}, line 1") for h in rows[0]]
+    header = [h for h, _ in parsed]
+    unit = dict(parsed)
     cols, has_xyz, has_quat = _columns(header, n, src)
     ids, vals = [], []
     for i, r in enumerate(rows[1:], start=2):
@@ -96,8 +111,14 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
     if len(set(ids)) != len(ids):
         raise InputError(f"{src}: repeated target ids")
     a = np.array(vals, dtype=float)
-    q = np.radians(a[:, :n]) if deg else a[:, :n]
+    q = _joints(a[:, :n], [unit[f"q{k}"] for k in range(1, n + 1)], deg, model, src)
     xyz = a[:, n:n + 3] if has_xyz else None
+    if xyz is not None and any(unit[c] is not None for c in "xyz"):
+        if model is None:
+            raise InputError(f"{src}, line 1: x, y, z declare a unit; the model is needed to "
+                             "convert it")
+        xyz = xyz * [length_scale(unit[c], model.length_unit, f"{src} column {c}")
+                     for c in "xyz"]
     rot = None
     if has_quat:
         quat = a[:, n + 3:n + 7]
@@ -108,6 +129,19 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
                              f"(norm {norm[bad[0]]:.6g})")
         rot = matrix_from_er(quat / norm[:, None])
     return Targets(tuple(ids), q, xyz, rot)
+
+
+def _joints(q: F64, declared: list[str | None], deg: bool, model: Manipulator | None,
+            src: str) -> F64:
+    """Program joint values to rad by the rule and checks of :mod:`zrp.units`."""
+    n = q.shape[1]
+    rev = np.ones(n, bool) if model is None else ~np.asarray(model.prismatic)
+    names = [f"q{k}" for k in range(1, n + 1)]
+    angle, scale = joint_column_units(declared, rev, deg, src=src, names=names,
+                                      length_unit="mm" if model is None else model.length_unit)
+    bounds = None if model is None else angle_bounds(model.lower, model.upper)
+    return joint_values_to_rad(q, rev, angle, src=src, names=names,
+                               lines=np.arange(2, len(q) + 2), bounds=bounds) * scale
 
 
 def write_commands(comp: Compensation, path: str | Path, *, deg: bool = False,
@@ -121,7 +155,8 @@ def write_commands(comp: Compensation, path: str | Path, *, deg: bool = False,
     q = np.degrees(comp.q_command) if deg else comp.q_command
     buf = io.StringIO()
     w = csv.writer(buf)
-    w.writerow(["target", *[f"q{k}" for k in range(1, n + 1)], "residual",
+    w.writerow(["target", *[f"q{k}{'[deg]' if deg else ''}" for k in range(1, n + 1)],
+                "residual",
                 "orientation_residual", "uncompensated", "sigma_min", "near_singular",
                 "near_limit", "converged"])
     ori = comp.orientation_residual

@@ -10,7 +10,7 @@ from zrp.calibration import PoseConditions, compensate_program, read_calibration
 from zrp.calibration import compensate as compensate_targets
 from zrp.calibration.targets import load_targets, write_commands
 from zrp.cli.app import emit
-from zrp.cli.options import real
+from zrp.cli.options import add_deg, real
 from zrp.errors import InputError
 from zrp.output import check_writable
 
@@ -26,7 +26,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--targets", required=True, metavar="T.csv", help="targets CSV")
     p.add_argument("--out", required=True, metavar="OUT.csv", help="commands CSV")
     p.add_argument("--force", action="store_true", help="overwrite the output file")
-    p.add_argument("--deg", action="store_true", help="joint values (in and out) in degrees")
+    add_deg(p)
     p.add_argument("--point", help="tool point the x, y, z targets are for (default: the "
                    "model's end point)")
     p.add_argument("--frame", choices=("base", "instrument"), default="base",
@@ -65,7 +65,7 @@ def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
 def _run(args: argparse.Namespace) -> int:
     check_writable([args.out], args.force)
     cal = read_calibration(args.calibration)
-    tg = load_targets(args.targets, cal.n, deg=args.deg)
+    tg = load_targets(args.targets, cal.n, deg=args.deg, model=cal.model)
     lim = _limits(args, cal.n)
     grav = None
     if args.mjcf is not None:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from zrp.cli.app import emit
-from zrp.cli.options import SEED, real, whole
+from zrp.cli.options import SEED, add_deg, real, whole
 from zrp.errors import InputError
 from zrp.gap.motion import write_trajectory
 from zrp.jsonio import dumps
@@ -64,8 +64,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--temp-rise", type=real(-100.0, 100.0, unit="K"), default=10.0, metavar="K",
                    help="warm-up of the robot during the session, K (default 10)")
     p.add_argument("--seed", type=SEED, default=0, help="seed of poses, noise and instrument")
-    p.add_argument("--deg", action="store_true", help="write q in degrees (then diagnose "
-                                                      "with --deg)")
+    add_deg(p)
     p.add_argument("--force", action="store_true",
                    help="replace --out and --truth if they exist (refused otherwise, before "
                         "anything is simulated)")
@@ -107,7 +106,7 @@ def _run(args: argparse.Namespace) -> int:
     procedure = sim.Procedure(approach=args.approach, temp_rise=args.temp_rise)
     run = sim.measure(robot, q, inst, rng, procedure, progress=args.progress)
     wall = time.perf_counter() - t0
-    sim.write_measurements(run, out, deg=args.deg, overwrite=args.force)
+    sim.write_measurements(run, out, deg=args.deg, overwrite=args.force, model=model)
     sim.write_truth(run, truth, overwrite=args.force)
     payload = {"measurements": str(out), "truth": str(truth), "poses": len(q),
                "points": run.measurements.n_rows, "effects": list(effects.active),

@@ -11,7 +11,7 @@ import numpy as np
 
 from zrp.calibration import plan_poses
 from zrp.cli.app import emit
-from zrp.cli.options import FINITE, LENGTH, SEED, whole
+from zrp.cli.options import FINITE, LENGTH, SEED, add_deg, whole
 from zrp.errors import InputError
 from zrp.gap.model.context import EFFECTS
 from zrp.model.files import load_model
@@ -32,7 +32,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="effects to identify (registration is always included)")
     p.add_argument("--out", required=True, metavar="OUT.csv", help="planned poses CSV")
     p.add_argument("--force", action="store_true", help="overwrite the output file")
-    p.add_argument("--deg", action="store_true", help="limits and output in degrees")
+    add_deg(p)
     p.add_argument("--limits", metavar="LO:HI,...", help="joint limits, one LO:HI per joint, "
                    "comma-separated (default +-2.5 rad)")
     p.add_argument("--floor", type=FINITE, metavar="Z", help="keep every joint and tool point "
