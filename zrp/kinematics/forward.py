@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from zrp.arrays import F64
+from zrp.arrays import F64, recycled_empty
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import all_in_range, joint_limits
@@ -208,7 +208,7 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
 def _out_buffer(out: object, shape: tuple[int, ...]) -> F64:
     """``out`` checked as the result buffer of :func:`end_effector_pose` (or a new one)."""
     if out is None:
-        return np.empty(shape)
+        return recycled_empty(shape)  # a fresh 56 MB costs a third of the kernel (zero-fill)
     if not (isinstance(out, np.ndarray) and out.dtype == np.float64
             and out.flags.c_contiguous and out.flags.writeable and out.shape == shape):
         got = (f"{type(out).__name__} {getattr(out, 'dtype', '')} shape "
@@ -229,7 +229,7 @@ def jacobian(model: Manipulator, q: ArrayLike) -> F64:
         if K.jac_packed(q, _packed(model), jac):
             return jac
     qf, batch = _flat(model, q)
-    jac = np.empty((qf.shape[0], 6, model.n))
+    jac = recycled_empty((qf.shape[0], 6, model.n))
     if not K.jac_batch(qf, *_karrays(model), joint_limits(model), np.empty((0, 7)), jac):
         _range_error(model, q)
     return jac.reshape(*batch, 6, model.n)
