@@ -10,8 +10,9 @@ from zrp.calibration import PoseConditions, compensate_program, read_calibration
 from zrp.calibration import compensate as compensate_targets
 from zrp.calibration.targets import load_targets, write_commands
 from zrp.cli.app import emit
-from zrp.cli.options import add_deg, real
+from zrp.cli.options import add_deg, joint_angles, real
 from zrp.errors import InputError
+from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable
 
 
@@ -47,26 +48,26 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          "load": "--load"})
 
 
-def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
+def _limits(args: argparse.Namespace, model: Manipulator) -> np.ndarray | None:
     if args.limits is None:
         return None
     pairs = args.limits.split(",")
-    if len(pairs) != n:
-        raise InputError(f"--limits: expected {n} LO:HI pairs, got {len(pairs)}")
+    if len(pairs) != model.n:
+        raise InputError(f"--limits: expected {model.n} LO:HI pairs, got {len(pairs)}")
     try:
         lim = np.array([[float(v) for v in s.split(":")] for s in pairs], dtype=float)
     except ValueError:
         raise InputError(f"--limits: expected LO:HI numbers, got {args.limits}") from None
-    if lim.shape != (n, 2):
+    if lim.shape != (model.n, 2):
         raise InputError(f"--limits: expected LO:HI pairs, got {args.limits}")
-    return np.radians(lim) if args.deg else lim
+    return joint_angles(model, lim, args.deg, "--limits")
 
 
 def _run(args: argparse.Namespace) -> int:
     check_writable([args.out], args.force)
     cal = read_calibration(args.calibration)
     tg = load_targets(args.targets, cal.n, deg=args.deg, model=cal.model)
-    lim = _limits(args, cal.n)
+    lim = _limits(args, cal.model)
     grav = None
     if args.mjcf is not None:
         # mjcf loads MuJoCo (+0.25 s): only when asked for

@@ -11,10 +11,11 @@ import numpy as np
 
 from zrp.calibration import plan_poses
 from zrp.cli.app import emit
-from zrp.cli.options import FINITE, LENGTH, SEED, add_deg, whole
+from zrp.cli.options import FINITE, LENGTH, SEED, add_deg, joint_angles, whole
 from zrp.errors import InputError
 from zrp.gap.model.context import EFFECTS
 from zrp.model.files import load_model
+from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
 
 
@@ -51,7 +52,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          "noise_sigma": "--noise"})
 
 
-def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
+def _limits(text: str | None, model: Manipulator, deg: bool) -> np.ndarray | None:
     if text is None:
         return None
     pairs = text.split(",")
@@ -59,9 +60,9 @@ def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
         lim = np.array([[float(v) for v in s.split(":")] for s in pairs], dtype=float)
     except ValueError:
         raise InputError(f"--limits: expected LO:HI numbers, got {text!r}") from None
-    if lim.shape != (n, 2):
-        raise InputError(f"--limits: expected {n} LO:HI pairs, got {text!r}")
-    return np.radians(lim) if deg else lim
+    if lim.shape != (model.n, 2):
+        raise InputError(f"--limits: expected {model.n} LO:HI pairs, got {text!r}")
+    return joint_angles(model, lim, deg, "--limits")
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -70,7 +71,7 @@ def _run(args: argparse.Namespace) -> int:
     with warnings.catch_warnings(record=True) as wl:
         warnings.simplefilter("always")
         plan = plan_poses(model, args.poses, args.effects, rng=np.random.default_rng(args.seed),
-                          limits=_limits(args.limits, model.n, args.deg),
+                          limits=_limits(args.limits, model, args.deg),
                           tool_points=args.tool or ((0.0, 0.0, 0.0),), floor_z=args.floor,
                           noise_sigma=args.noise,  # None: a tracker's 20 um in the model's unit
                           candidates=args.candidates)
