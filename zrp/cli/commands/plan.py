@@ -35,7 +35,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true", help="overwrite the output file")
     add_deg(p)
     p.add_argument("--limits", metavar="LO:HI,...", help="joint limits, one LO:HI per joint, "
-                   "comma-separated (default +-2.5 rad)")
+                   "comma-separated, within the model's (default: the model's limits, at most "
+                   "+-2.5 rad)")
     p.add_argument("--floor", type=FINITE, metavar="Z", help="keep every joint and tool point "
                    "above z = Z (base frame, length unit)")
     p.add_argument("--tool", nargs=3, type=FINITE, action="append", metavar=("X", "Y", "Z"),
@@ -78,15 +79,19 @@ def _run(args: argparse.Namespace) -> int:
     n = model.n
     buf = io.StringIO()
     w = csv.writer(buf)
-    w.writerow(["pose", *[f"q{k}" for k in range(1, n + 1)], *[f"dir{k}" for k in
-                                                               range(1, n + 1)]])
-    q = np.degrees(plan.q) if args.deg else plan.q
+    rev = ~np.asarray(model.prismatic)
+    w.writerow(["pose", *[f"q{k}[deg]" if args.deg and rev[k - 1] else f"q{k}"
+                          for k in range(1, n + 1)], *[f"dir{k}" for k in range(1, n + 1)]])
+    q = np.where(rev, np.degrees(plan.q), plan.q) if args.deg else plan.q
     for i in range(len(q)):
         w.writerow([f"P{i + 1:03d}", *(repr(float(v)) for v in q[i]),
                     *(int(v) for v in plan.direction[i])])
     path = write_text(args.out, buf.getvalue(), overwrite=args.force)
     lines = [f"{p}: predicted std {s:.3g} {u}"
              for p, s, u in zip(plan.names, plan.std, plan.units, strict=True)]
+    lines += [f"{p}: unidentifiable with these tool points (moves no point, or aliased with "
+              "others, in every pose); not planned"
+              for p in plan.unidentifiable]
     lines += [f"warning: {w.message}" for w in wl]
     lines += [f"log det per pose: {plan.log_det:.4g} (random start {plan.log_det_random:.4g})",
               f"wrote {path}"]
