@@ -3,20 +3,19 @@
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import warnings
 
 import numpy as np
 
 from zrp.calibration import plan_poses
+from zrp.calibration.planfile import write_plan
 from zrp.cli.app import emit
 from zrp.cli.options import FINITE, LENGTH, SEED, add_deg, joint_angles, whole
 from zrp.errors import InputError
 from zrp.gap.model.context import EFFECTS
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
-from zrp.output import check_writable, write_text
+from zrp.output import check_writable
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,8 +23,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "plan", help="plan the measurement poses of a calibration (D-optimal)",
         description="Choose N poses within the joint limits (above a floor) that make the "
         "chosen effects identifiable (D-optimal, DETMAX-style exchange); print the predicted "
-        "standard deviation of every parameter and warn about unidentifiable ones. Writes "
-        "OUT.csv: pose, q1..qn, dir1..dirn (zrp/calibration/README.md).")
+        "standard deviation of every parameter and list the unidentifiable ones. Writes "
+        "OUT.csv: pose, q1..qn, dir1..dirn, which zrp measure --poses OUT.csv measures "
+        "(zrp/calibration/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml", help="model TOML or built-in")
     p.add_argument("--poses", type=whole(1, 100_000), required=True, metavar="N",
                    help="poses to measure")
@@ -76,17 +76,7 @@ def _run(args: argparse.Namespace) -> int:
                           tool_points=args.tool or ((0.0, 0.0, 0.0),), floor_z=args.floor,
                           noise_sigma=args.noise,  # None: a tracker's 20 um in the model's unit
                           candidates=args.candidates)
-    n = model.n
-    buf = io.StringIO()
-    w = csv.writer(buf)
-    rev = ~np.asarray(model.prismatic)
-    w.writerow(["pose", *[f"q{k}[deg]" if args.deg and rev[k - 1] else f"q{k}"
-                          for k in range(1, n + 1)], *[f"dir{k}" for k in range(1, n + 1)]])
-    q = np.where(rev, np.degrees(plan.q), plan.q) if args.deg else plan.q
-    for i in range(len(q)):
-        w.writerow([f"P{i + 1:03d}", *(repr(float(v)) for v in q[i]),
-                    *(int(v) for v in plan.direction[i])])
-    path = write_text(args.out, buf.getvalue(), overwrite=args.force)
+    path = write_plan(plan, model, args.out, deg=args.deg, overwrite=args.force)
     lines = [f"{p}: predicted std {s:.3g} {u}"
              for p, s, u in zip(plan.names, plan.std, plan.units, strict=True)]
     lines += [f"{p}: unidentifiable with these tool points (moves no point, or aliased with "
