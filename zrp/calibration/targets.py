@@ -33,7 +33,11 @@ from zrp.units import (
     split_unit,
 )
 
-__all__ = ["Targets", "load_targets", "write_commands"]
+__all__ = ["Commands", "Targets", "load_commands", "load_targets", "write_commands"]
+
+#: The columns :func:`write_commands` writes besides target and q1..qn.
+COMMAND_FLAGS = ("residual", "orientation_residual", "uncompensated", "sigma_min",
+                 "near_singular", "near_limit", "converged")
 
 
 
@@ -142,6 +146,54 @@ def _joints(q: F64, declared: list[str | None], deg: bool, model: Manipulator | 
     bounds = None if model is None else angle_bounds(model.lower, model.upper)
     return joint_values_to_rad(q, rev, angle, src=src, names=names,
                                lines=np.arange(2, len(q) + 2), bounds=bounds) * scale
+
+
+@dataclass(frozen=True, eq=False)
+class Commands:
+    """A commands CSV read back (T rows): ``ids``, ``q`` (rad, (T, n)) and ``converged``
+    (T,) bool."""
+
+    ids: tuple[str, ...]
+    q: F64
+    converged: np.ndarray
+
+
+def load_commands(path: str | Path, model: Manipulator, *, deg: bool = False) -> Commands:
+    """Read the commands CSV of ``zrp compensate`` (:func:`write_commands`) for ``model``;
+    joint columns by the unit rule of :mod:`zrp.units` (``q1[deg]`` declared, or ``deg``).
+
+    Raises:
+        InputError: unreadable file, missing or unknown columns, non-numbers (file, line,
+            column); UnitError: a unit mix-up.
+    """
+    src = str(path)
+    try:
+        rows = [r for r in csv.reader(io.StringIO(Path(path).read_text(encoding="utf-8")))
+                if r]
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{src}: cannot read the commands file: {exc}") from None
+    if len(rows) < 2:
+        raise InputError(f"{src}: no commands (a header and at least one row expected)")
+    parsed = [split_unit(h, f"{src}, line 1") for h in rows[0]]
+    header = [h for h, _ in parsed]
+    n = model.n
+    joints = [f"q{k}" for k in range(1, n + 1)]
+    missing = [c for c in ["target", *joints, "converged"] if c not in header]
+    unknown = [c for c in header if c not in ("target", *joints, *COMMAND_FLAGS)]
+    if missing or unknown:
+        raise InputError(f"{src}, line 1: expected the columns of zrp compensate's output "
+                         f"(target, q1..q{n}, {', '.join(COMMAND_FLAGS)}); missing {missing},"
+                         f" unknown {unknown}")
+    col = {c: i for i, c in enumerate(header)}
+    ids, vals, conv = [], [], []
+    for i, r in enumerate(rows[1:], start=2):
+        if len(r) != len(header):
+            raise InputError(f"{src}, line {i}: {len(r)} fields, expected {len(header)}")
+        ids.append(r[col["target"]].strip())
+        vals.append([_number(r[col[c]], src, i, c) for c in joints])
+        conv.append(_number(r[col["converged"]], src, i, "converged") == 1.0)
+    q = _joints(np.array(vals), [dict(parsed)[c] for c in joints], deg, model, src)
+    return Commands(tuple(ids), q, np.array(conv))
 
 
 def write_commands(comp: Compensation, path: str | Path, *, deg: bool = False,
