@@ -43,7 +43,12 @@ from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
 __all__ = ["Plan", "PlanWarning", "design_std", "plan_poses"]
 
-ALIAS_TOL = 1e-6
+#: A parameter is aliased when less than this fraction of its column stays after projection on
+#: the columns before it: its predicted std would be inflated more than 1 / ALIAS_TOL times by
+#: the others (the variance inflation of a near-alias). 1e-3, not the fit's 1e-6: a URDF's
+#: rounded angles (rpy 1.5708 for pi/2, 3.7e-6 rad off) leave exact aliases 1e-6 apart, which
+#: planned as independent printed stds of 1e3 mm (xArm7's b2.y..b5.y).
+ALIAS_TOL = 1e-3
 
 
 class PlanWarning(ZRPWarning):
