@@ -168,6 +168,24 @@ def _fix(col: str, unit: str, flag: str, header: bool) -> str:
             else f"give them {switch} if they are in {'degrees' if unit == 'deg' else 'radians'}")
 
 
+def _angle_units(units: list[str | None] | str | None, cols: list[str], src: str
+                 ) -> list[str]:
+    unit = [units] * len(cols) if isinstance(units, str) or units is None else list(units)
+    return [canonical_angle_unit(u, f"{src} column {c}") if u is not None else "rad"
+            for u, c in zip(unit, cols, strict=True)]
+
+
+def _check_degree_columns(a: NDArray[np.float64], cols: list[str], src: str, flag: str,
+                          header: bool) -> None:
+    """Radians in degree columns (|values| ``a``, rows x columns): see joint_values_to_rad."""
+    if a.max() <= _TURN and a.max() >= RADIAN_LOOK_MIN:
+        raise UnitError(f"{src}: columns {', '.join(cols)} are in degrees, but every value lies "
+                        f"within +-2 pi (largest {a.max():.4g}) over {len(a)} rows: these look "
+                        f"like radians in a degree column; {_fix(cols[0], 'rad', flag, header)}"
+                        " (a degree program moving every joint by less than 6.3 degrees: write "
+                        "it in rad)")
+
+
 def joint_values_to_rad(values: ArrayLike, revolute: ArrayLike, units: list[str | None] | str,
                         *, src: str, names: list[str] | None = None,
                         lines: ArrayLike | None = None, bounds: ArrayLike | None = None,
@@ -204,13 +222,9 @@ def joint_values_to_rad(values: ArrayLike, revolute: ArrayLike, units: list[str 
     n = q.shape[1]
     rev = np.asarray(revolute, dtype=bool)
     cols = names or [f"q{k}" for k in range(1, n + 1)]
-    unit = [units] * n if isinstance(units, str) or units is None else list(units)
-    unit = [canonical_angle_unit(u, f"{src} column {c}") if u is not None else "rad"
-            for u, c in zip(unit, cols, strict=True)]
-    deg = rev & (np.array(unit) == "deg")
-    radc = rev & ~deg
+    deg = rev & (np.array(_angle_units(units, cols, src)) == "deg")
     bnd = np.full(n, _TURN) if bounds is None else np.maximum(np.asarray(bounds, float), _TURN)
-    big = radc[None, :] & (np.abs(q) > bnd[None, :] + 1e-9)
+    big = (rev & ~deg)[None, :] & (np.abs(q) > bnd[None, :] + 1e-9)
     if big.any():
         i, k = (int(v) for v in np.argwhere(big)[0])
         raise UnitError(f"{_where(src, lines, -1 if one else i)}: {'column ' if header else ''}"
@@ -219,14 +233,8 @@ def joint_values_to_rad(values: ArrayLike, revolute: ArrayLike, units: list[str 
                         f"be an angle in rad and looks like degrees; "
                         f"{_fix(cols[k], 'deg', flag, header)}")
     if deg.any() and len(q) >= RADIAN_LOOK_ROWS:
-        a = np.abs(q[:, deg])
-        if a.max() <= _TURN and a.max() >= RADIAN_LOOK_MIN:
-            shown = ", ".join(c for c, d in zip(cols, deg, strict=True) if d)
-            raise UnitError(f"{src}: columns {shown} are in degrees, but every value lies within "
-                            f"+-2 pi (largest {a.max():.4g}) over {len(q)} rows: these look like "
-                            f"radians in a degree column; {_fix(cols[0], 'rad', flag, header)}"
-                            " (a degree program moving every "
-                            "joint by less than 6.3 degrees: write it in rad)")
+        _check_degree_columns(np.abs(q[:, deg]), [c for c, d in zip(cols, deg, strict=True) if d],
+                              src, flag, header)
     q[:, deg] = np.radians(q[:, deg])
     return q[0] if one else q
 

@@ -82,6 +82,18 @@ def _rows(path: Path, src: str) -> list[list[str]]:
         raise InputError(f"{src}: not a CSV plan file ({exc})") from None
 
 
+def _columns(header: list[str], expected: list[str], model: Manipulator, src: str
+             ) -> dict[str, int]:
+    """Column positions; exactly the ``expected`` columns, in any order."""
+    if sorted(header) != sorted(expected):
+        missing = [c for c in expected if c not in header]
+        extra = [c for c in header if c not in expected]
+        raise InputError(f"{src} line 1: expected the columns pose, q1..q{model.n}, "
+                         f"dir1..dir{model.n} of {model.name!r}; missing {missing}, unknown "
+                         f"{extra}")
+    return {c: i for i, c in enumerate(header)}
+
+
 def read_plan(path: str | Path, model: Manipulator, *, deg: bool = False) -> PlannedPoses:
     """Read a plan file for ``model`` (module doc); joint columns without a unit are rad, or
     degrees with ``deg``.
@@ -95,22 +107,15 @@ def read_plan(path: str | Path, model: Manipulator, *, deg: bool = False) -> Pla
     if len(rows) < 2:
         raise InputError(f"{src}: no poses (a header and at least one row expected)")
     parsed = [split_unit(h, f"{src} line 1") for h in rows[0]]
-    header = [h for h, _ in parsed]
     unit = dict(parsed)
     n = model.n
     qcols = [f"q{k}" for k in range(1, n + 1)]
     dcols = [f"dir{k}" for k in range(1, n + 1)]
-    expected = ["pose", *qcols, *dcols]
-    if sorted(header) != sorted(expected):
-        missing = [c for c in expected if c not in header]
-        extra = [c for c in header if c not in expected]
-        raise InputError(f"{src} line 1: expected the columns pose, q1..q{n}, dir1..dir{n} of "
-                         f"{model.name!r}; missing {missing}, unknown {extra}")
-    col = {c: i for i, c in enumerate(header)}
+    col = _columns([h for h, _ in parsed], ["pose", *qcols, *dcols], model, src)
     ids, q, d = [], [], []
     for line, r in enumerate(rows[1:], start=2):
-        if len(r) != len(header):
-            raise InputError(f"{src} line {line}: {len(r)} fields, expected {len(header)}")
+        if len(r) != len(col):
+            raise InputError(f"{src} line {line}: {len(r)} fields, expected {len(col)}")
         ids.append(r[col["pose"]].strip())
         q.append([_number(r[col[c]], src, line, c) for c in qcols])
         d.append([_number(r[col[c]], src, line, c) for c in dcols])

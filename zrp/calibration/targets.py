@@ -84,6 +84,36 @@ def _columns(header: list[str], n: int, src: str) -> tuple[list[str], bool, bool
     return cols, has_xyz, has_quat
 
 
+def _read_rows(path: str | Path, what: str) -> list[list[str]]:
+    """The non-empty CSV records of ``path``; a header and a row at least."""
+    src = str(path)
+    try:
+        rows = list(csv.reader(io.StringIO(Path(path).read_text(encoding="utf-8"))))
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{src}: cannot read the {what} file: {exc}") from None
+    rows = [r for r in rows if r]
+    if len(rows) < 2:
+        raise InputError(f"{src}: no {what} (a header and at least one row expected)")
+    return rows
+
+
+def _header(rows: list[list[str]], src: str) -> tuple[list[str], dict[str, str | None]]:
+    """The column names and the unit each declares (zrp.units.split_unit)."""
+    parsed = [split_unit(h, f"{src}, line 1") for h in rows[0]]
+    return [h for h, _ in parsed], dict(parsed)
+
+
+def _positions(xyz: F64, unit: dict[str, str | None], model: Manipulator | None, src: str
+               ) -> F64:
+    """x, y, z in the model's length unit (a declared unit converted)."""
+    if all(unit[c] is None for c in "xyz"):
+        return xyz
+    if model is None:
+        raise InputError(f"{src}, line 1: x, y, z declare a unit; the model is needed to "
+                         "convert it")
+    return xyz * [length_scale(unit[c], model.length_unit, f"{src} column {c}") for c in "xyz"]
+
+
 def load_targets(path: str | Path, n: int, *, deg: bool = False,
                  model: Manipulator | None = None) -> Targets:
     """Read a targets CSV for a robot with ``n`` joints (see the module doc); ``model`` (with
@@ -94,16 +124,8 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False,
         InputError: unreadable file, bad header, field count, non-numbers (file, line, column).
     """
     src = str(path)
-    try:
-        rows = list(csv.reader(io.StringIO(Path(path).read_text(encoding="utf-8"))))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{src}: cannot read the targets file: {exc}") from exc
-    rows = [r for r in rows if r]
-    if len(rows) < 2:
-        raise InputError(f"{src}: no targets (a header and at least one row expected)")
-    parsed = [split_unit(h, f"{src}, line 1") for h in rows[0]]
-    header = [h for h, _ in parsed]
-    unit = dict(parsed)
+    rows = _read_rows(path, "targets")
+    header, unit = _header(rows, src)
     cols, has_xyz, has_quat = _columns(header, n, src)
     ids, vals = [], []
     for i, r in enumerate(rows[1:], start=2):
@@ -116,13 +138,7 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False,
         raise InputError(f"{src}: repeated target ids")
     a = np.array(vals, dtype=float)
     q = _joints(a[:, :n], [unit[f"q{k}"] for k in range(1, n + 1)], deg, model, src)
-    xyz = a[:, n:n + 3] if has_xyz else None
-    if xyz is not None and any(unit[c] is not None for c in "xyz"):
-        if model is None:
-            raise InputError(f"{src}, line 1: x, y, z declare a unit; the model is needed to "
-                             "convert it")
-        xyz = xyz * [length_scale(unit[c], model.length_unit, f"{src} column {c}")
-                     for c in "xyz"]
+    xyz = _positions(a[:, n:n + 3], unit, model, src) if has_xyz else None
     rot = None
     if has_quat:
         quat = a[:, n + 3:n + 7]
@@ -158,6 +174,15 @@ class Commands:
     converged: np.ndarray
 
 
+def _check_command_columns(header: list[str], joints: list[str], src: str) -> None:
+    missing = [c for c in ["target", *joints, "converged"] if c not in header]
+    unknown = [c for c in header if c not in ("target", *joints, *COMMAND_FLAGS)]
+    if missing or unknown:
+        raise InputError(f"{src}, line 1: expected the columns of zrp compensate's output "
+                         f"(target, q1..q{len(joints)}, {', '.join(COMMAND_FLAGS)}); missing "
+                         f"{missing}, unknown {unknown}")
+
+
 def load_commands(path: str | Path, model: Manipulator, *, deg: bool = False) -> Commands:
     """Read the commands CSV of ``zrp compensate`` (:func:`write_commands`) for ``model``;
     joint columns by the unit rule of :mod:`zrp.units` (``q1[deg]`` declared, or ``deg``).
@@ -167,23 +192,11 @@ def load_commands(path: str | Path, model: Manipulator, *, deg: bool = False) ->
             column); UnitError: a unit mix-up.
     """
     src = str(path)
-    try:
-        rows = [r for r in csv.reader(io.StringIO(Path(path).read_text(encoding="utf-8")))
-                if r]
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise InputError(f"{src}: cannot read the commands file: {exc}") from None
-    if len(rows) < 2:
-        raise InputError(f"{src}: no commands (a header and at least one row expected)")
-    parsed = [split_unit(h, f"{src}, line 1") for h in rows[0]]
-    header = [h for h, _ in parsed]
+    rows = _read_rows(path, "commands")
+    header, unit = _header(rows, src)
     n = model.n
     joints = [f"q{k}" for k in range(1, n + 1)]
-    missing = [c for c in ["target", *joints, "converged"] if c not in header]
-    unknown = [c for c in header if c not in ("target", *joints, *COMMAND_FLAGS)]
-    if missing or unknown:
-        raise InputError(f"{src}, line 1: expected the columns of zrp compensate's output "
-                         f"(target, q1..q{n}, {', '.join(COMMAND_FLAGS)}); missing {missing},"
-                         f" unknown {unknown}")
+    _check_command_columns(header, joints, src)
     col = {c: i for i, c in enumerate(header)}
     ids, vals, conv = [], [], []
     for i, r in enumerate(rows[1:], start=2):
@@ -192,7 +205,7 @@ def load_commands(path: str | Path, model: Manipulator, *, deg: bool = False) ->
         ids.append(r[col["target"]].strip())
         vals.append([_number(r[col[c]], src, i, c) for c in joints])
         conv.append(_number(r[col["converged"]], src, i, "converged") == 1.0)
-    q = _joints(np.array(vals), [dict(parsed)[c] for c in joints], deg, model, src)
+    q = _joints(np.array(vals), [unit[c] for c in joints], deg, model, src)
     return Commands(tuple(ids), q, np.array(conv))
 
 

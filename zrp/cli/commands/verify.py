@@ -8,6 +8,8 @@ import io
 
 import numpy as np
 
+from zrp.calibration import read_calibration
+from zrp.calibration.targets import load_commands, load_targets
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, add_deg
 from zrp.errors import InputError
@@ -39,10 +41,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    # sim loads MuJoCo: only when this command runs
-    from sim.studies.verify import read_truth, verify_program
-    from zrp.calibration import read_calibration
-    from zrp.calibration.targets import load_commands, load_targets
+    from sim.studies.verify import read_truth, verify_program  # sim loads MuJoCo: only here
 
     if args.out:
         check_writable([args.out], args.force)
