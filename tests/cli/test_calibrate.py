@@ -61,7 +61,7 @@ def test_compensate_program_and_limits(calibrated, tmp_path, capsys):
     assert rc == 0
     rows = list(csv.DictReader(open(out)))
     ref = compensate_program(read_calibration(comp_json), q)
-    got = np.radians([[float(r[f"q{k}"]) for k in range(1, 7)] for r in rows])
+    got = np.radians([[float(r[f"q{k}[deg]"]) for k in range(1, 7)] for r in rows])
     assert np.allclose(got, ref.q_command, atol=1e-12)
     assert all(r["converged"] == "1" for r in rows)
     lo1 = np.degrees(q[:, 0].min()) + 1e-3   # the lowest joint-1 target needs more

@@ -11,7 +11,7 @@ from zrp.calibration import CalibratedRobot, write_calibration
 from zrp.calibration.fullpose import FullPoseCalibration, full_pose_calibration
 from zrp.calibration.storage import calibration_document
 from zrp.cli.app import emit
-from zrp.cli.options import LENGTH, SEED, real, whole
+from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.gap import diagnose, load_measurements
 from zrp.gap.model.context import EFFECTS
 from zrp.gap.report import OUTPUT_FILES, write_outputs
@@ -31,7 +31,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", required=True, metavar="M.toml", help="model TOML or built-in")
     p.add_argument("--mjcf", metavar="M.xml", help="MJCF with inertias (gravity torques)")
     p.add_argument("--data", required=True, metavar="D.csv", help="measurement CSV")
-    p.add_argument("--deg", action="store_true", help="joint values are in degrees")
+    add_deg(p)
     p.add_argument("--frame", choices=("instrument", "base"), default="instrument",
                    help="frame of x, y, z (default instrument)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")

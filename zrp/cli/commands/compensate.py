@@ -10,8 +10,9 @@ from zrp.calibration import PoseConditions, compensate_program, read_calibration
 from zrp.calibration import compensate as compensate_targets
 from zrp.calibration.targets import load_targets, write_commands
 from zrp.cli.app import emit
-from zrp.cli.options import real
+from zrp.cli.options import add_deg, joint_angles, real
 from zrp.errors import InputError
+from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable
 
 
@@ -26,7 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--targets", required=True, metavar="T.csv", help="targets CSV")
     p.add_argument("--out", required=True, metavar="OUT.csv", help="commands CSV")
     p.add_argument("--force", action="store_true", help="overwrite the output file")
-    p.add_argument("--deg", action="store_true", help="joint values (in and out) in degrees")
+    add_deg(p)
     p.add_argument("--point", help="tool point the x, y, z targets are for (default: the "
                    "model's end point)")
     p.add_argument("--frame", choices=("base", "instrument"), default="base",
@@ -47,26 +48,26 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          "load": "--load"})
 
 
-def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
+def _limits(args: argparse.Namespace, model: Manipulator) -> np.ndarray | None:
     if args.limits is None:
         return None
     pairs = args.limits.split(",")
-    if len(pairs) != n:
-        raise InputError(f"--limits: expected {n} LO:HI pairs, got {len(pairs)}")
+    if len(pairs) != model.n:
+        raise InputError(f"--limits: expected {model.n} LO:HI pairs, got {len(pairs)}")
     try:
         lim = np.array([[float(v) for v in s.split(":")] for s in pairs], dtype=float)
     except ValueError:
         raise InputError(f"--limits: expected LO:HI numbers, got {args.limits}") from None
-    if lim.shape != (n, 2):
+    if lim.shape != (model.n, 2):
         raise InputError(f"--limits: expected LO:HI pairs, got {args.limits}")
-    return np.radians(lim) if args.deg else lim
+    return joint_angles(model, lim, args.deg, "--limits")
 
 
 def _run(args: argparse.Namespace) -> int:
     check_writable([args.out], args.force)
     cal = read_calibration(args.calibration)
-    tg = load_targets(args.targets, cal.n, deg=args.deg)
-    lim = _limits(args, cal.n)
+    tg = load_targets(args.targets, cal.n, deg=args.deg, model=cal.model)
+    lim = _limits(args, cal.model)
     grav = None
     if args.mjcf is not None:
         # mjcf loads MuJoCo (+0.25 s): only when asked for
