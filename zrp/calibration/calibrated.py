@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from zrp.arrays import F64
+from zrp.calibration.conditions import Conditions
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
@@ -38,8 +39,12 @@ from zrp.gap.results import Diagnosis
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import skew
 
-__all__ = ["CalibratedRobot", "PoseConditions", "chain"]
+__all__ = ["CalibratedRobot", "PoseConditions", "chain", "rotation_about"]
 
+
+def rotation_about(u: F64, angle: float) -> F64:
+    """Rotation about unit axis u (3,) by ``angle`` (rad), shape (3, 3) (Rodrigues)."""
+    return _rot(np.asarray(u, dtype=float), np.array([angle]))[0]
 
 
 def _rot(u: F64, q: F64) -> F64:
@@ -122,6 +127,11 @@ class CalibratedRobot:
         gravity_side_weights: without MJCF torques, the lumped masses (per joint and mass
             point, shape (n, J)) whose gravity torque decides the loaded flank of the backlash
             (the diagnosis's lumped-mass compliance fit), or None.
+        conditions: what the data were measured under (payloads, tool points, temperature
+            range, units, joint limits, instrument, data file hash; :mod:`.conditions`), or
+            None (unknown: nothing can be enforced).
+        widen: physical domains widened by the user (domain key -> upper bound,
+            :mod:`zrp.gap.model.domains`), or None.
     """
 
     model: Manipulator
@@ -142,6 +152,8 @@ class CalibratedRobot:
     compliance_model: str = "lumped_masses"
     withheld_rms: float | None = None
     gravity_side_weights: F64 | None = None
+    conditions: Conditions | None = None
+    widen: dict[str, float] | None = None
 
     def __post_init__(self) -> None:
         n = self.model.n
@@ -205,7 +217,7 @@ class CalibratedRobot:
                    tuple(ctx.harmonics), ctx.meas.frame,
                    "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
                    float(diag.nominal.rms if registration_only else diag.final.rms),
-                   _side_weights(ctx))
+                   _side_weights(ctx), Conditions.from_measurements(ctx.meas, ctx.model))
 
     # ---- prediction -----------------------------------------------------------------------
     def context(self, q: ArrayLike, cond: PoseConditions | None = None) -> Context:
@@ -315,5 +327,6 @@ def _fold(model: Manipulator, u: F64, bodies: F64, delta: F64, tools: F64
         axes / np.linalg.norm(axes, axis=1, keepdims=True), new_b, axial=r @ ee.axial,
         transverse=r @ ee.transverse, types=model.joint_types,
         name=f"{model.name} (calibrated)", length_unit=model.length_unit,
-        joint_names=[j.name for j in model.joints])
+        joint_names=[j.name for j in model.joints], limits=[j.limits for j in model.joints],
+        velocity_limits=[j.velocity_limit for j in model.joints])
     return folded, tools @ r.T
