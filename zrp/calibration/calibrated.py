@@ -219,6 +219,39 @@ class CalibratedRobot:
                    float(diag.nominal.rms if registration_only else diag.final.rms),
                    _side_weights(ctx), Conditions.from_measurements(ctx.meas, ctx.model))
 
+    @classmethod
+    def from_corrections(cls, nominal: Manipulator, joint_offsets: ArrayLike,
+                         axes: ArrayLike | None = None, bodies: ArrayLike | None = None
+                         ) -> CalibratedRobot:
+        """A purely geometric calibrated robot (base frame, no tool points, no joint map):
+        ``nominal`` with corrected axes (n, 3) and bodies (n + 1, 3) (default: the nominal's)
+        and revolute joint offsets delta (n,) folded in (e.g. a simulated calibration)."""
+        delta = np.asarray(joint_offsets, dtype=float)
+        if delta.shape != (nominal.n,):
+            raise InputError(f"joint_offsets: expected shape ({nominal.n},), got {delta.shape}")
+        u = np.asarray(nominal.axes if axes is None else axes, dtype=float)
+        b = np.asarray(nominal.bodies if bodies is None else bodies, dtype=float)
+        if u.shape != (nominal.n, 3) or b.shape != (nominal.n + 1, 3):
+            raise InputError(f"axes, bodies: expected shapes ({nominal.n}, 3) and "
+                             f"({nominal.n + 1}, 3), got {u.shape} and {b.shape}")
+        folded, tools = _fold(nominal, u / np.linalg.norm(u, axis=1, keepdims=True), b,
+                              np.where(nominal.prismatic, 0.0, delta), np.zeros((0, 3)))
+        return cls(folded, nominal, np.eye(3), np.zeros(3), (), tools,
+                   np.where(nominal.prismatic, 0.0, delta), frame="base")
+
+    def fold_rotations(self) -> F64:
+        """R_k(delta) per joint, shape (n, 3, 3): the rotation the folded offsets of joints
+        1..k give everything after joint k (identity without offsets); the identified axes are
+        u_k = R_{k-1}(delta)^T u'_k."""
+        r = np.eye(3)
+        out = np.empty((self.n, 3, 3))
+        for k in range(self.n):
+            u = r.T @ np.asarray(self.model.axes[k])
+            if not self.model.prismatic[k]:
+                r = r @ rotation_about(u, float(self.joint_offsets[k]))
+            out[k] = r
+        return out
+
     # ---- prediction -----------------------------------------------------------------------
     def context(self, q: ArrayLike, cond: PoseConditions | None = None) -> Context:
         """The diagnosis's :class:`~zrp.gap.Context` on commanded joint values q (P, n)."""

@@ -20,7 +20,7 @@ from collections.abc import Mapping
 import numpy as np
 
 from zrp.arrays import F64
-from zrp.calibration.calibrated import CalibratedRobot, rotation_about
+from zrp.calibration.calibrated import CalibratedRobot
 from zrp.gap.model.domains import DOMAINS, ImplausibleValueError, domain_key, violation
 
 __all__ = ["axis_tilts", "implausible_values", "validate_calibration"]
@@ -28,14 +28,13 @@ __all__ = ["axis_tilts", "implausible_values", "validate_calibration"]
 
 def axis_tilts(cal: CalibratedRobot) -> F64:
     """Angle (rad) between each identified axis and the nominal one, shape (n,)."""
-    r = np.eye(3)
+    rots = cal.fold_rotations()
     out = np.empty(cal.n)
     for k in range(cal.n):
+        r = np.eye(3) if k == 0 else rots[k - 1]
         u = r.T @ np.asarray(cal.model.axes[k])
         u0 = np.asarray(cal.nominal.axes[k])
         out[k] = float(np.arctan2(np.linalg.norm(np.cross(u, u0)), float(u @ u0)))
-        if not cal.model.prismatic[k]:
-            r = r @ rotation_about(u, float(cal.joint_offsets[k]))
     return out
 
 
