@@ -1,7 +1,8 @@
 """Export a calibrated robot into the robot's own URDF: a patched copy plus a side file.
 
-:func:`export_urdf` validates the calibration (:func:`zrp.calibration.validation.validate_calibration`:
-nothing implausible is exported), patches the URDF the robot was imported from
+:func:`export_urdf` validates the calibration
+(:func:`zrp.calibration.validation.validate_calibration`: nothing implausible is exported),
+patches the URDF the robot was imported from
 (:func:`zrp.model.urdf_patch.patch_urdf`: only the chain's origins and axes change; links,
 names, joint types, limits, inertias, meshes and fixed frames stay) with the folded geometry,
 turning each link's frame by its folded offsets (so meshes follow their link), and writes the

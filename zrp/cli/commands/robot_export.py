@@ -6,6 +6,8 @@ import argparse
 import re
 from pathlib import Path
 
+from zrp.calibration import read_calibration
+from zrp.calibration.export import export_urdf, side_document
 from zrp.cli.app import emit
 from zrp.errors import InputError
 from zrp.jsonio import dumps
@@ -64,9 +66,6 @@ def _text(model: Manipulator, fmt: str) -> str:
 def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]:
     """Export the calibration of --calibration: the patched --urdf or the format, and the
     side file; (the calibrated model, the side file)."""
-    from zrp.calibration import read_calibration
-    from zrp.calibration.export import export_urdf, side_document
-
     side = out.with_name(out.name.split(".")[0] + ".calibration.json")
     check_writable([out, side], args.force)
     cal = read_calibration(args.calibration)
