@@ -201,3 +201,47 @@ def test_end_link_on_a_moving_joint_needs_the_end_on_its_axis(tmp_path):
     # offsets alone keep the end point on the axis: that export is exact
     geo = CalibratedRobot.from_corrections(imp.model, np.full(imp.model.n, 2e-3))
     export_urdf(geo, src, tmp_path / "c.urdf", tmp_path / "c.json")
+
+
+def test_cli_measurements_to_a_patched_urdf(tmp_path, capsys):
+    """zrp import -> zrp calibrate -> zrp export --calibration --urdf: the patched URDF's
+    Pinocchio FK is the calibrated model's."""
+    pin = pytest.importorskip("pinocchio")
+    from zrp.calibration import read_calibration
+    from zrp.cli.app import main
+    from zrp.gap import Injection, synthesize
+    from zrp.kinematics import uniform_joint_values
+
+    src = os.path.join(_erd_root(), "ur_description/urdf/ur10_joint_limited_robot.urdf")
+    assert main(["import", src, "--end", "tool0", "--out", str(tmp_path / "ur10.toml")]) == 0
+    model = import_urdf(src, end_link="tool0").model
+    rng = np.random.default_rng(8)
+    meas = synthesize(model, uniform_joint_values(model, 60, rng),
+                      Injection(joint_offset={2: 1e-3, 3: -1.5e-3}), rng=rng, frame="base",
+                      noise_sigma=0.005)
+    meas.to_csv(tmp_path / "d.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["calibrate", "--model", str(tmp_path / "ur10.toml"), "--data",
+                     str(tmp_path / "d.csv"), "--frame", "base", "--effects", "joint_offset",
+                     "--out", str(tmp_path / "out")]) == 0
+    comp = tmp_path / "out" / "compensation.json"
+    out = tmp_path / "ur10_cal.urdf"
+    capsys.readouterr()
+    assert main(["export", "--calibration", str(comp), "--urdf", src, "--end", "tool0",
+                 "--to", "urdf", "--out", str(out), "--json"]) == 0
+    payload = json.loads(capsys.readouterr().out)
+    assert payload["side_file"] == str(tmp_path / "ur10_cal.calibration.json")
+    cal = read_calibration(comp)
+    pm = pin.buildModelFromUrdf(str(out))
+    assert pm.nq == 6 and list(pm.names)[1:] == list(model.joint_names)
+    d, fid = pm.createData(), pm.getFrameId("tool0", pin.FrameType.BODY)
+    q = uniform_joint_values(model, 5, rng)
+    fk = forward_kinematics(cal.model, q).position
+    for i in range(len(q)):
+        pin.framesForwardKinematics(pm, d, q[i])
+        assert np.abs(d.oMf[fid].translation * 1e3 - fk[i]).max() < 1e-9
+    # without --calibration, --urdf is refused by name
+    assert main(["export", "--model", str(tmp_path / "ur10.toml"), "--urdf", src, "--to",
+                 "urdf", "--out", str(tmp_path / "x.urdf")]) == 2
+    assert "--calibration" in capsys.readouterr().err

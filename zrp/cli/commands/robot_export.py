@@ -39,8 +39,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="with --calibration --to urdf: the URDF the robot was imported from; "
                    "the export patches it (same links, names, types, limits, inertias, "
                    "meshes; only the calibrated origins and axes change)")
-    p.add_argument("--base-link", metavar="LINK", help="with --urdf: the chain's base link")
-    p.add_argument("--end-link", metavar="LINK", help="with --urdf: the chain's end link")
+    p.add_argument("--base", metavar="LINK",
+                   help="with --urdf: the chain's base link, as given to zrp import")
+    p.add_argument("--end", metavar="LINK",
+                   help="with --urdf: the chain's end link, as given to zrp import")
     p.add_argument("--to", choices=tuple(FORMATS), required=True, help="output format")
     p.add_argument("--out", default=None, metavar="FILE",
                    help="file to write (default renders/<model><suffix>)")
@@ -72,8 +74,8 @@ def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]
     if args.urdf is not None:
         if args.to != "urdf":
             raise InputError("--urdf: patches a URDF; use it with --to urdf")
-        export_urdf(cal, args.urdf, out, side, base_link=args.base_link,
-                    end_link=args.end_link, overwrite=args.force)
+        export_urdf(cal, args.urdf, out, side, base_link=args.base,
+                    end_link=args.end, overwrite=args.force)
         return cal.model, side
     write_text(out, _text(cal.model, args.to), overwrite=args.force)
     write_text(side, dumps(side_document(cal, out.name, "", None, None)),
@@ -82,7 +84,7 @@ def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]
 
 
 def _run(args: argparse.Namespace) -> int:
-    if args.calibration is None and (args.urdf or args.base_link or args.end_link):
+    if args.calibration is None and (args.urdf or args.base or args.end):
         raise InputError("--urdf: patches the robot's URDF with a calibration; give "
                          "--calibration C.json")
     src = args.calibration or args.model
