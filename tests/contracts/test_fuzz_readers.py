@@ -10,7 +10,8 @@ CI runs a seeded slice (``derandomize=True``: the same cases every run) of
     ZRP_FUZZ_EXAMPLES=2500 python3 -m pytest -q tests/contracts/test_fuzz_readers.py
 
 runs 2,500 cases for each of the readers (four at first, 10,000 in all; the compensation
-file's reader, compensation.json, was added with issue 22: 2,500 cases, none escaped, 74 s). Its first run found one escape
+file's reader, compensation.json, was added with issue 22: 2,500 cases, none escaped, 74 s).
+Its first run found one escape
 (a non-UTF-8 joint name in an MJCF file: UnicodeDecodeError from MuJoCo's name lookup; fixed,
 kept below as a test); the run on the final code: 10,000 cases, none escaped (335 s on the shared
 2-core machine).
