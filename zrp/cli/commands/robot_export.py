@@ -39,6 +39,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="with --calibration --to urdf: the URDF the robot was imported from; "
                    "the export patches it (same links, names, types, limits, inertias, "
                    "meshes; only the calibrated origins and axes change)")
+    p.add_argument("--mjcf", metavar="SRC.xml",
+                   help="with --calibration --to mjcf: the MJCF the robot was imported from; "
+                   "the export patches it (only the chain's body poses, joint axes and the end "
+                   "site change)")
+    p.add_argument("--site", metavar="NAME", help="with --mjcf: the end site, as given to "
+                   "zrp import")
     p.add_argument("--base", metavar="LINK",
                    help="with --urdf: the chain's base link, as given to zrp import")
     p.add_argument("--end", metavar="LINK",
@@ -49,7 +55,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true",
                    help="replace --out if it exists (refused otherwise, before the work)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.set_defaults(func=_run)
+    p.set_defaults(func=_run, api_names={"end_link": "--end", "base_link": "--base",
+                                         "site": "--site", "body": "--end"})
 
 
 def _text(model: Manipulator, fmt: str) -> str:
@@ -71,6 +78,15 @@ def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]
     side = out.with_name(out.name.split(".")[0] + ".calibration.json")
     check_writable([out, side], args.force)
     cal = read_calibration(args.calibration)
+    if args.mjcf is not None:
+        if args.to != "mjcf":
+            raise InputError("--mjcf: patches an MJCF file; use it with --to mjcf")
+        # mjcf loads MuJoCo: only for this export
+        from mjcf.patch import export_mjcf
+
+        export_mjcf(cal, args.mjcf, out, side, site=args.site, body=args.end,
+                    overwrite=args.force)
+        return cal.model, side
     if args.urdf is not None:
         if args.to != "urdf":
             raise InputError("--urdf: patches a URDF; use it with --to urdf")
@@ -84,8 +100,9 @@ def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]
 
 
 def _run(args: argparse.Namespace) -> int:
-    if args.calibration is None and (args.urdf or args.base or args.end):
-        raise InputError("--urdf: patches the robot's URDF with a calibration; give "
+    if args.calibration is None and (args.urdf or args.mjcf or args.base or args.end
+                                     or args.site):
+        raise InputError("--urdf, --mjcf: patch the robot's file with a calibration; give "
                          "--calibration C.json")
     src = args.calibration or args.model
     stem = re.sub(r"[^A-Za-z0-9]+", "_", Path(src).stem).strip("_").lower() or "model"
