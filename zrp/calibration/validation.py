@@ -96,5 +96,5 @@ def validate_calibration(cal: CalibratedRobot, widen: Mapping[str, float] | None
         raise ImplausibleValueError(
             f"{where}: {len(bad)} value(s) outside their physical domain, refused (nothing "
             "implausible is written or used): " + "; ".join(bad)
-            + ". Rerun the diagnosis without the effect, or widen a domain only if the arm is "
-            "known to need it (widen={key: bound})")
+            + ". Rerun the diagnosis without that effect; an upper bound can be raised, "
+            "widen= (--widen on the command line), only for an arm known to need it")
