@@ -171,6 +171,9 @@ class CalibratedRobot:
             raise InputError(f"joint_offsets: expected shape ({n},)")
         if self.frame not in ("instrument", "base"):
             raise InputError(f"frame: expected 'instrument' or 'base', got {self.frame!r}")
+        if self.conditions is not None and len(self.conditions.joint_limits) != n:
+            raise InputError(f"conditions.joint_limits: {len(self.conditions.joint_limits)} "
+                             f"entries for {n} joints")
         bad = [t.name for t in self.terms if not 1 <= t.joint <= n]
         if bad:
             raise InputError(f"terms {bad}: joint outside 1..{n}")
