@@ -22,8 +22,8 @@ from typing import Any
 from zrp.errors import InputError, ZRPError
 from zrp.output import OutputDir
 
-__all__ = ["NOTEBOOKS", "NOTEBOOK_DIR", "NotebookError", "NotebookRun", "notebook_file_names",
-           "notebook_source", "run_notebooks"]
+__all__ = ["NOTEBOOKS", "NOTEBOOK_DIR", "NotebookError", "NotebookRun", "execute_notebook",
+           "mediapy_outputs", "notebook_file_names", "notebook_source", "run_notebooks"]
 
 NOTEBOOK_DIR = Path(__file__).with_name("notebooks")
 
@@ -116,12 +116,35 @@ def _html(nb: Any) -> str:
     return re.sub(r'<script src="">\s*</script>\s*', "", body)
 
 
-def _execute(name: str, timeout_s: float, kernel: str) -> tuple[Any, float]:
+def _require() -> None:
+    """A named error when the ``notebooks`` extra is missing."""
+    import importlib.util
+
+    missing = [m for m in ("jupytext", "nbclient", "nbconvert", "nbformat", "ipykernel")
+               if importlib.util.find_spec(m) is None]
+    if missing:
+        raise NotebookError(f"running the notebooks needs {', '.join(missing)}: pip install "
+                            "'zrp-accuracy[notebooks]'")
+
+
+def execute_notebook(source: str | Path, timeout_s: float = DEFAULT_TIMEOUT_S,
+                     kernel: str = "python3") -> tuple[Any, float]:
+    """Execute the jupytext percent-format file ``source`` top to bottom in a fresh kernel
+    (working folder: a temporary one): the executed notebook (nbformat) and its wall time, s.
+
+    Raises:
+        NotebookError: a cell raised, or the run took longer than ``timeout_s`` (a cell
+            longer than it is interrupted).
+    """
+    if not timeout_s > 0:
+        raise InputError(f"timeout_s: expected a positive time limit (s), got {timeout_s!r}")
+    _require()
     import jupytext
     from nbclient import NotebookClient
     from nbclient.exceptions import CellExecutionError, CellTimeoutError
 
-    nb = jupytext.read(notebook_source(name))
+    name = Path(source).stem
+    nb = jupytext.read(source)
     nb.metadata["kernelspec"] = {"name": kernel, "display_name": kernel, "language": "python"}
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as work:   # a notebook's own files stay out of the way
@@ -153,12 +176,13 @@ def run_notebooks(out: OutputDir, names: Sequence[str] | None = None, *,
     """
     if not timeout_s > 0:
         raise InputError(f"timeout_s: expected a positive time limit (s), got {timeout_s!r}")
+    _require()
     import nbformat
 
     runs = []
     for name in _check(names):
         _, stem, title, _ = _entry(name)
-        nb, seconds = _execute(name, timeout_s, kernel)
+        nb, seconds = execute_notebook(notebook_source(name), timeout_s, kernel)
         ipynb = out.write_text(f"{stem}.ipynb", nbformat.writes(nb))
         html = out.write_text(f"{stem}.html", _html(nb))
         runs.append(NotebookRun(name, title, ipynb, html, seconds, mediapy_outputs(nb)))

@@ -84,6 +84,21 @@ def why_apart(ex: PaperExample) -> str:
             "comparison.md gives every cell.")
 
 
+def _caption(ex: PaperExample, kind: str, style: str) -> str:
+    """The sentence under a figure: :func:`why_apart` for Figures 2-3, else none."""
+    return why_apart(ex) if kind == "JE" and style == "sweep" else ""
+
+
+def _draw_caption(fig: Any, caption: str) -> float:
+    """Draw ``caption`` under the axes (what the reader must know, in the figure itself);
+    returns the bottom margin the axes leave for it (fraction of the figure height)."""
+    if not caption:
+        return 0.03
+    fig.text(0.01, 0.045, caption, ha="left", va="bottom", fontsize=8, color="darkred",
+             wrap=True)
+    return 0.13
+
+
 def coincident_with(data: F64, names: list[str], rtol: float = 1e-2) -> dict[str, str]:
     """For each series equal to an earlier one (every sample within ``rtol`` of its largest
     value), the earlier
@@ -178,8 +193,8 @@ def paper_figures(ex: PaperExample, out: OutputDir, *, suffix: str = "",
         if not params or (only is not None and name not in only):
             continue
         ylabel, title = _labels(name, st.unit, bool(pubs))
-        caption = why_apart(ex) if kind == "JE" and style == "sweep" else ""
-        fig, ax = plt.subplots(figsize=(9.5, 5.4 if caption else 4.8))
+        caption = _caption(ex, kind, style)
+        fig, ax = plt.subplots(figsize=(9.5, 4.8 + 0.6 * bool(caption)))
         try:
             if style == "sweep":
                 _sweep(ax, ex, params, getattr(st, quantity), pubs.get(table), table, colors)
@@ -196,11 +211,7 @@ def paper_figures(ex: PaperExample, out: OutputDir, *, suffix: str = "",
                     if style == "sweep" and pubs else "")
             fig.text(0.99, 0.01, f"{note}{conv}; {ex.path.label}", ha="right", va="bottom",
                      fontsize=7, color="0.4")
-            if caption:   # what the reader must know, in the figure (issue: was only in
-                # comparison.md)
-                fig.text(0.01, 0.045, caption, ha="left", va="bottom", fontsize=8,
-                         color="darkred", wrap=True)
-            fig.tight_layout(rect=(0, 0.13 if caption else 0.03, 1, 1))
+            fig.tight_layout(rect=(0, _draw_caption(fig, caption), 1, 1))
             files.append(out.savefig(name.replace(".png", f"{suffix}.png"), fig, dpi=110))
         finally:
             plt.close(fig)
