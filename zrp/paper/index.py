@@ -139,7 +139,7 @@ def _preview(rel: str) -> str:
 #: except the notebooks, which say how to make them.
 START_HERE: tuple[tuple[str, str, tuple[str, ...]], ...] = (
     ("Notebooks, in order", "Run them top to bottom in Jupyter (sources: "
-     "sim/lessons/notebooks/), or read them executed here.", ("notebooks/*.html",)),
+     "sim/lessons/notebooks/), or read them executed here.", ("notebooks/[0-9]*.html",)),
     ("The paper's figures", "Figures 2-7 of the paper's example, ours beside the published "
      "values; comparison.md says cell by cell why they differ.",
      ("fig[2-7]_*[!d].png", "fig[2-7]_*_recovered.png", "comparison.md")),
