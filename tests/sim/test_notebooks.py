@@ -10,6 +10,7 @@ import importlib
 import importlib.util
 import re
 import shutil
+from pathlib import Path
 
 import pytest
 
@@ -154,3 +155,33 @@ def test_index_opens_with_the_student_path_in_chromium(executed, tmp_path):
     for run in runs.values():   # each notebook's page loads cleanly too
         console, _, _ = _browse(run.html, tmp_path)
         assert console == [], (run.name, console)
+
+
+def test_cli_lists_the_notebooks_and_names_bad_input(capsys):
+    import json
+
+    from zrp.cli.app import main
+
+    assert main(["notebooks", "--list", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["notebooks"]
+    assert [r["name"] for r in rows] == NAMES
+    assert all(Path(r["source"]).is_file() for r in rows)
+    assert main(["notebooks", "bogus"]) == 2
+    assert "NOTEBOOK: unknown notebook(s) ['bogus']" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_cli_runs_one_notebook_with_its_sentences(tmp_path, capsys, backend):
+    import json
+
+    from zrp.cli.app import main
+
+    _runner_installed()
+    out = tmp_path / "nb"
+    assert main(["notebooks", "kinematics", "--out", str(out), "--json"]) == 0
+    res = json.loads(capsys.readouterr().out)["notebooks"][0]
+    assert res["mediapy_outputs"] >= 1 and Path(res["html"]).is_file()
+    sentences = json.loads((out / DESCRIPTIONS).read_text())
+    assert sentences["01_zrp_kinematics.html"].startswith("Notebook 1, ZRP kinematics")
+    assert "01_zrp_kinematics.html" in (out / "index.html").read_text()
+    assert main(["notebooks", "kinematics", "--out", str(out)]) == 2   # no --force: refused

@@ -9,6 +9,7 @@ import json
 from pathlib import Path
 
 from zrp.cli.app import emit
+from zrp.cli.options import real
 from zrp.jsonio import dumps
 from zrp.output import OutputDir
 from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_index
@@ -34,7 +35,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", default=DEFAULT_OUT, metavar="DIR",
                    help="output folder (default renders/notebooks: generated output, "
                         "replaced; elsewhere existing files need --force)")
-    p.add_argument("--timeout", type=float, default=None, metavar="S",
+    p.add_argument("--timeout", type=real(0.0, 86400.0, open_lo=True, unit="s"), default=None,
+                   metavar="S",
                    help="time limit per notebook, s (default 300; the goal on a laptop is "
                         "120)")
     p.add_argument("--force", action="store_true", help="replace existing files in --out")
