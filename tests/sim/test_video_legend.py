@@ -62,3 +62,19 @@ def test_frames_show_the_arrow_exactly_when_the_legend_names_it(backend):
     # five legend lines with the arrow, four without (the arrow's line left blank)
     assert set(bands) <= {4, 5}, bands
     assert [b == 5 for b in bands] == shown
+
+
+def test_the_encoded_video_shows_the_arrow(backend, tmp_path):
+    """Through libx264 (yuv420p) the arrow's yellow survives: present mid-circle, absent at
+    the start where the deviation is 0 (colour within 60 of the painted one, summed over
+    RGB)."""
+    import imageio.v3 as iio
+
+    scene = paper_video_scene("JE2", 0.1, steps=60)
+    opts = sim.VideoOptions(width=W, height=H, fps=10, seconds=4.0, magnify=scene.magnify,
+                            backend=backend, format="mp4")
+    res = sim.render_video(scene.segments, tmp_path / "v.mp4", options=opts, progress=False)
+    frames = iio.imread(res.path, plugin="FFMPEG", index=None)
+    near = [int((np.abs(f[:, : W - 260].astype(int) - np.array(ARROW_RGB_U8)).sum(-1)
+                 <= 60).sum()) for f in frames]
+    assert near[0] == 0 and near[len(frames) // 2] > 50, near
