@@ -11,6 +11,7 @@ notebook is run.
 
 from __future__ import annotations
 
+import math
 import re
 import tempfile
 import time
@@ -133,11 +134,14 @@ def execute_notebook(source: str | Path, timeout_s: float = DEFAULT_TIMEOUT_S,
     (working folder: a temporary one): the executed notebook (nbformat) and its wall time, s.
 
     Raises:
-        NotebookError: a cell raised, or the run took longer than ``timeout_s`` (a cell
-            longer than it is interrupted).
+        NotebookError: a cell raised, or the run took longer than ``timeout_s`` (each cell
+            gets what is left of it, and is interrupted when it overruns).
+        InputError: no such file, or a non-positive ``timeout_s``.
     """
     if not timeout_s > 0:
         raise InputError(f"timeout_s: expected a positive time limit (s), got {timeout_s!r}")
+    if not Path(source).is_file():
+        raise InputError(f"source: no notebook text at {str(source)!r}")
     _require()
     import jupytext
     from nbclient import NotebookClient
@@ -147,14 +151,18 @@ def execute_notebook(source: str | Path, timeout_s: float = DEFAULT_TIMEOUT_S,
     nb = jupytext.read(source)
     nb.metadata["kernelspec"] = {"name": kernel, "display_name": kernel, "language": "python"}
     t0 = time.perf_counter()
+
+    def left_s(cell: Any) -> int:   # the time limit is the whole notebook's
+        return max(1, math.ceil(timeout_s - (time.perf_counter() - t0)))
+
     with tempfile.TemporaryDirectory() as work:   # a notebook's own files stay out of the way
-        client = NotebookClient(nb, timeout=int(timeout_s), kernel_name=kernel,
+        client = NotebookClient(nb, timeout_func=left_s, kernel_name=kernel,
                                 resources={"metadata": {"path": work}})
         try:
             client.execute()
         except CellTimeoutError as exc:
-            raise NotebookError(f"notebook {name}: a cell ran longer than the time limit of "
-                                f"{timeout_s:g} s") from exc
+            raise NotebookError(f"notebook {name}: ran over the time limit of {timeout_s:g} s "
+                                "(the cell running then was interrupted)") from exc
         except CellExecutionError as exc:
             raise NotebookError(f"notebook {name}: a cell failed:\n{exc}") from exc
     seconds = time.perf_counter() - t0

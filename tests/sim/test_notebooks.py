@@ -22,6 +22,7 @@ from sim.lessons.notebook_runner import (
     notebook_source,
     run_notebooks,
 )
+from zrp.errors import InputError
 from zrp.output import OutputDir
 from zrp.paper.index import DESCRIPTIONS, write_index
 
@@ -185,3 +186,15 @@ def test_cli_runs_one_notebook_with_its_sentences(tmp_path, capsys, backend):
     assert sentences["01_zrp_kinematics.html"].startswith("Notebook 1, ZRP kinematics")
     assert "01_zrp_kinematics.html" in (out / "index.html").read_text()
     assert main(["notebooks", "kinematics", "--out", str(out)]) == 2   # no --force: refused
+
+
+@pytest.mark.slow
+def test_the_time_limit_is_the_whole_notebooks(tmp_path):
+    """Three cells of 2 s each under a 4 s limit: no cell alone overruns, the notebook does."""
+    _runner_installed()
+    slow = tmp_path / "three.py"
+    slow.write_text("".join("# %%\nimport time\ntime.sleep(2)\n\n" for _ in range(3)))
+    with pytest.raises(NotebookError, match="time limit of 4 s"):
+        execute_notebook(slow, timeout_s=4)
+    with pytest.raises(InputError, match="source: no notebook text"):
+        execute_notebook(tmp_path / "missing.py")
