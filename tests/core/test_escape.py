@@ -110,8 +110,8 @@ def test_index_links_a_hostile_file_name_as_a_relative_file(tmp_path, capsys):
     page = index_html(tmp_path)
     p = _Links()
     p.feed(page)
-    assert set(p.tags) <= {"html", "head", "meta", "title", "style", "body", "h1", "p", "ul",
-                           "li", "a", "br", "img"}
+    assert set(p.tags) <= {"html", "head", "meta", "title", "style", "body", "h1", "h2", "p",
+                           "ul", "ol", "li", "a", "br", "img", "section", "strong", "code"}
     base = "https://example.org/r/"
     for url in p.urls:
         resolved = urljoin(base, url)

@@ -88,11 +88,19 @@ def cli_message(exc: BaseException, api_names: dict[str, str] | None = None) -> 
 @contextlib.contextmanager
 def one_line_warnings(prog: str) -> Iterator[None]:
     """Print each warning as one clean line ``prog: warning: message`` on stderr (not Python's
-    file:line plus source line), each distinct message once."""
+    file:line plus source line), each distinct message once. Where a caller records warnings
+    (``warnings.catch_warnings(record=True)``, ``pytest.warns``), they go to its record
+    instead, as they would without this context."""
     seen: set[str] = set()
+    outer = warnings._showwarnmsg_impl  # type: ignore[attr-defined]
+    recording = not (getattr(outer, "__module__", "") == "warnings"
+                     and outer.__name__ == "_showwarnmsg_impl")
 
     def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
              file: TextIO | None = None, line: str | None = None) -> None:
+        if recording:
+            outer(warnings.WarningMessage(message, category, filename, lineno, file, line))
+            return
         text = " ".join(str(message).split())
         if text not in seen:
             seen.add(text)

@@ -78,7 +78,7 @@ def _run(args: argparse.Namespace) -> int:
         compensate_program,
         read_calibration,
     )
-    from zrp.calibration import compensate as compensate_targets
+    from zrp.calibration import compensate as compensate_targets  # on use: quick --help
     from zrp.calibration.conditions import missing_conditions  # on use: keeps --help quick
     from zrp.calibration.targets import load_targets, write_commands  # on use: keeps --help quick
 

@@ -114,7 +114,7 @@ def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo (+0.1-0.2 s measured): only when this command runs, not for every `zrp`.
     import numpy as np  # on use: keeps --help quick
 
-    import sim
+    import sim  # MuJoCo: on use (see above)
     from zrp.model.files import load_model  # on use: keeps --help quick
 
     if args.noise is not None and not args.noise > 0:
