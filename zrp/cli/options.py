@@ -11,13 +11,15 @@ from __future__ import annotations
 import argparse
 import math
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from zrp.arguments import MAX_SEED
 from zrp.errors import InputError
-from zrp.model.manipulator import MAX_LENGTH, Manipulator
-from zrp.units import angle_bounds, joint_values_to_rad
+from zrp.limits import MAX_LENGTH, MAX_SEED
+
+if TYPE_CHECKING:
+    import numpy as np
+
+    from zrp.model.manipulator import Manipulator
 
 __all__ = [
     "DURATION",
@@ -120,6 +122,10 @@ def joint_angles(model: Manipulator, values: list[float] | np.ndarray, deg: bool
     """Joint values typed after ``option`` (n values, or (n, 2) limits) to rad for the
     revolute joints (prismatic ones stay in the length unit), checked by zrp.units: a value
     that cannot be an angle in rad names ``option`` and suggests ``--deg``."""
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.units import angle_bounds, joint_values_to_rad  # on use: keeps --help quick
+
     q = np.asarray(values, dtype=float)
     if q.shape[0] != model.n:
         raise InputError(f"{option}: expected {model.n} values for {model.name!r} "

@@ -30,6 +30,7 @@ from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import check_q, end_effector_pose
 from zrp.kinematics.ik import IKResult
+from zrp.manufacturing.choices import PAPER_PARAMETERS, PAPER_XI
 from zrp.manufacturing.perturb import (
     PAPER_SIGN_ZERO,
     Perturbation,
@@ -53,11 +54,6 @@ __all__ = [
 ]
 
 
-#: The perturbation levels of the paper's study, in percent.
-PAPER_XI: tuple[float, ...] = (-0.1, -0.07, -0.05, -0.02, 0.0, 0.02, 0.05, 0.07, 0.1)
-#: The perturbed parameters of the paper's study (links 5 and 6 have zero length).
-PAPER_PARAMETERS: tuple[str, ...] = ("LE2", "LE3", "LE4", "LE7", "JE1", "JE2", "JE3", "JE4",
-                                     "JE5", "JE6")
 
 
 @dataclass(frozen=True, eq=False)

@@ -8,7 +8,8 @@ paper's figures, the videos and the reports; every file follows, one sentence ea
 A sentence comes from, in order: a ``descriptions.json`` in the file's folder (file name ->
 sentence; the lessons write one), the :data:`CATALOGUE` of known outputs (shell patterns on
 the path relative to the root), else a plain statement that no description is registered.
-Links are relative, so the page works wherever the folder is copied.
+Links are relative (only: :func:`zrp.escape.file_href`), so the page works wherever the folder
+is copied, and every name is shown as text.
 """
 
 from __future__ import annotations
@@ -20,6 +21,7 @@ from fnmatch import fnmatch
 from pathlib import Path
 
 from zrp.errors import InputError
+from zrp.escape import file_href, html_text
 from zrp.output import LOCK_NAME, OutputDir, write_text
 
 __all__ = ["CATALOGUE", "INDEX_NAME", "START_HERE", "index_entries", "index_html",
@@ -125,10 +127,11 @@ def index_entries(root: str | os.PathLike[str]) -> list[tuple[str, str]]:
 
 
 def _preview(rel: str) -> str:
-    href = html.escape(rel, quote=True)
+    href = file_href(rel)
     ext = Path(rel).suffix.lower()
     if ext in (".png", ".gif", ".jpg"):
-        return f'<br><img src="{href}" alt="{href}" loading="lazy" style="max-width:640px">'
+        return (f'<br><img src="{href}" alt="{html_text(rel)}" loading="lazy" '
+                'style="max-width:640px">')
     if ext == ".mp4":
         return f'<br><video src="{href}" controls muted style="max-width:640px"></video>'
     return ""
@@ -164,8 +167,8 @@ def start_here_html(entries: list[tuple[str, str]]) -> list[str]:
             continue
         lines.append(f"<li><strong>{html.escape(title)}</strong>: {html.escape(purpose)}")
         if files:
-            lines += ["<ol>", *(f'<li><a href="{html.escape(rel, quote=True)}">'
-                                f"{html.escape(rel)}</a>: {html.escape(sentence)}</li>"
+            lines += ["<ol>", *(f'<li><a href="{file_href(rel)}">'
+                                f"{html_text(rel)}</a>: {html_text(sentence)}</li>"
                                 for rel, sentence in files), "</ol>"]
         else:
             lines.append(f"<br>{_NO_NOTEBOOKS}")
@@ -176,8 +179,10 @@ def start_here_html(entries: list[tuple[str, str]]) -> list[str]:
 def index_html(root: str | os.PathLike[str], title: str = "zrp outputs") -> str:
     """The page (HTML5): one list item per :func:`index_entries` entry."""
     entries = index_entries(root)
-    items = [f'<li><a href="{html.escape(rel, quote=True)}">{html.escape(rel)}</a>: '
-             f"{html.escape(sentence)}{_preview(rel)}</li>"
+    # relative links only, each component percent-encoded (zrp.escape): a file named
+    # "javascript:alert(1)" is a link to that file, never a script
+    items = [f'<li><a href="{file_href(rel)}">{html_text(rel)}</a>: '
+             f"{html_text(sentence)}{_preview(rel)}</li>"
              for rel, sentence in entries]
     return "\n".join([
         "<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',

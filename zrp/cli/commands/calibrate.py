@@ -7,19 +7,15 @@ import argparse
 import contextlib
 import dataclasses
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from zrp.calibration import CalibratedRobot, write_calibration
-from zrp.calibration.conditions import Conditions
-from zrp.calibration.fullpose import FullPoseCalibration, full_pose_calibration
-from zrp.calibration.storage import calibration_document
+if TYPE_CHECKING:
+    from zrp.calibration.fullpose import FullPoseCalibration
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
-from zrp.gap import diagnose, load_measurements
-from zrp.gap.model.context import EFFECTS
-from zrp.gap.model.domains import DOMAINS, ImplausibleValueError
-from zrp.gap.report import OUTPUT_FILES, write_outputs
-from zrp.model.files import load_model
+from zrp.gap.model.choices import EFFECTS
+from zrp.gap.model.domains import DOMAINS  # light: no NumPy
 from zrp.output import OutputDir
 
 FILES = ("calibrated.toml", "compensation.json")
@@ -84,6 +80,14 @@ def _widen(items: list[str]) -> dict[str, float] | None:
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s): only when this command runs
     from mjcf.gravity import gravity_torques
+    from zrp.calibration import CalibratedRobot, write_calibration  # on use: keeps --help quick
+    from zrp.calibration.conditions import Conditions  # on use: keeps --help quick
+    from zrp.calibration.fullpose import full_pose_calibration  # on use: keeps --help quick
+    from zrp.calibration.storage import calibration_document  # on use: keeps --help quick
+    from zrp.gap import diagnose, load_measurements  # on use: keeps --help quick
+    from zrp.gap.model.domains import ImplausibleValueError  # on use: keeps --help quick
+    from zrp.gap.report import OUTPUT_FILES, write_outputs  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     widen = _widen(args.widen)
     model = load_model(args.model)
@@ -92,7 +96,8 @@ def _run(args: argparse.Namespace) -> int:
     out_dir = Path(args.out)
     created = not out_dir.exists()
     try:
-        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES + FILES) as out:
+        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES + FILES,
+                       prune=True) as out:
             diag = diagnose(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, max_steps=args.max_steps, noise_sigma=args.noise,
                             use_orientation=not args.no_orientation,
@@ -107,9 +112,11 @@ def _run(args: argparse.Namespace) -> int:
                 instrument=args.instrument))
             files = write_outputs(diag, out, plots=False)
             try:
-                files += list(write_calibration(cal, out_dir / FILES[0], out_dir / FILES[1],
-                                                overwrite=True,
-                                                full_pose=None if full is None else full.fit))
+                cal_files = list(write_calibration(
+                    cal, out_dir / FILES[0], out_dir / FILES[1], overwrite=True,
+                    full_pose=None if full is None else full.fit))
+                out.written += cal_files  # this run's (the folder's prune keeps them)
+                files += cal_files
             except ImplausibleValueError as exc:
                 raise ImplausibleValueError(
                     f"{exc}. No calibration file was written; the diagnosis outputs in "

@@ -3,17 +3,16 @@
 from __future__ import annotations
 
 import argparse
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
-from zrp.calibration import PoseConditions, compensate_program, read_calibration
-from zrp.calibration import compensate as compensate_targets
-from zrp.calibration.conditions import missing_conditions
-from zrp.calibration.targets import load_targets, write_commands
+    from zrp.model.manipulator import Manipulator
+
 from zrp.cli.app import emit
 from zrp.cli.options import add_deg, joint_angles, real
 from zrp.errors import InputError
-from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable
 
 
@@ -55,6 +54,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _limits(args: argparse.Namespace, model: Manipulator) -> np.ndarray | None:
+    import numpy as np  # on use: keeps --help quick
+
     if args.limits is None:
         return None
     pairs = args.limits.split(",")
@@ -70,6 +71,17 @@ def _limits(args: argparse.Namespace, model: Manipulator) -> np.ndarray | None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.calibration import (  # on use: keeps --help quick
+        PoseConditions,
+        compensate_program,
+        read_calibration,
+    )
+    from zrp.calibration import compensate as compensate_targets  # on use: quick --help
+    from zrp.calibration.conditions import missing_conditions  # on use: keeps --help quick
+    from zrp.calibration.targets import load_targets, write_commands  # on use: keeps --help quick
+
     check_writable([args.out], args.force)
     cal = read_calibration(args.calibration, args.model_file)
     tg = load_targets(args.targets, cal.n, deg=args.deg, model=cal.model)

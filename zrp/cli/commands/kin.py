@@ -5,8 +5,12 @@ from __future__ import annotations
 import argparse
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
+
+    from zrp.model.manipulator import Manipulator
 
 from zrp.cli.app import emit
 from zrp.cli.options import (
@@ -20,16 +24,11 @@ from zrp.cli.options import (
     whole,
 )
 from zrp.errors import InputError, ZRPWarning
-from zrp.kinematics.forward import forward_kinematics
-from zrp.kinematics.ik import CORRECTIONS, track_trajectory
-from zrp.kinematics.posture import solve_pose
-from zrp.kinematics.redundant import track_posture
-from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
-from zrp.model.files import builtin_models, load_model
-from zrp.model.manipulator import MAX_LENGTH, Manipulator
+from zrp.kinematics.choices import CORRECTIONS, TIME_LAWS
+from zrp.limits import MAX_LENGTH
+from zrp.model.builtin import builtin_models
 from zrp.output import check_writable, claim_generated
-from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM, is_paper_model
-from zrp.rotations.rodrigues import er_angle
+from zrp.paper.choices import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM
 
 
 def _joint_values(model: Manipulator, values: list[float], deg: bool, name: str) -> np.ndarray:
@@ -107,6 +106,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _fk(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.kinematics.forward import forward_kinematics  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+    from zrp.rotations.rodrigues import er_angle  # on use: keeps --help quick
+
     model = load_model(args.model)
     q = _joint_values(model, args.q, args.deg, "--q")
     fk = forward_kinematics(model, q)
@@ -129,6 +134,15 @@ def _fk(args: argparse.Namespace) -> int:
 
 
 def _ik(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.kinematics.forward import forward_kinematics  # on use: keeps --help quick
+    from zrp.kinematics.ik import track_trajectory  # on use: keeps --help quick
+    from zrp.kinematics.redundant import track_posture  # on use: keeps --help quick
+    from zrp.kinematics.trajectory import Circle, Line  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     if args.q0 is None:
         if not is_paper_model(model):
@@ -187,6 +201,10 @@ def _ik(args: argparse.Namespace) -> int:
 
 
 def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.kinematics.posture import solve_pose  # on use: keeps --help quick
+
     sol = solve_pose(model, np.array(args.target), args.target_er, q0=q0)
     s = sol.summary()
     s["joint_names"] = list(model.joint_names)
@@ -206,6 +224,8 @@ def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> 
 
 
 def _models(args: argparse.Namespace) -> int:
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     models = {name: str(path) for name, path in sorted(builtin_models().items())}
     text = "\n".join(f"{k:10s} {load_model(v).name}  ({v})" for k, v in models.items())
     emit(args, models, text)

@@ -5,20 +5,18 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
-from zrp.calibration.planfile import read_plan
+    from zrp.model.manipulator import Manipulator
+
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, add_deg, real, whole
 from zrp.errors import InputError
-from zrp.gap.motion import write_trajectory
-from zrp.jsonio import dumps
-from zrp.kinematics import reachable_poses
-from zrp.model.files import builtin_models, load_model
-from zrp.model.manipulator import Manipulator
+from zrp.model.builtin import builtin_models
 from zrp.output import check_writable, write_text
-from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -88,7 +86,11 @@ def _count_or_plan(text: str) -> int | str:
 def _poses(args: argparse.Namespace, model: Manipulator, rng: np.random.Generator
            ) -> tuple[np.ndarray, np.ndarray | None]:
     """The poses to measure and the planned approach directions (None: the procedure's)."""
+    import numpy as np  # on use: keeps --help quick
+
     from sim.studies.trajectories import circle_poses  # with sim: MuJoCo only when run
+    from zrp.calibration.planfile import read_plan  # on use: keeps --help quick
+    from zrp.kinematics import reachable_poses  # on use: keeps --help quick
 
     if isinstance(args.poses, str):
         if args.trajectory != "random":
@@ -110,7 +112,10 @@ def _poses(args: argparse.Namespace, model: Manipulator, rng: np.random.Generato
 
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo (+0.1-0.2 s measured): only when this command runs, not for every `zrp`.
-    import sim
+    import numpy as np  # on use: keeps --help quick
+
+    import sim  # MuJoCo: on use (see above)
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     if args.noise is not None and not args.noise > 0:
         raise InputError(f"--noise: expected a positive sigma (model length unit), got "
@@ -124,6 +129,8 @@ def _run(args: argparse.Namespace) -> int:
     check_writable([out, truth], args.force)  # before the simulation, which takes a while
     model = load_model(args.model)
     if args.noise is None:  # a laser tracker's 20 um, whatever the model's unit
+        from zrp.units import TRACKER_NOISE_MM, units_per_mm  # NumPy: on use (quick --help)
+
         args.noise = TRACKER_NOISE_MM * units_per_mm(model.length_unit, "model.length_unit")
     if args.stream is not None:
         if isinstance(args.poses, str):
@@ -158,6 +165,8 @@ def _run(args: argparse.Namespace) -> int:
 def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> int:
     """``--stream``: the real robot in motion (sim/studies/trajectories.py)."""
     from sim.studies.trajectories import measure_stream  # MuJoCo: only when this command runs
+    from zrp.gap.motion import write_trajectory  # on use: keeps --help quick
+    from zrp.jsonio import dumps  # on use: keeps --help quick
 
     if args.effect:
         raise InputError("--effect: static effects are not simulated with --stream; use "

@@ -8,10 +8,9 @@ from pathlib import Path
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
-from zrp.gap.model.context import EFFECTS
-from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
-from zrp.jsonio import dumps
-from zrp.model.files import load_model
+from zrp.escape import md_text
+from zrp.gap.model.choices import EFFECTS
+from zrp.gap.motion.choices import MOTION_EFFECTS
 from zrp.output import OutputDir, check_writable
 
 OUTPUT_FILES = ("diagnosis_motion.json", "report_motion.md")
@@ -71,6 +70,10 @@ def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[obje
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.gap.motion import diagnose_motion, load_trajectory  # on use: keeps --help quick
+    from zrp.jsonio import dumps  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     if args.video:
         check_writable([args.video], args.force)  # before the work
@@ -97,7 +100,7 @@ def _run(args: argparse.Namespace) -> int:
 def _report(diag: object) -> str:
     d = diag  # MotionDiagnosis
     u = d.length_unit  # type: ignore[attr-defined]
-    lines = ["# Motion diagnosis", "", d.verdict, "",  # type: ignore[attr-defined]
+    lines = ["# Motion diagnosis", "", " ".join(d.verdict.split()), "",  # type: ignore[attr-defined]
              f"| phase | samples | RMS before ({u}) | after | withheld before | after |",
              "|---|---|---|---|---|---|"]
     for p in d.phases:  # type: ignore[attr-defined]
@@ -108,5 +111,5 @@ def _report(diag: object) -> str:
     lines += ["", "| parameter | value | 95 % interval |", "|---|---|---|"]
     for e in d.parameters:  # type: ignore[attr-defined]
         lo, hi = e.ci95
-        lines.append(f"| {e.name} | {e.value:.4g} {e.unit} | [{lo:.4g}, {hi:.4g}] |")
+        lines.append(f"| {md_text(e.name)} | {e.value:.4g} {e.unit} | [{lo:.4g}, {hi:.4g}] |")
     return "\n".join(lines) + "\n"

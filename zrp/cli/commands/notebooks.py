@@ -10,7 +10,6 @@ from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.options import real
-from zrp.jsonio import dumps
 from zrp.output import OutputDir
 from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_index
 
@@ -57,6 +56,8 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.jsonio import dumps  # on use: keeps --help quick
+
     if args.list:
         return _list(args)
     # sim (MuJoCo) and the Jupyter packages load only when notebooks run

@@ -4,17 +4,17 @@ from __future__ import annotations
 
 import argparse
 import warnings
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
-from zrp.calibration import plan_poses
-from zrp.calibration.planfile import write_plan
+    from zrp.model.manipulator import Manipulator
+
 from zrp.cli.app import emit
 from zrp.cli.options import FINITE, LENGTH, SEED, add_deg, joint_angles, whole
 from zrp.errors import InputError
-from zrp.gap.model.context import EFFECTS
-from zrp.model.files import load_model
-from zrp.model.manipulator import Manipulator
+from zrp.gap.model.choices import EFFECTS
 from zrp.output import check_writable
 
 
@@ -54,6 +54,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _limits(text: str | None, model: Manipulator, deg: bool) -> np.ndarray | None:
+    import numpy as np  # on use: keeps --help quick
+
     if text is None:
         return None
     pairs = text.split(",")
@@ -67,6 +69,12 @@ def _limits(text: str | None, model: Manipulator, deg: bool) -> np.ndarray | Non
 
 
 def _run(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.calibration import plan_poses  # on use: keeps --help quick
+    from zrp.calibration.planfile import write_plan  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     check_writable([args.out], args.force)
     model = load_model(args.model)
     with warnings.catch_warnings(record=True) as wl:

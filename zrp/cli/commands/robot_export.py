@@ -5,16 +5,13 @@ from __future__ import annotations
 import argparse
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from zrp.calibration import read_calibration
-from zrp.calibration.export import export_urdf, side_document
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 from zrp.cli.app import emit
 from zrp.errors import InputError
-from zrp.jsonio import dumps
-from zrp.model.dh_table import dumps_dh, to_dh
-from zrp.model.files import builtin_models, dumps_model, load_model
-from zrp.model.manipulator import Manipulator
-from zrp.model.urdf_writer import urdf_xml
+from zrp.model.builtin import builtin_models
 from zrp.output import check_writable, write_text
 
 FORMATS = {"urdf": ".urdf", "mjcf": ".xml", "dh": ".dh.toml", "mdh": ".mdh.toml",
@@ -60,6 +57,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _text(model: Manipulator, fmt: str) -> str:
+    from zrp.model.dh_table import dumps_dh, to_dh  # on use: keeps --help quick
+    from zrp.model.files import dumps_model  # on use: keeps --help quick
+    from zrp.model.urdf_writer import urdf_xml  # on use: keeps --help quick
+
     if fmt == "urdf":
         return urdf_xml(model)
     if fmt in ("dh", "mdh"):
@@ -75,6 +76,10 @@ def _text(model: Manipulator, fmt: str) -> str:
 def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]:
     """Export the calibration of --calibration: the patched --urdf or the format, and the
     side file; (the calibrated model, the side file)."""
+    from zrp.calibration import read_calibration  # on use: keeps --help quick
+    from zrp.calibration.export import export_urdf, side_document  # on use: keeps --help quick
+    from zrp.jsonio import dumps  # on use: keeps --help quick
+
     side = out.with_name(out.name.split(".")[0] + ".calibration.json")
     check_writable([out, side], args.force)
     cal = read_calibration(args.calibration)
@@ -100,6 +105,8 @@ def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     if args.calibration is None and (args.urdf or args.mjcf or args.base or args.end
                                      or args.site):
         raise InputError("--urdf, --mjcf: patch the robot's file with a calibration; give "

@@ -7,8 +7,10 @@ from __future__ import annotations
 
 import argparse
 import warnings
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 
 from zrp.cli.app import emit
 from zrp.cli.options import (
@@ -22,20 +24,14 @@ from zrp.cli.options import (
     whole,
 )
 from zrp.errors import InputError, ZRPWarning
-from zrp.kinematics.trajectory import TIME_LAWS
-from zrp.manufacturing.perturb import PAPER_SIGN_ZERO
-from zrp.manufacturing.study import (
-    PAPER_PARAMETERS,
-    PAPER_XI,
-    JointPath,
-    StudyResult,
-    load_joint_csv,
-    one_at_a_time,
-)
-from zrp.model.files import builtin_models, load_model
-from zrp.model.manipulator import Manipulator
+from zrp.kinematics.choices import TIME_LAWS
+from zrp.manufacturing.choices import PAPER_PARAMETERS, PAPER_SIGN_ZERO, PAPER_XI
+
+if TYPE_CHECKING:
+    from zrp.manufacturing.study import JointPath, StudyResult
+from zrp.model.builtin import builtin_models
 from zrp.output import OutputDir
-from zrp.paper.scenario import PUMA_Q0_DEG, circle_joint_path, is_paper_model
+from zrp.paper.choices import PUMA_Q0_DEG
 
 #: The tables ``zrp study --out DIR`` writes.
 STUDY_TABLES = tuple(f"study_{q}.{ext}" for q in ("delta_p", "delta_r", "angle_rad")
@@ -74,6 +70,8 @@ def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
 def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
     """Check the trajectory options against ``model`` before any work: --q0 has one value per
     joint, and is given for every model but the paper's PUMA (which has a default start)."""
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
+
     if args.joints:
         return
     if args.q0 is None:
@@ -91,6 +89,10 @@ def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
 
 def path_from_args(args: argparse.Namespace, model: Manipulator) -> JointPath:
     """The nominal joint trajectory the options describe."""
+
+    from zrp.manufacturing.study import load_joint_csv  # on use: keeps --help quick
+    from zrp.paper.scenario import circle_joint_path  # on use: keeps --help quick
+
     check_path_options(args, model)
     if args.joints:
         return load_joint_csv(args.joints, model, deg=args.deg)
@@ -140,6 +142,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run_study(args: argparse.Namespace, model: Manipulator,
                out: OutputDir | None) -> tuple[JointPath, StudyResult]:
+    from zrp.manufacturing.study import one_at_a_time  # on use: keeps --help quick
+
     path = path_from_args(args, model)
     st = one_at_a_time(model, path, args.params, args.xi, sign_zero_links=args.sign0_links,
                        sign_zero_axes=args.sign0_axes)
@@ -151,6 +155,10 @@ def _run_study(args: argparse.Namespace, model: Manipulator,
 
 
 def _study(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     check_path_options(args, model)
     files: list[str] = []

@@ -6,10 +6,6 @@ import argparse
 import csv
 import io
 
-import numpy as np
-
-from zrp.calibration import read_calibration
-from zrp.calibration.targets import load_commands, load_targets
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, add_deg
 from zrp.errors import InputError
@@ -41,7 +37,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
     from sim.studies.verify import read_truth, verify_program  # sim loads MuJoCo: only here
+    from zrp.calibration import read_calibration  # on use: keeps --help quick
+    from zrp.calibration.targets import load_commands, load_targets  # on use: keeps --help quick
 
     if args.out:
         check_writable([args.out], args.force)

@@ -40,11 +40,11 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from tqdm import tqdm
 
 from zrp.arguments import check_int
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.data.choices import MAX_ROWS
 from zrp.gap.data.csvrows import Accumulator, Columns, Header, check_header, parse_row
 from zrp.gap.data.measurements import FRAMES, DataWarning, Measurements
 from zrp.model.manipulator import Manipulator
@@ -52,9 +52,6 @@ from zrp.units import angle_bounds, joint_column_units, joint_values_to_rad, len
 
 __all__ = ["MAX_ROWS", "load_measurements"]
 
-#: Most data rows read by default: about 0.7 GB of memory per million rows at the peak of a
-#: whole diagnosis, so two million stay within 2 GB.
-MAX_ROWS = 2_000_000
 
 #: plausible temperatures, deg C.
 TEMP_RANGE = (-60.0, 150.0)
@@ -159,6 +156,8 @@ class _Reader:
 def _read(path: Path, src: str, model: Manipulator, progress: bool, max_rows: int | None
           ) -> tuple[list[str], Header, Columns]:
     """Stream the file once: the header, then each data row checked and appended."""
+    from tqdm import tqdm  # ~0.03 s: on use, so that `zrp diagnose --help` stays quick
+
     reader = _Reader(src, model, max_rows)
     bar = tqdm(desc=f"reading {path.name}", unit=" rows", disable=not progress,
                mininterval=1.0, leave=False)
