@@ -20,6 +20,7 @@ from zrp.arrays import F64
 from zrp.gap.analysis.checks import GapWarning
 from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.identifiability import GEOMETRIC, geometric_overlap
+from zrp.gap.fit.constrained import n_registration, within_domains
 from zrp.gap.fit.leastsq import (
     Aliased,
     FitResult,
@@ -144,14 +145,24 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
         return _Trial(Candidate(effect, (), 0, cv_rms(ctx, f1, s.folds), f1.bic - current.bic,
                                 f_test(current, f1), False, "no joint significant"),
                       None, aliased)
+    f1, outside = within_domains(ctx, f1, n_registration(f1.specs), s.fitting, s.rb0)
+    kept = [p for p in f1.specs if p.effect == effect]
+    if not kept:
+        return _Trial(Candidate(effect, (), 0, math.nan, math.nan, 1.0, False,
+                                "fitted values outside the physical domain: "
+                                + "; ".join(outside)), None, aliased)
     cv = cv_rms(ctx, f1, s.folds)
     pval = f_test(current, f1)
     dbic = f1.bic - current.bic
     joints = tuple(sorted({p.joint for p in kept if p.joint > 0}))
-    ok = pval < s.alpha and dbic < 0 and cv < current_cv * (1.0 - s.min_gain)
+    ok = (pval < s.alpha and dbic < 0 and cv < current_cv * (1.0 - s.min_gain)
+          and bool(kept))
     note = "" if ok else ("F test not significant" if pval >= s.alpha else
                           "BIC does not improve" if dbic >= 0 else
                           f"cross-validated RMS improves by less than {s.min_gain:.0%}")
+    if outside:
+        note = "; ".join(filter(None, [note, "joints taken out, outside the physical domain: "
+                                       + "; ".join(outside)]))
     return _Trial(Candidate(effect, joints, len(kept), cv, dbic, pval, ok, note), f1, aliased)
 
 
@@ -264,4 +275,5 @@ def backward_pass(ctx: Context, current: FitResult, nreg: int, s: SearchSettings
         pruned += sorted(drop)
         current = fit(ctx, [current.specs[i] for i in keep_idx], s.fitting,
                       current.theta[keep_idx], s.rb0)
+        current, _ = within_domains(ctx, current, nreg, s.fitting, s.rb0)
     return current, tuple(pruned)
