@@ -210,31 +210,33 @@ def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], 
             tau_fixed = tau  # the threshold settles with the fit: fixed, no held set flips
         keep = s > tau
         x = (theta - prior) / scales
-        reset = -(Vt[~keep].T @ (Vt[~keep] @ x))
-        ug = U[:, keep].T @ g
-        dx = -(Vt[keep].T @ (ug / s[keep]))
-        pred = float(ug @ ug)  # the Gauss-Newton decrease of |r|^2 predicted for t = 1
-        rss = float(r @ r)
-        base = theta + scales * reset
-        small_step = float(np.linalg.norm(dx)) <= 1e-10 * (1.0 + float(np.linalg.norm(x)))
-        moved = float(np.linalg.norm(reset)) > 1e-9
-        if not moved and (pred <= 1e-14 * rss or small_step):
+        c = Vt @ x
+        b = U.T @ g
+        s2 = tau * tau  # the prior's weight sigma^2 (eq. W4)
+        # eq. W4: the MAP Gauss-Newton step in the SVD basis; held components reset to 0
+        e = np.where(keep, -(s * b + s2 * c) / (s * s + s2), -c)
+        phi0 = float(r @ r) + s2 * float(c @ c)
+        after = (b + s * e) ** 2 + s2 * (c + e) ** 2
+        pred = float(np.sum(np.where(keep, b * b + s2 * c * c - after, 0.0)))
+        dx = Vt.T @ e
+        if float(np.linalg.norm(dx)) <= 1e-10 * (1.0 + float(np.linalg.norm(x))) or (
+                pred <= 1e-14 * phi0 and float(np.linalg.norm(e[~keep])) <= 1e-9):
             converged, reason = True, "converged"
             break
-        rss0 = rss if not moved else float(np.sum(residual(base) ** 2))
         t = 1.0
         while t >= 2.0 ** -30:
-            trial = base + t * scales * dx
+            trial = theta + t * scales * dx
             r_t = residual(trial)
-            if float(r_t @ r_t) <= rss0 - 1e-4 * t * pred or pred <= 1e-14 * rss:
+            xt = (trial - prior) / scales
+            if (float(r_t @ r_t) + s2 * float(xt @ xt) <= phi0 - 1e-4 * t * pred
+                    or pred <= 1e-14 * phi0 or (not keep.all() and t == 1.0
+                    and float(np.linalg.norm(e[~keep])) > 1e-9)):
                 break
             t *= 0.5
         else:
-            theta = base
-            r, J = evaluate(theta)
-            converged = pred <= 1e-10 * rss
-            reason = ("converged (no step lowers the residual further)" if converged else
-                      "stopped: no step along the Gauss-Newton direction lowers the residual")
+            converged = pred <= 1e-10 * phi0
+            reason = ("converged (no step lowers the objective further)" if converged else
+                      "stopped: no step along the Gauss-Newton direction lowers the objective")
             break
         theta = trial
         r, J = evaluate(theta)

@@ -5,7 +5,7 @@ writes a calibrated model (the same test refuses it there).
 =========================  ===================================  ==============================
 parameter                  domain (hard: outside it, not used)  tolerance (scale of the prior)
 =========================  ===================================  ==============================
-``q{k}.offset``            abs <= 0.2 rad (prismatic: 20 mm)    10 mrad (prismatic: 1 mm)
+``q{k}.offset``            abs <= 0.2 rad (prismatic: 20 mm)    2 mrad (prismatic: 1 mm)
 ``q{k}.scale``             abs <= 0.02                          1e-3
 ``q{k}.sin{h}/cos{h}``     each abs <= 5 mrad; amplitude too    0.5 mrad
 ``q{k}.backlash``          0 <= b <= 20 mrad                    1 mrad
@@ -132,7 +132,7 @@ def tolerance(name: str, effect: str, unit: str) -> float | None:
     :mod:`zrp.gap.fit.wellposed`), or None when it has none in absolute terms (compliance, the
     registration: scaled by their Jacobian columns there)."""
     per_m = _length_scale(unit)
-    fixed = {"joint_offset": 1e-3 * per_m if per_m is not None else 1e-2,
+    fixed = {"joint_offset": 1e-3 * per_m if per_m is not None else 2e-3,
              "encoder_scale": 1e-3, "cyclic_error": 5e-4, "backlash": 1e-3,
              "axis_misalignment": 2e-3, "thermal_expansion": 2.3e-5,
              "link_length": 1e-3 * per_m if per_m is not None else None}

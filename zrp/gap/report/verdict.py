@@ -141,6 +141,32 @@ def _trust(diag: Diagnosis) -> list[str]:
     return parts
 
 
+def identification_text(diag: Diagnosis) -> list[str]:
+    """What the data could not pin (held at nominal), which effects left their physical
+    domains, and any fit that stopped before converging."""
+    parts = []
+    held = diag.held_directions
+    if held:
+        shown = "; ".join(h.describe(diag.length_unit) for h in held[:3])
+        more = f" and {len(held) - 3} more" if len(held) > 3 else ""
+        parts.append(f"{len(held)} parameter combination(s) the data cannot pin stayed at "
+                     f"their nominal values: {shown}{more}.")
+    seen: set[str] = set()
+    for effect, note in diag.outside_domain:
+        if effect not in diag.final_joints and effect not in seen:
+            seen.add(effect)
+            items = note.split("physical domain: ", 1)[-1].split("; ")
+            why = "; ".join(items[:1] + [i.split(" outside ")[0] for i in items[1:]])
+            parts.append(f"{effect} fits these data only with values outside its physical "
+                         f"domain ({why}); the residual has a shape that effect cannot "
+                         "produce physically, so it was not accepted.")
+    stops = diag.solver_stops
+    if stops:
+        parts.append(f"{len(stops)} fit(s) stopped before converging ({stops[0]}): their "
+                     "values are not at the least-squares minimum.")
+    return parts
+
+
 def _against_floor(diag: Diagnosis) -> list[str]:
     floor, final, unit = diag.noise_floor, diag.final, diag.length_unit
     if floor.rms is None:
@@ -218,6 +244,7 @@ def verdict_text(diag: Diagnosis) -> str:
     if bl:
         parts.append(bl)
     parts += _against_floor(diag)
+    parts += identification_text(diag)
     parts += _trust(diag)
     if diag.full_pose is not None:
         parts.append(full_pose_text(diag))
