@@ -1,12 +1,13 @@
 """Plausibility as a constraint: a fitted model keeps only parameters inside their physical
 domains (:mod:`zrp.gap.model.domains`).
 
-A group of parameters (one joint of an effect) any of whose values leaves its domain is taken
-out of the model, which puts it back at its nominal value 0 (inside every domain: no play,
-no deflection, no tilt), and the rest is refitted; repeated until every value is inside. This
-is the active-set answer to a bound-constrained least-squares problem whose bounds are met at
-the nominal (Lawson & Hanson 1974, ch. 23: a variable at its bound leaves the free set), without
-ever clamping a value silently: every group taken out is reported with the reason.
+A parameter whose value leaves its domain (both of a cyclic error's pair when their amplitude
+does) is taken out of the model, which puts it back at its nominal value 0 (inside every
+domain: no play, no deflection, no tilt), and the rest is refitted; repeated until every
+value is inside. This is the active-set answer to a bound-constrained least-squares problem
+whose bounds are met at the nominal (Lawson & Hanson 1974, ch. 23: a variable at its bound
+leaves the free set), without ever clamping a value silently: every parameter taken out is
+reported with the reason.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.arrays import F64
-from zrp.gap.fit.leastsq import FitResult, fit, group_key
+from zrp.gap.fit.leastsq import FitResult, fit
 from zrp.gap.model.context import REGISTRATION, Context, ParamSpec
 from zrp.gap.model.domains import domain_violations
 
@@ -44,21 +45,20 @@ def outside_domains(ctx: Context, result: FitResult, first: int = 0) -> list[tup
 
 def within_domains(ctx: Context, result: FitResult, first: int, fitting: NDArray[np.int64],
                    rb0: F64) -> tuple[FitResult, tuple[str, ...]]:
-    """``result`` without the groups (from index ``first`` on) whose values leave their
+    """``result`` without the parameters (from index ``first`` on) whose values leave their
     domains, refitted until none does (module docstring).
 
     Returns:
-        the fit (``result`` itself when nothing left a domain) and the reasons of the groups
-        taken out, in words.
+        the fit (``result`` itself when nothing left a domain) and the reasons of the
+        parameters taken out, in words.
     """
     reasons: list[str] = []
     while True:
         bad = outside_domains(ctx, result, first)
         if not bad:
             return result, tuple(reasons)
-        groups = {group_key(result.specs[i]) for i, _ in bad}
+        out = {i for i, _ in bad}
         reasons += [why for _, why in bad]
-        keep: Sequence[int] = [i for i, s in enumerate(result.specs)
-                               if i < first or group_key(s) not in groups]
+        keep: Sequence[int] = [i for i in range(len(result.specs)) if i not in out]
         result = fit(ctx, [result.specs[i] for i in keep], fitting, result.theta[list(keep)],
                      rb0)

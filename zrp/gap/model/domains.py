@@ -50,6 +50,8 @@ DEFAULT_MAX_TILT_RAD = 5e-3
 MAX_CYCLIC_RAD = 5e-3
 #: Largest link (body-vector) correction, metres.
 MAX_LINK_M = 0.02
+#: Largest play or cyclic error of a prismatic joint, metres.
+MAX_PLAY_M = 1e-3
 #: Largest encoder zero error (rad; prismatic joints: MAX_LINK_M).
 MAX_OFFSET_RAD = 0.2
 
@@ -104,11 +106,17 @@ def parameter_domain(name: str, effect: str, unit: str, *,
     """
     per_m = _length_scale(unit)
     if effect == "backlash":
+        if per_m is not None:  # a prismatic joint's play, in a length unit
+            return Domain(0.0, MAX_PLAY_M * per_m, "a play is never negative and a drive "
+                          "keeps it below 1 mm")
         return Domain(0.0, 0.02, "a play is never negative and a gear train keeps it below "
                       "20 mrad")
     if effect == "joint_compliance" and name.endswith((".compliance", ".compliance_payload")):
         return Domain(0.0, 1e-3, "a joint deflects with its load, not against it")
     if effect == "cyclic_error":
+        if per_m is not None:
+            return _symmetric(MAX_PLAY_M * per_m, "a screw's or rack's cyclic error is below "
+                              "1 mm")
         return _symmetric(MAX_CYCLIC_RAD, "a gear train's cyclic transmission error is a few "
                           "mrad at most")
     if effect == "axis_misalignment":
@@ -133,7 +141,9 @@ def tolerance(name: str, effect: str, unit: str) -> float | None:
     registration: scaled by their Jacobian columns there)."""
     per_m = _length_scale(unit)
     fixed = {"joint_offset": 1e-3 * per_m if per_m is not None else 2e-3,
-             "encoder_scale": 1e-3, "cyclic_error": 5e-4, "backlash": 1e-3,
+             "encoder_scale": 1e-3,
+             "cyclic_error": 5e-5 * per_m if per_m is not None else 5e-4,
+             "backlash": 1e-4 * per_m if per_m is not None else 1e-3,
              "axis_misalignment": 2e-3, "thermal_expansion": 2.3e-5,
              "link_length": 1e-3 * per_m if per_m is not None else None}
     return fixed.get(effect)
@@ -152,7 +162,7 @@ def domain_violations(names: Sequence[str], effects: Sequence[str], units: Seque
         d = parameter_domain(n, e, u, max_tilt_rad=max_tilt_rad)
         if d is not None and not d.contains(v):
             out.append((i, f"{n} = {v:.3g} {u} outside {d.describe(u)}: {d.why}"))
-        if e == "cyclic_error":
+        if e == "cyclic_error" and _length_scale(u) is None:
             pairs.setdefault(n.replace(".sin", ".h").replace(".cos", ".h"), []).append(i)
     flagged = {i for i, _ in out}
     for key, idx in pairs.items():

@@ -161,7 +161,7 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
                           "BIC does not improve" if dbic >= 0 else
                           f"cross-validated RMS improves by less than {s.min_gain:.0%}")
     if outside:
-        note = "; ".join(filter(None, [note, "joints taken out, outside the physical domain: "
+        note = "; ".join(filter(None, [note, "parameters taken out, outside the physical domain: "
                                        + "; ".join(outside)]))
     return _Trial(Candidate(effect, joints, len(kept), cv, dbic, pval, ok, note), f1, aliased)
 
