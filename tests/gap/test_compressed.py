@@ -51,7 +51,9 @@ def _case():
 
 def test_fit_equals_levenberg_marquardt_on_the_tall_jacobian():
     """On a well-posed problem (nothing held) the well-posed solver lands where scipy's
-    Levenberg-Marquardt does on the tall, uncompressed problem (an independent reference)."""
+    Levenberg-Marquardt does on the tall, uncompressed problem (an independent reference), up
+    to the prior's pull (eq. W4: a shift of at most a few hundredths of a standard error
+    where the data pin every direction far better than the tolerances)."""
     ctx, poses, specs, th0, rb0 = _case()
     reg = fit(ctx, specs, poses, th0, rb0)
     keep, _ = leastsq.check_identifiable(ctx, reg, effect_parameters(ctx, "joint_offset")[0])
@@ -64,11 +66,14 @@ def test_fit_equals_levenberg_marquardt_on_the_tall_jacobian():
                         method="lm", x_scale="jac", xtol=1e-14, ftol=1e-14, gtol=1e-14)
     assert new.converged and ref.status > 0 and not new.held
     se = np.sqrt(np.diag(new.cov))
-    assert np.max(np.abs(new.theta - ref.x) / se) < 1e-6  # in standard errors
-    np.testing.assert_allclose(new.residual, ref.fun, rtol=0, atol=1e-9)
+    assert np.max(np.abs(new.theta - ref.x) / se) < 0.05  # in standard errors
+    np.testing.assert_allclose(new.rss, ref.fun @ ref.fun, rtol=1e-3)
     J = ref.jac
     cov = np.linalg.inv(J.T @ J) * (ref.fun @ ref.fun) / (J.shape[0] - J.shape[1])
-    np.testing.assert_allclose(new.cov, cov, rtol=1e-6)
+    se_ref = np.sqrt(np.diag(cov))
+    np.testing.assert_allclose(se, se_ref, rtol=1e-3)
+    np.testing.assert_allclose(new.cov / np.outer(se, se), cov / np.outer(se_ref, se_ref),
+                               atol=1e-3)  # the correlations
 
 
 def test_fit_from_the_identifiability_evaluation_is_the_same_fit():

@@ -223,10 +223,13 @@ def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], 
                 pred <= 1e-14 * phi0 and float(np.linalg.norm(e[~keep])) <= 1e-9):
             converged, reason = True, "converged"
             break
-        t = 1.0
+        t, J_t = 1.0, None
         while t >= 2.0 ** -30:
             trial = theta + t * scales * dx
-            r_t = residual(trial)
+            if t == 1.0:  # usually accepted: evaluate the Jacobian with it
+                r_t, J_t = evaluate(trial)
+            else:
+                r_t, J_t = residual(trial), None
             xt = (trial - prior) / scales
             if (float(r_t @ r_t) + s2 * float(xt @ xt) <= phi0 - 1e-4 * t * pred
                     or pred <= 1e-14 * phi0 or (not keep.all() and t == 1.0
@@ -239,11 +242,12 @@ def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], 
                       "stopped: no step along the Gauss-Newton direction lowers the objective")
             break
         theta = trial
-        r, J = evaluate(theta)
+        r, J = (r_t, J_t) if J_t is not None else evaluate(theta)
     else:
         reason = f"stopped at the iteration limit ({max_iterations}) before converging"
-    _, _, s, Vt, _, tau = _decompose(r, J, scales, tau_fixed)
-    keep = s > tau
+    if reason != "converged":  # the decomposition at theta is not at hand
+        _, _, s, Vt, _, tau = _decompose(r, J, scales, tau_fixed)
+        keep = s > tau
     held = _held(Vt, s, keep, names, tau, RANK_RTOL * float(s[0]) if s.size else 0.0)
     return Solution(theta, r, J, _covariance(r, s, Vt, keep, scales), held, converged, it,
                     reason)
