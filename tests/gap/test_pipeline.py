@@ -159,7 +159,7 @@ def test_backlash_is_the_full_play_and_negative_play_is_refused():
     assert all(s.effect != "backlash" or d.final_fit.theta[i] >= 0
                for i, s in enumerate(d.final_fit.specs))
     assert any(e == "backlash" and "q2.backlash" in n for e, n in d.outside_domain)
-    assert "backlash fits these data only with values outside its physical domain" in (
+    assert "backlash was not accepted: fitted to these data it needs values outside" in (
         verdict_text(d))
 
 

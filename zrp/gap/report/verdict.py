@@ -153,13 +153,18 @@ def identification_text(diag: Diagnosis) -> list[str]:
                      f"their nominal values: {shown}{more}.")
     seen: set[str] = set()
     for effect, note in diag.outside_domain:
-        if effect not in diag.final_joints and effect not in seen:
-            seen.add(effect)
-            items = note.split("physical domain: ", 1)[-1].split("; ")
-            why = "; ".join(items[:1] + [i.split(" outside ")[0] for i in items[1:]])
-            parts.append(f"{effect} fits these data only with values outside its physical "
-                         f"domain ({why}); the residual has a shape that effect cannot "
-                         "produce physically, so it was not accepted.")
+        if effect in seen:
+            continue
+        seen.add(effect)
+        items = note.split("physical domain: ", 1)[-1].split("; earlier")[0].split("; ")
+        why = "; ".join(items[:1] + [i.split(" outside ")[0] for i in items[1:]])
+        if note.startswith("fitted values outside"):
+            parts.append(f"{effect} was not accepted: fitted to these data it needs values "
+                         f"outside its physical domain ({why}); the residual has a shape "
+                         "that effect cannot produce physically.")
+        else:
+            parts.append(f"{effect}: parameters whose fitted values left their physical "
+                         f"domain were taken out ({why}).")
     stops = diag.solver_stops
     if stops:
         parts.append(f"{len(stops)} fit(s) stopped before converging ({stops[0]}): their "

@@ -146,13 +146,16 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
                                 f_test(current, f1), False, "no joint significant"),
                       None, aliased)
     f1, outside = within_domains(ctx, f1, n_registration(f1.specs), s.fitting, s.rb0)
+    own_names = {p.name for p in specs}
+    own = [w for w in outside if w.split(" = ")[0] in own_names]
+    others = [w.split(" outside ")[0] for w in outside if w not in own]
     kept = [p for p in f1.specs if p.effect == effect]
     if not kept:
         return _Trial(Candidate(effect, (), 0, math.nan, math.nan, 1.0, False,
                                 "fitted values outside the physical domain: "
-                                + "; ".join(outside)), None, aliased)
+                                + "; ".join(own)), None, aliased)
     cv = cv_rms(ctx, f1, s.folds)
-    pval = f_test(current, f1)
+    pval = f_test(_nested(ctx, current, f1, s), f1)
     dbic = f1.bic - current.bic
     joints = tuple(sorted({p.joint for p in kept if p.joint > 0}))
     ok = (pval < s.alpha and dbic < 0 and cv < current_cv * (1.0 - s.min_gain)
@@ -160,10 +163,23 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
     note = "" if ok else ("F test not significant" if pval >= s.alpha else
                           "BIC does not improve" if dbic >= 0 else
                           f"cross-validated RMS improves by less than {s.min_gain:.0%}")
-    if outside:
+    if own:
         note = "; ".join(filter(None, [note, "parameters taken out, outside the physical domain: "
-                                       + "; ".join(outside)]))
+                                       + "; ".join(own)]))
+    if others:
+        note = "; ".join(filter(None, [note, "earlier parameters taken out, outside their "
+                                       "domains: " + "; ".join(others)]))
     return _Trial(Candidate(effect, joints, len(kept), cv, dbic, pval, ok, note), f1, aliased)
+
+
+def _nested(ctx: Context, current: FitResult, f1: FitResult, s: SearchSettings) -> FitResult:
+    """The model the F test compares ``f1`` with: ``current``, or, when the domains took some
+    of its parameters out of ``f1``, ``current`` refitted without them (nested in ``f1``)."""
+    names = {p.name for p in f1.specs}
+    idx = [i for i, p in enumerate(current.specs) if p.name in names]
+    if len(idx) == len(current.specs):
+        return current
+    return fit(ctx, [current.specs[i] for i in idx], s.fitting, current.theta[idx], s.rb0)
 
 
 def _try_backlash(ctx: Context, current: FitResult, current_cv: float,
