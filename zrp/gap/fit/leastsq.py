@@ -193,27 +193,6 @@ def orthonormal_basis(a: F64, rtol: float = 1e-10) -> F64:
     return (q @ v2) / np.sqrt(w2)
 
 
-def _covariance(jac: F64, residual: F64) -> F64:
-    """sigma^2 (J^T J)^-1 with column scaling; inf where J^T J is singular."""
-    p = jac.shape[1]
-    dof = max(jac.shape[0] - p, 1)
-    s2 = float(residual @ residual) / dof
-    d = np.linalg.norm(jac, axis=0)
-    d = np.where(d > 0, d, 1.0)
-    js = jac / d
-    w, v = np.linalg.eigh(js.T @ js)
-    with np.errstate(divide="ignore"):
-        inv = np.where(w > max(w.max(), 1e-300) * 1e-12, 1.0 / w, np.inf)
-    cov = (v * np.where(np.isfinite(inv), inv, 0.0)) @ v.T
-    if not np.all(np.isfinite(inv)):
-        # parameters touching the null space get an infinite variance
-        null = v[:, ~np.isfinite(inv)]
-        touched = np.abs(null).max(axis=1) > 1e-6
-        cov[touched, :] = np.inf
-        cov[:, touched] = np.inf
-    return s2 * cov / np.outer(d, d)
-
-
 def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: ArrayLike,
         base_rotation: ArrayLike, *, start: Evaluation | None = None) -> FitResult:
     """Least squares with the analytic Jacobian of :class:`~zrp.gap.model.problem.Problem`:
