@@ -1,32 +1,40 @@
-"""Well-posed identification: a scaled, truncated-SVD Gauss-Newton solver that leaves at their
-nominal values the parameter combinations the data cannot pin.
+"""Well-posed identification: a scaled Gauss-Newton solver with a prior on the manufacturing
+tolerances that leaves at their nominal values the parameter combinations the data cannot pin.
 
 Each parameter is scaled by its manufacturing tolerance d_j (:func:`zrp.gap.model.domains.
-tolerance`; the registration, which has no tolerance, and the compliances by the value that
-moves the tool by 1 mm RMS; the base rotation by 1 rad): x = D^-1 (theta - theta_nom), so one
+tolerance`; the registration, which has none, by 1 rad (rotation) and the arm's length
+(translations, tool points), so that it is practically free; the compliances by the value that
+moves the tool by 1 mm RMS): x = D^-1 (theta - theta_nom), so one
 unit of x is one typical error (column scaling; Hollerbach & Wampler 1996, Schroer et al. 1997).
 Linearised at the current theta, with the SVD of the scaled Jacobian J D = U S V^T, the
 combination c_i = v_i^T x of the parameters is estimated from the data with the standard error
 
     se(c_i) = sigma / s_i                                                             (W1)
 
-(sigma: the residual standard deviation per coordinate). Where se(c_i) > 1 the data know c_i
-less well than the tolerance already does, so the data-only estimate is worse than the
-nominal. The step is the truncated-SVD (minimum-norm) Gauss-Newton step (Hansen 1987)
+(sigma: the residual standard deviation per coordinate, of the full linearised fit: the noise
+the estimate actually sees, measurement noise plus what the model leaves). Where se(c_i) > 1
+the data know c_i less well than the tolerance already does. Such a combination is held at
+its nominal value (truncated SVD, Hansen 1987):
 
-    dx = -sum_{s_i > tau} v_i (u_i^T r) / s_i  -  sum_{s_i <= tau} v_i (v_i^T x),
-    tau = max(sigma, 1e-10 s_1)                                                        (W2)
+    held:  s_i <= tau,   tau = max(sigma, 1e-10 s_1)                                   (W2)
 
-which keeps every held combination at its nominal value (the second sum resets any drift) and
-solves for the others. It is the hard-threshold form of the MAP estimate with a prior
-x ~ N(0, I) on the tolerances, x_MAP = sum_i v_i s_i (u_i^T (-r)) / (s_i^2 + sigma^2), whose
-filter factor s_i^2 / (s_i^2 + sigma^2) passes a direction by more than half exactly when
-s_i > sigma (Tikhonov 1963; the Bayesian reading: Tarantola 2005, ch. 3). The steps are
-damped by backtracking (Armijo) from the linearised solution, until the predicted decrease is
-below 1e-14 of the residual sum of squares or the step below 1e-10 tolerances; the iteration
-limit, when reached, is reported (``converged`` False with the reason), never only warned.
+and the others are estimated with the prior x ~ N(0, I) on the tolerances (the MAP estimate;
+Tikhonov 1963; the Bayesian reading: Tarantola 2005, ch. 3), whose Gauss-Newton step from x
+in the SVD basis (c = V^T x, b = U^T r) is, per direction,
 
-The covariance is that of the truncated estimate plus the prior's on the held directions:
+    e_i = -(s_i b_i + sigma^2 c_i) / (s_i^2 + sigma^2)   (kept),    e_i = -c_i   (held),
+    dx = V e                                                                           (W4)
+
+(the linear problem's MAP solution filters each direction by s_i^2 / (s_i^2 + sigma^2), which
+passes more than half exactly when s_i > sigma: the hard hold of W2 is where the prior
+dominates). The objective |r|^2 + sigma^2 |x|^2 is lowered by backtracking (Armijo) from the
+linearised solution; the iteration stops when the predicted decrease is below 1e-14 of it or the
+step below 1e-10 tolerances. The threshold is fixed after :data:`FREEZE_AFTER` iterations (the
+held set cannot flip). An iteration limit, when reached, is reported (``converged`` False with
+the reason), never only warned.
+
+The covariance is that of the estimate on the kept directions plus the prior's on the held
+ones:
 
     C = D (V_k S_k^-2 V_k^T sigma^2 + V_h V_h^T) D                                    (W3)
 
@@ -186,11 +194,43 @@ def _covariance(r: F64, s: F64, Vt: F64, keep: NDArray[np.bool_], scales: F64) -
     return c * np.outer(scales, scales)
 
 
+def _map_step(g: F64, U: F64, s: F64, Vt: F64, x: F64, keep: NDArray[np.bool_], s2: float
+              ) -> tuple[F64, float, float]:
+    """Eq. W4 in the SVD basis: the step e (held components reset to 0), the predicted
+    decrease of the objective |r|^2 + sigma^2 |x|^2 on the kept directions, and its value."""
+    c = Vt @ x
+    b = U.T @ g
+    e = np.where(keep, -(s * b + s2 * c) / (s * s + s2), -c)
+    after = (b + s * e) ** 2 + s2 * (c + e) ** 2
+    pred = float(np.sum(np.where(keep, b * b + s2 * c * c - after, 0.0)))
+    return e, pred, float(g @ g) + s2 * float(c @ c)
+
+
+def _line_search(evaluate: Callable[[F64], tuple[F64, F64]],
+                 residual: Callable[[F64], F64], theta: F64, step: F64, prior: F64,
+                 scales: F64, s2: float, phi0: float, pred: float, resets: bool
+                 ) -> tuple[F64, F64, F64 | None] | None:
+    """Backtracking (Armijo) on the objective along ``step``: (theta, r, J or None) of the
+    first accepted point, or None when none lowers it. A step that resets held directions is
+    taken whole (the reset is the point of it)."""
+    t = 1.0
+    while t >= 2.0 ** -30:
+        trial = theta + t * step
+        r_t, J_t = evaluate(trial) if t == 1.0 else (residual(trial), None)
+        xt = (trial - prior) / scales
+        if (float(r_t @ r_t) + s2 * float(xt @ xt) <= phi0 - 1e-4 * t * pred
+                or pred <= 1e-14 * phi0 or (resets and t == 1.0)):
+            return trial, r_t, J_t
+        t *= 0.5
+    return None
+
+
 def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], F64],
           theta0: F64, prior: F64, scales: F64, names: Sequence[str], *,
           start: tuple[F64, F64] | None = None,
           max_iterations: int = MAX_ITERATIONS) -> Solution:
-    """Minimise |r(theta)|^2 by the truncated-SVD Gauss-Newton steps of eq. W2.
+    """Minimise |r(theta)|^2 + sigma^2 |x|^2 by the Gauss-Newton steps of eq. W4, the
+    directions at or below the noise held at the prior (eq. W2).
 
     Args:
         evaluate: theta -> (r (m,), J (m, p)).
@@ -210,39 +250,23 @@ def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], 
             tau_fixed = tau  # the threshold settles with the fit: fixed, no held set flips
         keep = s > tau
         x = (theta - prior) / scales
-        c = Vt @ x
-        b = U.T @ g
         s2 = tau * tau  # the prior's weight sigma^2 (eq. W4)
-        # eq. W4: the MAP Gauss-Newton step in the SVD basis; held components reset to 0
-        e = np.where(keep, -(s * b + s2 * c) / (s * s + s2), -c)
-        phi0 = float(r @ r) + s2 * float(c @ c)
-        after = (b + s * e) ** 2 + s2 * (c + e) ** 2
-        pred = float(np.sum(np.where(keep, b * b + s2 * c * c - after, 0.0)))
+        e, pred, phi0 = _map_step(g, U, s, Vt, x, keep, s2)
+        resets = float(np.linalg.norm(e[~keep])) > 1e-9
         dx = Vt.T @ e
         if float(np.linalg.norm(dx)) <= 1e-10 * (1.0 + float(np.linalg.norm(x))) or (
-                pred <= 1e-14 * phi0 and float(np.linalg.norm(e[~keep])) <= 1e-9):
+                pred <= 1e-14 * phi0 and not resets):
             converged, reason = True, "converged"
             break
-        t, J_t = 1.0, None
-        while t >= 2.0 ** -30:
-            trial = theta + t * scales * dx
-            if t == 1.0:  # usually accepted: evaluate the Jacobian with it
-                r_t, J_t = evaluate(trial)
-            else:
-                r_t, J_t = residual(trial), None
-            xt = (trial - prior) / scales
-            if (float(r_t @ r_t) + s2 * float(xt @ xt) <= phi0 - 1e-4 * t * pred
-                    or pred <= 1e-14 * phi0 or (not keep.all() and t == 1.0
-                    and float(np.linalg.norm(e[~keep])) > 1e-9)):
-                break
-            t *= 0.5
-        else:
+        found = _line_search(evaluate, residual, theta, scales * dx, prior, scales, s2,
+                             phi0, pred, resets)
+        if found is None:
             converged = pred <= 1e-10 * phi0
             reason = ("converged (no step lowers the objective further)" if converged else
                       "stopped: no step along the Gauss-Newton direction lowers the objective")
             break
-        theta = trial
-        r, J = (r_t, J_t) if J_t is not None else evaluate(theta)
+        theta, r, J_t = found
+        r, J = (r, J_t) if J_t is not None else evaluate(theta)
     else:
         reason = f"stopped at the iteration limit ({max_iterations}) before converging"
     if reason != "converged":  # the decomposition at theta is not at hand

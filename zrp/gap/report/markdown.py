@@ -9,6 +9,7 @@ from collections.abc import Sequence
 from scipy.spatial.transform import Rotation
 
 from zrp.gap.analysis.where import Region, WhereAnalysis
+from zrp.gap.report.identification import identification_markdown
 from zrp.gap.report.verdict import (
     baseline_text,
     final_effects_text,
@@ -368,7 +369,8 @@ def report_markdown(diag: Diagnosis) -> str:
     """The text of report.md."""
     u = diag.length_unit
     L = (_header(diag) + _shrink(diag) + _parameters(diag) + _full_pose(diag) + _trust(diag)
-         + _ranking(diag) + _aliasing(diag) + _where(diag.where.nominal, u))
+         + identification_markdown(diag) + _ranking(diag) + _aliasing(diag)
+         + _where(diag.where.nominal, u))
     if diag.where.after_final_model is not None:
         L += _remains(diag.where.after_final_model, u)
     if diag.warnings:

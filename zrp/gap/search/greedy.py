@@ -145,10 +145,7 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
         return _Trial(Candidate(effect, (), 0, cv_rms(ctx, f1, s.folds), f1.bic - current.bic,
                                 f_test(current, f1), False, "no joint significant"),
                       None, aliased)
-    f1, outside = within_domains(ctx, f1, n_registration(f1.specs), s.fitting, s.rb0)
-    own_names = {p.name for p in specs}
-    own = [w for w in outside if w.split(" = ")[0] in own_names]
-    others = [w.split(" outside ")[0] for w in outside if w not in own]
+    f1, own, others = _in_domains(ctx, f1, specs, s)
     kept = [p for p in f1.specs if p.effect == effect]
     if not kept:
         return _Trial(Candidate(effect, (), 0, math.nan, math.nan, 1.0, False,
@@ -158,18 +155,33 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
     pval = f_test(_nested(ctx, current, f1, s), f1)
     dbic = f1.bic - current.bic
     joints = tuple(sorted({p.joint for p in kept if p.joint > 0}))
-    ok = (pval < s.alpha and dbic < 0 and cv < current_cv * (1.0 - s.min_gain)
-          and bool(kept))
+    ok, note = _judged(pval, dbic, cv / current_cv if current_cv > 0 else math.inf, s, own,
+                       others)
+    return _Trial(Candidate(effect, joints, len(kept), cv, dbic, pval, ok, note), f1, aliased)
+
+
+def _judged(pval: float, dbic: float, cv_ratio: float, s: SearchSettings, own: list[str],
+            others: list[str]) -> tuple[bool, str]:
+    """Whether a candidate passes (F test, BIC, CV gain) and its note."""
+    ok = pval < s.alpha and dbic < 0 and cv_ratio < 1.0 - s.min_gain
     note = "" if ok else ("F test not significant" if pval >= s.alpha else
                           "BIC does not improve" if dbic >= 0 else
                           f"cross-validated RMS improves by less than {s.min_gain:.0%}")
-    if own:
-        note = "; ".join(filter(None, [note, "parameters taken out, outside the physical domain: "
-                                       + "; ".join(own)]))
-    if others:
-        note = "; ".join(filter(None, [note, "earlier parameters taken out, outside their "
-                                       "domains: " + "; ".join(others)]))
-    return _Trial(Candidate(effect, joints, len(kept), cv, dbic, pval, ok, note), f1, aliased)
+    return ok, "; ".join(filter(None, [
+        note, own and "parameters taken out, outside the physical domain: " + "; ".join(own),
+        others and "earlier parameters taken out, outside their domains: " + "; ".join(others)]))
+
+
+def _in_domains(ctx: Context, f1: FitResult, specs: list[ParamSpec], s: SearchSettings
+                ) -> tuple[FitResult, list[str], list[str]]:
+    """``f1`` inside the physical domains (:func:`~zrp.gap.fit.constrained.within_domains`),
+    with the reasons for the candidate's own parameters taken out and the names of earlier
+    ones taken out."""
+    f1, outside = within_domains(ctx, f1, n_registration(f1.specs), s.fitting, s.rb0)
+    own_names = {p.name for p in specs}
+    own = [w for w in outside if w.split(" = ")[0] in own_names]
+    others = [w.split(" outside ")[0] for w in outside if w not in own]
+    return f1, own, others
 
 
 def _nested(ctx: Context, current: FitResult, f1: FitResult, s: SearchSettings) -> FitResult:
