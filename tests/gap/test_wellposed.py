@@ -108,6 +108,13 @@ def test_full_pose_recovers_the_parameters_within_their_intervals():
         err = abs(fp.theta[i] - truth.get(name, 0.0))
         assert err <= z * fp.stderr[i], (name, fp.theta[i], fp.stderr[i])
     assert not d.held_directions and d.final_fit.converged and not d.solver_stops
+    assert d.full_pose.fit.converged
+    # withheld orientation error beside the position error: nominal, final, geometric
+    ori_nominal = d.full_pose.withheld_orientation_nominal
+    assert d.full_pose.withheld_orientation_after < d.full_pose.withheld_orientation_before
+    assert d.full_pose.withheld_orientation_before < ori_nominal
+    assert d.full_pose.baseline_withheld is not None
+    assert f"{1e3 * ori_nominal:.3g} mrad after registration" in verdict_text(d)
 
 
 def test_solver_is_the_map_estimate_of_a_linear_problem():

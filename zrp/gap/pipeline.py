@@ -178,7 +178,10 @@ def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosi
         full = refit_full_pose(ctx, diag.final_fit, diag.fitting_poses, diag.withheld_poses,
                                len(diag.registration), sigma, candidates=cands,
                                alpha=st["alpha"], min_gain=st["min_gain"],
-                               max_steps=st["max_steps"])
+                               max_steps=st["max_steps"], nominal=diag.nominal_fit,
+                               baseline=None if diag.assessment is None
+                               or diag.assessment.baseline.fit is diag.final_fit
+                               else diag.assessment.baseline.fit)
     settings = {**diag.settings, "orientation": used, "orientation_sigma_rad": sigma}
     return dataclasses.replace(diag, full_pose=full, settings=settings)
 

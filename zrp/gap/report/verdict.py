@@ -151,8 +151,8 @@ def identification_text(diag: Diagnosis) -> list[str]:
         more = f" and {len(held) - 3} more" if len(held) > 3 else ""
         parts.append(f"{len(held)} parameter combination(s) the data cannot pin stayed at "
                      f"their nominal values: {shown}{more}.")
-    seen: set[str] = set()
-    for effect, note in diag.outside_domain:
+    seen: set[str] = set()  # named only while a gap remains: then it says why it was not closed
+    for effect, note in (diag.outside_domain if diag.unexplained is not False else ()):
         if effect in seen:
             continue
         seen.add(effect)
@@ -228,12 +228,18 @@ def full_pose_text(diag: Diagnosis) -> str:
            f"fit (median; {best.name} x{best.ratio:.2f})")
     reveal = "".join(f" Orientations reveal {a.effect} (joint {a.joint}; p = {a.p_value:.2g}), "
                      "which positions see weakly." for a in fp.added)
+    nominal = ("" if not np.isfinite(fp.withheld_orientation_nominal) else
+               f"{1e3 * fp.withheld_orientation_nominal:.3g} mrad after registration, ")
+    base = ("" if fp.baseline_withheld is None else
+            f" (the complete geometric calibration from positions and orientations: "
+            f"{1e3 * fp.baseline_withheld[0]:.3g} mrad, {fp.baseline_withheld[1]:.4g} "
+            f"{diag.length_unit})")
     return (f"Measured orientations (noise {1e3 * fp.sigma_orientation:.3g} mrad, {src}) "
-            f"add: {std}; withheld orientation error "
+            f"add: {std}; withheld orientation error {nominal}"
             f"{1e3 * fp.withheld_orientation_before:.3g} -> "
             f"{1e3 * fp.withheld_orientation_after:.3g} mrad, withheld position RMS "
-            f"{fp.withheld_rms_position_only:.4g} -> {fp.withheld_rms:.4g} {diag.length_unit}."
-            + reveal)
+            f"{fp.withheld_rms_position_only:.4g} -> {fp.withheld_rms:.4g} {diag.length_unit}"
+            f"{base}." + reveal)
 
 
 def verdict_text(diag: Diagnosis) -> str:
