@@ -111,8 +111,9 @@ def test_full_pose_recovers_the_parameters_within_their_intervals():
     assert d.full_pose.fit.converged
     # withheld orientation error beside the position error: nominal, final, geometric
     ori_nominal = d.full_pose.withheld_orientation_nominal
-    assert d.full_pose.withheld_orientation_after < d.full_pose.withheld_orientation_before
-    assert d.full_pose.withheld_orientation_before < ori_nominal
+    noise = np.sqrt(3.0) * 1e-4  # RMS angle of the orientation noise
+    assert d.full_pose.withheld_orientation_after <= 1.2 * noise
+    assert d.full_pose.withheld_orientation_before <= 1.2 * noise < ori_nominal
     assert d.full_pose.baseline_withheld is not None
     assert f"{1e3 * ori_nominal:.3g} mrad after registration" in verdict_text(d)
 
