@@ -25,6 +25,7 @@ position-only fit's (the same formula, :func:`zrp.gap.fit.leastsq.fit`).
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -35,9 +36,11 @@ from scipy.spatial.transform import Rotation
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.fit.constrained import n_registration
 from zrp.gap.fit.leastsq import FitResult, FitWarning, fit, initial_registration
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.domains import domain_violations
 from zrp.gap.model.problem import Problem
 from zrp.rotations import left_jacobian
 
@@ -125,6 +128,8 @@ class FullPoseFit:
         sigma_orientation_given: sigma_orientation was given (False: estimated).
         converged, stop_reason, held: the solver's report (:mod:`zrp.gap.fit.wellposed`;
             held: the combinations positions and orientations together cannot pin).
+        outside_domain: parameters taken out because their values left their physical
+            domains, with the reasons.
     """
 
     specs: tuple[ParamSpec, ...]
@@ -140,6 +145,7 @@ class FullPoseFit:
     converged: bool = True
     stop_reason: str = ""
     held: tuple[HeldDirection, ...] = ()
+    outside_domain: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         p = len(self.specs)
@@ -171,6 +177,29 @@ def probe_start(prob: Problem, theta: F64, measured: F64) -> F64:
 def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
                   orientation: bool = True, orientation_sigma: float | None = None,
                   passes: int = 3) -> FullPoseFit:
+    """:func:`_fit_once` inside the physical domains: a parameter whose value leaves its domain
+    (:mod:`zrp.gap.model.domains`) is taken out and the rest refitted, as in the position fits
+    (:mod:`zrp.gap.fit.constrained`), so the result's ``specs`` may be fewer (the reasons are
+    in ``outside_domain``)."""
+    reasons: list[str] = []
+    while True:
+        fp = _fit_once(ctx, specs, poses, orientation=orientation,
+                       orientation_sigma=orientation_sigma, passes=passes)
+        first = n_registration(fp.specs)
+        bad = domain_violations([x.name for x in fp.specs[first:]],
+                                [x.effect for x in fp.specs[first:]],
+                                [x.unit for x in fp.specs[first:]], fp.theta[first:],
+                                max_tilt_rad=ctx.max_tilt_rad)
+        if not bad:
+            return dataclasses.replace(fp, outside_domain=tuple(reasons))
+        reasons += [why for _, why in bad]
+        out = {first + i for i, _ in bad}
+        specs = [x for i, x in enumerate(fp.specs) if i not in out]
+
+
+def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
+              orientation: bool = True, orientation_sigma: float | None = None,
+              passes: int = 3) -> FullPoseFit:
     """Identify ``specs`` on ``poses`` from positions and, with ``orientation``, the measured
     orientations, each weighted by its own noise (module doc).
 
