@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import warnings
 
 import numpy as np
@@ -161,3 +162,22 @@ def test_a_five_fold_worse_model_is_not_within_the_noise():
     assert "5.27x worse" in ch.note("mm") and "equally good" not in ch.note("mm")
     assert FinalChoice("geometric_baseline", 0.101, 0.100, z=1.0).within_noise
     assert FinalChoice("search", 0.5, 0.6).note("mm") == ""
+
+
+def test_a_solver_stopped_early_says_so_in_the_result_and_the_verdict(ur_positions):
+    """A Gauss-Newton solve cut at one iteration on a nonlinear problem reports it (field and
+    words); a diagnosis with such a fit names it in its verdict and diagnosis.json."""
+    _m, d = ur_positions
+    f = d.final_fit
+    prob = Problem(d.context, f.specs, d.fitting_poses, f.base_rotation)
+    start = np.array(f.theta)
+    start[-1] += 5e-3  # away from the solution: one step does not get there
+    sol = solve(prob.residual_and_jacobian, prob.residual, start, start * 0, np.ones(len(start)),
+                [s.name for s in f.specs], max_iterations=1)
+    assert not sol.converged and "iteration limit (1)" in sol.reason
+    msg = f"least squares with {len(f.specs)} parameters: {sol.reason}"
+    stopped = dataclasses.replace(d, warnings=(msg,))
+    assert stopped.solver_stops == (msg,)
+    assert "stopped before converging" in verdict_text(stopped)
+    assert diagnosis_document(stopped)["identification"]["stopped_early"] == [msg]
+    assert not d.solver_stops and "stopped before" not in verdict_text(d)
