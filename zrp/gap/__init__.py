@@ -32,10 +32,14 @@ from zrp.gap.fit.leastsq import FitResult as FitResult
 from zrp.gap.fit.leastsq import FitWarning as FitWarning
 from zrp.gap.fit.metrics import Metrics as Metrics
 from zrp.gap.fit.registration import Registration as Registration
+from zrp.gap.fit.wellposed import HeldDirection as HeldDirection
 from zrp.gap.model.context import EFFECTS as EFFECTS
 from zrp.gap.model.context import REGISTRATION as REGISTRATION
 from zrp.gap.model.context import Context as Context
 from zrp.gap.model.context import ParamSpec as ParamSpec
+from zrp.gap.model.domains import Domain as Domain
+from zrp.gap.model.domains import domain_violations as domain_violations
+from zrp.gap.model.domains import parameter_domain as parameter_domain
 from zrp.gap.model.effects import effect_parameters as effect_parameters
 from zrp.gap.options import DiagnosisOptions as DiagnosisOptions
 from zrp.gap.pipeline import diagnose as diagnose
@@ -56,10 +60,12 @@ __all__ = [
     "DataWarning",
     "Diagnosis",
     "DiagnosisOptions",
+    "Domain",
     "FitResult",
     "FitWarning",
     "GapWarning",
     "GeometricBaseline",
+    "HeldDirection",
     "Injection",
     "Measurements",
     "Metrics",
@@ -72,9 +78,11 @@ __all__ = [
     "Where",
     "WhereAnalysis",
     "diagnose",
+    "domain_violations",
     "effect_parameters",
     "load_measurements",
     "noise_floor",
+    "parameter_domain",
     "split_poses",
     "synthesize",
     "write_outputs",
