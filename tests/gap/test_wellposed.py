@@ -181,3 +181,27 @@ def test_a_solver_stopped_early_says_so_in_the_result_and_the_verdict(ur_positio
     assert "stopped before converging" in verdict_text(stopped)
     assert diagnosis_document(stopped)["identification"]["stopped_early"] == [msg]
     assert not d.solver_stops and "stopped before" not in verdict_text(d)
+
+
+def test_a_tilt_beyond_the_default_domain_needs_the_widen_option():
+    """A 12 mrad axis tilt is outside the default domain (a few mrad of a machined part): not
+    used; with max_tilt_rad widened it is identified within its interval."""
+    from zrp.gap import Injection, synthesize
+    from zrp.kinematics import uniform_joint_values
+
+    puma = zrp.load_model("puma")
+    rng = np.random.default_rng(2)
+    q = uniform_joint_values(puma, 150, rng)
+    meas = synthesize(puma, q, Injection(tilt={3: (12e-3, 0.0)}), rng=rng)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        narrow = diagnose(puma, meas, seed=0)
+        wide = diagnose(puma, meas, seed=0, max_tilt_rad=0.02)
+    assert all(abs(v) <= 5e-3 for s, v in zip(narrow.final_fit.specs, narrow.final_fit.theta,
+                                              strict=True) if s.effect == "axis_misalignment")
+    assert any("u3.t1" in n for _, n in narrow.outside_domain)
+    p = wide.parameter("u3.t1")
+    assert p.ci95_effect[0] <= 12e-3 <= p.ci95_effect[1]
+    assert wide.final.rms < narrow.final.rms
+    with pytest.raises(zrp.errors.InputError, match="max_tilt_rad"):
+        diagnose(puma, meas, max_tilt_rad=-1.0)
