@@ -56,7 +56,7 @@ def within_domains(ctx: Context, result: FitResult, first: int, fitting: NDArray
     while True:
         bad = outside_domains(ctx, result, first)
         if not bad:
-            return result, tuple(reasons)
+            return result, tuple(dict.fromkeys(reasons))
         out = {i for i, _ in bad}
         reasons += [why for _, why in bad]
         keep: Sequence[int] = [i for i in range(len(result.specs)) if i not in out]

@@ -9,6 +9,15 @@ from zrp.gap.results import Diagnosis
 __all__ = ["identification_markdown"]
 
 
+def _short(note: str) -> str:
+    """A candidate's domain note with the reason given once (the first item in full, the
+    others as name = value)."""
+    head, _, items = note.partition("domain: ")
+    parts = items.split("; earlier")[0].split("; ")
+    return head + "domain: " + "; ".join(parts[:1] + [p.split(" outside ")[0].split(" above ")[0]
+                                                      for p in parts[1:]])
+
+
 def identification_markdown(diag: Diagnosis) -> list[str]:
     """Lines of report.md."""
     u = diag.length_unit
@@ -28,8 +37,13 @@ def identification_markdown(diag: Diagnosis) -> list[str]:
     else:
         L.append("Every combination of the final model's parameters is pinned by the data.\n")
     if diag.outside_domain:
-        L.append("Fitted values outside their physical domain (taken out, never used):\n")
-        L += [f"- {e}: {n}" for e, n in diag.outside_domain]
+        L.append("Fitted values outside their physical domain (taken out, never used; the "
+                 "first time per effect, all in diagnosis.json `identification`):\n")
+        seen: set[str] = set()
+        for e, note in diag.outside_domain:
+            if e not in seen:
+                seen.add(e)
+                L.append(f"- {e}: {_short(note)}")
         L.append("")
     f = diag.final_fit
     L.append(f"Solver: {f.stop_reason or 'converged'} after {f.iterations} iteration(s)"
