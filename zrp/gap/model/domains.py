@@ -9,7 +9,7 @@ parameter                  domain (hard: outside it, not used)  tolerance (scale
 ``q{k}.scale``             abs <= 0.02                          1e-3
 ``q{k}.sin{h}/cos{h}``     each abs <= 5 mrad; amplitude too    0.5 mrad
 ``q{k}.backlash``          0 <= b <= 20 mrad                    1 mrad
-``q{k}.compliance``        0 <= c <= 1e-3 rad/(N m)             (Jacobian scale, below)
+``q{k}.compliance``        c >= 0 (also ``_payload``)           (Jacobian scale, below)
 ``u{k}.t1/t2``             abs <= ``max_tilt_rad`` (5 mrad)     2 mrad
 ``b{k}.x/y/z``             abs <= 20 mm                         1 mm
 ``kappa``                  abs <= 1e-4 1/degC                   2.3e-5 1/degC (aluminium)
@@ -112,7 +112,7 @@ def parameter_domain(name: str, effect: str, unit: str, *,
         return Domain(0.0, 0.02, "a play is never negative and a gear train keeps it below "
                       "20 mrad")
     if effect == "joint_compliance" and name.endswith((".compliance", ".compliance_payload")):
-        return Domain(0.0, 1e-3, "a joint deflects with its load, not against it")
+        return Domain(0.0, math.inf, "a joint deflects with its load, not against it")
     if effect == "cyclic_error":
         if per_m is not None:
             return _symmetric(MAX_PLAY_M * per_m, "a screw's or rack's cyclic error is below "
