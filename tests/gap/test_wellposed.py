@@ -110,6 +110,8 @@ def test_full_pose_recovers_the_parameters_within_their_intervals():
         assert err <= z * fp.stderr[i], (name, fp.theta[i], fp.stderr[i])
     assert not d.held_directions and d.final_fit.converged and not d.solver_stops
     assert d.full_pose.fit.converged
+    fp_doc = diagnosis_document(d)["identification"]["full_pose"]
+    assert fp_doc["converged"] is True and fp_doc["outside_domain"] == []
     # withheld orientation error beside the position error: nominal, final, geometric
     ori_nominal = d.full_pose.withheld_orientation_nominal
     noise = np.sqrt(3.0) * 1e-4  # RMS angle of the orientation noise

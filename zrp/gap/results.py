@@ -232,6 +232,8 @@ class Diagnosis(EffectsFound):
         b = None if self.assessment is None else self.assessment.baseline.fit
         if b is not None and not b.converged:
             out.append(f"geometric calibration: {b.stop_reason}")
+        if self.full_pose is not None and not self.full_pose.fit.converged:
+            out.append(f"full-pose refit: {self.full_pose.fit.stop_reason}")
         out += [w for w in self.warnings if w.startswith("least squares with")]
         return tuple(dict.fromkeys(out))
 
@@ -252,7 +254,12 @@ class Diagnosis(EffectsFound):
                            "reason": f.stop_reason},
                 "stopped_early": list(self.solver_stops),
                 "outside_domain": [{"effect": e, "note": n} for e, n in self.outside_domain],
-                "max_tilt_rad": self.context.max_tilt_rad}
+                "max_tilt_rad": self.context.max_tilt_rad,
+                "full_pose": None if self.full_pose is None else {
+                    "held_directions": [h.to_dict() for h in self.full_pose.fit.held],
+                    "converged": self.full_pose.fit.converged,
+                    "reason": self.full_pose.fit.stop_reason,
+                    "outside_domain": list(self.full_pose.fit.outside_domain)}}
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON document (schema in zrp/gap/README.md) without the verdict, which the
