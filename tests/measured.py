@@ -33,13 +33,15 @@ def full_pose_measurements(model: zrp.Manipulator, n_poses: int, seed: int, *,
                            tilt: tuple[int, int, float], tools: ArrayLike,
                            probe_rotation: NDArray[np.float64], sigma_orientation: float,
                            joint_offset: Mapping[int, float] | None = None,
-                           sigma_position: float = 0.02, quat: bool = True) -> Measurements:
+                           sigma_position: float = 0.02, quat: bool = True,
+                           span_rad: float = 2.5) -> Measurements:
     """Positions of every tool point and the flange orientation of ``n_poses`` random poses.
 
     The true robot is ``model`` with joint ``tilt[0]``'s (1-based) axis turned by ``tilt[2]``
     rad towards its tangent ``tilt[1]`` (0 or 1, :func:`axis_tangents`), u' = (u + a t) / |.|,
     and the joint values shifted by ``joint_offset`` {joint: rad} (the data record the
-    commanded values). Poses are uniform in +-2.5 rad, drawn from ``default_rng(seed)``;
+    commanded values). Poses are uniform in +-``span_rad`` rad (default 2.5), drawn from
+    ``default_rng(seed)``;
     then the position noise (``sigma_position`` per coordinate), then the orientation noise
     (rotation vectors of ``sigma_orientation`` rad per component) are drawn from the same
     generator. The measured orientation is noise @ R_b @ R_n @ ``probe_rotation``, with the
@@ -49,7 +51,7 @@ def full_pose_measurements(model: zrp.Manipulator, n_poses: int, seed: int, *,
     rng = np.random.default_rng(seed)
     tools = np.atleast_2d(np.asarray(tools, dtype=float))
     m = len(tools)
-    q = uniform_joint_values(model, n_poses, rng, np.tile([-2.5, 2.5], (model.n, 1)))
+    q = uniform_joint_values(model, n_poses, rng, np.tile([-span_rad, span_rad], (model.n, 1)))
     joint, tangent, angle = tilt
     axes = np.array(model.axes, dtype=float)
     v = axes[joint - 1] + angle * axis_tangents(axes[joint - 1])[tangent]

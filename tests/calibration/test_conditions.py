@@ -169,7 +169,7 @@ def test_missing_condition_error_is_named():
     (Term("q2.compliance", "joint_compliance", 2, "rad/(N m)", -1e-6),
      r"q2.compliance = -1e-06 rad/\(N m\) is outside .* 0 <= value"),
     (Term("q6.sin1", "cyclic_error", 6, "rad", 1.04),
-     r"q6.amplitude1 .* = 1.04 rad is outside its physical domain 0 <= value <= 0.01"),
+     r"q6.amplitude1 .* = 1.04 rad is outside its physical domain 0 <= value <= 0.005"),
 ])
 def test_implausible_values_are_refused_by_the_writer(run, tmp_path, term, match):
     cal = read_calibration(run / "out" / "compensation.json")

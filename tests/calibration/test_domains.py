@@ -20,8 +20,9 @@ from zrp.gap.model.domains import DOMAINS, domain_key, parameter_bounds, violati
     ("q1.scale", "encoder_scale", "encoder_scale"),
     ("u4.t1", "axis_misalignment", "axis_tilt"),
     ("kappa", "thermal_expansion", "thermal_expansion"),
-    ("q1.offset", "joint_offset", None),
-    ("b3.x", "link_length", None),
+    ("q1.offset", "joint_offset", "joint_offset"),
+    ("b3.x", "link_length", "link_length"),
+    ("tool1.x", "registration", None),
 ])
 def test_every_parameter_kind_has_its_domain(name, effect, key):
     assert domain_key(name, effect) == key
@@ -29,13 +30,19 @@ def test_every_parameter_kind_has_its_domain(name, effect, key):
 
 def test_bounds_and_units():
     assert parameter_bounds("q3.backlash", "backlash") == (0.0, DOMAINS["backlash"].upper)
-    # a prismatic joint's play (mm) keeps the lower bound only
-    assert parameter_bounds("q3.backlash", "backlash", "mm") == (0.0, math.inf)
+    # a prismatic joint's play (mm): at most 1 mm
+    assert parameter_bounds("q3.backlash", "backlash", "mm") == (0.0, 1.0)
+    # compliance_payload (rad/kg) keeps the lower bound only
+    assert parameter_bounds("q2.compliance_payload", "joint_compliance", "rad/kg") == (
+        0.0, math.inf)
     # each member of a grouped domain is bounded on both sides by the group's bound
     assert parameter_bounds("u2.t1", "axis_misalignment") == (-0.005, 0.005)
     assert parameter_bounds("u2.t1", "axis_misalignment", widen={"axis_tilt": 0.02}) == (
         -0.02, 0.02)
-    assert parameter_bounds("q1.offset", "joint_offset") == (-math.inf, math.inf)
+    assert parameter_bounds("q1.offset", "joint_offset") == (-0.2, 0.2)
+    assert parameter_bounds("q1.offset", "joint_offset", "mm") == (-20.0, 20.0)
+    assert parameter_bounds("b3.x", "link_length", "mm") == (-20.0, 20.0)
+    assert parameter_bounds("tool1.x", "registration", "mm") == (-math.inf, math.inf)
     assert violation("backlash", "q1.backlash", 0.0) is None
     assert "q1.backlash = -1e-09 rad" in violation("backlash", "q1.backlash", -1e-9)
     assert violation("thermal_expansion", "kappa", -2e-4, "1/degC") is not None

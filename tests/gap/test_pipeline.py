@@ -147,15 +147,20 @@ def test_full_registration_with_a_large_rotation():
             assert qv.ci95[0] - 1e-9 <= true <= qv.ci95[1] + 1e-9
 
 
-def test_backlash_is_the_full_play_and_negative_play_is_flagged():
+def test_backlash_is_the_full_play_and_negative_play_is_refused():
     d = _quiet(PUMA, _meas(Injection(backlash={2: 8e-4}), n=200), seed=0)
     p = d.parameter("q2.backlash")
     assert p.ci95[0] <= 8e-4 <= p.ci95[1]  # the full play, as `zrp measure` defines it
     assert not d.assessment.implausible
-    with pytest.warns(GapWarning, match="negative"):
-        d = diagnose(PUMA, _meas(Injection(backlash={2: -8e-4}), n=200), seed=0)
-    assert any(m.startswith("q2.backlash") for m in d.assessment.implausible)
-    assert "implausible" in verdict_text(d)
+    # a negative play is what no gear train does: backlash is not accepted, and the verdict
+    # says why (issue 22: plausibility as a constraint, not a footnote)
+    d = _quiet(PUMA, _meas(Injection(backlash={2: -8e-4}), n=200), seed=0)
+    assert "backlash" not in d.final_joints
+    assert all(s.effect != "backlash" or d.final_fit.theta[i] >= 0
+               for i, s in enumerate(d.final_fit.specs))
+    assert any(e == "backlash" and "q2.backlash" in n for e, n in d.outside_domain)
+    assert "backlash was not accepted: fitted to these data it needs values outside" in (
+        verdict_text(d))
 
 
 def test_no_effect_on_a_joint_the_data_do_not_excite():

@@ -38,10 +38,14 @@ _LAZY = {
     "FitWarning": "zrp.gap.fit.leastsq",
     "Metrics": "zrp.gap.fit.metrics",
     "Registration": "zrp.gap.fit.registration",
+    "HeldDirection": "zrp.gap.fit.wellposed",
     "EFFECTS": "zrp.gap.model.context",
     "REGISTRATION": "zrp.gap.model.context",
     "Context": "zrp.gap.model.context",
     "ParamSpec": "zrp.gap.model.context",
+    "Domain": "zrp.gap.model.domains",
+    "domain_violations": "zrp.gap.model.domains",
+    "parameter_domain": "zrp.gap.model.domains",
     "effect_parameters": "zrp.gap.model.effects",
     "DiagnosisOptions": "zrp.gap.options",
     "diagnose": "zrp.gap.pipeline",
@@ -73,10 +77,14 @@ if TYPE_CHECKING:  # type checkers and IDEs see the same names, imported eagerly
     from zrp.gap.fit.leastsq import FitWarning as FitWarning
     from zrp.gap.fit.metrics import Metrics as Metrics
     from zrp.gap.fit.registration import Registration as Registration
+    from zrp.gap.fit.wellposed import HeldDirection as HeldDirection
     from zrp.gap.model.context import EFFECTS as EFFECTS
     from zrp.gap.model.context import REGISTRATION as REGISTRATION
     from zrp.gap.model.context import Context as Context
     from zrp.gap.model.context import ParamSpec as ParamSpec
+    from zrp.gap.model.domains import Domain as Domain
+    from zrp.gap.model.domains import domain_violations as domain_violations
+    from zrp.gap.model.domains import parameter_domain as parameter_domain
     from zrp.gap.model.effects import effect_parameters as effect_parameters
     from zrp.gap.options import DiagnosisOptions as DiagnosisOptions
     from zrp.gap.pipeline import diagnose as diagnose
@@ -97,10 +105,12 @@ __all__ = [
     "DataWarning",
     "Diagnosis",
     "DiagnosisOptions",
+    "Domain",
     "FitResult",
     "FitWarning",
     "GapWarning",
     "GeometricBaseline",
+    "HeldDirection",
     "Injection",
     "Measurements",
     "Metrics",
@@ -113,9 +123,11 @@ __all__ = [
     "Where",
     "WhereAnalysis",
     "diagnose",
+    "domain_violations",
     "effect_parameters",
     "load_measurements",
     "noise_floor",
+    "parameter_domain",
     "split_poses",
     "synthesize",
     "write_outputs",

@@ -12,6 +12,7 @@ from zrp.arguments import check_float, check_int
 from zrp.errors import InputError
 from zrp.gap.data.choices import MAX_WITHHELD
 from zrp.gap.model.choices import EFFECTS
+from zrp.gap.model.domains import DEFAULT_MAX_TILT_RAD
 
 __all__ = ["MAX_WITHHELD", "DiagnosisOptions"]
 
@@ -34,6 +35,9 @@ class DiagnosisOptions:
         harmonics: harmonics of ``cyclic_error``.
         gravity_dir: gravity direction in the base frame (lumped-mass compliance model).
         progress: show a progress bar.
+        max_tilt_rad: the largest axis tilt accepted (rad; default a few mrad of a machined
+            part, :data:`zrp.gap.model.domains.DEFAULT_MAX_TILT_RAD`): widen it for a robot
+            known to carry a larger tilt.
 
     Raises:
         InputError: naming the argument at fault.
@@ -49,6 +53,7 @@ class DiagnosisOptions:
     harmonics: tuple[int, ...] = (1, 2)
     gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0)
     progress: bool = False
+    max_tilt_rad: float = DEFAULT_MAX_TILT_RAD
 
     def __post_init__(self) -> None:
         bad = [e for e in self.effects if e not in EFFECTS]
@@ -60,6 +65,7 @@ class DiagnosisOptions:
         check_float(self.alpha, "alpha", 0.0, 1.0, open_lo=True, open_hi=True)
         check_float(self.min_gain, "min_gain", 0.0, 1.0, open_hi=True)
         check_int(self.max_steps, "max_steps", 1, len(EFFECTS))
+        check_float(self.max_tilt_rad, "max_tilt_rad", 0.0, 0.5, open_lo=True, unit="rad")
         if self.noise_sigma is not None:
             check_float(self.noise_sigma, "noise_sigma", 0.0, open_lo=True, unit="length unit")
         if not self.harmonics or not all(isinstance(h, numbers.Integral) and 1 <= h <= 100
@@ -77,4 +83,5 @@ class DiagnosisOptions:
         """The options as they appear in diagnosis.json's ``settings``."""
         return {"effects": list(self.effects), "alpha": self.alpha, "min_gain": self.min_gain,
                 "max_steps": self.max_steps, "folds": self.folds,
-                "harmonics": list(self.harmonics), "gravity_dir": list(self.gravity_dir)}
+                "harmonics": list(self.harmonics), "gravity_dir": list(self.gravity_dir),
+                "max_tilt_rad": self.max_tilt_rad}

@@ -49,6 +49,7 @@ from zrp.gap.fit.profiles import with_gravity_side
 from zrp.gap.fit.registration import registration_of
 from zrp.gap.fit.uncertainty import correlations, interval_covariance, plausibility
 from zrp.gap.model.context import EFFECTS, MIN_EXCITATION_RAD, Context
+from zrp.gap.model.domains import DEFAULT_MAX_TILT_RAD
 from zrp.gap.model.effects import effect_parameters, registration_parameters
 from zrp.gap.options import DiagnosisOptions
 from zrp.gap.results import UNEXPLAINED_RATIO, Diagnosis, Where
@@ -79,7 +80,8 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
              progress: bool = False,
              max_points: int | None = MAX_POINTS,
              use_orientation: bool = True,
-             orientation_sigma: float | None = None) -> Diagnosis:
+             orientation_sigma: float | None = None,
+             max_tilt_rad: float = DEFAULT_MAX_TILT_RAD) -> Diagnosis:
     """Diagnose the gap between ``model`` and ``measurements``.
 
     Args:
@@ -103,6 +105,9 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
             ``full_pose``); False: positions only.
         orientation_sigma: orientation noise per component (rad) weighting the orientation
             residuals; None: estimated from them. Needs measured orientations.
+        max_tilt_rad: the largest axis tilt a fitted model may carry (rad; the domain of
+            ``axis_misalignment``, :mod:`zrp.gap.model.domains`): widen it for a part known
+            to be tilted.
 
     Returns:
         the :class:`Diagnosis`.
@@ -122,7 +127,7 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
                          f"{effects!r}")
     opts = DiagnosisOptions(tuple(effects), withheld_fraction, folds, alpha, min_gain,
                             max_steps, noise_sigma, tuple(harmonics), tuple(gravity_dir),
-                            progress)
+                            progress, max_tilt_rad)
     if measurements.n_joints != model.n:
         raise InputError(f"{measurements.source}: {measurements.n_joints} joint columns, but "
                          f"the model {model.name!r} has {model.n} joints")
@@ -173,7 +178,10 @@ def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosi
         full = refit_full_pose(ctx, diag.final_fit, diag.fitting_poses, diag.withheld_poses,
                                len(diag.registration), sigma, candidates=cands,
                                alpha=st["alpha"], min_gain=st["min_gain"],
-                               max_steps=st["max_steps"])
+                               max_steps=st["max_steps"], nominal=diag.nominal_fit,
+                               baseline=None if diag.assessment is None
+                               or diag.assessment.baseline.fit is diag.final_fit
+                               else diag.assessment.baseline.fit)
     settings = {**diag.settings, "orientation": used, "orientation_sigma_rad": sigma}
     return dataclasses.replace(diag, full_pose=full, settings=settings)
 
@@ -212,7 +220,8 @@ def _prepare(model: Manipulator, meas: Measurements, gravity_torque: ArrayLike |
              opts: DiagnosisOptions, rng: np.random.Generator) -> _Prepared:
     check_poses(meas)
     tau = check_gravity_torque(gravity_torque, len(meas.pose_ids), model.n)
-    ctx = Context(model, meas, tau, opts.gravity_dir, opts.harmonics)
+    ctx = Context(model, meas, tau, opts.gravity_dir, opts.harmonics,
+                  max_tilt_rad=opts.max_tilt_rad)
     fitting, withheld, folds = split_poses(meas, rng, opts.withheld_fraction, opts.folds)
     check_points(meas, fitting)
     check_units(ctx, fitting)

@@ -30,6 +30,7 @@ from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.data.noise import NoiseFloor
 from zrp.gap.fit.leastsq import Aliased, FitResult
 from zrp.gap.fit.metrics import Metrics
+from zrp.gap.fit.wellposed import HeldDirection
 from zrp.gap.model.context import Context
 from zrp.gap.search.posefit import FullPoseResult
 from zrp.gap.search.steps import Z95 as Z95
@@ -217,6 +218,49 @@ class Diagnosis(EffectsFound):
         raise InputError(f"no identified parameter {name!r}; identified: "
                          f"{', '.join(p.name for p in self.final_parameters)}")
 
+    @property
+    def held_directions(self) -> tuple[HeldDirection, ...]:
+        """The parameter combinations of the final model that the data cannot pin, kept at
+        their nominal values (:mod:`zrp.gap.fit.wellposed`)."""
+        return self.final_fit.held
+
+    @property
+    def solver_stops(self) -> tuple[str, ...]:
+        """Fits that stopped before converging, in words (empty when every fit converged):
+        the final model's, the geometric baseline's and any fit whose warning was caught."""
+        out = [] if self.final_fit.converged else [f"final model: {self.final_fit.stop_reason}"]
+        b = None if self.assessment is None else self.assessment.baseline.fit
+        if b is not None and not b.converged:
+            out.append(f"geometric calibration: {b.stop_reason}")
+        if self.full_pose is not None and not self.full_pose.fit.converged:
+            out.append(f"full-pose refit: {self.full_pose.fit.stop_reason}")
+        out += [w for w in self.warnings if w.startswith("least squares with")]
+        return tuple(dict.fromkeys(out))
+
+    @property
+    def outside_domain(self) -> tuple[tuple[str, str], ...]:
+        """(effect, why) of the candidates whose fitted values left their physical domains
+        (:mod:`zrp.gap.model.domains`) and were taken out or not added."""
+        cands = [c for st in self.steps for c in st.candidates]
+        cands += list(self.where.last_candidates or ())
+        return tuple(dict.fromkeys((c.effect, c.note) for c in cands
+                                   if "physical domain" in c.note))
+
+    def identification(self) -> dict[str, Any]:
+        """The well-posedness record of diagnosis.json's ``identification``."""
+        f = self.final_fit
+        return {"held_directions": [h.to_dict() for h in self.held_directions],
+                "solver": {"converged": f.converged, "iterations": f.iterations,
+                           "reason": f.stop_reason},
+                "stopped_early": list(self.solver_stops),
+                "outside_domain": [{"effect": e, "note": n} for e, n in self.outside_domain],
+                "max_tilt_rad": self.context.max_tilt_rad,
+                "full_pose": None if self.full_pose is None else {
+                    "held_directions": [h.to_dict() for h in self.full_pose.fit.held],
+                    "converged": self.full_pose.fit.converged,
+                    "reason": self.full_pose.fit.stop_reason,
+                    "outside_domain": list(self.full_pose.fit.outside_domain)}}
+
     def to_dict(self) -> dict[str, Any]:
         """The JSON document (schema in zrp/gap/README.md) without the verdict, which the
         report words and inserts after ``unexplained``
@@ -240,6 +284,7 @@ class Diagnosis(EffectsFound):
             "split": self.split,
             "where": self.where.to_dict(),
             "aliased": [a.to_dict() for a in self.aliased],
+            "identification": self.identification(),
             "warnings": list(self.warnings),
             **({} if self.assessment is None else self.assessment.to_dict()),
             "full_pose": None if self.full_pose is None else self.full_pose.to_dict(),

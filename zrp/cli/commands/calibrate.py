@@ -15,7 +15,7 @@ from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
 from zrp.gap.model.choices import EFFECTS
-from zrp.gap.model.domains import DOMAINS  # light: no NumPy
+from zrp.gap.model.domains import DEFAULT_MAX_TILT_RAD, DOMAINS  # light: no NumPy
 from zrp.output import OutputDir
 
 FILES = ("calibrated.toml", "compensation.json")
@@ -101,7 +101,9 @@ def _run(args: argparse.Namespace) -> int:
             diag = diagnose(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, max_steps=args.max_steps, noise_sigma=args.noise,
                             use_orientation=not args.no_orientation,
-                            orientation_sigma=args.orientation_sigma)
+                            orientation_sigma=args.orientation_sigma,
+                            # --widen axis_tilt=B is also the search's tilt domain
+                            max_tilt_rad=(widen or {}).get("axis_tilt", DEFAULT_MAX_TILT_RAD))
             cal = CalibratedRobot.from_diagnosis(diag)
             full = None
             if diag.full_pose is not None:

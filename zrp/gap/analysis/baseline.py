@@ -18,6 +18,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.arrays import F64
+from zrp.gap.fit.constrained import n_registration, within_domains
 from zrp.gap.fit.leastsq import FitResult, cv_rms, fit, identifiable_start
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.model.context import Context, ParamSpec
@@ -84,6 +85,7 @@ def _on_top(ctx: Context, base: FitResult, extra: list[ParamSpec], fitting: NDAr
     keep, _, start = identifiable_start(ctx, base, extra)
     f = fit(ctx, list(base.specs) + keep, fitting,
             np.concatenate([base.theta, np.zeros(len(keep))]), rb0, start=start)
+    f, _ = within_domains(ctx, f, n_registration(f.specs), fitting, rb0)
     return f, len(keep), len(extra) - len(keep)
 
 

@@ -25,18 +25,22 @@ position-only fit's (the same formula, :func:`zrp.gap.fit.leastsq.fit`).
 
 from __future__ import annotations
 
+import dataclasses
+import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from zrp.arrays import F64
 from zrp.errors import InputError
-from zrp.gap.fit.leastsq import FitResult, _covariance, fit, initial_registration
+from zrp.gap.fit.constrained import n_registration
+from zrp.gap.fit.leastsq import FitResult, FitWarning, fit, initial_registration
+from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.domains import domain_violations
 from zrp.gap.model.problem import Problem
 from zrp.rotations import left_jacobian
 
@@ -122,6 +126,10 @@ class FullPoseFit:
         position: the position-only fit (the start).
         orientation: orientations were used.
         sigma_orientation_given: sigma_orientation was given (False: estimated).
+        converged, stop_reason, held: the solver's report (:mod:`zrp.gap.fit.wellposed`;
+            held: the combinations positions and orientations together cannot pin).
+        outside_domain: parameters taken out because their values left their physical
+            domains, with the reasons.
     """
 
     specs: tuple[ParamSpec, ...]
@@ -134,6 +142,10 @@ class FullPoseFit:
     position: FitResult
     orientation: bool
     sigma_orientation_given: bool = False
+    converged: bool = True
+    stop_reason: str = ""
+    held: tuple[HeldDirection, ...] = ()
+    outside_domain: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         p = len(self.specs)
@@ -165,6 +177,29 @@ def probe_start(prob: Problem, theta: F64, measured: F64) -> F64:
 def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
                   orientation: bool = True, orientation_sigma: float | None = None,
                   passes: int = 3) -> FullPoseFit:
+    """:func:`_fit_once` inside the physical domains: a parameter whose value leaves its domain
+    (:mod:`zrp.gap.model.domains`) is taken out and the rest refitted, as in the position fits
+    (:mod:`zrp.gap.fit.constrained`), so the result's ``specs`` may be fewer (the reasons are
+    in ``outside_domain``)."""
+    reasons: list[str] = []
+    while True:
+        fp = _fit_once(ctx, specs, poses, orientation=orientation,
+                       orientation_sigma=orientation_sigma, passes=passes)
+        first = n_registration(fp.specs)
+        bad = domain_violations([x.name for x in fp.specs[first:]],
+                                [x.effect for x in fp.specs[first:]],
+                                [x.unit for x in fp.specs[first:]], fp.theta[first:],
+                                max_tilt_rad=ctx.max_tilt_rad)
+        if not bad:
+            return dataclasses.replace(fp, outside_domain=tuple(reasons))
+        reasons += [why for _, why in bad]
+        out = {first + i for i, _ in bad}
+        specs = [x for i, x in enumerate(fp.specs) if i not in out]
+
+
+def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
+              orientation: bool = True, orientation_sigma: float | None = None,
+              passes: int = 3) -> FullPoseFit:
     """Identify ``specs`` on ``poses`` from positions and, with ``orientation``, the measured
     orientations, each weighted by its own noise (module doc).
 
@@ -207,18 +242,26 @@ def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
         return (np.concatenate([rp / sp, eo.ravel() / so]),
                 np.vstack([jp / sp, jo.reshape(-1, p + 3) / so]))
 
+    start = prob.residual_and_jacobian(pos.theta)[1]
+    scales = np.concatenate([parameter_scales(ctx, specs, start), np.ones(3)])
+    prior = np.concatenate([prior_values(specs, pos.theta), np.zeros(3)])
+    names = [sp_.name for sp_ in specs] + ["probe.rx", "probe.ry", "probe.rz"]
     for _ in range(1 if orientation_sigma is not None else passes):
-        res = least_squares(lambda v, s=so: both(v, s)[0], x, jac=lambda v, s=so: both(v, s)[1],
-                            method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12,
-                            max_nfev=100)
-        x = res.x
+        sol = solve(lambda v, s=so: both(v, s), lambda v, s=so: both(v, s)[0], x, prior,
+                    scales, names)
+        x = sol.theta
         e, _ = orientation_residual(prob, x[:p], x[p:], rt0, measured)
         if orientation_sigma is None:
             so = float(np.sqrt(np.sum(e ** 2) / max(e.size - 3, 1))) or 1e-9
     r, J = both(x, so)
-    cov = _covariance(J, r)
+    sol = solve(lambda v, s=so: both(v, s), lambda v, s=so: both(v, s)[0], x, prior, scales,
+                names, start=(r, J))
+    x, cov = sol.theta, sol.cov
+    if not sol.converged:
+        warnings.warn(f"least squares with {len(names)} parameters (full pose): {sol.reason}",
+                      FitWarning, stacklevel=2)
     se = np.sqrt(np.clip(np.diag(cov), 0.0, None))[:p]
     rt = Rotation.from_rotvec(x[p:]).as_matrix() @ rt0
     ang = float(np.sqrt(np.mean(np.sum(e ** 2, axis=1))))
     return FullPoseFit(tuple(specs), x[:p], se, rt, sp, so, ang, pos, True,
-                       orientation_sigma is not None)
+                       orientation_sigma is not None, sol.converged, sol.reason, sol.held)

@@ -14,12 +14,12 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import (
     special,  # chdtrc/fdtrc: the chi2/F survival functions without scipy.stats (1 s import)
 )
-from scipy.optimize import least_squares
 
 from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
+from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
-from zrp.gap.model.problem import Evaluation, Problem, compressed
+from zrp.gap.model.problem import Evaluation, Problem
 from zrp.jsonio import dict_from_dataclass
 
 #: Two-sided 95 % quantile of the standard normal (the one home of the constant in zrp.gap).
@@ -66,7 +66,11 @@ class FitResult:
         jac: Jacobian at the solution, shape (3R, p).
         base_rotation: R_b0 used by the problem, shape (3, 3).
         poses: pose indices fitted, shape (S,).
-        converged: the solver reported success.
+        converged: the solver met its stop test.
+        held: the parameter combinations the data cannot pin, kept at their nominal values
+            (:mod:`zrp.gap.fit.wellposed`).
+        stop_reason: why the solver stopped, in words.
+        iterations: its Gauss-Newton iterations.
     """
 
     specs: tuple[ParamSpec, ...]
@@ -77,6 +81,9 @@ class FitResult:
     base_rotation: F64
     poses: NDArray[np.int64]
     converged: bool
+    held: tuple[HeldDirection, ...] = ()
+    stop_reason: str = ""
+    iterations: int = 0
 
     def __post_init__(self) -> None:
         p = len(self.specs)
@@ -186,32 +193,12 @@ def orthonormal_basis(a: F64, rtol: float = 1e-10) -> F64:
     return (q @ v2) / np.sqrt(w2)
 
 
-def _covariance(jac: F64, residual: F64) -> F64:
-    """sigma^2 (J^T J)^-1 with column scaling; inf where J^T J is singular."""
-    p = jac.shape[1]
-    dof = max(jac.shape[0] - p, 1)
-    s2 = float(residual @ residual) / dof
-    d = np.linalg.norm(jac, axis=0)
-    d = np.where(d > 0, d, 1.0)
-    js = jac / d
-    w, v = np.linalg.eigh(js.T @ js)
-    with np.errstate(divide="ignore"):
-        inv = np.where(w > max(w.max(), 1e-300) * 1e-12, 1.0 / w, np.inf)
-    cov = (v * np.where(np.isfinite(inv), inv, 0.0)) @ v.T
-    if not np.all(np.isfinite(inv)):
-        # parameters touching the null space get an infinite variance
-        null = v[:, ~np.isfinite(inv)]
-        touched = np.abs(null).max(axis=1) > 1e-6
-        cov[touched, :] = np.inf
-        cov[:, touched] = np.inf
-    return s2 * cov / np.outer(d, d)
-
-
 def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: ArrayLike,
-        base_rotation: ArrayLike, *, max_nfev: int = 100,
-        start: Evaluation | None = None) -> FitResult:
-    """Least squares (scipy ``least_squares``, Levenberg-Marquardt) with the analytic
-    Jacobian of :class:`~zrp.gap.model.problem.Problem`.
+        base_rotation: ArrayLike, *, start: Evaluation | None = None) -> FitResult:
+    """Least squares with the analytic Jacobian of :class:`~zrp.gap.model.problem.Problem`:
+    the scaled truncated-SVD Gauss-Newton solver of :mod:`zrp.gap.fit.wellposed` (eqs. W1-W3),
+    which keeps the combinations the data cannot pin at their nominal values (the effect
+    parameters at 0, the registration at ``theta0``) and reports them (``held``).
 
     Args:
         specs: parameters (p).
@@ -227,35 +214,21 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
         raise InputError(f"{prob.n_residuals // 3} measured points give {prob.n_residuals} "
                          f"coordinates, not enough for {prob.size} parameters; measure more "
                          "poses")
-    cache: dict[bytes, tuple[F64, F64, F64, F64]] = {}  # the last two points evaluated
-
-    def evaluated(th: F64) -> tuple[F64, F64, F64, F64]:
-        key = th.tobytes()
-        if key not in cache:
-            if len(cache) > 1:
-                del cache[next(iter(cache))]
-            r, J = prob.residual_and_jacobian(th)
-            cache[key] = (*compressed(r, J), r, J)
-        return cache[key]
-
-    def both(th: F64) -> tuple[F64, F64]:
-        return evaluated(th)[:2]
-
+    at0 = None
     if (start is not None and np.array_equal(start.poses, prob.poses)
             and np.array_equal(start.theta, theta0) and start.jac.shape[1] == prob.size):
-        cache[theta0.tobytes()] = (*compressed(start.residual, start.jac), start.residual,
-                                   start.jac)
-
-    res = least_squares(lambda th: both(th)[0], theta0, jac=lambda th: both(th)[1],
-                        method="lm", x_scale="jac", xtol=1e-12, ftol=1e-12, gtol=1e-12,
-                        max_nfev=max_nfev)
-    r, J = evaluated(res.x)[2:]  # the solution is one of the last two points evaluated
-    ok = bool(res.status > 0)
-    if not ok:
-        warnings.warn(f"least squares did not converge ({res.message}) with "
-                      f"{len(specs)} parameters", FitWarning, stacklevel=2)
-    return FitResult(tuple(specs), res.x, _covariance(J, r), r, J, np.asarray(base_rotation),
-                     np.asarray(poses, dtype=np.int64), ok)
+        at0 = (start.residual, start.jac)
+    else:
+        at0 = prob.residual_and_jacobian(theta0)
+    scales = parameter_scales(ctx, specs, at0[1])
+    sol = solve(prob.residual_and_jacobian, prob.residual, theta0, prior_values(specs, theta0),
+                scales, [s.name for s in specs], start=at0)
+    if not sol.converged:
+        warnings.warn(f"least squares with {len(specs)} parameters: {sol.reason}", FitWarning,
+                      stacklevel=2)
+    return FitResult(tuple(specs), sol.theta, sol.cov, sol.residual, sol.jac,
+                     np.asarray(base_rotation), np.asarray(poses, dtype=np.int64),
+                     sol.converged, sol.held, sol.reason, sol.iterations)
 
 
 @dataclass(frozen=True)

@@ -18,6 +18,7 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.model.choices import EFFECTS, REGISTRATION
+from zrp.gap.model.domains import DEFAULT_MAX_TILT_RAD
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.identification import axis_tangents
 from zrp.model.manipulator import Manipulator
@@ -100,6 +101,8 @@ class Context:
             the two flanks instead of a hard choice. None: use ``backlash_switch`` alone.
         payload_kg: a payload at the tool that the MJCF torques lack, kg (added to them for
             the backlash flank; the diagnosis profiles it).
+        max_tilt_rad: the largest axis tilt a fit may accept (the domain of
+            ``axis_misalignment``, :mod:`zrp.gap.model.domains`).
     """
 
     model: Manipulator
@@ -112,6 +115,7 @@ class Context:
     backlash_switch: tuple[float, ...] | None = None
     backlash_switch_weights: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None = None
     payload_kg: float = 0.0
+    max_tilt_rad: float = DEFAULT_MAX_TILT_RAD
 
     def __post_init__(self) -> None:
         if self.meas.n_joints != self.model.n:

@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from zrp.escape import md_text as _t
 from zrp.gap.analysis.where import Region, WhereAnalysis
+from zrp.gap.report.identification import identification_markdown
 from zrp.gap.report.verdict import (
     baseline_text,
     final_effects_text,
@@ -381,7 +382,8 @@ def report_markdown(diag: Diagnosis, *, figures: bool = True) -> str:
     """The text of report.md (linking the plots beside it when ``figures``)."""
     u = diag.length_unit
     L = (_header(diag) + _shrink(diag, figures) + _parameters(diag) + _full_pose(diag)
-         + _trust(diag) + _ranking(diag) + _aliasing(diag) + _where(diag.where.nominal, u))
+         + _trust(diag) + identification_markdown(diag) + _ranking(diag) + _aliasing(diag)
+         + _where(diag.where.nominal, u))
     if diag.where.after_final_model is not None:
         L += _remains(diag.where.after_final_model, u)
     if diag.warnings:

@@ -141,6 +141,37 @@ def _trust(diag: Diagnosis) -> list[str]:
     return parts
 
 
+def identification_text(diag: Diagnosis) -> list[str]:
+    """What the data could not pin (held at nominal), which effects left their physical
+    domains, and any fit that stopped before converging."""
+    parts = []
+    held = diag.held_directions
+    if held:
+        shown = "; ".join(h.describe(diag.length_unit) for h in held[:3])
+        more = f" and {len(held) - 3} more" if len(held) > 3 else ""
+        parts.append(f"{len(held)} parameter combination(s) the data cannot pin stayed at "
+                     f"their nominal values: {shown}{more}.")
+    seen: set[str] = set()  # named only while a gap remains: then it says why it was not closed
+    for effect, note in (diag.outside_domain if diag.unexplained is not False else ()):
+        if effect in seen:
+            continue
+        seen.add(effect)
+        items = note.split("physical domain: ", 1)[-1].split("; earlier")[0].split("; ")
+        why = "; ".join(items[:1] + [i.split(" outside ")[0] for i in items[1:]])
+        if note.startswith("fitted values outside"):
+            parts.append(f"{effect} was not accepted: fitted to these data it needs values "
+                         f"outside its physical domain ({why}); the residual has a shape "
+                         "that effect cannot produce physically.")
+        else:
+            parts.append(f"{effect}: parameters whose fitted values left their physical "
+                         f"domain were taken out ({why}).")
+    stops = diag.solver_stops
+    if stops:
+        parts.append(f"{len(stops)} fit(s) stopped before converging ({stops[0]}): their "
+                     "values are not at the least-squares minimum.")
+    return parts
+
+
 def _against_floor(diag: Diagnosis) -> list[str]:
     floor, final, unit = diag.noise_floor, diag.final, diag.length_unit
     if floor.rms is None:
@@ -197,12 +228,18 @@ def full_pose_text(diag: Diagnosis) -> str:
            f"fit (median; {best.name} x{best.ratio:.2f})")
     reveal = "".join(f" Orientations reveal {a.effect} (joint {a.joint}; p = {a.p_value:.2g}), "
                      "which positions see weakly." for a in fp.added)
+    nominal = ("" if not np.isfinite(fp.withheld_orientation_nominal) else
+               f"{1e3 * fp.withheld_orientation_nominal:.3g} mrad after registration, ")
+    base = ("" if fp.baseline_withheld is None else
+            f" (the complete geometric calibration from positions and orientations: "
+            f"{1e3 * fp.baseline_withheld[0]:.3g} mrad, {fp.baseline_withheld[1]:.4g} "
+            f"{diag.length_unit})")
     return (f"Measured orientations (noise {1e3 * fp.sigma_orientation:.3g} mrad, {src}) "
-            f"add: {std}; withheld orientation error "
+            f"add: {std}; withheld orientation error {nominal}"
             f"{1e3 * fp.withheld_orientation_before:.3g} -> "
             f"{1e3 * fp.withheld_orientation_after:.3g} mrad, withheld position RMS "
-            f"{fp.withheld_rms_position_only:.4g} -> {fp.withheld_rms:.4g} {diag.length_unit}."
-            + reveal)
+            f"{fp.withheld_rms_position_only:.4g} -> {fp.withheld_rms:.4g} {diag.length_unit}"
+            f"{base}." + reveal)
 
 
 def verdict_text(diag: Diagnosis) -> str:
@@ -218,6 +255,7 @@ def verdict_text(diag: Diagnosis) -> str:
     if bl:
         parts.append(bl)
     parts += _against_floor(diag)
+    parts += identification_text(diag)
     parts += _trust(diag)
     if diag.full_pose is not None:
         parts.append(full_pose_text(diag))

@@ -20,6 +20,7 @@ from zrp.arrays import F64
 from zrp.gap.analysis.checks import GapWarning
 from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.identifiability import GEOMETRIC, geometric_overlap
+from zrp.gap.fit.constrained import n_registration, within_domains
 from zrp.gap.fit.leastsq import (
     Aliased,
     FitResult,
@@ -144,15 +145,53 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
         return _Trial(Candidate(effect, (), 0, cv_rms(ctx, f1, s.folds), f1.bic - current.bic,
                                 f_test(current, f1), False, "no joint significant"),
                       None, aliased)
+    f1, own, others = _in_domains(ctx, f1, specs, s)
+    kept = [p for p in f1.specs if p.effect == effect]
+    if not kept:
+        return _Trial(Candidate(effect, (), 0, math.nan, math.nan, 1.0, False,
+                                "fitted values outside the physical domain: "
+                                + "; ".join(own)), None, aliased)
     cv = cv_rms(ctx, f1, s.folds)
-    pval = f_test(current, f1)
+    pval = f_test(_nested(ctx, current, f1, s), f1)
     dbic = f1.bic - current.bic
     joints = tuple(sorted({p.joint for p in kept if p.joint > 0}))
-    ok = pval < s.alpha and dbic < 0 and cv < current_cv * (1.0 - s.min_gain)
+    ok, note = _judged(pval, dbic, cv / current_cv if current_cv > 0 else math.inf, s, own,
+                       others)
+    return _Trial(Candidate(effect, joints, len(kept), cv, dbic, pval, ok, note), f1, aliased)
+
+
+def _judged(pval: float, dbic: float, cv_ratio: float, s: SearchSettings, own: list[str],
+            others: list[str]) -> tuple[bool, str]:
+    """Whether a candidate passes (F test, BIC, CV gain) and its note."""
+    ok = pval < s.alpha and dbic < 0 and cv_ratio < 1.0 - s.min_gain
     note = "" if ok else ("F test not significant" if pval >= s.alpha else
                           "BIC does not improve" if dbic >= 0 else
                           f"cross-validated RMS improves by less than {s.min_gain:.0%}")
-    return _Trial(Candidate(effect, joints, len(kept), cv, dbic, pval, ok, note), f1, aliased)
+    return ok, "; ".join(filter(None, [
+        note, own and "parameters taken out, outside the physical domain: " + "; ".join(own),
+        others and "earlier parameters taken out, outside their domains: " + "; ".join(others)]))
+
+
+def _in_domains(ctx: Context, f1: FitResult, specs: list[ParamSpec], s: SearchSettings
+                ) -> tuple[FitResult, list[str], list[str]]:
+    """``f1`` inside the physical domains (:func:`~zrp.gap.fit.constrained.within_domains`),
+    with the reasons for the candidate's own parameters taken out and the names of earlier
+    ones taken out."""
+    f1, outside = within_domains(ctx, f1, n_registration(f1.specs), s.fitting, s.rb0)
+    own_names = {p.name for p in specs}
+    own = [w for w in outside if w.split(" = ")[0] in own_names]
+    others = [w.split(" outside ")[0] for w in outside if w not in own]
+    return f1, own, others
+
+
+def _nested(ctx: Context, current: FitResult, f1: FitResult, s: SearchSettings) -> FitResult:
+    """The model the F test compares ``f1`` with: ``current``, or, when the domains took some
+    of its parameters out of ``f1``, ``current`` refitted without them (nested in ``f1``)."""
+    names = {p.name for p in f1.specs}
+    idx = [i for i, p in enumerate(current.specs) if p.name in names]
+    if len(idx) == len(current.specs):
+        return current
+    return fit(ctx, [current.specs[i] for i in idx], s.fitting, current.theta[idx], s.rb0)
 
 
 def _try_backlash(ctx: Context, current: FitResult, current_cv: float,
@@ -264,4 +303,5 @@ def backward_pass(ctx: Context, current: FitResult, nreg: int, s: SearchSettings
         pruned += sorted(drop)
         current = fit(ctx, [current.specs[i] for i in keep_idx], s.fitting,
                       current.theta[keep_idx], s.rb0)
+        current, _ = within_domains(ctx, current, nreg, s.fitting, s.rb0)
     return current, tuple(pruned)

@@ -94,6 +94,10 @@ class FullPoseResult:
         parameters: the effect parameters' precision, with and without orientations.
         added: groups the orientations revealed (:mod:`zrp.gap.search.posesearch`), in order; the
             fit includes them, the position-only figures ("before") do not.
+        withheld_orientation_nominal: the same RMS angle for the registration alone (the
+            nominal model), rad; NaN when not computed.
+        baseline_withheld: withheld (orientation RMS rad, position RMS length unit) of the
+            complete geometric calibration refitted from positions and orientations, or None.
     """
 
     fit: FullPoseFit
@@ -106,6 +110,8 @@ class FullPoseResult:
     withheld_rms: float
     parameters: tuple[ParameterPrecision, ...]
     added: tuple[OrientationStep, ...] = ()
+    withheld_orientation_nominal: float = float("nan")
+    baseline_withheld: tuple[float, float] | None = None
 
     def __post_init__(self) -> None:
         vals = (self.sigma_orientation, self.withheld_orientation_before,
@@ -142,6 +148,10 @@ class FullPoseResult:
                                                  "full_pose": self.withheld_orientation_after},
                 "withheld_rms": {"position_only": self.withheld_rms_position_only,
                                  "full_pose": self.withheld_rms},
+                "withheld_orientation_rms_nominal_rad": self.withheld_orientation_nominal,
+                "baseline_full_pose_withheld": None if self.baseline_withheld is None else {
+                    "orientation_rms_rad": self.baseline_withheld[0],
+                    "rms": self.baseline_withheld[1]},
                 "std_ratio_median": self.std_ratio_median,
                 "added_by_orientation": [a.to_dict() for a in self.added],
                 "parameters": [p.to_dict() for p in self.parameters]}
@@ -160,7 +170,9 @@ def refit_full_pose(ctx: Context, final: FitResult, fitting: NDArray[np.int64],
                     withheld: NDArray[np.int64], n_registration: int,
                     orientation_sigma: float | None = None, *,
                     candidates: dict[str, list[ParamSpec]] | None = None, alpha: float = 1e-3,
-                    min_gain: float = 0.01, max_steps: int = 2) -> FullPoseResult:
+                    min_gain: float = 0.01, max_steps: int = 2,
+                    nominal: FitResult | None = None,
+                    baseline: FitResult | None = None) -> FullPoseResult:
     """Refit ``final``'s parameters with the measured orientations, add the effects only the
     orientations reveal (:mod:`zrp.gap.search.posesearch`) and judge the estimates on the withheld
     poses (module doc).
@@ -173,6 +185,9 @@ def refit_full_pose(ctx: Context, final: FitResult, fitting: NDArray[np.int64],
         orientation_sigma: orientation noise per component (rad); None: estimated.
         candidates: effect -> parameters the orientation search may add (None: no search).
         alpha, min_gain, max_steps: of the orientation search (the diagnosis's own).
+        nominal: the registration fit, whose withheld orientation error is reported beside.
+        baseline: the complete geometric calibration, refitted from positions and
+            orientations and judged on the withheld poses too.
 
     Raises:
         InputError: no orientations, a non-positive ``orientation_sigma``.
@@ -195,16 +210,29 @@ def refit_full_pose(ctx: Context, final: FitResult, fitting: NDArray[np.int64],
         fp, added = forward_search(ctx, fp0, candidates, fitting, meas_rot[fitting], refit,
                                    (ori0, pos0), alpha, min_gain, max_steps)
     start = fp0.position  # the diagnosis's final model, positions only
-    rt0 = probe_start(Problem(ctx, start.specs, fitting, start.base_rotation), start.theta,
-                      meas_rot[fitting])
-    prob0 = Problem(ctx, start.specs, w, start.base_rotation)
-    before, _ = orientation_residual(prob0, start.theta, np.zeros(3), rt0, meas_rot[w])
+    before = _position_only_orientation(ctx, start, fitting, w, meas_rot)
     ori, pos_rms = judge(fp)
     pos = fp.position
     params = tuple(ParameterPrecision(s.name, s.effect, s.unit, float(fp.theta[i]),
                                       float(pos.stderr[i]), float(fp.stderr[i]))
                    for i, s in enumerate(fp.specs) if i >= n_registration
                    and np.isfinite(pos.stderr[i]) and np.isfinite(fp.stderr[i]))
+    nom = (float("nan") if nominal is None
+           else _position_only_orientation(ctx, nominal, fitting, w, meas_rot))
+    base = None if baseline is None else judge(fit_full_pose(
+        ctx, baseline.specs, fitting, orientation_sigma=orientation_sigma))
+    prob0 = Problem(ctx, start.specs, w, start.base_rotation)
     return FullPoseResult(fp, fp.sigma_orientation, fp.sigma_orientation_given,
-                          fp.probe_rotation, _angle_rms(before), ori,
-                          _rms(prob0, start.theta), pos_rms, params, added)
+                          fp.probe_rotation, before, ori, _rms(prob0, start.theta), pos_rms,
+                          params, added, nom, base)
+
+
+def _position_only_orientation(ctx: Context, f: FitResult, fitting: NDArray[np.int64],
+                               withheld: NDArray[np.int64], meas_rot: F64) -> float:
+    """Withheld RMS orientation error (rad) of a position-only fit, its probe rotation taken
+    from the fitting poses (:func:`~zrp.gap.fit.fullpose.probe_start`)."""
+    rt0 = probe_start(Problem(ctx, f.specs, fitting, f.base_rotation), f.theta,
+                      meas_rot[fitting])
+    prob = Problem(ctx, f.specs, withheld, f.base_rotation)
+    e, _ = orientation_residual(prob, f.theta, np.zeros(3), rt0, meas_rot[withheld])
+    return _angle_rms(e)
