@@ -33,8 +33,8 @@ from pathlib import Path
 
 from zrp.errors import InputError, ZRPError
 
-__all__ = ["MAX_LINE_CHARS", "MAX_STREAM_BYTES", "MAX_TEXT_BYTES", "iter_lines", "read_text",
-           "text_encoding"]
+__all__ = ["MAX_LINE_CHARS", "MAX_STREAM_BYTES", "MAX_TEXT_BYTES", "check_file", "iter_lines",
+           "read_text", "text_encoding"]
 
 #: Largest file read whole (model TOML, URDF, MJCF): 256 MiB (a URDF of 20,000 joints is
 #: about 10 MB).
@@ -66,10 +66,11 @@ def _mb(n: int) -> str:
     return f"{n / 2**20:,.1f} MiB" if n >= 2**20 else f"{n:,} bytes"
 
 
-def _check_file(path: Path, label: str, max_bytes: int, allow_stream: bool,
+def check_file(path: Path, label: str, max_bytes: int, allow_stream: bool,
                 error: type[ZRPError]) -> bool:
     """Stat ``path``: True when it is a regular file (its size checked), False for an allowed
-    stream; anything else is an error."""
+    stream; anything else is an ``error`` naming ``label`` (also for binary files, e.g. a
+    checkpoint)."""
     try:
         st = os.stat(path)
     except FileNotFoundError:
@@ -121,7 +122,7 @@ def iter_lines(path: str | os.PathLike[str], *, label: str | None = None,
     """
     p = Path(path)
     label = str(p) if label is None else label
-    _check_file(p, label, max_bytes, allow_stream, error)
+    check_file(p, label, max_bytes, allow_stream, error)
     try:
         fh = open(p, "rb")
     except OSError as exc:
@@ -182,7 +183,7 @@ def read_text(path: str | os.PathLike[str], *, label: str | None = None,
     :func:`iter_lines`."""
     p = Path(path)
     label = str(p) if label is None else label
-    _check_file(p, label, max_bytes, allow_stream, error)
+    check_file(p, label, max_bytes, allow_stream, error)
     try:
         with open(p, "rb") as fh:
             raw = fh.read(max_bytes + 1)
