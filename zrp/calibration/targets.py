@@ -22,8 +22,12 @@ from zrp.calibration.compensation import Compensation
 from zrp.errors import InputError
 from zrp.output import write_text
 from zrp.rotations import matrix_from_er
+from zrp.textio import iter_lines
 
-__all__ = ["Targets", "load_targets", "write_commands"]
+__all__ = ["MAX_TARGETS", "Targets", "load_targets", "write_commands"]
+
+#: Most targets read from one file.
+MAX_TARGETS = 1_000_000
 
 
 
@@ -77,11 +81,17 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
         InputError: unreadable file, bad header, field count, non-numbers (file, line, column).
     """
     src = str(path)
+    reader = csv.reader(iter_lines(path, label=src))  # a regular file, lines bounded
+    rows = []
     try:
-        rows = list(csv.reader(io.StringIO(Path(path).read_text(encoding="utf-8"))))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{src}: cannot read the targets file: {exc}") from exc
-    rows = [r for r in rows if r]
+        for r in reader:
+            if len(rows) > MAX_TARGETS:
+                raise InputError(f"{src}, line {reader.line_num}: more than {MAX_TARGETS:,} "
+                                 "targets; split the program")
+            if r:
+                rows.append(r)
+    except csv.Error as exc:
+        raise InputError(f"{src}, line {reader.line_num}: not a CSV file ({exc})") from None
     if len(rows) < 2:
         raise InputError(f"{src}: no targets (a header and at least one row expected)")
     header = [h.strip() for h in rows[0]]

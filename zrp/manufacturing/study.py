@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from zrp.arrays import F64
-from zrp.errors import InputError, ModelFileError, ZRPWarning
+from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import check_q, end_effector_pose
@@ -39,6 +39,7 @@ from zrp.manufacturing.perturb import (
 from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply
+from zrp.textio import iter_lines
 
 __all__ = [
     "PAPER_PARAMETERS",
@@ -110,44 +111,65 @@ def _check_radians(q: F64, model: Manipulator, p: Path) -> None:
                          "`zrp ik` writes it): convert it with numpy.radians")
 
 
+#: Most rows of a joint trajectory CSV (a path of 2 million steps is ~100 MB of numbers).
+MAX_JOINT_ROWS = 2_000_000
+
+
+def _joint_rows(p: Path, n: int) -> tuple[list[str], F64, list[float | None]]:
+    """Stream the CSV (:func:`zrp.textio.iter_lines`: a regular file, lines bounded): the
+    header, the t, q1..qn values (R, n + 1) and the largest IK errors, if logged."""
+    reader = csv.reader(iter_lines(p, label=str(p)))
+    header: list[str] | None = None
+    vals: list[list[float]] = []
+    ecols: list[int | None] = []
+    errs: list[float | None] = []
+    try:
+        for row in reader:
+            i = reader.line_num
+            if header is None:
+                header = [h.strip() for h in row]
+                ecols = [header.index(c) if c in header else None
+                         for c in ("position_error", "orientation_error_rad")]
+                errs = [None if j is None else -math.inf for j in ecols]
+                continue
+            if len(vals) >= MAX_JOINT_ROWS:
+                raise InputError(f"{p}, line {i}: more than {MAX_JOINT_ROWS:,} rows; thin the "
+                                 "joint trajectory (every k-th step)")
+            if len(row) < n + 1:
+                raise InputError(f"{p}, line {i}: expected at least {n + 1} columns (t, "
+                                 f"q1..q{n}), got {len(row)}")
+            try:
+                vals.append([float(x) for x in row[:n + 1]])
+            except ValueError as exc:
+                raise InputError(f"{p}, line {i}: not a number: {exc}") from None
+            if not all(math.isfinite(v) for v in vals[-1]):
+                raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:n + 1]}")
+            for k, j in enumerate(ecols):  # written by `zrp ik` (IKResult.save_csv)
+                errs[k] = _larger(errs[k], row, j)
+    except csv.Error as exc:
+        raise InputError(f"{p}, line {reader.line_num}: not a CSV file ({exc})") from None
+    if header is None or len(vals) < 2:
+        raise InputError(f"{p}: expected a header and at least 2 rows of t, q1..q{n}")
+    return header, np.array(vals), errs
+
+
+def _larger(best: float | None, row: list[str], j: int | None) -> float | None:
+    """The running maximum of column ``j`` (None once a value is missing or not a number)."""
+    if best is None or j is None:
+        return None
+    try:
+        return max(best, float(row[j]))
+    except (ValueError, IndexError):
+        return None
+
+
 def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
     """Read a joint trajectory CSV: a header row, time (s) in the first column and the n joint
     values in the next n columns (the layout ``zrp ik`` writes; rad / length unit). The IK
     errors are taken from ``position_error`` / ``orientation_error_rad`` columns if present."""
     p = Path(path)
-    try:
-        with p.open(newline="", encoding="utf-8-sig") as fh:
-            rows = list(csv.reader(fh))
-    except OSError as exc:
-        raise ModelFileError(f"{p}: cannot read joint trajectory: {exc}") from exc
-    except (UnicodeDecodeError, csv.Error) as exc:
-        raise InputError(f"{p}: not a CSV text file in UTF-8 ({exc})") from None
-    if len(rows) < 3:
-        raise InputError(f"{p}: expected a header and at least 2 rows of t, q1..q{model.n}")
-    data = []
-    for i, row in enumerate(rows[1:], start=2):
-        if len(row) < model.n + 1:
-            raise InputError(f"{p}, line {i}: expected at least {model.n + 1} columns (t, "
-                             f"q1..q{model.n}), got {len(row)}")
-        try:
-            data.append([float(x) for x in row[:model.n + 1]])
-        except ValueError as exc:
-            raise InputError(f"{p}, line {i}: not a number: {exc}") from exc
-        if not all(math.isfinite(v) for v in data[-1]):
-            raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:model.n + 1]}")
-    _check_radians(np.array(data)[:, 1:], model, p)
-    arr = np.array(data)
-    header = [h.strip() for h in rows[0]]
-    errs: list[float | None] = []
-    for col in ("position_error", "orientation_error_rad"):
-        if col in header:  # written by `zrp ik` (IKResult.save_csv)
-            j = header.index(col)
-            try:
-                errs.append(max(float(r[j]) for r in rows[1:]))
-            except (ValueError, IndexError):
-                errs.append(None)
-        else:
-            errs.append(None)
+    _, arr, errs = _joint_rows(p, model.n)
+    _check_radians(arr[:, 1:], model, p)
     return JointPath(arr[:, 0], arr[:, 1:], f"joint trajectory {p.name}", errs[0], errs[1])
 
 
