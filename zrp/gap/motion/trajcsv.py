@@ -44,6 +44,10 @@ __all__ = ["load_trajectory", "write_trajectory"]
 
 def _header(row: list[str], n: int, name: str) -> dict[str, int]:
     cols = {c.strip(): i for i, c in enumerate(row)}
+    if len(cols) != len(row):
+        seen: set[str] = set()
+        twice = next(c.strip() for c in row if c.strip() in seen or seen.add(c.strip()))
+        raise InputError(f"{name} line 1: column {twice!r} appears twice; each column once")
     need = ["t", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z"]
     missing = [c for c in need if c not in cols]
     if missing:
