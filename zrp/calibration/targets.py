@@ -74,14 +74,10 @@ def _columns(header: list[str], n: int, src: str) -> tuple[list[str], bool, bool
     return cols, has_xyz, has_quat
 
 
-def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
-    """Read a targets CSV for a robot with ``n`` joints (see the module doc).
-
-    Raises:
-        InputError: unreadable file, bad header, field count, non-numbers (file, line, column).
-    """
-    src = str(path)
-    reader = csv.reader(iter_lines(path, label=src))  # a regular file, lines bounded
+def _read_rows(path: str | Path, src: str) -> list[list[str]]:
+    """The non-empty records of the file (:func:`zrp.textio.iter_lines`: a regular file,
+    lines bounded), at most :data:`MAX_TARGETS` + 1."""
+    reader = csv.reader(iter_lines(path, label=src))
     rows = []
     try:
         for r in reader:
@@ -92,6 +88,17 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
                 rows.append(r)
     except csv.Error as exc:
         raise InputError(f"{src}, line {reader.line_num}: not a CSV file ({exc})") from None
+    return rows
+
+
+def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
+    """Read a targets CSV for a robot with ``n`` joints (see the module doc).
+
+    Raises:
+        InputError: unreadable file, bad header, field count, non-numbers (file, line, column).
+    """
+    src = str(path)
+    rows = _read_rows(path, src)
     if len(rows) < 2:
         raise InputError(f"{src}: no targets (a header and at least one row expected)")
     header = [h.strip() for h in rows[0]]

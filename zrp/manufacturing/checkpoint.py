@@ -19,6 +19,7 @@ from __future__ import annotations
 import hashlib
 import io
 import json
+import math
 import os
 import pickle
 from dataclasses import dataclass, field
@@ -164,46 +165,62 @@ def _read(p: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     return head, data
 
 
+def _bad(p: Path, field: str, why: str) -> InputError:
+    return InputError(f"checkpoint {p}: field {field} {why}; remove the file to start afresh")
+
+
+def _is_int(v: Any) -> bool:
+    return type(v) is int
+
+
+def _header_fields(p: Path, head: dict[str, Any], n_chunks: int | None
+                   ) -> tuple[int, list[int], int]:
+    """(ready, waiting, per_chunk) of the header, each of the right type and range."""
+    ready, waiting, per = head.get("ready"), head.get("waiting"), head.get("per_chunk")
+    if not isinstance(head.get("identity"), dict):
+        raise _bad(p, "identity", "is not a table of the run's inputs")
+    if not _is_int(per) or per not in (2, 4):
+        raise _bad(p, "per_chunk", f"is {per!r}; expected 2 or 4 histograms a chunk")
+    top = n_chunks if n_chunks is not None else math.inf
+    if not _is_int(ready) or not 0 <= ready <= top:
+        raise _bad(p, "ready", f"is {ready!r}; expected a chunk count 0..{n_chunks}")
+    ok = isinstance(waiting, list) and all(_is_int(i) and ready < i < top for i in waiting)
+    if not ok or len(set(waiting)) != len(waiting):
+        raise _bad(p, "waiting", f"is {str(waiting)[:80]}; expected distinct chunk indices "
+                   f"after ready={ready}")
+    return ready, list(waiting), per
+
+
+def _array_fields(p: Path, data: dict[str, np.ndarray], k: int, n_wait: int) -> None:
+    """counts (k, B), stats (k, 5) and elapsed (1 + n_wait,) of the right kinds."""
+    shapes = {"counts": (k, None), "stats": (k, 5), "elapsed": (1 + n_wait,)}
+    for name, shape in shapes.items():
+        a = data.get(name)
+        if a is None or a.shape[:1] != shape[:1] or a.ndim != len(shape) \
+                or (len(shape) == 2 and shape[1] is not None and a.shape[1] != shape[1]):
+            raise _bad(p, name, f"has shape {None if a is None else a.shape}; expected "
+                       f"{tuple('B' if s is None else s for s in shape)}")
+    el = data["elapsed"]
+    if data["counts"].dtype.kind not in "iu" or el.dtype.kind != "f" \
+            or not np.all(np.isfinite(el)) or np.any(el < 0):
+        raise _bad(p, "counts/elapsed", "holds values of the wrong kind (negative or not "
+                   "finite)")
+
+
 def _fields(p: Path, head: dict[str, Any], data: dict[str, np.ndarray],
             sizes: list[int] | None) -> tuple[int, list[int], int]:
     """(ready, waiting, per_chunk) after every field was checked against the arrays and the
     run's chunk sizes (``sizes``); a field out of place is an error naming it."""
-
-    def bad(field: str, why: str) -> InputError:
-        return InputError(f"checkpoint {p}: field {field} {why}; remove the file to start "
-                          "afresh")
-
-    ready, waiting, per = head.get("ready"), head.get("waiting"), head.get("per_chunk")
-    if not isinstance(head.get("identity"), dict):
-        raise bad("identity", "is not a table of the run's inputs")
-    if type(per) is not int or per not in (2, 4):
-        raise bad("per_chunk", f"is {per!r}; expected 2 or 4 histograms a chunk")
-    n_chunks = len(sizes) if sizes is not None else None
-    if type(ready) is not int or ready < 0 or (n_chunks is not None and ready > n_chunks):
-        raise bad("ready", f"is {ready!r}; expected a chunk count 0..{n_chunks}")
-    if not isinstance(waiting, list) or any(type(i) is not int for i in waiting) \
-            or len(set(waiting)) != len(waiting) or any(i <= ready for i in waiting) \
-            or (n_chunks is not None and any(i >= n_chunks for i in waiting)):
-        raise bad("waiting", f"is {str(waiting)[:80]}; expected distinct chunk indices after "
-                  f"ready={ready}")
-    k = per * (1 + len(waiting))
-    shapes = {"counts": (k, None), "stats": (k, 5), "elapsed": (1 + len(waiting),)}
-    for name, shape in shapes.items():
-        a = data.get(name)
-        if a is None or a.ndim != len(shape) or any(
-                want is not None and got != want for got, want in zip(a.shape, shape, strict=True)):
-            raise bad(name, f"has shape {None if a is None else a.shape}; expected "
-                      f"{tuple('B' if s is None else s for s in shape)}")
-    if data["counts"].dtype.kind not in "iu" or not np.all(np.isfinite(data["elapsed"])) \
-            or np.any(data["elapsed"] < 0):
-        raise bad("counts/elapsed", "holds values of the wrong kind (negative or not finite)")
+    ready, waiting, per = _header_fields(p, head, None if sizes is None else len(sizes))
+    _array_fields(p, data, per * (1 + len(waiting)), len(waiting))
     if sizes is not None:
         want = [sum(sizes[:ready])] * per + [sizes[i] for i in waiting for _ in range(per)]
-        got = [int(v) for v in data["stats"][:, 0]]
+        got = [int(v) if np.isfinite(v) else -1 for v in data["stats"][:, 0]]
         if got != want:
-            raise bad("ready", f"= {ready} with waiting {waiting} does not match the robots "
-                      f"its histograms count ({got[0]} robots merged, expected {want[0]})")
-    return ready, [int(i) for i in waiting], per
+            raise _bad(p, "ready", f"= {ready} with waiting {waiting} does not match the "
+                       f"robots its histograms count ({got[0]} robots merged, expected "
+                       f"{want[0]})")
+    return ready, waiting, per
 
 
 def load_merge(path: str | os.PathLike[str], identity: dict[str, str],

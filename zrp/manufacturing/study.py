@@ -135,15 +135,7 @@ def _joint_rows(p: Path, n: int) -> tuple[list[str], F64, list[float | None]]:
             if len(vals) >= MAX_JOINT_ROWS:
                 raise InputError(f"{p}, line {i}: more than {MAX_JOINT_ROWS:,} rows; thin the "
                                  "joint trajectory (every k-th step)")
-            if len(row) < n + 1:
-                raise InputError(f"{p}, line {i}: expected at least {n + 1} columns (t, "
-                                 f"q1..q{n}), got {len(row)}")
-            try:
-                vals.append([float(x) for x in row[:n + 1]])
-            except ValueError as exc:
-                raise InputError(f"{p}, line {i}: not a number: {exc}") from None
-            if not all(math.isfinite(v) for v in vals[-1]):
-                raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:n + 1]}")
+            vals.append(_joint_row(row, n, p, i))
             for k, j in enumerate(ecols):  # written by `zrp ik` (IKResult.save_csv)
                 errs[k] = _larger(errs[k], row, j)
     except csv.Error as exc:
@@ -151,6 +143,20 @@ def _joint_rows(p: Path, n: int) -> tuple[list[str], F64, list[float | None]]:
     if header is None or len(vals) < 2:
         raise InputError(f"{p}: expected a header and at least 2 rows of t, q1..q{n}")
     return header, np.array(vals), errs
+
+
+def _joint_row(row: list[str], n: int, p: Path, i: int) -> list[float]:
+    """t, q1..qn of one row (line ``i``), finite numbers."""
+    if len(row) < n + 1:
+        raise InputError(f"{p}, line {i}: expected at least {n + 1} columns (t, "
+                         f"q1..q{n}), got {len(row)}")
+    try:
+        v = [float(x) for x in row[:n + 1]]
+    except ValueError as exc:
+        raise InputError(f"{p}, line {i}: not a number: {exc}") from None
+    if not all(math.isfinite(x) for x in v):
+        raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:n + 1]}")
+    return v
 
 
 def _larger(best: float | None, row: list[str], j: int | None) -> float | None:

@@ -182,8 +182,8 @@ def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
     for tr, ranked in trace:
         if tr.fit is None or tr.effect not in final_all.effects:
             continue
-        ties = tuple(r.effect for r in ranked[1:] if r.fit is not None
-                     and r.cv_rms <= 1.01 * tr.cv_rms)
+        ties = tuple(r.effect for r in ranked[1:]  # untried: cv_rms = inf
+                     if r.cv_rms <= 1.01 * tr.cv_rms)
         steps.append(MotionStep(tr.effect, tr.joints, tr.cv_rms, tr.p_value, tr.bic_delta,
                                 Metrics.of(eng.residual(tr.fit, split.withheld)),
                                 tuple(r.to_dict() for r in ranked), ties))
