@@ -14,12 +14,10 @@ from typing import Any
 import numpy as np
 
 from zrp.errors import InputError
+from zrp.limits import MAX_SEED
 
 __all__ = ["MAX_SEED", "check_float", "check_instance", "check_int", "check_seed"]
 
-#: Largest seed accepted (NumPy's SeedSequence takes any non-negative integer; 2**63 - 1 keeps
-#: it an int64 everywhere a seed is recorded).
-MAX_SEED = 2**63 - 1
 
 
 def _whole(value: object) -> bool:

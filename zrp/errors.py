@@ -15,6 +15,7 @@ __all__ = [
     "ModelFileError",
     "OutputBusyError",
     "OutputExistsError",
+    "OutputKindError",
     "SingularityError",
     "SingularityWarning",
     "TrackingWarning",
@@ -74,12 +75,22 @@ class OutputExistsError(ZRPError, FileExistsError):
 class OutputBusyError(ZRPError, RuntimeError):
     """Another run is writing into the same output folder (it holds the folder's lock)."""
 
-    def __init__(self, folder: object, pid: int, host: str) -> None:
+    def __init__(self, folder: object, pid: int, host: str, lock: object = None,
+                 waited_s: float = 0.0) -> None:
         self.folder, self.pid, self.host = str(folder), pid, host
+        self.lock = None if lock is None else str(lock)
         who = f"process {pid}" + (f" on {host}" if host else "") if pid > 0 else "another run"
-        super().__init__(f"{folder}: {who} is writing into this folder; wait for it to finish "
-                         "or choose another output folder (a lock left by a crashed run is "
-                         "taken over automatically)")
+        held = f" (lock file {lock}" + (f", waited {waited_s:.0f} s)" if waited_s else ")") \
+            if lock is not None else ""
+        super().__init__(f"{folder}: {who} is writing into this folder{held}; wait for it to "
+                         "finish or choose another output folder (a lock left by a crashed run "
+                         "is taken over automatically)")
+
+
+class OutputKindError(InputError):
+    """An output path that is not a regular file (a symbolic link, a device, a FIFO, a
+    socket) or an output folder reached through a symbolic link: never replaced or written
+    through, even with ``overwrite=True``."""
 
 
 class UnitError(ModelError, InputError):

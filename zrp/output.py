@@ -5,10 +5,20 @@
 * Each file appears whole or not at all: it is written under a temporary name in the same
   folder and moved into place with :func:`os.replace` (atomic on POSIX and Windows), so an
   interrupted run never leaves half a CSV behind.
+* Only regular files are replaced: a symbolic link, a device, a FIFO or a socket at an output
+  path is refused with :class:`~zrp.errors.OutputKindError`, even with ``overwrite=True`` (as
+  root, ``--out /dev/null --force`` would otherwise replace the system's). An output folder
+  that is itself a symbolic link is refused, not resolved (the message names its target, to
+  pass instead), so a run never writes through a link into another folder.
+* A name longer than the file system allows (255 bytes a component) is refused by name.
 * An output folder belongs to one run at a time: :class:`OutputDir` holds a lock file
   (``.zrp-output.lock``, created with ``O_EXCL``) while it writes, so two concurrent runs into
-  one folder never mix their files; the second is refused with :class:`OutputBusyError`
-  naming the first one's process. A lock left by a process that no longer runs is taken over.
+  one folder never mix their files; the second waits at most ``lock_wait_s`` seconds
+  (:data:`LOCK_WAIT_S`), then is refused with :class:`OutputBusyError` naming the lock file and
+  the holder's process. A lock left by a process that no longer runs is taken over.
+* A writer that declares the files it owns (``names``) with ``prune=True`` removes, on a clean
+  exit, those of them an earlier run left and this run did not write (the plots of a run
+  before ``--no-plots``), so no stale file is left beside (or linked from) the new results.
 
 Typical use::
 
@@ -25,17 +35,19 @@ from __future__ import annotations
 import contextlib
 import os
 import socket
+import stat
 import time
 from collections.abc import Iterable, Iterator, Sequence
 from pathlib import Path
 from typing import Any
 
-from zrp.errors import InputError, OutputBusyError, OutputExistsError
-from zrp.jsonio import dumps
+from zrp.errors import InputError, OutputBusyError, OutputExistsError, OutputKindError
 
 __all__ = [
     "GENERATED_MARK",
     "LOCK_NAME",
+    "LOCK_WAIT_S",
+    "NAME_MAX_BYTES",
     "OutputDir",
     "atomic_path",
     "check_writable",
@@ -50,6 +62,16 @@ LOCK_NAME = ".zrp-output.lock"
 #: Mark of a folder created for generated output (the commands' default folders, such as
 #: ``renders/``): see :func:`claim_generated`.
 GENERATED_MARK = ".zrp-generated"
+#: Longest wait for another run's lock on an output folder before :class:`OutputBusyError`.
+LOCK_WAIT_S = 3.0
+#: Longest file or folder name (one path component, UTF-8 bytes) on common file systems
+#: (ext4, XFS, APFS, NTFS): a longer one is refused by name before anything is written.
+NAME_MAX_BYTES = 255
+#: Longest suffix the temporary file keeps (so writers that infer the format from it can).
+_SUFFIX_MAX = 16
+_KINDS = ((stat.S_ISCHR, "a character device"), (stat.S_ISBLK, "a block device"),
+          (stat.S_ISFIFO, "a FIFO (named pipe)"), (stat.S_ISSOCK, "a socket"),
+          (stat.S_ISDIR, "a folder"))
 
 
 def _as_path(path: str | os.PathLike[str], field: str) -> Path:
@@ -58,7 +80,47 @@ def _as_path(path: str | os.PathLike[str], field: str) -> Path:
     p = Path(path)
     if not str(p).strip():
         raise InputError(f"{field}: expected a file or folder path, got an empty string")
+    for part in p.parts:
+        n = len(os.fsencode(part))
+        if n > NAME_MAX_BYTES:
+            raise InputError(f"{field}: name too long ({n} bytes; file systems allow "
+                             f"{NAME_MAX_BYTES} a name): {part[:40]}...")
     return p
+
+
+def _lstat(p: Path) -> os.stat_result | None:
+    """``os.lstat`` of ``p`` (None when missing); other failures are named errors."""
+    try:
+        return os.lstat(p)
+    except (FileNotFoundError, NotADirectoryError):
+        return None
+    except OSError as exc:
+        raise InputError(f"{p}: cannot check the path ({exc.strerror or exc})") from exc
+
+
+def check_regular(p: Path) -> bool:
+    """True when ``p`` exists as a regular file, False when missing.
+
+    Raises:
+        OutputKindError: ``p`` is a symbolic link or a special file (device, FIFO, socket),
+            which no writer replaces, even with ``overwrite=True``.
+    """
+    st = _lstat(p)
+    if st is None:
+        return False
+    if stat.S_ISLNK(st.st_mode):
+        try:
+            target = os.readlink(p)
+        except OSError:
+            target = "?"
+        raise OutputKindError(f"{p}: is a symbolic link (to {target}); an output is written "
+                              "only as a regular file, never through or over a link, even with "
+                              "--force: remove the link or choose another name")
+    for test, kind in _KINDS:
+        if test(st.st_mode):
+            raise OutputKindError(f"{p}: is {kind}, not a regular file; outputs replace only "
+                                  "regular files, even with --force: choose another name")
+    return True
 
 
 def check_writable(paths: Iterable[str | os.PathLike[str]], overwrite: bool) -> list[Path]:
@@ -72,14 +134,21 @@ def check_writable(paths: Iterable[str | os.PathLike[str]], overwrite: bool) -> 
         InputError: a path names an existing folder, or lies under an existing file.
     """
     out = [_as_path(p, "path") for p in paths]
+    existing = []
     for p in out:
-        if p.is_dir():
+        st = _lstat(p)
+        if st is not None and stat.S_ISDIR(st.st_mode):
             raise InputError(f"{p}: is a folder; expected a file name to write")
         for parent in p.parents:
-            if parent.exists() and not parent.is_dir():
+            try:
+                bad = parent.exists() and not parent.is_dir()
+            except OSError as exc:
+                raise InputError(f"{p}: cannot check the path ({exc.strerror or exc})") from exc
+            if bad:
                 raise InputError(f"{p}: cannot write under {parent}, which is a file, not a "
                                  "folder")
-    existing = [p for p in out if p.exists() or p.is_symlink()]
+        if check_regular(p):
+            existing.append(p)
     if existing and not overwrite:
         raise OutputExistsError(existing)
     return out
@@ -109,12 +178,14 @@ def atomic_path(path: str | os.PathLike[str], *, overwrite: bool = False) -> Ite
     """
     (p,) = check_writable([path], overwrite)
     _mkdir(p.parent)
-    tmp = p.with_name(f".{p.stem}.{os.getpid()}-{time.monotonic_ns()}.tmp{p.suffix}")
+    suffix = p.suffix if len(p.suffix) <= _SUFFIX_MAX else ""
+    tmp = p.with_name(f".zrp-{os.getpid()}-{time.monotonic_ns()}.tmp{suffix}")
     try:
         yield tmp
         if not tmp.exists():
             raise InputError(f"{p}: the writer produced no file")
-        if not overwrite and p.exists():  # appeared while we were writing
+        # checked again: a link or a device may have appeared while we were writing
+        if check_regular(p) and not overwrite:
             raise OutputExistsError([p])
         os.replace(tmp, p)
     except OSError as exc:
@@ -143,6 +214,8 @@ def write_bytes(path: str | os.PathLike[str], data: bytes, *, overwrite: bool = 
 def write_json(path: str | os.PathLike[str], obj: Any, *, overwrite: bool = False,
                indent: int | None = 2) -> Path:
     """Write ``obj`` as strict JSON (:func:`zrp.jsonio.dumps`: no NaN) atomically."""
+    from zrp.jsonio import dumps  # NumPy: on use, so that `zrp --help` does not load it
+
     return write_text(path, dumps(obj, indent), overwrite=overwrite)
 
 
@@ -195,28 +268,62 @@ class OutputDir:
     """
 
     def __init__(self, path: str | os.PathLike[str], *, overwrite: bool = False,
-                 names: Sequence[str] = ()) -> None:
+                 names: Sequence[str] = (), prune: bool = False,
+                 lock_wait_s: float = LOCK_WAIT_S) -> None:
         self.root = _as_path(path, "out_dir")
         self.overwrite = bool(overwrite)
         self.names = tuple(names)
+        self.prune = bool(prune)
+        self.lock_wait_s = float(lock_wait_s)
         self.written: list[Path] = []
+        #: files of an earlier run removed on exit (``prune``): declared, not written now
+        self.removed: list[Path] = []
         self._lock: Path | None = None
 
     # ---- the lock --------------------------------------------------------------------------
+    def _holder(self, lock: Path) -> tuple[int, str]:
+        """(pid, host) written in the lock file; (-1, "") when unreadable. Read without
+        following a link or blocking on a FIFO, at most 256 bytes."""
+        try:
+            fd = os.open(lock, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_NOFOLLOW", 0))
+        except FileNotFoundError:
+            return 0, ""
+        except OSError as exc:
+            raise OutputKindError(f"{lock}: the output folder's lock file cannot be read "
+                                  f"({exc.strerror or exc}); remove it if no run is writing "
+                                  "into the folder") from exc
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                raise OutputKindError(f"{lock}: the output folder's lock is not a regular "
+                                      "file; remove it if no run is writing into the folder")
+            text = os.read(fd, 256).decode("utf-8", "replace")
+        finally:
+            os.close(fd)
+        pid_s, _, host = text.strip().partition(" ")
+        try:
+            return int(pid_s), host
+        except ValueError:
+            return -1, ""
+
     def _acquire(self) -> None:
         lock = self.root / LOCK_NAME
         me = f"{os.getpid()} {socket.gethostname()}\n"
-        for _ in range(3):
+        t0 = time.monotonic()
+        pid, host, stale = -1, "", 0
+        while True:
             try:
                 fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
             except FileExistsError:
-                try:
-                    pid_s, _, host = lock.read_text(encoding="utf-8").strip().partition(" ")
-                    pid = int(pid_s)
-                except (OSError, ValueError):
-                    pid, host = -1, ""
+                pid, host = self._holder(lock)
                 if pid > 0 and (host != socket.gethostname() or _pid_alive(pid)):
-                    raise OutputBusyError(self.root, pid, host) from None
+                    waited = time.monotonic() - t0
+                    if waited >= self.lock_wait_s:
+                        raise OutputBusyError(self.root, pid, host, lock, waited) from None
+                    time.sleep(min(0.2, self.lock_wait_s))
+                    continue
+                stale += 1
+                if stale > 3:
+                    raise OutputBusyError(self.root, -1, "", lock) from None
                 with contextlib.suppress(OSError):  # stale: its process has ended
                     lock.unlink()
                 continue
@@ -227,9 +334,12 @@ class OutputDir:
                 fh.write(me)
             self._lock = lock
             return
-        raise OutputBusyError(self.root, -1, "")
 
     def __enter__(self) -> OutputDir:
+        if self.root.is_symlink():
+            raise OutputKindError(f"{self.root}: the output folder is a symbolic link (to "
+                                  f"{os.readlink(self.root)}); refused, not resolved: pass the "
+                                  f"real folder ({self.root.resolve()}) to write there")
         if self.root.exists() and not self.root.is_dir():
             raise InputError(f"{self.root}: exists and is not a folder; expected an output "
                              "folder")
@@ -248,8 +358,25 @@ class OutputDir:
                 self._lock.unlink()
             self._lock = None
 
-    def __exit__(self, *exc: object) -> None:
-        self._release()
+    def __exit__(self, exc_type: object, *exc: object) -> None:
+        try:
+            if exc_type is None and self.prune and self._lock is not None:
+                self._prune()
+        finally:
+            self._release()
+
+    def _prune(self) -> None:
+        """Remove the declared files this run did not write (left by an earlier run)."""
+        mine = set(self.written)
+        for name in self.names:
+            p = self.root / name
+            if p not in mine and check_regular(p):
+                try:
+                    p.unlink()
+                except OSError as exc:
+                    raise InputError(f"{p}: an earlier run's output that this run does not "
+                                     f"make cannot be removed ({exc.strerror or exc})") from exc
+                self.removed.append(p)
 
     # ---- writing ---------------------------------------------------------------------------
     def _target(self, name: str) -> Path:
@@ -258,6 +385,10 @@ class OutputDir:
         p = self.root / name
         if Path(name).is_absolute() or ".." in Path(name).parts:
             raise InputError(f"{name!r}: expected a file name inside {self.root}")
+        for sub in list(p.parents)[: len(Path(name).parts) - 1]:  # folders inside the root
+            if sub.is_symlink():
+                raise OutputKindError(f"{sub}: is a symbolic link inside the output folder; "
+                                      "refused, not resolved: remove it")
         return p
 
     @contextlib.contextmanager

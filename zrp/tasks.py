@@ -19,7 +19,6 @@ from itertools import islice
 from typing import Any, TypeVar
 
 from zrp.errors import InputError
-from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["WINDOW", "TaskFailure", "map_tasks"]
 
@@ -38,6 +37,8 @@ class TaskFailure:
     traceback: str
 
     def to_dict(self) -> dict[str, Any]:
+        from zrp.jsonio import dict_from_dataclass  # NumPy: on use (quick `zrp --help`)
+
         return dict_from_dataclass(self, exclude=("traceback",))
 
 

@@ -2,28 +2,36 @@
 
 Every module in ``zrp/cli/commands/`` defines ``register(subparsers)``, which adds its parser and
 sets ``func`` (called with the parsed namespace, returning an exit code). Errors derived from
-:class:`zrp.ZRPError` are printed as one clear line (exit code 2) instead of a traceback.
+:class:`zrp.ZRPError` are printed as one clear line (exit code 2) instead of a traceback, and
+every warning as one line ``zrp CMD: warning: ...`` (:func:`one_line_warnings`), the same in
+every command.
+
+Registration stays light: a command module imports its numerical code (SciPy, numba, MuJoCo,
+Matplotlib, Dask) inside the function that runs it, so ``zrp --help`` and ``zrp CMD --help``
+start quickly (tests/cli/test_startup.py checks it; tests/benchmarks/bench_cli_startup.py
+times it).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
 import pkgutil
 import re
 import signal
 import sys
-from collections.abc import Sequence
-from typing import Any
+import warnings
+from collections.abc import Iterator, Sequence
+from typing import Any, TextIO
 
 from zrp import __version__
 from zrp.cli import commands
 from zrp.cli.signals import handling
 from zrp.errors import OutputExistsError, ZRPError
-from zrp.jsonio import dumps
 from zrp.packages import PackageShadowedError, check_own_packages
 
-__all__ = ["API_TO_CLI", "build_parser", "cli_message", "emit", "main"]
+__all__ = ["API_TO_CLI", "build_parser", "cli_message", "emit", "main", "one_line_warnings"]
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -43,6 +51,8 @@ def build_parser() -> argparse.ArgumentParser:
 def emit(args: argparse.Namespace, payload: dict[str, Any], text: str) -> None:
     """Print ``payload`` as JSON when ``--json`` was given, else the human-readable ``text``."""
     if getattr(args, "json", False):
+        from zrp.jsonio import dumps  # NumPy: only when a command prints JSON
+
         print(dumps(payload), end="")
     else:
         print(text)
@@ -75,6 +85,33 @@ def cli_message(exc: BaseException, api_names: dict[str, str] | None = None) -> 
     return text
 
 
+@contextlib.contextmanager
+def one_line_warnings(prog: str) -> Iterator[None]:
+    """Print each warning as one clean line ``prog: warning: message`` on stderr (not Python's
+    file:line plus source line), each distinct message once. Where a caller records warnings
+    (``warnings.catch_warnings(record=True)``, ``pytest.warns``), they go to its record
+    instead, as they would without this context."""
+    seen: set[str] = set()
+    outer = warnings._showwarnmsg_impl  # type: ignore[attr-defined]
+    recording = not (getattr(outer, "__module__", "") == "warnings"
+                     and outer.__name__ == "_showwarnmsg_impl")
+
+    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+             file: TextIO | None = None, line: str | None = None) -> None:
+        if recording:
+            outer(warnings.WarningMessage(message, category, filename, lineno, file, line))
+            return
+        text = " ".join(str(message).split())
+        if text not in seen:
+            seen.add(text)
+            print(f"{prog}: warning: {text}", file=sys.stderr if file is None else file)
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("always")
+        warnings.showwarning = show
+        yield
+
+
 def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
@@ -93,7 +130,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         # SIGTERM (a batch scheduler's time limit, `kill`) stops a command like Ctrl-C: it
         # closes its cluster and keeps what it saves when stopped (a Monte Carlo checkpoint)
-        with handling(signal.SIGTERM, _interrupt):
+        with handling(signal.SIGTERM, _interrupt), one_line_warnings(f"zrp {args.command}"):
             return int(args.func(args) or 0)
     except ZRPError as exc:
         msg = cli_message(exc, getattr(args, "api_names", None))

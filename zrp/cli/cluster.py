@@ -80,6 +80,25 @@ def check_cluster_options(args: argparse.Namespace) -> None:
         raise InputError(f"--workers: expected at least 1 worker, got {args.workers}")
 
 
+#: how to install the optional Dask dependency (the ``cluster`` extra)
+INSTALL_CLUSTER = 'pip install "zrp-accuracy[cluster]"'
+
+
+def _dask(field: str) -> Any:
+    """The ``dask`` module, imported now (~1 s: only when a cluster is asked for).
+
+    Raises:
+        InputError: Dask (dask.distributed) is not installed: names ``field`` and the extra.
+    """
+    try:
+        import dask
+        import distributed  # noqa: F401
+    except ImportError as exc:
+        raise InputError(f"{field}: runs on a Dask cluster, and dask.distributed is not "
+                         f"installed ({exc}); install it with {INSTALL_CLUSTER}") from None
+    return dask
+
+
 @contextlib.contextmanager
 def local_cluster(workers: int) -> Iterator[Any]:
     """A :class:`distributed.Client` of a new LocalCluster of ``workers`` processes (one
@@ -87,8 +106,7 @@ def local_cluster(workers: int) -> Iterator[Any]:
     on exit."""
     if isinstance(workers, bool) or not isinstance(workers, int) or workers < 1:
         raise InputError(f"workers: expected an integer >= 1, got {workers!r}")
-    # dask.distributed costs ~1 s to import: only when a cluster is asked for
-    import dask
+    dask = _dask("--workers")
     from distributed import Client, LocalCluster
 
     environ = dict(dask.config.get("distributed.nanny.pre-spawn-environ", {}))
@@ -126,7 +144,8 @@ def executor(workers: int | None = None, scheduler: str | None = None, *,
         raise InputError("--workers, --scheduler: give one of them, not both")
     with contextlib.ExitStack() as stack:
         if scheduler is not None:
-            from distributed import Client  # ~1 s to import: only when a cluster is asked for
+            _dask(field)
+            from distributed import Client
 
             try:
                 client = stack.enter_context(Client(scheduler, timeout="10s"))

@@ -10,12 +10,11 @@ import numpy as np
 
 from zrp.arguments import check_float, check_int
 from zrp.errors import InputError
-from zrp.gap.model.context import EFFECTS
+from zrp.gap.data.choices import MAX_WITHHELD
+from zrp.gap.model.choices import EFFECTS
 
 __all__ = ["MAX_WITHHELD", "DiagnosisOptions"]
 
-#: Largest share of poses withheld: at least half of them remain for fitting and ranking.
-MAX_WITHHELD = 0.5
 
 
 @dataclass(frozen=True)

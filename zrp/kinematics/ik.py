@@ -33,6 +33,7 @@ from zrp.errors import (
     UnreachableError,
 )
 from zrp.kinematics import _ik_kernels as IKK
+from zrp.kinematics.choices import CORRECTIONS, TASKS
 from zrp.kinematics.forward import _karrays, check_q, end_effector_pose
 from zrp.kinematics.posture import check_limits_along
 from zrp.kinematics.trajectory import Trajectory
@@ -41,8 +42,6 @@ from zrp.output import write_text
 
 __all__ = ["CORRECTIONS", "TASKS", "IKResult", "track_trajectory"]
 
-CORRECTIONS = ("newton", "feedback", "none")
-TASKS = ("pose", "position")
 
 
 @dataclass(frozen=True, eq=False)

@@ -20,6 +20,7 @@ from numpy.typing import ArrayLike
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.kinematics.choices import TIME_LAWS
 
 __all__ = [
     "TIME_LAWS",
@@ -33,7 +34,6 @@ __all__ = [
 ]
 
 OrientationLaw = Callable[[F64], tuple[F64, F64]]
-TIME_LAWS = ("quintic", "cycloidal")
 
 
 def _vec3(value: ArrayLike, name: str) -> F64:

@@ -6,12 +6,11 @@ from __future__ import annotations
 import numpy as np
 
 from zrp.errors import InputError
+from zrp.manufacturing.choices import DISTRIBUTIONS
 
 __all__ = ["DISTRIBUTIONS", "check_distribution", "check_percentile", "nonnegative",
            "positive_int"]
 
-#: Parameter distributions of a tolerance: "uniform" (half-width) or "normal" (3 sigma).
-DISTRIBUTIONS = ("uniform", "normal")
 
 
 def check_percentile(pct: float, name: str = "percentile") -> float:

@@ -33,6 +33,7 @@ from numpy.typing import ArrayLike
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.manufacturing.choices import PAPER_SIGN_ZERO
 from zrp.model.manipulator import Manipulator
 
 __all__ = [
@@ -49,8 +50,6 @@ __all__ = [
 
 SignZero = Literal[-1, 0, 1]
 
-#: sign(0) implied by the published tables: links 0, axes +1 (see the module docstring).
-PAPER_SIGN_ZERO: dict[str, int] = {"links": 0, "axes": 1}
 
 _NAME_RX = re.compile(r"^\s*(LE|JE)\s*(\d+)\s*$", re.IGNORECASE)
 

@@ -30,6 +30,7 @@ from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import check_q, end_effector_pose
 from zrp.kinematics.ik import IKResult
+from zrp.manufacturing.choices import PAPER_PARAMETERS, PAPER_XI
 from zrp.manufacturing.perturb import (
     PAPER_SIGN_ZERO,
     Perturbation,
@@ -40,6 +41,7 @@ from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply
 from zrp.textio import iter_lines
+from zrp.units import angle_bounds, joint_column_units, joint_values_to_rad, split_unit
 
 __all__ = [
     "PAPER_PARAMETERS",
@@ -53,11 +55,6 @@ __all__ = [
 ]
 
 
-#: The perturbation levels of the paper's study, in percent.
-PAPER_XI: tuple[float, ...] = (-0.1, -0.07, -0.05, -0.02, 0.0, 0.02, 0.05, 0.07, 0.1)
-#: The perturbed parameters of the paper's study (links 5 and 6 have zero length).
-PAPER_PARAMETERS: tuple[str, ...] = ("LE2", "LE3", "LE4", "LE7", "JE1", "JE2", "JE3", "JE4",
-                                     "JE5", "JE6")
 
 
 @dataclass(frozen=True, eq=False)
@@ -99,83 +96,77 @@ class JointPath:
                    float(ik.orientation_error.max()))
 
 
-def _check_radians(q: F64, model: Manipulator, p: Path) -> None:
-    """Refuse revolute values beyond 2 pi: the file is most likely in degrees."""
-    rev = ~np.asarray(model.prismatic)
-    big = np.abs(q[:, rev]) > 2.0 * math.pi + 1e-6
-    if big.any():
-        i, k = (int(v) for v in np.argwhere(big)[0])
-        kk = int(np.flatnonzero(rev)[k])
-        raise InputError(f"{p}, line {i + 2}: q{kk + 1} is {q[i, kk]:g}, more than 2 pi rad: the "
-                         "joint values look like degrees; a joint trajectory is in rad (as "
-                         "`zrp ik` writes it): convert it with numpy.radians")
-
-
 #: Most rows of a joint trajectory CSV (a path of 2 million steps is ~100 MB of numbers).
 MAX_JOINT_ROWS = 2_000_000
 
 
-def _joint_rows(p: Path, n: int) -> tuple[list[str], F64, list[float | None]]:
-    """Stream the CSV (:func:`zrp.textio.iter_lines`: a regular file, lines bounded): the
-    header, the t, q1..qn values (R, n + 1) and the largest IK errors, if logged."""
+def _read_rows(p: Path) -> list[list[str]]:
+    """The CSV records, streamed (:func:`zrp.textio.iter_lines`: a regular file, lines
+    bounded; at most :data:`MAX_JOINT_ROWS` rows)."""
     reader = csv.reader(iter_lines(p, label=str(p)))
-    header: list[str] | None = None
-    vals: list[list[float]] = []
-    ecols: list[int | None] = []
-    errs: list[float | None] = []
+    rows: list[list[str]] = []
     try:
         for row in reader:
-            i = reader.line_num
-            if header is None:
-                header = [h.strip() for h in row]
-                ecols = [header.index(c) if c in header else None
-                         for c in ("position_error", "orientation_error_rad")]
-                errs = [None if j is None else -math.inf for j in ecols]
-                continue
-            if len(vals) >= MAX_JOINT_ROWS:
-                raise InputError(f"{p}, line {i}: more than {MAX_JOINT_ROWS:,} rows; thin the "
-                                 "joint trajectory (every k-th step)")
-            vals.append(_joint_row(row, n, p, i))
-            for k, j in enumerate(ecols):  # written by `zrp ik` (IKResult.save_csv)
-                errs[k] = _larger(errs[k], row, j)
+            if len(rows) > MAX_JOINT_ROWS:
+                raise InputError(f"{p}, line {reader.line_num}: more than {MAX_JOINT_ROWS:,} "
+                                 "rows; thin the joint trajectory (every k-th step)")
+            rows.append(row)
     except csv.Error as exc:
         raise InputError(f"{p}, line {reader.line_num}: not a CSV file ({exc})") from None
-    if header is None or len(vals) < 2:
-        raise InputError(f"{p}: expected a header and at least 2 rows of t, q1..q{n}")
-    return header, np.array(vals), errs
+    return rows
 
 
-def _joint_row(row: list[str], n: int, p: Path, i: int) -> list[float]:
-    """t, q1..qn of one row (line ``i``), finite numbers."""
-    if len(row) < n + 1:
-        raise InputError(f"{p}, line {i}: expected at least {n + 1} columns (t, "
-                         f"q1..q{n}), got {len(row)}")
-    try:
-        v = [float(x) for x in row[:n + 1]]
-    except ValueError as exc:
-        raise InputError(f"{p}, line {i}: not a number: {exc}") from None
-    if not all(math.isfinite(x) for x in v):
-        raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:n + 1]}")
-    return v
+def _time_and_joints(rows: list[list[str]], n: int, p: Path) -> F64:
+    """t and q1..qn of each data row (after the header), finite numbers, shape (R, 1 + n)."""
+    data = []
+    for i, row in enumerate(rows[1:], start=2):
+        if len(row) < n + 1:
+            raise InputError(f"{p}, line {i}: expected at least {n + 1} columns (t, "
+                             f"q1..q{n}), got {len(row)}")
+        try:
+            data.append([float(x) for x in row[:n + 1]])
+        except ValueError as exc:
+            raise InputError(f"{p}, line {i}: not a number: {exc}") from exc
+        if not all(math.isfinite(v) for v in data[-1]):
+            raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:n + 1]}")
+    return np.array(data)
 
 
-def _larger(best: float | None, row: list[str], j: int | None) -> float | None:
-    """The running maximum of column ``j`` (None once a value is missing or not a number)."""
-    if best is None or j is None:
-        return None
-    try:
-        return max(best, float(row[j]))
-    except (ValueError, IndexError):
-        return None
+def _joints_to_rad(q: F64, declared: list[str | None], model: Manipulator, deg: bool,
+                   src: str) -> F64:
+    """Joint columns by the unit rule of :mod:`zrp.units` (declared, or ``deg``), checked."""
+    rev = ~np.asarray(model.prismatic)
+    declared = declared + [None] * (model.n - len(declared))
+    angle, scale = joint_column_units(declared, rev, deg, src=src, length_unit=model.length_unit)
+    return joint_values_to_rad(q, rev, angle, src=src, lines=np.arange(2, len(q) + 2),
+                               bounds=angle_bounds(model.lower, model.upper)) * scale
 
 
-def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
+def load_joint_csv(path: str | Path, model: Manipulator, *, deg: bool = False) -> JointPath:
     """Read a joint trajectory CSV: a header row, time (s) in the first column and the n joint
-    values in the next n columns (the layout ``zrp ik`` writes; rad / length unit). The IK
-    errors are taken from ``position_error`` / ``orientation_error_rad`` columns if present."""
+    values in the next n columns (the layout ``zrp ik`` writes; rad / length unit, or degrees
+    with ``deg``, or the unit a column declares, ``q1[deg]``: the rule and checks of
+    :mod:`zrp.units`). The IK errors are taken from ``position_error`` /
+    ``orientation_error_rad`` columns if present."""
     p = Path(path)
-    _, arr, errs = _joint_rows(p, model.n)
-    _check_radians(arr[:, 1:], model, p)
+    rows = _read_rows(p)
+    if len(rows) < 3:
+        raise InputError(f"{p}: expected a header and at least 2 rows of t, q1..q{model.n}")
+    arr = _time_and_joints(rows, model.n, p)
+    parsed = [split_unit(h, f"{p}, line 1") for h in rows[0]]
+    header = [h for h, _ in parsed]
+    arr[:, 1:] = _joints_to_rad(arr[:, 1:], [u for _, u in parsed[1:model.n + 1]], model, deg,
+                                str(p))
+    errs: list[float | None] = []
+    for col in ("position_error", "orientation_error_rad"):
+        if col in header:  # written by `zrp ik` (IKResult.save_csv)
+            j = header.index(col)
+            try:
+                errs.append(max(float(r[j]) for r in rows[1:]))
+            except (ValueError, IndexError):
+                errs.append(None)
+        else:
+            errs.append(None)
     return JointPath(arr[:, 0], arr[:, 1:], f"joint trajectory {p.name}", errs[0], errs[1])
 
 

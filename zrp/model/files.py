@@ -20,13 +20,13 @@ import os
 import re
 import sys
 from collections.abc import Callable
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from zrp.errors import InputError, ModelError, ModelFileError
+from zrp.model.builtin import builtin_models
 from zrp.model.manipulator import EndEffector, Joint, Manipulator
 from zrp.output import write_text
 from zrp.textio import read_text
@@ -240,7 +240,3 @@ def save_model(model: Manipulator, path: str | Path, *, overwrite: bool = False)
     return write_text(path, dumps_model(model), overwrite=overwrite)
 
 
-def builtin_models() -> dict[str, Path]:
-    """Model files shipped with the package, by short name (e.g. ``"puma"``)."""
-    root = resources.files("zrp.model.builtin")
-    return {Path(str(f)).stem: Path(str(f)) for f in root.iterdir() if str(f).endswith(".toml")}

@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.arrays import F64
 from zrp.errors import ModelError, ZRPWarning
+from zrp.limits import MAX_LENGTH
 from zrp.units import canonical_length_unit, units_per_mm
 
 __all__ = [
@@ -51,9 +52,6 @@ UNIT_EXACT_TOL = 1e-12
 UNIT_WARN_TOL = 1e-3
 #: Largest |u_a . u_t| accepted as perpendicular.
 PERP_TOL = 1e-9
-#: Largest magnitude of a model vector component, in the model's length unit (1e9 mm is
-#: 1000 km): beyond it sums and products of lengths lose all precision or overflow.
-MAX_LENGTH = 1e9
 
 
 def check_vector3(value: ArrayLike, where: str) -> F64:

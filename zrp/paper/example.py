@@ -47,6 +47,7 @@ from zrp.manufacturing.study import (
 )
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
+from zrp.paper.choices import CIRCLES
 from zrp.paper.claims import check_claims
 from zrp.paper.comparison import Cell, compare_with_published, kind_columns, table_value
 from zrp.paper.placement import RECOVERED, placement_path
@@ -101,7 +102,6 @@ class PaperExample:
             raise InputError("PaperExample: study must be a StudyResult and path a JointPath")
 
 
-CIRCLES = ("default", "recovered")
 
 
 def _circle_path(name: str, steps: int) -> JointPath:

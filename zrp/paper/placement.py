@@ -33,6 +33,7 @@ from zrp.kinematics.trajectory import Circle, TimeLaw
 from zrp.manufacturing.study import JointPath, one_at_a_time
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
+from zrp.paper.choices import ORIENTATION_LAWS
 from zrp.paper.published import (
     JE_PARAMS,
     LIKELY_TYPOS,
@@ -56,7 +57,6 @@ __all__ = [
     "placement_path",
 ]
 
-ORIENTATION_LAWS = ("held", "turning")
 #: Names and units of the 9 continuous unknowns, in the order of :meth:`CirclePlacement.vector`.
 UNKNOWNS = ("q1_0 (deg)", "q2_0 (deg)", "q3_0 (deg)", "q4_0 (deg)", "q5_0 (deg)", "q6_0 (deg)",
             "normal azimuth (deg)", "normal elevation (deg)", "psi, start to centre (deg)")

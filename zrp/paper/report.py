@@ -10,6 +10,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
+from zrp.escape import md_text
 from zrp.output import OutputDir
 from zrp.paper.circles import RECOVERED_FIGURES, circles_markdown
 from zrp.paper.comparison import kind_columns
@@ -208,7 +209,8 @@ def comparison_markdown(ex: PaperExample) -> str:
         "# Numerical example: comparison with the published Tables 2 and 3" if pub else
         "# One-at-a-time study (the paper's numerical example applied to another model)",
         "",
-        f"Model: {ex.model.name}. Trajectory: {ex.path.label} ({st.t.size} samples).",
+        f"Model: {md_text(ex.model.name)}. Trajectory: {md_text(ex.path.label)} "
+        f"({st.t.size} samples).",
         f"Sign convention: {st.convention} (the defaults the published numbers imply).",
         "Table 2 quantities in mm (model length unit); Table 3 is delta_R of eq (15) as the paper "
         "defines it (2 sqrt(2) sin(theta/2), ~ sqrt(2) x the error angle in rad).",

@@ -34,6 +34,7 @@ from zrp.kinematics.trajectory import Circle
 from zrp.manufacturing.study import JointPath
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
+from zrp.paper.choices import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM
 
 __all__ = [
     "PUMA_DURATION_S",
@@ -47,11 +48,6 @@ __all__ = [
     "puma_circle_ik",
 ]
 
-#: The start configuration chosen for the paper's PUMA (deg).
-PUMA_Q0_DEG = (0.0, 0.0, 0.0, 0.0, 90.0, 0.0)
-#: The circle's radius (mm) and duration (s), as in the paper.
-PUMA_RADIUS_MM = 125.0
-PUMA_DURATION_S = 4.0
 
 
 @dataclass(frozen=True, eq=False)

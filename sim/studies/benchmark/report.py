@@ -1,6 +1,7 @@
 """Blind benchmark, part 6: the report - Markdown text, CSV tables, JSON and the confusion
 plot - written through :class:`zrp.output.OutputDir` (checked up front, atomic, one run at a
-time per folder).
+time per folder). Text cells reach summary.md through :func:`zrp.escape.md_text` and the CSV
+tables through :func:`zrp.escape.csv_cell`: a model name or an error message is only text.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from sim.studies.benchmark.results import BenchmarkResult, confusion_matrix, sum
 from sim.studies.benchmark.scenarios import DEFAULT_NOISE_MM, BenchmarkConfig
 from sim.studies.benchmark.scoring import ScenarioScore
 from zrp.errors import OutputExistsError
+from zrp.escape import csv_cell, md_text
 from zrp.output import OutputDir
 
 if TYPE_CHECKING:
@@ -38,7 +40,7 @@ def _md_table(header: list[str], rows: list[list[Any]]) -> str:
     def fmt(v: Any) -> str:
         if isinstance(v, float):
             return "-" if not math.isfinite(v) else f"{v:.3g}"
-        return str(v)
+        return md_text(v)
     lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     lines += ["| " + " | ".join(fmt(v) for v in r) + " |" for r in rows]
     return "\n".join(lines)
@@ -67,7 +69,7 @@ def render_text(result: BenchmarkResult) -> str:
 
 def _intro(result: BenchmarkResult) -> list[str]:
     cfg = result.config
-    return [f"# Blind gap benchmark: {result.model_name}", "",
+    return [f"# Blind gap benchmark: {md_text(result.model_name)}", "",
             f"{len(result.scores)} scenarios (seed {cfg.seed}), {cfg.poses} poses each "
             f"({cfg.poses_from} poses, {cfg.approach} approach, {cfg.reflectors} "
             f"reflector{'s' if cfg.reflectors > 1 else ''}), tracker noise "
@@ -217,7 +219,7 @@ def _scenario_rows(result: BenchmarkResult) -> list[list[Any]]:
 
 def _write_csv(out: OutputDir, name: str, rows: list[list[Any]]) -> None:
     with out.path(name) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        csv.writer(fh).writerows(rows)
+        csv.writer(fh).writerows([csv_cell(c) for c in r] for r in rows)
 
 
 def _write_all(result: BenchmarkResult, out: OutputDir, plots: bool) -> list[Path]:
@@ -249,7 +251,8 @@ def write_outputs(result: BenchmarkResult, out: str | os.PathLike[str] | OutputD
     if isinstance(out, OutputDir):
         return _write_all(result, out, plots)
     try:
-        with OutputDir(out, overwrite=overwrite, names=output_names(plots)) as folder:
+        # every file it may write is checked, and an earlier run's plot removed without plots
+        with OutputDir(out, overwrite=overwrite, names=output_names(True), prune=True) as folder:
             return _write_all(result, folder, plots)
     except OutputExistsError as exc:
         if not exc.paths:

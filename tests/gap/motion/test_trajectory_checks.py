@@ -36,15 +36,17 @@ def test_joints_in_degrees_are_named_in_the_static_loaders_words(tmp_path):
     path = _csv(tmp_path, _traj(), deg=True)
     with pytest.raises(InputError) as motion:
         load_trajectory(path, PUMA)
-    assert "line 2: column q1 is 10, more than 2 pi rad: the joint values look like degrees; " \
-           "pass deg=True (--deg on the command line)" in str(motion.value)
-    # the static loader says the same about the same values
+    assert "d.csv line 2: q1 is 10, beyond 6.283 rad" in str(motion.value)
+    assert "(--deg on the command line)" in str(motion.value)
+    # the static loader says the same about the same values (zrp.units.joint_values_to_rad;
+    # only the remedy differs: a static CSV may also declare its column's unit)
     static = tmp_path / "static.csv"
     static.write_text("pose,q1,q2,q3,q4,q5,q6,x,y,z\nP1,10,-20,30,5,60,0,1,2,3\n")
     with pytest.raises(InputError) as stat:
         load_measurements(static, PUMA)
-    tail = lambda e: str(e.value).split(": ", 1)[1]  # noqa: E731 (after "file line N")
-    assert tail(motion) == tail(stat)
+    same = "q1 is 10, beyond 6.283 rad (one turn, or the joint's limit): it cannot be an angle " \
+           "in rad and looks like degrees"
+    assert same in str(motion.value) and same in str(stat.value)
     np.testing.assert_allclose(load_trajectory(path, PUMA, deg=True).q, _traj().q, atol=1e-12)
 
 

@@ -5,23 +5,14 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
-import warnings
-from collections.abc import Iterator
 from pathlib import Path
-from typing import TextIO
 
 from zrp.cli.app import emit
 from zrp.cli.fleet import add_fleet_options, is_fleet, refuse_fleet_options, run_fleet
-from zrp.cli.options import LENGTH, SEED, real, whole
+from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
-from zrp.gap import diagnose as run_diagnosis
-from zrp.gap import load_measurements
-from zrp.gap.data.csvfile import MAX_ROWS
-from zrp.gap.data.subsample import MAX_POINTS
-from zrp.gap.model.context import EFFECTS
-from zrp.gap.options import MAX_WITHHELD
-from zrp.gap.report import OUTPUT_FILES, diagnosis_document, verdict_text, write_outputs
-from zrp.model.files import load_model
+from zrp.gap.data.choices import MAX_POINTS, MAX_ROWS, MAX_WITHHELD
+from zrp.gap.model.choices import EFFECTS
 from zrp.output import OutputDir
 
 
@@ -39,7 +30,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "one hinge/slide joint per model joint, same order and zero)")
     p.add_argument("--data", required=True, metavar="D.csv",
                    help="measurement CSV, or a quoted glob ('fleet/*.csv') for a fleet")
-    p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
+    add_deg(p)
     p.add_argument("--frame", choices=("instrument", "base"), default="instrument",
                    help="frame of x, y, z (default instrument: the base frame is estimated)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
@@ -92,28 +83,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     })
 
 
-@contextlib.contextmanager
-def one_line_warnings(prog: str) -> Iterator[None]:
-    """Print each warning as one clean line ``prog: warning: message`` on stderr (not Python's
-    file:line plus source line), each distinct message once."""
-    seen: set[str] = set()
-
-    def show(message: Warning | str, category: type[Warning], filename: str, lineno: int,
-             file: TextIO | None = None, line: str | None = None) -> None:
-        text = " ".join(str(message).split())
-        if text not in seen:
-            seen.add(text)
-            print(f"{prog}: warning: {text}", file=sys.stderr if file is None else file)
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("always")
-        warnings.showwarning = show
-        yield
-
-
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s measured): only when this command runs, not for every `zrp`.
     from mjcf.gravity import gravity_torques
+    from zrp.gap import diagnose as run_diagnosis  # on use: keeps --help quick
+    from zrp.gap import load_measurements  # on use: keeps --help quick
+    from zrp.gap.report import (  # on use: keeps --help quick
+        OUTPUT_FILES,
+        diagnosis_document,
+        verdict_text,
+        write_outputs,
+    )
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     if args.max_steps < 1:
         raise InputError(f"--max-steps: expected at least 1, got {args.max_steps}")
@@ -132,8 +113,7 @@ def _run(args: argparse.Namespace) -> int:
     try:
         # the folder is this run's from here on: existing outputs are refused before the
         # computation, and a concurrent run into the same folder is refused, never mixed in
-        with (OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES) as out,
-              one_line_warnings("zrp diagnose")):
+        with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES, prune=True) as out:
             diag = run_diagnosis(model, meas, gravity_torque=tau, effects=args.effects,
                             seed=args.seed, withheld_fraction=args.withheld, folds=args.folds,
                             alpha=args.alpha, max_steps=args.max_steps, noise_sigma=args.noise,

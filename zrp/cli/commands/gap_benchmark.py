@@ -9,14 +9,14 @@ from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.options import FRACTION, SEED, real, whole
 from zrp.errors import InputError
-from zrp.model.files import builtin_models, load_model
+from zrp.model.builtin import builtin_models
 from zrp.output import OutputDir, claim_generated
 
 DEFAULT_OUT = "renders/gap_benchmark"
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    from zrp.gap.model.context import EFFECTS as EFFECT_NAMES  # light: no MuJoCo at parser build
+    from zrp.gap.model.choices import EFFECTS as EFFECT_NAMES  # light: no SciPy, numba
 
     p = sub.add_parser(
         "gap-benchmark", help="blind benchmark of the gap diagnosis on simulated robots",
@@ -86,6 +86,7 @@ def _run(args: argparse.Namespace) -> int:
         run_benchmark,
         write_outputs,
     )
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     out = Path(args.out or DEFAULT_OUT)
     overwrite = args.force or (args.out is None and claim_generated(out))
@@ -102,7 +103,7 @@ def _run(args: argparse.Namespace) -> int:
                           reflectors=args.reflectors)
     model = load_model(args.model)
     # the folder is locked and its files checked before the (long) run
-    with OutputDir(out, overwrite=overwrite, names=output_names(not args.no_plots)) as folder:
+    with OutputDir(out, overwrite=overwrite, names=output_names(True), prune=True) as folder:
         # the work folder must be visible to the workers (same path on a remote cluster)
         with executor_from_args(args) as ex:
             result = run_benchmark(model, cfg, work, progress=not args.no_progress, executor=ex,

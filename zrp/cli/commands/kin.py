@@ -5,41 +5,41 @@ from __future__ import annotations
 import argparse
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
+
+    from zrp.model.manipulator import Manipulator
 
 from zrp.cli.app import emit
-from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, real, whole
+from zrp.cli.options import (
+    DURATION,
+    FINITE,
+    LENGTH,
+    MAX_STEPS,
+    add_deg,
+    joint_angles,
+    real,
+    whole,
+)
 from zrp.errors import InputError, ZRPWarning
-from zrp.kinematics.forward import forward_kinematics
-from zrp.kinematics.ik import CORRECTIONS, track_trajectory
-from zrp.kinematics.posture import solve_pose
-from zrp.kinematics.redundant import track_posture
-from zrp.kinematics.trajectory import TIME_LAWS, Circle, Line
-from zrp.model.files import builtin_models, load_model
-from zrp.model.manipulator import MAX_LENGTH, Manipulator
+from zrp.kinematics.choices import CORRECTIONS, TIME_LAWS
+from zrp.limits import MAX_LENGTH
+from zrp.model.builtin import builtin_models
 from zrp.output import check_writable, claim_generated
-from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM, is_paper_model
-from zrp.rotations.rodrigues import er_angle
+from zrp.paper.choices import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM
 
 
-def _joint_values(model: Manipulator, values: list[float], rad: bool, name: str) -> np.ndarray:
-    if len(values) != model.n:
-        raise InputError(f"{name}: expected {model.n} values for {model.name!r} "
-                         f"({', '.join(model.joint_names)}), got {len(values)}")
-    q = np.array(values, dtype=float)
-    if not rad:
-        q = np.where(model.prismatic, q, np.radians(q))
-    return q
+def _joint_values(model: Manipulator, values: list[float], deg: bool, name: str) -> np.ndarray:
+    return joint_angles(model, values, deg, name)
 
 
 def _add_model(p: argparse.ArgumentParser) -> None:
     p.add_argument("--model", default="puma", metavar="FILE",
                    help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
                         "; default puma)")
-    p.add_argument("--rad", action="store_true",
-                   help="joint angles are given in rad (default: deg); prismatic values are "
-                        "always in the model's length unit")
+    add_deg(p)
     p.add_argument("--json", action="store_true", help="print JSON")
 
 
@@ -106,8 +106,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _fk(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.kinematics.forward import forward_kinematics  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+    from zrp.rotations.rodrigues import er_angle  # on use: keeps --help quick
+
     model = load_model(args.model)
-    q = _joint_values(model, args.q, args.rad, "--q")
+    q = _joint_values(model, args.q, args.deg, "--q")
     fk = forward_kinematics(model, q)
     payload = {
         "model": model.name, "length_unit": model.length_unit, "q_rad_or_length": q,
@@ -128,6 +134,15 @@ def _fk(args: argparse.Namespace) -> int:
 
 
 def _ik(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.kinematics.forward import forward_kinematics  # on use: keeps --help quick
+    from zrp.kinematics.ik import track_trajectory  # on use: keeps --help quick
+    from zrp.kinematics.redundant import track_posture  # on use: keeps --help quick
+    from zrp.kinematics.trajectory import Circle, Line  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     if args.q0 is None:
         if not is_paper_model(model):
@@ -135,9 +150,9 @@ def _ik(args: argparse.Namespace) -> int:
                 f"--q0: required for {model.name!r} ({model.n} joints): the default start "
                 f"configuration ({' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg) is the "
                 f"paper's, for its PUMA only; give --q0 with {model.n} values")
-        q0 = _joint_values(model, list(PUMA_Q0_DEG), False, "--q0")
+        q0 = _joint_values(model, list(PUMA_Q0_DEG), True, "--q0")
     else:
-        q0 = _joint_values(model, args.q0, args.rad, "--q0")
+        q0 = _joint_values(model, args.q0, args.deg, "--q0")
     if args.target is not None:
         return _ik_target(args, model, q0)
     stem = Path(args.model).stem
@@ -186,11 +201,15 @@ def _ik(args: argparse.Namespace) -> int:
 
 
 def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.kinematics.posture import solve_pose  # on use: keeps --help quick
+
     sol = solve_pose(model, np.array(args.target), args.target_er, q0=q0)
     s = sol.summary()
     s["joint_names"] = list(model.joint_names)
-    shown = np.where(model.prismatic, sol.q, sol.q if args.rad else np.degrees(sol.q))
-    unit = "rad" if args.rad else "deg"
+    shown = np.where(model.prismatic, sol.q, np.degrees(sol.q) if args.deg else sol.q)
+    unit = "deg" if args.deg else "rad"
     s["q_shown"], s["q_shown_unit"] = shown.tolist(), unit
     text = "\n".join([
         f"{model.name}: target {args.target} {model.length_unit} reached "
@@ -205,6 +224,8 @@ def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> 
 
 
 def _models(args: argparse.Namespace) -> int:
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     models = {name: str(path) for name, path in sorted(builtin_models().items())}
     text = "\n".join(f"{k:10s} {load_model(v).name}  ({v})" for k, v in models.items())
     emit(args, models, text)

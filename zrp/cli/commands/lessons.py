@@ -8,7 +8,6 @@ import json
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.jsonio import dumps
 from zrp.output import OutputDir
 from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_index
 
@@ -38,6 +37,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo, the lessons Matplotlib and the diagnosis: only when this command runs
     from sim.lessons import lesson_file_names, run_lessons
+    from zrp.jsonio import dumps  # on use: keeps --help quick
 
     out = Path(args.out)
     names = args.names or None

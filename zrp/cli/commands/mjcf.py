@@ -9,8 +9,7 @@ from pathlib import Path
 from zrp.cli.app import emit
 from zrp.cli.options import real
 from zrp.errors import InputError
-from zrp.manufacturing.perturb import Perturbation
-from zrp.model.files import builtin_models, load_model, save_model
+from zrp.model.builtin import builtin_models
 
 
 def _perturbations(items: list[str] | None) -> dict[str, float]:
@@ -64,6 +63,8 @@ def _slug(text: str) -> str:
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.1 s measured): only when this command runs, not for every `zrp`.
     import mjcf
+    from zrp.manufacturing.perturb import Perturbation  # on use: keeps --help quick
+    from zrp.model.files import load_model, save_model  # on use: keeps --help quick
 
     if args.source:
         model = mjcf.from_mjcf(args.source, site=args.site, body=args.body,

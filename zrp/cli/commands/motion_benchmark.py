@@ -8,7 +8,6 @@ from pathlib import Path
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, whole
 from zrp.errors import InputError
-from zrp.model.files import load_model
 
 DEFAULT_OUT = Path("renders") / "motion_benchmark"
 
@@ -35,6 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo: only when this command runs.
     from sim.studies.benchmark.motion import markdown, run_motion_benchmark
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     if args.moves < 2:
         raise InputError(f"--moves: expected at least 2 moves, got {args.moves}")

@@ -6,14 +6,12 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.cli.options import LENGTH, SEED, real, whole
+from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
-from zrp.gap.data.csvfile import MAX_ROWS
-from zrp.gap.model.context import EFFECTS
-from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
-from zrp.gap.motion.data import RATE_RANGE_HZ, TIME_UNITS
-from zrp.jsonio import dumps
-from zrp.model.files import load_model
+from zrp.escape import md_text
+from zrp.gap.data.choices import MAX_ROWS
+from zrp.gap.model.choices import EFFECTS
+from zrp.gap.motion.choices import MOTION_EFFECTS, RATE_RANGE_HZ, TIME_UNITS
 from zrp.output import OutputDir, check_writable
 
 OUTPUT_FILES = ("diagnosis_motion.json", "report_motion.md")
@@ -29,7 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml", help="model file or built-in name")
     p.add_argument("--data", required=True, metavar="D.csv", help="trajectory CSV")
-    p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
+    add_deg(p)
     p.add_argument("--time-unit", choices=sorted(TIME_UNITS), default="s",
                    help="unit of the t (and tq) column (default s; a median sample rate outside "
                         f"{RATE_RANGE_HZ[0]:g} Hz to {RATE_RANGE_HZ[1]:g} Hz is refused)")
@@ -80,6 +78,10 @@ def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[obje
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.gap.motion import diagnose_motion, load_trajectory  # on use: keeps --help quick
+    from zrp.jsonio import dumps  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     if args.video:
         check_writable([args.video], args.force)  # before the work
@@ -107,7 +109,7 @@ def _run(args: argparse.Namespace) -> int:
 def _report(diag: object) -> str:
     d = diag  # MotionDiagnosis
     u = d.length_unit  # type: ignore[attr-defined]
-    lines = ["# Motion diagnosis", "", d.verdict, "",  # type: ignore[attr-defined]
+    lines = ["# Motion diagnosis", "", " ".join(d.verdict.split()), "",  # type: ignore[attr-defined]
              f"| phase | samples | RMS before ({u}) | after | withheld before | after |",
              "|---|---|---|---|---|---|"]
     for p in d.phases:  # type: ignore[attr-defined]
@@ -118,5 +120,5 @@ def _report(diag: object) -> str:
     lines += ["", "| parameter | value | 95 % interval |", "|---|---|---|"]
     for e in d.parameters:  # type: ignore[attr-defined]
         lo, hi = e.ci95
-        lines.append(f"| {e.name} | {e.value:.4g} {e.unit} | [{lo:.4g}, {hi:.4g}] |")
+        lines.append(f"| {md_text(e.name)} | {e.value:.4g} {e.unit} | [{lo:.4g}, {hi:.4g}] |")
     return "\n".join(lines) + "\n"

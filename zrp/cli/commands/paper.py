@@ -9,19 +9,20 @@ from __future__ import annotations
 import argparse
 import time
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from zrp.cli.app import emit
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
 from zrp.errors import InputError
-from zrp.model.files import load_model
-from zrp.model.manipulator import Manipulator
+
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 from zrp.output import OutputDir, claim_generated
-from zrp.paper.example import CIRCLES, PaperExample, run_paper_example
+from zrp.paper.choices import CIRCLES
+
+if TYPE_CHECKING:
+    from zrp.paper.example import PaperExample
 from zrp.paper.index import INDEX_NAME, write_index
-from zrp.paper.report import output_names, write_paper_outputs
-from zrp.paper.scenario import is_paper_model
-from zrp.paper.scenes import paper_video_file_name, paper_video_scene
 
 DEFAULT_OUT = "renders"
 
@@ -60,6 +61,8 @@ _TRAJECTORY_DEFAULTS = {"joints": None, "q0": None, "radius": 125.0, "normal": N
 def _named_circle(args: argparse.Namespace, model: Manipulator) -> str | None:
     """The named circle to run ("default" / "recovered"), or None for a custom trajectory;
     --circle with trajectory options or another model is an error naming them."""
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
+
     custom = [f"--{k.replace('_', '-')}" for k, v in _TRAJECTORY_DEFAULTS.items()
               if getattr(args, k) != v]
     if args.circle is None:
@@ -73,6 +76,9 @@ def _named_circle(args: argparse.Namespace, model: Manipulator) -> str | None:
 
 def _video_name(args: argparse.Namespace, model: Manipulator) -> str | None:
     """The video's file name (.mp4, or .gif without ffmpeg), or None when none is made."""
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
+    from zrp.paper.scenes import paper_video_file_name  # on use: keeps --help quick
+
     if args.no_video or not is_paper_model(model):
         return None
     # sim loads MuJoCo and its GL backend (about 0.3 s measured): only when a video is made
@@ -84,6 +90,8 @@ def _video_name(args: argparse.Namespace, model: Manipulator) -> str | None:
 def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
            model: Manipulator, circle: str) -> dict[str, Any]:
     """Render the nominal-vs-perturbed video of the paper's circle into the locked folder."""
+    from zrp.paper.scenes import paper_video_scene  # on use: keeps --help quick
+
     if args.no_video:
         return {"status": "skipped (--no-video)"}
     if name is None:
@@ -106,6 +114,9 @@ def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
 def _compute(args: argparse.Namespace, model: Manipulator, out: OutputDir
              ) -> tuple[PaperExample, list[Path], float]:
     """IK, study, comparison and claims, written into the (checked and locked) folder."""
+    from zrp.paper.example import run_paper_example  # on use: keeps --help quick
+    from zrp.paper.report import write_paper_outputs  # on use: keeps --help quick
+
     t0 = time.perf_counter()
     circle = _named_circle(args, model)
     path = None if circle else path_from_args(args, model)
@@ -178,6 +189,9 @@ def _claims_lines(ch: dict[str, Any]) -> list[str]:
 
 
 def _paper(args: argparse.Namespace) -> int:
+    from zrp.model.files import load_model  # on use: keeps --help quick
+    from zrp.paper.report import output_names  # on use: keeps --help quick
+
     out, overwrite = _output_folder(args)
     model = load_model(args.model)
     check_path_options(args, model)

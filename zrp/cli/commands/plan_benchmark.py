@@ -8,7 +8,6 @@ from pathlib import Path
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, whole
 from zrp.errors import InputError
-from zrp.model.files import load_model
 from zrp.output import OutputDir, claim_generated
 
 DEFAULT_OUT = "renders/plan_benchmark"
@@ -53,6 +52,7 @@ def _run(args: argparse.Namespace) -> int:
 
     # (the same reason: MuJoCo is loaded only when this command runs)
     from sim.studies.planning import design_rows, render_k_study, run_k_study
+    from zrp.model.files import load_model  # on use: keeps --help quick
 
     out = Path(args.out or DEFAULT_OUT)
     overwrite = args.force or (args.out is None and claim_generated(out))

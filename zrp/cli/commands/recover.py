@@ -8,8 +8,7 @@ import argparse
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, whole
 from zrp.errors import InputError
-from zrp.paper.inverse import local_pinning, recover_circle
-from zrp.paper.placement import CELL_LABELS, ORIENTATION_LAWS
+from zrp.paper.choices import ORIENTATION_LAWS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,6 +32,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.paper.inverse import local_pinning, recover_circle  # on use: keeps --help quick
+    from zrp.paper.placement import CELL_LABELS  # on use: keeps --help quick
+
     for name in ("popsize", "maxiter", "starts"):
         if getattr(args, name) < 1:
             raise InputError(f"--{name}: expected a positive integer, got {getattr(args, name)}")

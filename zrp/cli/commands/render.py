@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING, Any
 from zrp.cli.app import emit
 from zrp.cli.options import MAX_FPS, MAX_HEIGHT, MAX_SECONDS, MAX_WIDTH, PERCENT, real, whole
 from zrp.output import OutputDir, claim_generated
-from zrp.paper.scenes import PAPER_LEVELS, Scene, paper_video_scene, teaching_sweep_scene
 
 if TYPE_CHECKING:
     from sim import VideoOptions
+    from zrp.paper.scenes import Scene
 
 DEFAULT_OUT = "renders"
 
@@ -74,6 +74,12 @@ def _result(r: Any) -> dict[str, Any]:
 def _videos(args: argparse.Namespace, video_options: type[VideoOptions]
             ) -> list[tuple[Scene, VideoOptions]]:
     """The paper video's scene and options, and the teaching sweep's under ``--sweep``."""
+    from zrp.paper.scenes import (  # on use: keeps --help quick
+        PAPER_LEVELS,
+        paper_video_scene,
+        teaching_sweep_scene,
+    )
+
     opts = video_options(width=args.width, height=args.height, fps=args.fps,
                          seconds=args.seconds, magnify=args.magnify, format=args.format,
                          backend=args.backend)

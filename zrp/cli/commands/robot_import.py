@@ -5,13 +5,13 @@ from __future__ import annotations
 import argparse
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from zrp.cli.app import emit
 from zrp.errors import InputError, ModelFileError
-from zrp.model.dh_table import loads_dh
-from zrp.model.files import loads_model, save_model
-from zrp.model.manipulator import Manipulator
-from zrp.model.urdf import import_urdf
+
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable
 from zrp.textio import read_text
 
@@ -57,6 +57,10 @@ def _kind(text: str) -> str:
 
 
 def _read(args: argparse.Namespace) -> tuple[Manipulator, dict[str, object]]:
+    from zrp.model.dh_table import loads_dh  # on use: keeps --help quick
+    from zrp.model.files import loads_model  # on use: keeps --help quick
+    from zrp.model.urdf import import_urdf  # on use: keeps --help quick
+
     src = Path(args.source)
     text = read_text(src, label=str(src), error=ModelFileError)  # a regular file, size checked
     kind = _kind(text)
@@ -83,6 +87,8 @@ def _read(args: argparse.Namespace) -> tuple[Manipulator, dict[str, object]]:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from zrp.model.files import save_model  # on use: keeps --help quick
+
     out = Path(args.out or f"renders/{_slug(Path(args.source).stem)}.toml")
     check_writable([out], args.force)
     model, info = _read(args)

@@ -7,26 +7,31 @@ from __future__ import annotations
 
 import argparse
 import warnings
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 
 from zrp.cli.app import emit
-from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, PERCENT, whole
-from zrp.errors import InputError, ZRPWarning
-from zrp.kinematics.trajectory import TIME_LAWS
-from zrp.manufacturing.perturb import PAPER_SIGN_ZERO
-from zrp.manufacturing.study import (
-    PAPER_PARAMETERS,
-    PAPER_XI,
-    JointPath,
-    StudyResult,
-    load_joint_csv,
-    one_at_a_time,
+from zrp.cli.options import (
+    DURATION,
+    FINITE,
+    LENGTH,
+    MAX_STEPS,
+    PERCENT,
+    add_deg,
+    joint_angles,
+    whole,
 )
-from zrp.model.files import builtin_models, load_model
-from zrp.model.manipulator import Manipulator
+from zrp.errors import InputError, ZRPWarning
+from zrp.kinematics.choices import TIME_LAWS
+from zrp.manufacturing.choices import PAPER_PARAMETERS, PAPER_SIGN_ZERO, PAPER_XI
+
+if TYPE_CHECKING:
+    from zrp.manufacturing.study import JointPath, StudyResult
+from zrp.model.builtin import builtin_models
 from zrp.output import OutputDir
-from zrp.paper.scenario import PUMA_Q0_DEG, circle_joint_path, is_paper_model
+from zrp.paper.choices import PUMA_Q0_DEG
 
 #: The tables ``zrp study --out DIR`` writes.
 STUDY_TABLES = tuple(f"study_{q}.{ext}" for q in ("delta_p", "delta_r", "angle_rad")
@@ -40,12 +45,15 @@ def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
                         "; default puma)")
     g = p.add_argument_group("trajectory (nominal inverse kinematics of a circle, or a file)")
     g.add_argument("--joints", metavar="CSV", default=None,
-                   help="joint trajectory CSV: header, then t (s) and q1..qn (rad / length unit)"
+                   help="joint trajectory CSV: header, then t (s) and q1..qn (rad, --deg or "
+                        "q1[deg]; prismatic: length unit)"
                         " per row, e.g. written by `zrp ik`; replaces the circle")
-    g.add_argument("--q0", nargs="+", type=FINITE, metavar="DEG", default=None,
-                   help="start configuration in deg (prismatic joints in the length unit); "
-                        f"default {' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} for the paper's "
-                        "PUMA (the built-in puma), required for every other model")
+    g.add_argument("--q0", nargs="+", type=FINITE, metavar="Q", default=None,
+                   help="start configuration, rad (deg with --deg; prismatic joints in the "
+                        "length unit); "
+                        f"default {' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg for the "
+                        "paper's PUMA (the built-in puma), required for every other model")
+    add_deg(g)
     g.add_argument("--radius", type=LENGTH, default=125.0,
                    help="circle radius, length unit (default 125)")
     g.add_argument("--normal", nargs=3, type=FINITE, default=None, metavar=("X", "Y", "Z"),
@@ -62,6 +70,8 @@ def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
 def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
     """Check the trajectory options against ``model`` before any work: --q0 has one value per
     joint, and is given for every model but the paper's PUMA (which has a default start)."""
+    from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
+
     if args.joints:
         return
     if args.q0 is None:
@@ -69,8 +79,9 @@ def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
             raise InputError(
                 f"--q0: required for {model.name!r} ({model.n} joints): the default start "
                 f"configuration ({' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg) is the paper's,"
-                f" for its PUMA only; give --q0 with {model.n} values in deg (prismatic joints "
-                f"in {model.length_unit}), or a joint trajectory with --joints CSV")
+                f" for its PUMA only; give --q0 with {model.n} values (rad, or deg with --deg;"
+                f" prismatic joints in {model.length_unit}), or a joint trajectory with "
+                "--joints CSV")
     elif len(args.q0) != model.n:
         raise InputError(f"--q0: expected {model.n} values for {model.name!r}, got "
                          f"{len(args.q0)}")
@@ -78,10 +89,14 @@ def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
 
 def path_from_args(args: argparse.Namespace, model: Manipulator) -> JointPath:
     """The nominal joint trajectory the options describe."""
+
+    from zrp.manufacturing.study import load_joint_csv  # on use: keeps --help quick
+    from zrp.paper.scenario import circle_joint_path  # on use: keeps --help quick
+
     check_path_options(args, model)
     if args.joints:
-        return load_joint_csv(args.joints, model)
-    q0 = None if args.q0 is None else np.where(model.prismatic, args.q0, np.radians(args.q0))
+        return load_joint_csv(args.joints, model, deg=args.deg)
+    q0 = None if args.q0 is None else joint_angles(model, args.q0, args.deg, "--q0")
     with warnings.catch_warnings():
         warnings.simplefilter("default", ZRPWarning)
         return circle_joint_path(model, q0=q0, radius=args.radius, duration=args.duration,
@@ -127,6 +142,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run_study(args: argparse.Namespace, model: Manipulator,
                out: OutputDir | None) -> tuple[JointPath, StudyResult]:
+    from zrp.manufacturing.study import one_at_a_time  # on use: keeps --help quick
+
     path = path_from_args(args, model)
     st = one_at_a_time(model, path, args.params, args.xi, sign_zero_links=args.sign0_links,
                        sign_zero_axes=args.sign0_axes)
@@ -138,6 +155,10 @@ def _run_study(args: argparse.Namespace, model: Manipulator,
 
 
 def _study(args: argparse.Namespace) -> int:
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     check_path_options(args, model)
     files: list[str] = []

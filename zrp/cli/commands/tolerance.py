@@ -7,24 +7,20 @@ import math
 import sys
 from concurrent.futures import Executor
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    from zrp.model.manipulator import Manipulator
 
 from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
 from zrp.cli.options import LENGTH, SEED, TOLERANCE, real, whole
 from zrp.errors import InputError
-from zrp.manufacturing.allocation import allocate_tolerances
-from zrp.manufacturing.budget import tolerance_report
-from zrp.manufacturing.plots import check_png_path, histogram_png
-from zrp.manufacturing.population import MonteCarloResult, monte_carlo
-from zrp.manufacturing.reduction import MonteCarloSummary, monte_carlo_summary
-from zrp.manufacturing.study import JointPath
-from zrp.manufacturing.tolerance import DISTRIBUTIONS, Tolerances
-from zrp.model.files import load_model
-from zrp.model.manipulator import Manipulator
+
+if TYPE_CHECKING:
+    from zrp.manufacturing.study import JointPath
+from zrp.manufacturing.choices import DISTRIBUTIONS
 from zrp.output import check_writable
 
 #: Above this many robots `zrp tolerance` reduces on the workers (gathering costs 32 bytes a
@@ -118,6 +114,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _tolerance(args: argparse.Namespace) -> int:
+    from zrp.manufacturing.plots import check_png_path  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     check_path_options(args, model)
     if not 0.0 < args.percentile < 100.0:
@@ -164,6 +163,11 @@ def _allocate(args: argparse.Namespace, model: Manipulator, path: JointPath,
               ex: Executor | None) -> int:
     """--allocate: the loosest tolerances meeting the requirement, verified (the verification
     Monte Carlo runs on the executor)."""
+    import numpy as np  # on use: keeps --help quick
+
+    from zrp.manufacturing.allocation import allocate_tolerances  # on use: keeps --help quick
+    from zrp.manufacturing.plots import histogram_png  # on use: keeps --help quick
+
     rng = np.random.default_rng(args.seed)
     u = model.length_unit
     al = allocate_tolerances(model, path.q, rng=rng, max_delta_p=args.max_dp,
@@ -213,6 +217,18 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
     draws its robots from (--seed, i), so the result is the same in this process and on any
     number of workers. With --reduce (implied above GATHER_LIMIT robots) each chunk comes back
     as histograms: percentiles are known to their bin, extremes exactly."""
+    from zrp.manufacturing.budget import tolerance_report  # on use: keeps --help quick
+    from zrp.manufacturing.plots import histogram_png  # on use: keeps --help quick
+    from zrp.manufacturing.population import (  # on use: keeps --help quick
+        MonteCarloResult,
+        monte_carlo,
+    )
+    from zrp.manufacturing.reduction import (  # on use: keeps --help quick
+        MonteCarloSummary,
+        monte_carlo_summary,
+    )
+    from zrp.manufacturing.tolerance import Tolerances  # on use: keeps --help quick
+
     u = model.length_unit
     offsets = args.offsets is not None
     tol = Tolerances.build(model, length=args.length, angle_rad=args.angle,

@@ -7,7 +7,6 @@ import argparse
 
 from zrp.cli.app import emit
 from zrp.cli.options import MAX_STEPS, PERCENT, whole
-from zrp.paper.scenes import paper_video_scene
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -30,6 +29,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo (and the viewer GLFW): only when this command runs
     import sim
+    from zrp.paper.scenes import paper_video_scene  # on use: keeps --help quick
 
     ok, why = sim.display_status()
     if not ok:

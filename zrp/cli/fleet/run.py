@@ -8,20 +8,18 @@ import glob
 import json
 import sys
 from pathlib import Path
-from typing import Any
-
-from tqdm.auto import tqdm
+from typing import TYPE_CHECKING, Any
 
 from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.fleet.summary import fleet_csv, fleet_figure, fleet_markdown, fleet_summary
-from zrp.cli.fleet.tasks import RobotTask, diagnose_robot, robot_row
 from zrp.cli.options import LENGTH
 from zrp.errors import InputError
-from zrp.gap.report import OUTPUT_FILES
-from zrp.model.files import load_model
 from zrp.output import OutputDir, check_writable
 from zrp.tasks import TaskFailure, map_tasks
+
+if TYPE_CHECKING:
+    from zrp.cli.fleet.tasks import RobotTask
 
 __all__ = ["FLEET_FILES", "add_fleet_options", "is_fleet", "refuse_fleet_options", "run_fleet"]
 
@@ -56,6 +54,9 @@ def add_fleet_options(p: argparse.ArgumentParser) -> None:
 
 
 def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[RobotTask]:
+    from zrp.cli.fleet.tasks import RobotTask  # on use: keeps --help quick
+    from zrp.model.files import load_model  # on use: keeps --help quick
+
     model = load_model(args.model)
     names = [f.stem for f in files]
     dup = sorted({n for n in names if names.count(n) > 1})
@@ -76,6 +77,8 @@ def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[Robot
 
 def _previous(tasks: list[RobotTask]) -> dict[str, dict[str, Any]]:
     """Rows of the robots an interrupted run finished."""
+    from zrp.cli.fleet.tasks import robot_row  # on use: keeps --help quick
+
     done = {}
     for t in tasks:
         if (t.out / DONE_MARKER).exists() and (t.out / "diagnosis.json").exists():
@@ -86,6 +89,10 @@ def _previous(tasks: list[RobotTask]) -> dict[str, dict[str, Any]]:
 
 def _diagnose_all(args: argparse.Namespace, todo: list[RobotTask]
                   ) -> tuple[list[dict[str, Any]], list[TaskFailure]]:
+    from tqdm.auto import tqdm  # ~0.1 s (asyncio): only when a fleet runs
+
+    from zrp.cli.fleet.tasks import diagnose_robot  # on use: keeps --help quick
+
     rows: list[dict[str, Any]] = []
     failures: list[TaskFailure] = []
     show = sys.stderr.isatty() if args.progress is None else args.progress
@@ -127,6 +134,8 @@ def _write_fleet(folder: OutputDir, args: argparse.Namespace, doc: dict[str, Any
 
 def run_fleet(args: argparse.Namespace) -> int:
     """The fleet run; exit code 1 when some robot could not be diagnosed (the rest was)."""
+    from zrp.gap.report import OUTPUT_FILES  # on use: keeps --help quick
+
     files = _fleet_files(args)
     out = Path(args.out)
     tasks = _tasks(args, files, out)

@@ -1,5 +1,8 @@
 """The fleet summary: which robots are out of tolerance and which effect dominates - as a
-document (fleet.json), a table (CSV, Markdown) and a plot (Matplotlib, imported on use)."""
+document (fleet.json), a table (CSV, Markdown) and a plot (Matplotlib, imported on use).
+
+Robot names are the users' file names: every one (and every failure message) reaches fleet.md
+through :func:`zrp.escape.md_text` and fleet.csv through :func:`zrp.escape.csv_cell`."""
 
 from __future__ import annotations
 
@@ -9,6 +12,8 @@ import math
 from collections import Counter
 from typing import Any
 
+from zrp.escape import csv_cell
+from zrp.escape import md_text as _t
 from zrp.tasks import TaskFailure
 
 __all__ = ["COLUMNS", "fleet_csv", "fleet_figure", "fleet_markdown", "fleet_summary"]
@@ -73,7 +78,7 @@ def fleet_csv(doc: dict[str, Any]) -> str:
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(COLUMNS)
     for r in doc["rows"]:
-        w.writerow([";".join(map(str, r[c])) if isinstance(r[c], list) else r[c]
+        w.writerow([csv_cell(";".join(map(str, r[c])) if isinstance(r[c], list) else r[c])
                     for c in COLUMNS])
     return buf.getvalue()
 
@@ -88,7 +93,8 @@ def fleet_markdown(doc: dict[str, Any]) -> str:
     out = [f"# Fleet diagnosis: {doc['robots']} robots", "",
            f"Tolerance: largest withheld error after registration <= {doc['tolerance']:g} {u}.",
            f"Out of tolerance: **{len(doc['out_of_tolerance'])} of {n}** diagnosed robots"
-           + (f" ({', '.join(doc['out_of_tolerance'])})" if doc["out_of_tolerance"] else "")
+           + (f" ({', '.join(map(_t, doc['out_of_tolerance']))})" if doc["out_of_tolerance"]
+              else "")
            + f"; {len(doc['fixed_by_correction'])} of them within tolerance once the "
            "diagnosed effects are corrected.",
            f"Dominant effect across the fleet (named first most often): "
@@ -100,14 +106,14 @@ def fleet_markdown(doc: dict[str, Any]) -> str:
     out += ["", f"| robot | points | RMS {u} | max {u} | out of tolerance | corrected max {u} "
             "| first effect [joints] | shrink |", "|---|---|---|---|---|---|---|---|"]
     for r in doc["rows"]:
-        out.append(f"| {r['robot']} | {r['points']} | {_f(r['error_rms'])} | "
+        out.append(f"| {_t(r['robot'])} | {r['points']} | {_f(r['error_rms'])} | "
                    f"{_f(r['error_max'])} | {'**yes**' if r['out_of_tolerance'] else 'no'} | "
                    f"{_f(r['corrected_max'])} | {r['top_effect']} {r['top_joints']} | "
                    f"{_f(r['shrink'])} |")
     if doc["failures"]:
         out += ["", "## Robots that could not be diagnosed (the others were)", "",
                 "| input | error |", "|---|---|"]
-        out += [f"| {f['task']} | {f['error']} |" for f in doc["failures"]]
+        out += [f"| {_t(f['task'])} | {_t(f['error'])} |" for f in doc["failures"]]
     if doc["resumed"]:
         out += ["", f"Resumed: {doc['resumed']} diagnoses taken from an interrupted run."]
     out += ["", "Each robot's own report: robots/NAME/report.md."]

@@ -8,8 +8,6 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from zrp.gap import diagnose, load_measurements
-from zrp.gap.report import diagnosis_document, write_outputs
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["RobotTask", "diagnose_robot", "robot_row"]
@@ -63,6 +61,8 @@ def diagnose_robot(task: RobotTask) -> dict[str, Any]:
     """Load, diagnose, write the robot's report; return its :func:`robot_row`."""
     # mjcf loads MuJoCo: only in a fleet run that was given an MJCF
     from mjcf.gravity import gravity_torques
+    from zrp.gap import diagnose, load_measurements  # on use: keeps --help quick
+    from zrp.gap.report import diagnosis_document, write_outputs  # on use: keeps --help quick
 
     meas = load_measurements(task.data, task.model, **task.read)
     tau = None if task.mjcf is None else gravity_torques(task.mjcf, meas.q_pose, field="--mjcf")

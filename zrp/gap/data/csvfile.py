@@ -5,9 +5,11 @@ One row per measured point, rows in measurement order. Columns (header names, an
 * ``pose`` (required): an id; all rows of a pose share the same joint values.
 * ``point`` (optional): which target on the tool (e.g. one of several reflectors); default "p".
 * ``q1`` .. ``qn`` (required): joint values, rad (deg with ``deg=True``) for revolute joints,
-  the model's length unit for prismatic ones.
-* ``x``, ``y``, ``z`` (required): measured position in the model's length unit, in the
-  instrument's frame (or the robot's base frame with ``frame="base"``).
+  the model's length unit for prismatic ones, unless the header declares the unit
+  (``q1[deg]``, ``q3[mm]``: the rule of :mod:`zrp.units`, checked there).
+* ``x``, ``y``, ``z`` (required): measured position in the model's length unit (or the unit
+  the header declares, ``x[m]``), in the instrument's frame (or the robot's base frame with
+  ``frame="base"``).
 * ``qw``, ``qx``, ``qy``, ``qz`` (optional, all four): measured orientation (loaded and checked;
   the diagnosis chooses effects from positions only and says so with a warning; zrp calibrate
   and zrp.gap.fit.fullpose use them).
@@ -33,7 +35,6 @@ record: a form feed or U+2028 inside a quoted field stays in the field.
 from __future__ import annotations
 
 import csv
-import math
 import os
 import warnings
 from collections.abc import Iterable, Iterator
@@ -41,21 +42,19 @@ from pathlib import Path
 
 import numpy as np
 from numpy.typing import NDArray
-from tqdm import tqdm
 
 from zrp.arguments import check_int
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.data.choices import MAX_ROWS
 from zrp.gap.data.csvrows import Accumulator, Columns, Header, check_header, parse_row
 from zrp.gap.data.measurements import FRAMES, DataWarning, Measurements
 from zrp.model.manipulator import Manipulator
 from zrp.textio import iter_lines
+from zrp.units import angle_bounds, joint_column_units, joint_values_to_rad, length_scale
 
-__all__ = ["MAX_ROWS", "joint_units_to_rad", "load_measurements"]
+__all__ = ["MAX_ROWS", "load_measurements"]
 
-#: Most data rows read by default: about 0.7 GB of memory per million rows at the peak of a
-#: whole diagnosis, so two million stay within 2 GB.
-MAX_ROWS = 2_000_000
 
 #: plausible temperatures, deg C.
 TEMP_RANGE = (-60.0, 150.0)
@@ -136,6 +135,8 @@ class _Reader:
 def _read(path: Path, src: str, model: Manipulator, progress: bool, max_rows: int | None
           ) -> tuple[list[str], Header, Columns]:
     """Stream the file once: the header, then each data row checked and appended."""
+    from tqdm import tqdm  # ~0.03 s: on use, so that `zrp diagnose --help` stays quick
+
     reader = _Reader(src, model, max_rows)
     bar = tqdm(desc=f"reading {path.name}", unit=" rows", disable=not progress,
                mininterval=1.0, leave=False)
@@ -155,21 +156,16 @@ def _read(path: Path, src: str, model: Manipulator, progress: bool, max_rows: in
     return header, h, acc.columns(h)
 
 
-def joint_units_to_rad(q: F64, model: Manipulator, deg: bool, lines: NDArray[np.int64],
-                       src: str) -> None:
-    """Revolute joint values to rad (in place) with ``deg``; else refuse values > 2 pi (the
-    static and the trajectory loaders share it, and its wording)."""
+def _units(c: Columns, h: Header, model: Manipulator, deg: bool, src: str) -> None:
+    """Joint columns to rad (revolute) and the model's length unit (prismatic), positions to
+    the model's length unit, in place, by the rule and checks of :mod:`zrp.units`."""
     rev = ~np.asarray(model.prismatic)
-    if deg:
-        q[:, rev] = np.radians(q[:, rev])
-        return
-    big = np.abs(q[:, rev]) > 2.0 * math.pi + 1e-6
-    if big.any():
-        i, k = (int(v) for v in np.argwhere(big)[0])
-        kk = int(np.flatnonzero(rev)[k])
-        raise InputError(
-            f"{src} line {lines[i]}: column q{kk + 1} is {q[i, kk]:g}, more than 2 pi rad: "
-            "the joint values look like degrees; pass deg=True (--deg on the command line)")
+    angle, scale = joint_column_units([h.units[q] for q in h.qcols], rev, deg, src=src,
+                                      length_unit=model.length_unit, names=h.qcols)
+    c.q[:] = joint_values_to_rad(c.q, rev, angle, src=src, names=h.qcols, lines=c.lines,
+                                 bounds=angle_bounds(model.lower, model.upper)) * scale
+    for k, x in enumerate("xyz"):
+        c.xyz[:, k] *= length_scale(h.units[x], model.length_unit, f"{src} column {x}")
 
 
 def _check_scalars(scalars: dict[str, F64], lines: NDArray[np.int64], src: str) -> None:
@@ -215,9 +211,9 @@ def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: 
     src = str(path)
     if frame not in FRAMES:
         raise InputError(f"frame: {frame!r} is not a frame; expected one of {FRAMES}")
-    _, _, c = _read(path, src, model, progress,
+    _, h, c = _read(path, src, model, progress,
                     None if max_rows is None else check_int(max_rows, "max_rows", 1))
-    joint_units_to_rad(c.q, model, deg, c.lines, src)
+    _units(c, h, model, deg, src)
     _check_scalars(c.scalars, c.lines, src)
     if c.quat is not None:
         warnings.warn(f"{src}: measured orientations (qw..qz) are loaded; the diagnosis chooses "

@@ -24,12 +24,11 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.arguments import check_int
+from zrp.gap.data.choices import MAX_POINTS
 from zrp.gap.data.measurements import DataWarning, Measurements
 
 __all__ = ["MAX_POINTS", "subsample_poses"]
 
-#: Default most measured points (rows) a diagnosis uses; beyond it a subsample of poses.
-MAX_POINTS = 5000
 
 
 def subsample_poses(meas: Measurements, max_points: int | None, seed: int

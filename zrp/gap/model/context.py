@@ -17,6 +17,7 @@ from numpy.typing import NDArray
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
+from zrp.gap.model.choices import EFFECTS, REGISTRATION
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.identification import axis_tangents
 from zrp.model.manipulator import Manipulator
@@ -32,10 +33,6 @@ __all__ = [
 ]
 
 
-#: Candidate effects, in the order they are tried (ties are broken by this order).
-EFFECTS = ("joint_offset", "encoder_scale", "link_length", "axis_misalignment",
-           "joint_compliance", "backlash", "thermal_expansion", "cyclic_error")
-REGISTRATION = ("base_frame", "tool_offset")
 #: A revolute joint must span at least this range (rad, 2 deg) over the poses to carry an
 #: encoder scale, a cyclic error or backlash (prismatic: this fraction of the reach).
 MIN_EXCITATION_RAD = float(np.radians(2.0))

@@ -21,19 +21,13 @@ from scipy.interpolate import CubicSpline
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import FRAMES, Measurements
+from zrp.gap.motion.choices import RATE_RANGE_HZ, TIME_UNITS
 
 __all__ = ["MIN_SAMPLES", "RATE_RANGE_HZ", "TIME_UNITS", "Trajectory", "check_rate"]
 
 #: fewest samples a trajectory diagnosis accepts.
 MIN_SAMPLES = 50
 
-#: plausible median sample rates of a tracker stream, Hz: laser trackers and optical
-#: trackers stream at 10 Hz to a few kHz; below 5 Hz the motion effects (ms delays and lags,
-#: vibration) cannot be resolved, and above 100 kHz the time stamps are not in seconds.
-RATE_RANGE_HZ = (5.0, 100_000.0)
-
-#: time stamp units of a trajectory CSV, in s.
-TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6}
 
 
 def check_rate(t: F64, lines: NDArray[np.int64] | None, source: str) -> None:

@@ -52,6 +52,7 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import KINDS, Context, ParamSpec
+from zrp.gap.motion.choices import MOTION_EFFECTS
 from zrp.gap.motion.columns import Deviation, JointColumn, combine
 from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.kernels import first_order_lag, mode_response, play
@@ -60,8 +61,6 @@ __all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "JointColumn", "MotionContext
            "effect_columns", "joint_mode", "limit_step", "linearise", "mode_band", "plausible",
            "tested"]
 
-MOTION_EFFECTS = ("sync_delay", "servo_lag", "reversal_friction", "dynamic_compliance",
-                  "residual_vibration")
 #: effects whose parameters are physically positive (a negative estimate is not that effect)
 POSITIVE = ("servo_lag", "reversal_friction", "dynamic_compliance", "residual_vibration")
 #: where the mode's linearisation starts when no value is given (rad/s, 1)

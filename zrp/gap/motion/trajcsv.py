@@ -33,11 +33,12 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from zrp.errors import InputError
-from zrp.gap.data.csvfile import MAX_ROWS, joint_units_to_rad
+from zrp.gap.data.choices import MAX_ROWS
 from zrp.gap.motion.data import TIME_UNITS, Trajectory, check_rate
 from zrp.model.manipulator import Manipulator
 from zrp.output import atomic_path
 from zrp.textio import iter_lines
+from zrp.units import angle_bounds, joint_values_to_rad
 
 __all__ = ["load_trajectory", "write_trajectory"]
 
@@ -148,17 +149,19 @@ def load_trajectory(path: str | os.PathLike[str], model: Manipulator, *, deg: bo
     a[:, 0] *= TIME_UNITS[time_unit]
     if "tq" in numeric:
         a[:, -1] *= TIME_UNITS[time_unit]
-    joint_units_to_rad(a[:, 1:1 + n], model, deg, line_no, name)
     check_rate(np.unique(a[:, 0]), line_no, name)
-    return _assemble(a, numeric, points, line_no, model, frame, name)
+    return _assemble(a, numeric, points, line_no, model, deg, frame, name)
 
 
 def _assemble(a: np.ndarray, numeric: list[str], points: list[str] | None,
-              lines: np.ndarray, model: Manipulator, frame: str, name: str) -> Trajectory:
+              lines: np.ndarray, model: Manipulator, deg: bool, frame: str, name: str
+              ) -> Trajectory:
     """Rows grouped into samples (equal t), point labels checked, q at the tracker times."""
     n = model.n
     t = a[:, 0]
-    q = a[:, 1:1 + n]
+    q = joint_values_to_rad(a[:, 1:1 + n], ~np.asarray(model.prismatic),
+                            "deg" if deg else "rad", src=name, lines=lines,
+                            bounds=angle_bounds(model.lower, model.upper), header=False)
     xyz = a[:, 1 + n:4 + n]
     back = np.flatnonzero(np.diff(t) < 0)
     if back.size:

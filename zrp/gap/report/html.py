@@ -13,6 +13,8 @@ figures are still shown whole.
 Only the small subset of Markdown that :func:`~zrp.gap.report.markdown.report_markdown`
 writes is translated: headings, paragraphs, ``- `` lists, pipe tables, ``**bold**``,
 ```code``` and ``![alt](file.png)`` figures (scatter points are rasterised inside the SVG).
+Backslash escapes (:func:`zrp.escape.md_text`, on every user string) are honoured as CommonMark
+does: an escaped character is shown as text, never as bold, code, a cell or a tag.
 """
 
 from __future__ import annotations
@@ -78,14 +80,27 @@ _CSP = ("default-src 'none'; img-src data:; style-src 'unsafe-inline'; "
         "script-src 'unsafe-inline'")
 
 
+_ESCAPED = re.compile(r"\\([!-/:-@\[-`{-~])")
+_HELD = re.compile("\x00(\\d+)\x00")
+#: a cell boundary: a pipe not escaped by a backslash
+_CELL = re.compile(r"(?<!\\)\|")
+
+
 def _inline(text: str) -> str:
-    t = html.escape(text, quote=False)
+    held: list[str] = []
+
+    def hold(m: re.Match[str]) -> str:  # an escaped character: text, whatever follows
+        held.append(html.escape(m.group(1)))
+        return f"\x00{len(held) - 1}\x00"
+
+    t = html.escape(_ESCAPED.sub(hold, text.replace("\x00", "")), quote=False)
     t = re.sub(r"\*\*(.+?)\*\*", r"<b>\1</b>", t)
-    return re.sub(r"`([^`]+)`", r"<code>\1</code>", t)
+    t = re.sub(r"`([^`]+)`", r"<code>\1</code>", t)
+    return _HELD.sub(lambda m: held[int(m.group(1))], t)
 
 
 def _table(rows: list[str]) -> str:
-    cells = [[c.strip() for c in r.strip().strip("|").split("|")] for r in rows]
+    cells = [[c.strip() for c in _CELL.split(r.strip().strip("|"))] for r in rows]
     head, body = cells[0], [c for c in cells[1:] if not all(set(x) <= {"-", ":"} for x in c)]
     out = ["<table><thead><tr>" + "".join(f"<th>{_inline(c)}</th>" for c in head)
            + "</tr></thead><tbody>"]

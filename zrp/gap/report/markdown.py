@@ -1,5 +1,9 @@
 """report.md: the diagnosis for a reader (verdict, shrink table, parameters, ranking, aliasing,
-where the gap lies, warnings, method)."""
+where the gap lies, warnings, method).
+
+Every string that comes from the user's files (model name, data file, point labels, names,
+warnings that quote them) passes through :func:`zrp.escape.md_text`: one line, Markdown and
+HTML punctuation escaped, so a label can add neither a section nor a table cell nor a tag."""
 
 from __future__ import annotations
 
@@ -8,6 +12,7 @@ from collections.abc import Sequence
 
 from scipy.spatial.transform import Rotation
 
+from zrp.escape import md_text as _t
 from zrp.gap.analysis.where import Region, WhereAnalysis
 from zrp.gap.report.verdict import (
     baseline_text,
@@ -55,7 +60,7 @@ def _parameter_table(params: Sequence[ParameterEstimate], *, flags: Sequence[str
         bad = any(f.startswith(p.name + " = ") for f in flags)
         both = "" if not joint else (
             f"{value_ci(p.value, *p.ci95_effect, p.unit)[1]} | " if p.ci95_effect else "| ")
-        out.append(f"| {p.name} | {v} | {ci} | {both}{'NO' if bad else 'yes'} |")
+        out.append(f"| {_t(p.name)} | {v} | {ci} | {both}{'NO' if bad else 'yes'} |")
     return out
 
 
@@ -79,18 +84,25 @@ def _regions(regions: Sequence[Region], u: str) -> list[str]:
 
 def _header(diag: Diagnosis) -> list[str]:
     s = diag.settings
-    return [f"# Sim-to-real gap diagnosis: {diag.model_name}\n",
+    return [f"# Sim-to-real gap diagnosis: {_t(diag.model_name)}\n",
             "## Verdict\n",
             verdict_text(diag) + "\n",
             "## Data\n",
-            f"Data: {diag.context.meas.source}: {s['n_poses']} poses, {s['n_points']} measured "
-            f"points ({', '.join(s['point_labels'])}), frame `{s['frame']}`. Fitting set "
+            f"Data: {_t(diag.context.meas.source)}: {s['n_poses']} poses, {s['n_points']} "
+            f"measured points ({', '.join(map(_t, s['point_labels']))}), frame "
+            f"`{s['frame']}`. Fitting set "
             f"{len(diag.fitting_poses)} poses, withheld set {len(diag.withheld_poses)} poses "
             "(never used for fitting; only to choose between the search's model and the "
             f"geometric calibration), {s['folds']} cross-validation folds.\n"]
 
 
-def _shrink(diag: Diagnosis) -> list[str]:
+#: the figures report.md shows (file, alt text), when the plots are written beside it
+FIGURES = (("shrink.png", "shrink"), ("residuals_before_after.png", "residuals"),
+           ("residual_vs_joint.png", "residual vs joint"), ("residual_map.png", "workspace"),
+           ("correlation.png", "correlation"))
+
+
+def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
     u, nf, nom = diag.length_unit, diag.noise_floor, diag.nominal
     L = ["## How far the gap shrinks (withheld poses)\n",
          f"| step | effect | joints | RMS ({u}) | p95 ({u}) | max ({u}) | CV RMS ({u}) "
@@ -136,9 +148,9 @@ def _shrink(diag: Diagnosis) -> list[str]:
                  + (" Distances between rigidly linked points measure the instrument's noise "
                     "only; the robot's repeatability adds to it, so the attainable floor is "
                     "somewhat higher." if nf.method == "rigid_links" else ""))
-    L += ["\n![shrink](shrink.png)\n", "![residuals](residuals_before_after.png)\n",
-          "![residual vs joint](residual_vs_joint.png)\n", "![workspace](residual_map.png)\n",
-          "![correlation](correlation.png)\n"]
+    if figures:
+        L.append("")
+        L += [f"![{alt}]({name})\n" for name, alt in FIGURES]
     return L
 
 
@@ -193,7 +205,7 @@ def _frame(diag: Diagnosis) -> list[str]:
             v, ci = value_ci(q.value, *q.ci95, q.unit)
             if q.unit == "rad":
                 v += f" ({math.degrees(q.value):.4f} deg)"
-            L.append(f"| {q.name} | {v} | {ci} |")
+            L.append(f"| {_t(q.name)} | {v} | {ci} |")
         L.append("")
     L += ["Tool points (flange frame at the zero reference):\n",
           f"| point | x ({u}) | y ({u}) | z ({u}) |", "|---|---|---|---|"]
@@ -202,7 +214,7 @@ def _frame(diag: Diagnosis) -> list[str]:
         for q in qs:
             v, ci = value_ci(q.value, *q.ci95, "")
             cells.append(f"{v.strip()} {ci.strip()}")
-        L.append(f"| {lab} | " + " | ".join(cells) + " |")
+        L.append(f"| {_t(lab)} | " + " | ".join(cells) + " |")
     L.append("")
     return L
 
@@ -214,7 +226,7 @@ def _trust(diag: Diagnosis) -> list[str]:
     L = ["## How far to trust the numbers\n"]
     if a.implausible:
         L.append("Physically implausible final values:\n")
-        L += [f"- {m}" for m in a.implausible]
+        L += [f"- {_t(m)}" for m in a.implausible]
         L.append("")
     if a.unexcited:
         L.append(f"Joints the data do not excite (no scale, cyclic error or backlash placed on "
@@ -224,7 +236,7 @@ def _trust(diag: Diagnosis) -> list[str]:
              f"against each other, the sums are better determined than each): "
              f"{len(c.strong)} of {len(c.names) * (len(c.names) - 1) // 2}. The full matrix is "
              "in diagnosis.json (`correlation`) and report.html.\n")
-    L += [f"- {x} ~ {y}: {rho:+.3f}" for x, y, rho in c.strong[:20]]
+    L += [f"- {_t(x)} ~ {_t(y)}: {rho:+.3f}" for x, y, rho in c.strong[:20]]
     if len(c.strong) > 20:
         L.append(f"- ... and {len(c.strong) - 20} more")
     L += ["", "What remains, weighed against the data's own evidence:\n",
@@ -257,7 +269,8 @@ def _aliasing(diag: Diagnosis) -> list[str]:
         L.append("Reported, never absorbed silently: a dropped parameter is not estimated; "
                  "its effect is carried by its partners.\n")
         for a in diag.aliased:
-            L.append(f"- {a.name} ({a.effect}) vs {', '.join(a.partners) or 'registration'}: "
+            L.append(f"- {_t(a.name)} ({a.effect}) vs "
+                     f"{', '.join(map(_t, a.partners)) or 'registration'}: "
                      f"{'not identifiable (dropped)' if a.dropped else 'weakly identifiable'}"
                      f" (independent share {a.fraction:.2g})")
         L.append("")
@@ -266,7 +279,7 @@ def _aliasing(diag: Diagnosis) -> list[str]:
         L.append("Not identifiable on top of the registration, per effect (robot structure or "
                  "these poses; 'limited by data' means richer poses would identify it):\n")
         for eff, v in rows:
-            items = ", ".join(f"{a.name} ~ {'/'.join(a.partners) or 'no effect'}"
+            items = ", ".join(f"{_t(a.name)} ~ {'/'.join(map(_t, a.partners)) or 'no effect'}"
                               for a in v.not_identifiable)
             L.append(f"- {eff}: {items}")
             if v.limited_by_data:
@@ -282,7 +295,7 @@ def _where(w: WhereAnalysis, u: str) -> list[str]:
     if w.temperature_r2 is not None:
         extra.append(f"temperature {w.temperature_r2:.2f}")
     L = ["## Where the gap lies (fitting poses, after registration)\n",
-         "RMS per point: " + ", ".join(f"{k} {v:.4g} {u}" for k, v in w.per_point.items())
+         "RMS per point: " + ", ".join(f"{_t(k)} {v:.4g} {u}" for k, v in w.per_point.items())
          + ".\n",
          "Share of the residual explained by a smooth function of each joint angle (R^2): "
          + ", ".join(f"q{j.joint} {j.r2:.2f}" for j in w.joints) + ".\n",
@@ -293,7 +306,7 @@ def _where(w: WhereAnalysis, u: str) -> list[str]:
          "Singular directions of the identification Jacobian carrying most residual:\n"]
     for c in w.components:
         L.append(f"- share {c.share:.3f}, singular value {c.singular_value:.3g}: "
-                 + ", ".join(f"{n} ({v:+.2f})" for n, v in c.parameters))
+                 + ", ".join(f"{_t(n)} ({v:+.2f})" for n, v in c.parameters))
     L.append("\nWorkspace regions (horizontal radius x height):\n")
     return L + _regions(w.regions, u)
 
@@ -358,21 +371,21 @@ def _full_pose(diag: Diagnosis) -> list[str]:
     if fp.parameters:
         L += ["| parameter | unit | value (full pose) | std, positions only | std, full pose "
               "| ratio |", "|---|---|---|---|---|---|"]
-        L += [f"| {p.name} | {p.unit} | {p.value:.4g} | {p.std_position_only:.3g} | "
+        L += [f"| {_t(p.name)} | {p.unit} | {p.value:.4g} | {p.std_position_only:.3g} | "
               f"{p.std_full_pose:.3g} | {p.ratio:.2f} |" for p in fp.parameters]
         L.append("")
     return L
 
 
-def report_markdown(diag: Diagnosis) -> str:
-    """The text of report.md."""
+def report_markdown(diag: Diagnosis, *, figures: bool = True) -> str:
+    """The text of report.md (linking the plots beside it when ``figures``)."""
     u = diag.length_unit
-    L = (_header(diag) + _shrink(diag) + _parameters(diag) + _full_pose(diag) + _trust(diag)
-         + _ranking(diag) + _aliasing(diag) + _where(diag.where.nominal, u))
+    L = (_header(diag) + _shrink(diag, figures) + _parameters(diag) + _full_pose(diag)
+         + _trust(diag) + _ranking(diag) + _aliasing(diag) + _where(diag.where.nominal, u))
     if diag.where.after_final_model is not None:
         L += _remains(diag.where.after_final_model, u)
     if diag.warnings:
         L.append("\n## Warnings\n")
-        L.extend(f"- {m}" for m in diag.warnings)
+        L.extend(f"- {_t(m)}" for m in diag.warnings)
     L += ["\n## Method\n", METHOD]
     return "\n".join(L) + "\n"

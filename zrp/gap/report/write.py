@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from zrp.escape import csv_cell
 from zrp.gap.report.html import report_html
 from zrp.gap.report.markdown import report_markdown
 from zrp.gap.report.plots import DPI, PLOT_FILES, figures, withheld_rows
@@ -50,7 +51,7 @@ def residuals_csv(diag: Diagnosis) -> str:
     w.writerow(["line", "pose", "point", "before_x", "before_y", "before_z", "before_norm",
                 "after_x", "after_y", "after_z", "after_norm"])
     for i, r in enumerate(withheld_rows(diag)):
-        w.writerow([int(meas.lines[r]), meas.pose[r], meas.point[r],
+        w.writerow([int(meas.lines[r]), csv_cell(meas.pose[r]), csv_cell(meas.point[r]),
                     *(f"{v:.6g}" for v in rb[i]), f"{np.linalg.norm(rb[i]):.6g}",
                     *(f"{v:.6g}" for v in ra[i]), f"{np.linalg.norm(ra[i]):.6g}"])
     return buf.getvalue()
@@ -67,7 +68,7 @@ def _write(diag: Diagnosis, out: OutputDir, plots: bool) -> list[Path]:
             buf = io.BytesIO()
             fig.savefig(buf, format="svg", dpi=DPI)
             svgs[name] = buf.getvalue()
-    md = report_markdown(diag)
+    md = report_markdown(diag, figures=plots)
     out.write_text("report.md", md)
     out.write_text("report.html", report_html(md, svgs, f"Gap diagnosis: {diag.model_name}"))
     return out.written[first:]
@@ -82,7 +83,8 @@ def write_outputs(diag: Diagnosis, out_dir: str | os.PathLike[str] | OutputDir, 
         out_dir: the folder, or an :class:`~zrp.output.OutputDir` the caller has entered
             (then its own ``overwrite`` policy applies, and it should have checked
             :data:`OUTPUT_FILES` on entry).
-        overwrite: replace files that exist (for a folder path).
+        overwrite: replace files that exist (for a folder path); the plots of an earlier
+            run are removed when this one makes none (``prune``, :class:`~zrp.output.OutputDir`).
 
     Returns:
         the paths written, in order.
@@ -94,5 +96,5 @@ def write_outputs(diag: Diagnosis, out_dir: str | os.PathLike[str] | OutputDir, 
     """
     if isinstance(out_dir, OutputDir):
         return _write(diag, out_dir, plots)
-    with OutputDir(out_dir, overwrite=overwrite, names=OUTPUT_FILES) as out:
+    with OutputDir(out_dir, overwrite=overwrite, names=OUTPUT_FILES, prune=True) as out:
         return _write(diag, out, plots)
