@@ -22,6 +22,7 @@ from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 from zrp.model.urdf import from_urdf
+from zrp.textio import read_text, text_encoding
 from zrp.units import metres_per_unit
 
 __all__ = ["from_mjcf", "load_mujoco_model", "manipulator_from_mujoco"]
@@ -44,7 +45,7 @@ def load_mujoco_model(source: str | os.PathLike[str] | mujoco.MjModel) -> mujoco
         raise InputError(f"source: expected a file path, an XML string or a mujoco.MjModel, got "
                          f"{type(source).__name__}")
     path = Path(source)
-    if not path.is_file():
+    if not path.exists():
         raise MJCFImportError(f"source: no such file {str(path)!r} (expected an MJCF .xml or a "
                               f".urdf file)")
     _check_utf8(path)
@@ -55,19 +56,15 @@ def load_mujoco_model(source: str | os.PathLike[str] | mujoco.MjModel) -> mujoco
 
 
 def _check_utf8(path: Path) -> None:
-    """MJCF and URDF files are UTF-8 XML: name the first line that is not."""
-    try:
-        with path.open("rb") as fh:
-            for lineno, raw in enumerate(fh, start=1):
-                try:
-                    raw.decode("utf-8")
-                except UnicodeDecodeError as exc:
-                    raise MJCFImportError(
-                        f"source {str(path)!r}, line {lineno}: byte 0x{raw[exc.start]:02x} is "
-                        "not UTF-8 text; MJCF and URDF files must be UTF-8") from None
-    except OSError as exc:
-        raise MJCFImportError(f"source {str(path)!r}: cannot read ({exc.strerror or exc})"
-                              ) from exc
+    """MJCF and URDF files are UTF-8 XML in a regular file of bounded size
+    (:func:`zrp.textio.read_text`): name the first line that is not UTF-8."""
+    label = f"source {str(path)!r}"
+    text = read_text(path, label=label, error=MJCFImportError)
+    with path.open("rb") as fh:
+        head = fh.read(4)
+    if text and text_encoding(head) != "utf-8-sig":
+        raise MJCFImportError(f"{label}: the file is UTF-16; MuJoCo reads MJCF and URDF files "
+                              "as UTF-8: save it as UTF-8")
 
 
 def _name(m: mujoco.MjModel, obj: mujoco.mjtObj, i: int) -> str:

@@ -25,6 +25,7 @@ from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.rotations import matrix_from_er
+from zrp.textio import iter_lines
 from zrp.units import (
     angle_bounds,
     joint_column_units,
@@ -33,7 +34,11 @@ from zrp.units import (
     split_unit,
 )
 
-__all__ = ["Commands", "Targets", "load_commands", "load_targets", "write_commands"]
+__all__ = ["MAX_TARGETS", "Commands", "Targets", "load_commands", "load_targets",
+           "write_commands"]
+
+#: Most rows read from a targets or commands file.
+MAX_TARGETS = 1_000_000
 
 #: The columns :func:`write_commands` writes besides target and q1..qn.
 COMMAND_FLAGS = ("residual", "orientation_residual", "uncompensated", "sigma_min",
@@ -85,13 +90,21 @@ def _columns(header: list[str], n: int, src: str) -> tuple[list[str], bool, bool
 
 
 def _read_rows(path: str | Path, what: str) -> list[list[str]]:
-    """The non-empty CSV records of ``path``; a header and a row at least."""
+    """The non-empty CSV records of ``path``, streamed (:func:`zrp.textio.iter_lines`: a
+    regular file, lines bounded; at most :data:`MAX_TARGETS` rows); a header and a row at
+    least."""
     src = str(path)
+    reader = csv.reader(iter_lines(path, label=src))
+    rows: list[list[str]] = []
     try:
-        rows = list(csv.reader(io.StringIO(Path(path).read_text(encoding="utf-8"))))
-    except (OSError, UnicodeDecodeError, csv.Error) as exc:
-        raise InputError(f"{src}: cannot read the {what} file: {exc}") from None
-    rows = [r for r in rows if r]
+        for r in reader:
+            if len(rows) > MAX_TARGETS:
+                raise InputError(f"{src}, line {reader.line_num}: more than {MAX_TARGETS:,} "
+                                 "rows; split the file")
+            if r:
+                rows.append(r)
+    except csv.Error as exc:
+        raise InputError(f"{src}, line {reader.line_num}: not a CSV file ({exc})") from None
     if len(rows) < 2:
         raise InputError(f"{src}: no {what} (a header and at least one row expected)")
     return rows

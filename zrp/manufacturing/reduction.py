@@ -223,8 +223,8 @@ def monte_carlo_summary(model: Manipulator, q: ArrayLike, tolerances: Tolerances
     identity: dict[str, str] = {}
     if checkpoint is not None:
         identity = run_identity(tasks)
-        state = load_merge(checkpoint, identity, edges, resume=resume,
-                           overwrite=overwrite) or state
+        state = load_merge(checkpoint, identity, edges, resume=resume, overwrite=overwrite,
+                           sizes=[t.size for t in tasks]) or state
         save_merge(checkpoint, identity, state)  # fails here, before any work, if unwritable
     todo = [t for t in tasks if not state.done(t.index)]
     resumed = n_robots - sum(t.size for t in todo)

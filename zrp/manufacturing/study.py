@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from zrp.arrays import F64
-from zrp.errors import InputError, ModelFileError, ZRPWarning
+from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import check_q, end_effector_pose
@@ -40,6 +40,7 @@ from zrp.manufacturing.perturb import (
 from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply
+from zrp.textio import iter_lines
 from zrp.units import angle_bounds, joint_column_units, joint_values_to_rad, split_unit
 
 __all__ = [
@@ -95,6 +96,26 @@ class JointPath:
                    float(ik.orientation_error.max()))
 
 
+#: Most rows of a joint trajectory CSV (a path of 2 million steps is ~100 MB of numbers).
+MAX_JOINT_ROWS = 2_000_000
+
+
+def _read_rows(p: Path) -> list[list[str]]:
+    """The CSV records, streamed (:func:`zrp.textio.iter_lines`: a regular file, lines
+    bounded; at most :data:`MAX_JOINT_ROWS` rows)."""
+    reader = csv.reader(iter_lines(p, label=str(p)))
+    rows: list[list[str]] = []
+    try:
+        for row in reader:
+            if len(rows) > MAX_JOINT_ROWS:
+                raise InputError(f"{p}, line {reader.line_num}: more than {MAX_JOINT_ROWS:,} "
+                                 "rows; thin the joint trajectory (every k-th step)")
+            rows.append(row)
+    except csv.Error as exc:
+        raise InputError(f"{p}, line {reader.line_num}: not a CSV file ({exc})") from None
+    return rows
+
+
 def _time_and_joints(rows: list[list[str]], n: int, p: Path) -> F64:
     """t and q1..qn of each data row (after the header), finite numbers, shape (R, 1 + n)."""
     data = []
@@ -128,13 +149,7 @@ def load_joint_csv(path: str | Path, model: Manipulator, *, deg: bool = False) -
     :mod:`zrp.units`). The IK errors are taken from ``position_error`` /
     ``orientation_error_rad`` columns if present."""
     p = Path(path)
-    try:
-        with p.open(newline="", encoding="utf-8-sig") as fh:
-            rows = list(csv.reader(fh))
-    except OSError as exc:
-        raise ModelFileError(f"{p}: cannot read joint trajectory: {exc}") from exc
-    except (UnicodeDecodeError, csv.Error) as exc:
-        raise InputError(f"{p}: not a CSV text file in UTF-8 ({exc})") from None
+    rows = _read_rows(p)
     if len(rows) < 3:
         raise InputError(f"{p}: expected a header and at least 2 rows of t, q1..q{model.n}")
     arr = _time_and_joints(rows, model.n, p)

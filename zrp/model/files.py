@@ -29,6 +29,7 @@ from zrp.errors import InputError, ModelError, ModelFileError
 from zrp.model.builtin import builtin_models
 from zrp.model.manipulator import EndEffector, Joint, Manipulator
 from zrp.output import write_text
+from zrp.textio import read_text
 from zrp.units import canonical_length_unit
 
 if sys.version_info >= (3, 11):
@@ -97,7 +98,7 @@ def load_model(path: str | Path) -> Manipulator:
         raise ModelFileError(f"path: expected a model file name or a built-in model "
                              f"{sorted(builtin_models())}, got {path!r}")
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         builtins = builtin_models()
         if str(path) in builtins:
             p = builtins[str(path)]
@@ -105,10 +106,7 @@ def load_model(path: str | Path) -> Manipulator:
             raise ModelFileError(
                 f"{path}: no such model file; built-in models are {sorted(builtins)}"
             )
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ModelFileError(f"{p}: cannot read model file: {exc}") from exc
+    text = read_text(p, error=ModelFileError)  # a regular file, size checked, UTF-8/16
     return loads_model(text, str(p))
 
 

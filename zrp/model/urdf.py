@@ -18,6 +18,7 @@ an error that names them (for a mobile manipulator, start at the arm's base link
 
 from __future__ import annotations
 
+import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +28,7 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.errors import ModelFileError
 from zrp.model.manipulator import Manipulator
+from zrp.textio import read_text
 from zrp.units import metres_per_unit
 
 __all__ = ["URDFImport", "URDFJoint", "URDFTree", "from_urdf", "import_urdf", "read_urdf"]
@@ -52,23 +54,30 @@ class URDFJoint:
 
 @dataclass(frozen=True)
 class URDFTree:
-    """The kinematic tree: link names, joints by child link, and the root link."""
+    """The kinematic tree: link names, joints by child link, and the root link (the joints
+    form a tree: :func:`read_urdf` refuses cycles and undeclared links)."""
 
     name: str
     source: str
     links: tuple[str, ...]
     joints: dict[str, URDFJoint]  # keyed by child link
     root: str
+    _kids: dict[str, list[str]] = field(default_factory=dict, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        if not self._kids:  # children by parent link, in document order: built once
+            for child, j in self.joints.items():
+                self._kids.setdefault(j.parent, []).append(child)
 
     def children(self, link: str) -> list[str]:
-        return [c for c, j in self.joints.items() if j.parent == link]
+        return list(self._kids.get(link, ()))
 
     def leaves(self, start: str) -> list[str]:
         """Links without children in the subtree under ``start`` (depth first)."""
         out, stack = [], [start]
         while stack:
             link = stack.pop()
-            kids = self.children(link)
+            kids = self._kids.get(link, ())
             if not kids:
                 out.append(link)
             stack.extend(reversed(kids))
@@ -80,7 +89,7 @@ class URDFTree:
         link = end
         while link != base:
             j = self.joints.get(link)
-            if j is None:
+            if j is None or len(chain) > len(self.joints):
                 raise ModelFileError(f"{self.source}: end_link {end!r} is not below base_link "
                                      f"{base!r} in the kinematic tree")
             chain.append(j)
@@ -120,16 +129,31 @@ def rpy_matrix(rpy: F64) -> F64:
                      [-sp, cp * sr, cp * cr]])
 
 
+def _number(lim: ET.Element, attr: str, default: str | None, where: str) -> float | None:
+    """The finite number in attribute ``attr`` of a ``<limit>`` (``default`` when absent)."""
+    text = lim.get(attr, default)
+    if text is None:
+        return None
+    try:
+        v = float(text)
+    except ValueError:
+        raise ModelFileError(f"{where} limit {attr}: {text!r} is not a number") from None
+    if not np.isfinite(v):
+        raise ModelFileError(f"{where} limit {attr}: {text!r} is not a finite number")
+    return v
+
+
 def _limits(el: ET.Element, jtype: str, where: str) -> tuple[tuple[float, float] | None,
                                                              float | None]:
     lim = el.find("limit")
     if lim is None:
         return None, None
-    vel = lim.get("velocity")
-    v = float(vel) if vel is not None and float(vel) > 0 else None
+    vel = _number(lim, "velocity", None, where)
+    v = vel if vel is not None and vel > 0 else None
     if jtype == "continuous":
         return None, v
-    lo, hi = float(lim.get("lower", "0")), float(lim.get("upper", "0"))
+    lo, hi = _number(lim, "lower", "0", where), _number(lim, "upper", "0", where)
+    assert lo is not None and hi is not None
     if lo > hi:
         raise ModelFileError(f"{where} limit: lower {lo} > upper {hi}")
     return (lo, hi), v
@@ -164,22 +188,68 @@ def _joint(el: ET.Element, source: str) -> URDFJoint:
                      vel, mimic.get("joint") if mimic is not None else None)
 
 
+def _parse(source: str | Path) -> tuple[ET.Element, str]:
+    """The root element and a label: a path is read with :func:`zrp.textio.read_text` (a
+    regular file, size checked, UTF-8 or UTF-16 decoded); text starting with ``<`` is XML."""
+    text_given = isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<")
+    if text_given:
+        label, text = "<urdf string>", str(source)
+    else:
+        if not isinstance(source, (str, os.PathLike)):
+            raise ModelFileError(f"source: expected a URDF file path or XML text, got "
+                                 f"{type(source).__name__}")
+        label = str(source)
+        text = read_text(source, label=label, error=ModelFileError)
+    try:
+        return ET.fromstring(text.lstrip("\ufeff")), label
+    except ET.ParseError as exc:
+        raise ModelFileError(f"{label}, line {exc.position[0]}: not valid XML: {exc}") from exc
+
+
+def _check_links(label: str, links: tuple[str, ...], joints: dict[str, URDFJoint],
+                 root: str | None) -> None:
+    """Every joint between declared links and every link reachable from ``root``: otherwise
+    the joints hold a cycle (a self-loop included), named. Linear in the joints."""
+    declared = set(links)
+    for j in joints.values():
+        for role, link in (("parent", j.parent), ("child", j.child)):
+            if link not in declared:
+                raise ModelFileError(f"{label}: joint {j.name!r}: {role} link {link!r} is not "
+                                     "a <link> of the robot")
+    kids: dict[str, list[str]] = {}
+    for child, j in joints.items():
+        kids.setdefault(j.parent, []).append(child)
+    seen, stack = ({root}, [root]) if root is not None else (set(), [])
+    while stack:
+        for c in kids.get(stack.pop(), ()):
+            if c not in seen:
+                seen.add(c)
+                stack.append(c)
+    lost = [lk for lk in links if lk not in seen]
+    if not lost:
+        return
+    on_path: list[str] = []
+    link = lost[0]
+    while link not in on_path:  # every lost link has a parent: walking up must repeat
+        on_path.append(link)
+        link = joints[link].parent
+    cycle = on_path[on_path.index(link):][::-1]
+    names = [joints[c].name for c in cycle]
+    raise ModelFileError(f"{label}: the joints {names} form a cycle through the links "
+                         f"{cycle}; a URDF is a tree (each link has one parent and the root "
+                         "none)")
+
+
 def read_urdf(source: str | Path) -> URDFTree:
     """Parse a URDF file path (or URDF XML text) into its kinematic tree.
 
     Raises:
-        ModelFileError: unreadable file, invalid XML (with its line), a joint without parent or
-            child, an unknown joint type, several roots or a link with two parents.
+        ModelFileError: unreadable file (not a regular file, too large, not UTF-8/UTF-16),
+            invalid XML (with its line), a joint without parent or child, an unknown joint
+            type, a limit that is not a number, several roots, a link with two parents, a
+            joint naming an undeclared link, or joints forming a cycle.
     """
-    text_given = isinstance(source, str) and source.lstrip().startswith("<")
-    label = "<urdf string>" if text_given else str(source)
-    try:
-        root_el = (ET.fromstring(source) if text_given
-                   else ET.parse(source).getroot())
-    except ET.ParseError as exc:
-        raise ModelFileError(f"{label}, line {exc.position[0]}: not valid XML: {exc}") from exc
-    except OSError as exc:
-        raise ModelFileError(f"{label}: cannot read the URDF file: {exc}") from exc
+    root_el, label = _parse(source)
     if root_el.tag != "robot":
         raise ModelFileError(f"{label}: the root element is <{root_el.tag}>; expected <robot>")
     links = tuple(el.get("name", "") for el in root_el.findall("link"))
@@ -193,33 +263,53 @@ def read_urdf(source: str | Path) -> URDFTree:
                                  f"({joints[j.child].name!r}, {j.name!r})")
         joints[j.child] = j
     roots = [lk for lk in links if lk not in joints]
+    if not roots:
+        _check_links(label, links, joints, None)
     if len(roots) != 1:
-        raise ModelFileError(f"{label}: expected one root link, found {roots}")
+        shown = roots[:10] + (["..."] if len(roots) > 10 else [])
+        raise ModelFileError(f"{label}: expected one root link, found {len(roots)}: {shown}")
+    _check_links(label, links, joints, roots[0])
     return URDFTree(root_el.get("name", "") or Path(label).stem, label, links, joints,
                     roots[0])
 
 
 def _default_end(tree: URDFTree, base: str) -> str:
     """When every leaf under ``base`` lies on one chain of moving joints: the leaf at its end
-    if it is the only one, else the last moving link (e.g. a UR's ``ee_link`` and ``tool0``)."""
-    chains = {}
-    for leaf in tree.leaves(base):
-        moving = tuple(j.name for j in tree.path(base, leaf) if j.type != "fixed")
-        chains.setdefault(moving, leaf)
-    chains.pop((), None)
-    longest = max(chains, key=len, default=())
-    if not longest:
+    if it is the only one, else the last moving link (e.g. a UR's ``ee_link`` and ``tool0``).
+
+    Linear in the links: a leaf's chain of moving joints is known from its last moving joint
+    (``last``), and the chains are all one chain when those joints lie on one path."""
+    last: dict[str, str | None] = {base: None}  # link -> child link of its last moving joint
+    up: dict[str, str | None] = {}  # moving joint (by child link) -> the one before it
+    depth: dict[str | None, int] = {None: 0}
+    chains: dict[str, str] = {}  # last moving joint -> first leaf (depth first)
+    stack = [base]
+    while stack:
+        link = stack.pop()
+        kids = tree.children(link)
+        if not kids and last[link] is not None:
+            chains.setdefault(last[link], link)  # type: ignore[arg-type]
+        for c in reversed(kids):
+            if tree.joints[c].type == "fixed":
+                last[c] = last[link]
+            else:
+                last[c], up[c], depth[c] = c, last[link], depth[last[link]] + 1
+            stack.append(c)
+    if not chains:
         raise ModelFileError(f"{tree.source}: no moving joint below base_link {base!r}")
-    if any(c[:len(longest)] != longest[:len(c)] for c in chains):
+    longest = max(chains, key=lambda k: depth[k])
+    on_longest, k = set(), longest
+    while k is not None:
+        on_longest.add(k)
+        k = up[k]
+    if any(c not in on_longest for c in chains):
         raise ModelFileError(
             f"{tree.source}: the kinematic tree below {base!r} branches; name the end effector "
             f"(end_link=NAME), e.g. one of the branch ends {sorted(chains.values())}")
-    tips = [leaf for leaf in tree.leaves(base)
-            if tuple(j.name for j in tree.path(base, leaf) if j.type != "fixed") == longest]
+    tips = [leaf for leaf in tree.leaves(base) if last[leaf] == longest]
     if len(tips) == 1:  # one tool link (behind fixed joints or not)
         return tips[0]
-    last = next(j for j in tree.joints.values() if j.name == longest[-1])
-    return last.child
+    return longest
 
 
 def _check_chain(tree: URDFTree, chain: list[URDFJoint], base: str) -> None:

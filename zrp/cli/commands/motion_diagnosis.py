@@ -9,8 +9,9 @@ from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
 from zrp.escape import md_text
+from zrp.gap.data.choices import MAX_ROWS
 from zrp.gap.model.choices import EFFECTS
-from zrp.gap.motion.choices import MOTION_EFFECTS
+from zrp.gap.motion.choices import MOTION_EFFECTS, RATE_RANGE_HZ, TIME_UNITS
 from zrp.output import OutputDir, check_writable
 
 OUTPUT_FILES = ("diagnosis_motion.json", "report_motion.md")
@@ -27,6 +28,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", required=True, metavar="M.toml", help="model file or built-in name")
     p.add_argument("--data", required=True, metavar="D.csv", help="trajectory CSV")
     add_deg(p)
+    p.add_argument("--time-unit", choices=sorted(TIME_UNITS), default="s",
+                   help="unit of the t (and tq) column (default s; a median sample rate outside "
+                        f"{RATE_RANGE_HZ[0]:g} Hz to {RATE_RANGE_HZ[1]:g} Hz is refused)")
+    p.add_argument("--max-rows", type=whole(1), default=MAX_ROWS, metavar="N",
+                   help=f"most data rows read (default {MAX_ROWS:,}); a larger file is refused "
+                        "at the first row beyond")
     p.add_argument("--mjcf", metavar="M.xml", help="MJCF with the inertias (inverse-dynamics "
                    "torques for dynamic_compliance, the arm's own stiffness and damping for "
                    "residual_vibration; one hinge/slide joint per model joint)")
@@ -51,7 +58,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "n_segments": "--segments",
                                          "seed": "--seed", "effects": "--effects",
                                          "torque": "--mjcf", "magnify": "--magnify",
-                                         "overwrite": "--force"})
+                                         "overwrite": "--force", "time_unit": "--time-unit",
+                                         "max_rows": "--max-rows"})
 
 
 def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[object, object]:
@@ -77,7 +85,8 @@ def _run(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     if args.video:
         check_writable([args.video], args.force)  # before the work
-    traj = load_trajectory(args.data, model, deg=args.deg, frame=args.frame)
+    traj = load_trajectory(args.data, model, deg=args.deg, frame=args.frame,
+                           time_unit=args.time_unit, max_rows=args.max_rows)
     tau, terms = _torque(args, model, traj)
     with OutputDir(Path(args.out), overwrite=args.force, names=OUTPUT_FILES) as folder:
         diag = diagnose_motion(model, traj, torque=tau, mode_terms=terms, effects=args.effects,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 import warnings
 from typing import TYPE_CHECKING
 
@@ -65,7 +66,23 @@ def _limits(text: str | None, model: Manipulator, deg: bool) -> np.ndarray | Non
         raise InputError(f"--limits: expected LO:HI numbers, got {text!r}") from None
     if lim.shape != (model.n, 2):
         raise InputError(f"--limits: expected {model.n} LO:HI pairs, got {text!r}")
+    _check_limits(lim, pairs)
     return joint_angles(model, lim, deg, "--limits")
+
+
+def _check_limits(lim: np.ndarray, pairs: list[str]) -> None:
+    """Every pair finite with LO <= HI and at least one joint free to move: a NaN, an inverted
+    pair or all joints fixed (20 identical poses) is an error naming the joint."""
+    for k, (lo, hi) in enumerate(lim, start=1):
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            raise InputError(f"--limits: joint {k} is {pairs[k - 1]!r}; expected finite "
+                             "numbers LO:HI")
+        if lo > hi:
+            raise InputError(f"--limits: joint {k} is {pairs[k - 1]!r}: LO > HI; expected "
+                             "LO <= HI")
+    if bool((lim[:, 1] - lim[:, 0] <= 0.0).all()):
+        raise InputError("--limits: every joint has LO = HI: no joint can move, so every "
+                         "planned pose would be the same; give at least one joint a range")
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -8,11 +8,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from zrp.cli.app import emit
-from zrp.errors import InputError
+from zrp.errors import InputError, ModelFileError
 
 if TYPE_CHECKING:
     from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable
+from zrp.textio import read_text
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -45,15 +46,13 @@ def _slug(text: str) -> str:
     return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_").lower() or "model"
 
 
-def _kind(src: Path) -> str:
-    """"urdf", "mjcf" or "toml", from the file's content (not its name)."""
-    try:
-        head = src.read_text(encoding="utf-8", errors="replace")[:4096]
-    except OSError as exc:
-        raise InputError(f"FILE: cannot read {str(src)!r}: {exc}") from exc
-    if not head.lstrip().startswith("<"):
+def _kind(text: str) -> str:
+    """"urdf", "mjcf" or "toml", from the file's content (not its name): XML whose first
+    element (after a byte-order mark, declarations and comments) is ``<robot`` is a URDF."""
+    head = text[:65536].lstrip("\ufeff \t\r\n")
+    if not head.startswith("<"):
         return "toml"
-    body = re.sub(r"<\?.*?\?>|<!--.*?-->", "", head, flags=re.S).lstrip()
+    body = re.sub(r"<\?.*?\?>|<!--.*?-->|<!DOCTYPE[^>]*>", "", head, flags=re.S).lstrip()
     return "urdf" if body.startswith("<robot") else "mjcf"
 
 
@@ -63,7 +62,8 @@ def _read(args: argparse.Namespace) -> tuple[Manipulator, dict[str, object]]:
     from zrp.model.urdf import import_urdf  # on use: keeps --help quick
 
     src = Path(args.source)
-    kind = _kind(src)
+    text = read_text(src, label=str(src), error=ModelFileError)  # a regular file, size checked
+    kind = _kind(text)
     if kind == "urdf":
         if args.site:
             raise InputError("--site: a URDF has no sites; name the end link with --end")
@@ -72,7 +72,6 @@ def _read(args: argparse.Namespace) -> tuple[Manipulator, dict[str, object]]:
         return imp.model, {"format": "urdf", "base_link": imp.base_link,
                            "end_link": imp.end_link, "notes": list(imp.notes)}
     if kind == "toml":
-        text = src.read_text(encoding="utf-8")
         if re.search(r"^\s*\[\[\s*row\s*\]\]", text, re.M):
             table = loads_dh(text, str(src))
             return table.model(), {"format": f"dh ({table.convention})"}

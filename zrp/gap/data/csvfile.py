@@ -25,8 +25,10 @@ format.
 
 The file is read in one pass, record by record, into compact arrays (memory about 8 bytes a
 number plus the pose ids), as UTF-8 (with or without a byte-order mark) or UTF-16 with its
-byte-order mark; a byte that does not decode, or a field longer than
-``csv.field_size_limit()`` (131,072 characters), is an error naming its line. Only CR/LF end a
+byte-order mark, through :func:`zrp.textio.iter_lines` (a regular file only: a FIFO or a
+device is refused; a line longer than 1 Mi characters is refused while it streams); a byte
+that does not decode, or a field longer than ``csv.field_size_limit()`` (131,072
+characters), is an error naming its line. Only CR/LF end a
 record: a form feed or U+2028 inside a quoted field stays in the field.
 """
 
@@ -48,6 +50,7 @@ from zrp.gap.data.choices import MAX_ROWS
 from zrp.gap.data.csvrows import Accumulator, Columns, Header, check_header, parse_row
 from zrp.gap.data.measurements import FRAMES, DataWarning, Measurements
 from zrp.model.manipulator import Manipulator
+from zrp.textio import iter_lines
 from zrp.units import angle_bounds, joint_column_units, joint_values_to_rad, length_scale
 
 __all__ = ["MAX_ROWS", "load_measurements"]
@@ -57,16 +60,9 @@ __all__ = ["MAX_ROWS", "load_measurements"]
 TEMP_RANGE = (-60.0, 150.0)
 
 
-def _encoding(path: Path) -> str:
-    """UTF-16 when the file starts with its byte-order mark, else UTF-8 (with or without BOM)."""
-    with open(path, "rb") as fh:
-        head = fh.read(2)
-    return "utf-16" if head in (b"\xff\xfe", b"\xfe\xff") else "utf-8-sig"
-
-
 def _records(fh: Iterable[str], src: str) -> Iterator[tuple[int, list[str]]]:
-    """(first line number, fields) of each record of a CSV text stream; a decoding error or an
-    over-long field is an :class:`InputError` naming the line."""
+    """(first line number, fields) of each record of a CSV text stream; an over-long field is
+    an :class:`InputError` naming the line."""
     reader = csv.reader(fh)
     last = 0
     while True:
@@ -74,29 +70,12 @@ def _records(fh: Iterable[str], src: str) -> Iterator[tuple[int, list[str]]]:
             rec = next(reader)
         except StopIteration:
             return
-        except UnicodeDecodeError as exc:
-            line = _undecodable_line(src) or reader.line_num + 1
-            raise InputError(
-                f"{src} line {line}: byte 0x{exc.object[exc.start]:02x} is not "
-                f"{exc.encoding.upper()} text; save the file as UTF-8 (or UTF-16 with a "
-                "byte-order mark)") from None
         except csv.Error as exc:
             raise InputError(f"{src} line {last + 1}: {exc} (at most "
                              f"{csv.field_size_limit()} characters a field); expected a "
                              "measurement CSV") from None
         yield last + 1, rec
         last = reader.line_num
-
-
-def _undecodable_line(src: str) -> int | None:
-    """The first line of a UTF-8 file that does not decode (read again, only after an error)."""
-    with open(src, "rb") as fh:
-        for lineno, raw in enumerate(fh, start=1):
-            try:
-                raw.decode("utf-8")
-            except UnicodeDecodeError:
-                return lineno
-    return None
 
 
 class _Reader:
@@ -161,8 +140,8 @@ def _read(path: Path, src: str, model: Manipulator, progress: bool, max_rows: in
     reader = _Reader(src, model, max_rows)
     bar = tqdm(desc=f"reading {path.name}", unit=" rows", disable=not progress,
                mininterval=1.0, leave=False)
-    with open(path, newline="", encoding=_encoding(path)) as fh, bar:
-        for lineno, rec in _records(fh, src):
+    with bar:  # zrp.textio: a regular file, lines bounded, UTF-8 or UTF-16 decoded
+        for lineno, rec in _records(iter_lines(path, label=src), src):
             if reader.feed(lineno, rec) and reader.rows % 10000 == 0:
                 bar.update(10000)
     header, h, acc = reader.parsed()
@@ -232,13 +211,8 @@ def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: 
     src = str(path)
     if frame not in FRAMES:
         raise InputError(f"frame: {frame!r} is not a frame; expected one of {FRAMES}")
-    if not path.is_file():
-        raise InputError(f"{src}: no such file")
-    try:
-        _, h, c = _read(path, src, model, progress,
-                        None if max_rows is None else check_int(max_rows, "max_rows", 1))
-    except OSError as exc:
-        raise InputError(f"{src}: cannot read ({exc.strerror or exc})") from exc
+    _, h, c = _read(path, src, model, progress,
+                    None if max_rows is None else check_int(max_rows, "max_rows", 1))
     _units(c, h, model, deg, src)
     _check_scalars(c.scalars, c.lines, src)
     if c.quat is not None:

@@ -10,6 +10,7 @@ unchanged on the same data. The commanded joint values are interpolated by a cub
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -20,11 +21,31 @@ from scipy.interpolate import CubicSpline
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import FRAMES, Measurements
+from zrp.gap.motion.choices import RATE_RANGE_HZ, TIME_UNITS
 
-__all__ = ["MIN_SAMPLES", "Trajectory"]
+__all__ = ["MIN_SAMPLES", "RATE_RANGE_HZ", "TIME_UNITS", "Trajectory", "check_rate"]
 
 #: fewest samples a trajectory diagnosis accepts.
 MIN_SAMPLES = 50
+
+
+
+def check_rate(t: F64, lines: NDArray[np.int64] | None, source: str) -> None:
+    """Refuse a stream whose median sample rate lies outside :data:`RATE_RANGE_HZ` (time
+    stamps in ms or us read as s, or a stream that is no tracker's), naming the range."""
+    if t.size < 2:
+        return
+    dt = float(np.median(np.diff(t)))
+    rate = 1.0 / dt if dt > 0 else math.inf
+    lo, hi = RATE_RANGE_HZ
+    if lo <= rate <= hi:
+        return
+    where = f"{source} line {int(lines[0])}" if lines is not None and len(lines) else source
+    hint = ("are the time stamps in ms or us? name their unit: time_unit=\"ms\" "
+            "(--time-unit ms on the command line)" if rate < lo else
+            "the time stamps must be in s (or name their unit with time_unit, --time-unit)")
+    raise InputError(f"{where}: column t has a median sample interval of {dt:g} s "
+                     f"({rate:g} Hz); a tracker stream is {lo:g} Hz to {hi:g} Hz: {hint}")
 
 
 def _frozen(a: ArrayLike) -> F64:

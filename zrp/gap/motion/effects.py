@@ -53,11 +53,13 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.model.context import KINDS, Context, ParamSpec
 from zrp.gap.motion.choices import MOTION_EFFECTS
+from zrp.gap.motion.columns import Deviation, JointColumn, combine
 from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.kernels import first_order_lag, mode_response, play
 
-__all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "MotionContext", "MotionParam", "effect_columns",
-           "joint_mode", "limit_step", "linearise", "mode_band", "plausible", "tested"]
+__all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "JointColumn", "MotionContext", "MotionParam",
+           "effect_columns", "joint_mode", "limit_step", "linearise", "mode_band", "plausible",
+           "tested"]
 
 #: effects whose parameters are physically positive (a negative estimate is not that effect)
 POSITIVE = ("servo_lag", "reversal_friction", "dynamic_compliance", "residual_vibration")
@@ -101,8 +103,9 @@ class Column:
         name, unit, effect: as in :class:`~zrp.gap.model.context.ParamSpec`.
         joint: 1-based joint, 0 for a parameter acting on all joints.
         value: the value at which d and D are evaluated.
-        d: the joint deviation d(theta), shape (S, n).
-        D: its derivative, shape (S, n).
+        d: the joint deviation d(theta), shape (S, n) (a :class:`JointColumn` when it acts on
+            one joint).
+        D: its derivative, shape (S, n) (idem).
         via: for a coupling column (eq. M7), the parameter through which ``name`` acts
             here (the mode's gain); "" for the parameter's own column.
     """
@@ -112,15 +115,13 @@ class Column:
     effect: str
     joint: int
     value: float
-    d: F64
-    D: F64
+    d: Deviation
+    D: Deviation
     via: str = ""
 
 
-def _one_joint(s: int, n: int, k: int, col: F64) -> F64:
-    out = np.zeros((s, n))
-    out[:, k] = col
-    return out
+def _one_joint(s: int, n: int, k: int, col: F64) -> JointColumn:
+    return JointColumn(n, k, np.array(col, dtype=float).reshape(s))
 
 
 def _moving(traj: Trajectory) -> list[int]:
@@ -172,7 +173,8 @@ def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | Non
         name = f"q{k + 1}.dyn_compliance"
         c = float(values.get(name, 0.0))
         D = _one_joint(s, n, k, -torque[:, k])  # the joint yields to the torque it carries
-        out.append(Column(name, "rad/(N m)", "dynamic_compliance", k + 1, c, c * D, D))
+        out.append(Column(name, "rad/(N m)", "dynamic_compliance", k + 1, c,
+                          JointColumn(n, k, c * D.col), D))
     return out
 
 
@@ -227,7 +229,7 @@ def _vibration(traj: Trajectory, values: Mapping[str, float], terms: F64 | None 
         delay, lag = couple.get("sync.delay"), couple.get(f"q{k + 1}.lag")
         f, f_delay, f_lag = _drive(traj, k, delay, lag)
         y, dw, dz = joint_mode(traj, k, w, z, terms, forcing=f)
-        zero = np.zeros((s, n))
+        zero = JointColumn(n, k, np.zeros(s))
         out += [Column(p + "gain", "1", "residual_vibration", k + 1, g,
                        _one_joint(s, n, k, g * y), _one_joint(s, n, k, y)),
                 Column(p + "omega", "rad/s", "residual_vibration", k + 1, w, zero,
@@ -316,14 +318,19 @@ def linearise(cols: list[Column]) -> tuple[F64 | None, list[MotionParam]]:
         else:
             own = c if not c.via else o
             merged[c.name] = Column(c.name, own.unit, own.effect, own.joint, own.value,
-                                    o.d + c.d, o.D + c.D)
+                                    combine(o.d, c.d), combine(o.D, c.D))
     shift = None
     specs = []
     for c in merged.values():
-        part = c.d - c.D * c.value
-        if np.any(part != 0.0):
+        part = combine(c.d, c.D, -c.value)
+        if isinstance(part, JointColumn):
+            if np.any(part.col != 0.0):
+                if shift is None:
+                    shift = np.zeros(part.shape)
+                shift[:, part.k] += part.col
+        elif np.any(part != 0.0):
             shift = part if shift is None else shift + part
-        basis = np.array(c.D)
+        basis = c.D  # the column's own array, frozen: no copy of (S, n) per parameter
         basis.setflags(write=False)
         specs.append(MotionParam(c.name, c.unit, c.effect, "dq", c.joint, 0, basis,
                                  f"q{c.joint}" if c.joint else "all"))

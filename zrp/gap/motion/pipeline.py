@@ -7,20 +7,23 @@ of the fitting samples: at 1 kHz neighbouring samples add little information but
 
 from __future__ import annotations
 
+import functools
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from zrp.arrays import F64, I64
+from zrp.blas import blas_threads
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import ALIAS_TOL, initial_registration, point_errors
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.model.context import EFFECTS, Context
 from zrp.gap.model.effects import registration_parameters
 from zrp.gap.model.problem import Problem
-from zrp.gap.motion.data import Trajectory
+from zrp.gap.motion.data import Trajectory, check_rate
 from zrp.gap.motion.effects import MOTION_EFFECTS
 from zrp.gap.motion.fitting import Engine, ModelFit
 from zrp.gap.motion.results import MotionDiagnosis, MotionEstimate, MotionStep, PhaseError
@@ -37,6 +40,7 @@ def _check(model: Manipulator, traj: Trajectory, torque: ArrayLike | None,
     if not isinstance(traj, Trajectory):
         raise InputError(f"trajectory: expected a zrp.gap.motion.Trajectory, got "
                          f"{type(traj).__name__}")
+    check_rate(traj.t, traj.lines, traj.source)
     if traj.n_joints != model.n:
         raise InputError(f"trajectory has {traj.n_joints} joint columns but the model "
                          f"{model.name!r} has {model.n} joints")
@@ -110,6 +114,19 @@ def _phase_table(traj: Trajectory, before: F64, after: F64, withheld: I64) -> tu
     return tuple(out)
 
 
+def _one_blas_thread(fn: Callable[..., MotionDiagnosis]) -> Callable[..., MotionDiagnosis]:
+    """Run ``fn`` with one BLAS thread, as the static diagnosis does (:mod:`zrp.blas`: many
+    small dense problems; OpenBLAS threads spin against each other under load)."""
+
+    @functools.wraps(fn)
+    def run(*args: Any, **kwargs: Any) -> MotionDiagnosis:
+        with blas_threads(1):
+            return fn(*args, **kwargs)
+
+    return run
+
+
+@_one_blas_thread
 def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
                     torque: ArrayLike | None = None, mode_terms: ArrayLike | None = None,
                     effects: Sequence[str] = MOTION_EFFECTS,
@@ -165,8 +182,8 @@ def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
     for tr, ranked in trace:
         if tr.fit is None or tr.effect not in final_all.effects:
             continue
-        ties = tuple(r.effect for r in ranked[1:] if r.fit is not None
-                     and r.cv_rms <= 1.01 * tr.cv_rms)
+        ties = tuple(r.effect for r in ranked[1:]  # untried: cv_rms = inf
+                     if r.cv_rms <= 1.01 * tr.cv_rms)
         steps.append(MotionStep(tr.effect, tr.joints, tr.cv_rms, tr.p_value, tr.bic_delta,
                                 Metrics.of(eng.residual(tr.fit, split.withheld)),
                                 tuple(r.to_dict() for r in ranked), ties))

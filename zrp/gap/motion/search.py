@@ -6,7 +6,7 @@ over folds of whole time segments (:func:`~zrp.gap.fit.leastsq.cv_rms`)."""
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -119,11 +119,15 @@ def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
         trials = [try_effect(eng, current, e, poses, folds, alpha) for e in left]
         ranked = sorted(trials, key=lambda tr: tr.cv_rms)
         best = ranked[0]
+        # the ranking keeps its scores, not the losers' fits: each fit holds arrays of the
+        # whole trajectory (bases, shifts: memory linear in the samples per fit kept)
+        light = [replace(tr, fit=None) for tr in ranked[1:]]
         if (best.fit is None or best.p_value >= alpha or best.bic_delta >= 0
                 or best.cv_rms > (1.0 - min_gain) * cur_cv):
-            steps.append((Trial(best.effect, None, note="stop"), ranked))
+            steps.append((Trial(best.effect, None, note="stop"),
+                          [replace(best, fit=None), *light]))
             break
-        steps.append((best, ranked))
+        steps.append((best, [best, *light]))
         current, cur_cv = best.fit, best.cv_rms
     return current, steps
 
