@@ -39,6 +39,7 @@ from zrp.errors import ModelError
 from zrp.jsonio import dumps
 from zrp.model.manipulator import Manipulator, hand_frame
 from zrp.output import check_writable, write_text
+from zrp.textio import read_text
 from zrp.units import metres_per_unit
 
 __all__ = ["export_mjcf", "patch_mjcf", "relocate_assets"]
@@ -243,7 +244,7 @@ def export_mjcf(cal: CalibratedRobot, source: str | os.PathLike[str], xml_path: 
     text = patch_mjcf(source, cal.model, site=site, body=body, rotations=cal.fold_rotations(),
                       out_dir=Path(xml_path).resolve().parent)
     try:
-        original = Path(source).read_text(encoding="utf-8")
+        original = read_text(source, error=MJCFImportError)
     except (OSError, UnicodeDecodeError) as exc:
         raise MJCFImportError(f"{source}: cannot read ({exc})") from exc
     side = side_document(cal, Path(xml_path).name, original, None, site or body)

@@ -9,6 +9,8 @@ import os
 import pytest
 
 import zrp
+from zrp.calibration import read_calibration
+from zrp.calibration.planfile import read_plan
 from zrp.calibration.targets import load_targets
 from zrp.cli import main
 from zrp.errors import ZRPError
@@ -26,6 +28,8 @@ READERS = {
     "trajectory": lambda p: load_trajectory(p, PUMA),
     "targets": lambda p: load_targets(p, 6),
     "joints": lambda p: load_joint_csv(p, PUMA),
+    "compensation": lambda p: read_calibration(p),
+    "plan": lambda p: read_plan(p, PUMA),
 }
 
 

@@ -24,6 +24,7 @@ from zrp.errors import InputError
 from zrp.jsonio import dumps
 from zrp.model.urdf_patch import patch_urdf
 from zrp.output import check_writable, write_text
+from zrp.textio import read_text
 
 __all__ = ["SIDE_KIND", "export_urdf", "side_document"]
 
@@ -74,7 +75,7 @@ def export_urdf(cal: CalibratedRobot, source: str | Path, urdf_path: str | Path,
     check_writable([urdf_path, side_path], overwrite)
     validate_calibration(cal, cal.widen, "export")
     try:
-        text = Path(source).read_text(encoding="utf-8")
+        text = read_text(source)  # a regular file, size checked, UTF-8/16
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{source}: cannot read the URDF ({exc})") from exc
     urdf = patch_urdf(text, cal.model, base_link=base_link, end_link=end_link,

@@ -21,6 +21,7 @@ from zrp.calibration.planning import Plan
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
+from zrp.textio import read_text
 from zrp.units import angle_bounds, joint_column_units, joint_values_to_rad, split_unit
 
 __all__ = ["PlannedPoses", "read_plan", "write_plan"]
@@ -70,10 +71,8 @@ def _number(text: str, src: str, line: int, col: str) -> float:
 
 
 def _rows(path: Path, src: str) -> list[list[str]]:
-    if not path.is_file():
-        raise InputError(f"{src}: no such plan file")
     try:
-        text = path.read_text(encoding="utf-8-sig")
+        text = read_text(path, label=src)  # a regular file, size checked, BOM dropped
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{src}: cannot read the plan file: {exc}") from None
     try:

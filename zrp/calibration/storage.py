@@ -26,6 +26,7 @@ from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
 from zrp.rotations import er_from_matrix, rotvec_from_er
+from zrp.textio import read_text
 from zrp.version import __version__
 
 __all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "model_file_path",
@@ -180,7 +181,7 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
     """
     src = str(comp_path)
     try:
-        doc = json.loads(Path(comp_path).read_text(encoding="utf-8"))
+        doc = json.loads(read_text(comp_path, label=src))  # a regular file, size checked
     except (OSError, ValueError) as exc:
         raise InputError(f"{src}: cannot read the compensation file: {exc}") from exc
     if not isinstance(doc, dict):
