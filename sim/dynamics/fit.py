@@ -79,6 +79,8 @@ def solve(d: Design, b: F64, sigma: F64, rows: np.ndarray | None = None,
           with_cov: bool = True) -> Fit:
     """Fit theta to b = tau - tau0 (S, n) on ``rows`` (all by default), eq. F1-F2."""
     rows = np.arange(b.shape[0]) if rows is None else rows
+    if d.a.shape[-1] == 0:
+        return Fit(np.zeros(0), np.zeros((0, 0)), 0.0, np.zeros(0, dtype=bool))
     aw, bw, scale = _weighted(d, b, sigma, rows)
     x = _lsq(aw, bw, d.lower * scale, d.upper * scale)
     theta = x / scale

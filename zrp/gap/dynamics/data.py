@@ -126,31 +126,32 @@ def _kind(name: str, src: str) -> str:
     return GROUPS[split[0]]
 
 
+def _group_present(names: list[str], prefix: str, n: int, src: str) -> bool:
+    """Whether all of prefix1..prefixn are given (none: False; some: an error)."""
+    cols = [c for c in names if (_split_name(c) or ("", 0))[0] == prefix]
+    want = [f"{prefix}{k}" for k in range(1, n + 1)]
+    extra = sorted(set(cols) - set(want))
+    if extra:
+        raise InputError(f"{src} line 1: column(s) {', '.join(extra)} beyond the {n} joints "
+                         f"of q1..q{n}")
+    if cols and len(cols) != n:
+        raise InputError(f"{src} line 1: {prefix}1..{prefix}{n} must all be given; got "
+                         f"only {', '.join(c for c in want if c in cols)}")
+    return bool(cols)
+
+
 def _groups(names: list[str], src: str) -> tuple[int, tuple[str, ...]]:
     """The number of joints (from q1..qn) and the complete groups present."""
     n = sum(1 for c in names if (_split_name(c) or ("", 0))[0] == "q")
-    need = ["t", *(f"q{k}" for k in range(1, n + 1))]
-    missing = [c for c in need if c not in names]
+    missing = [c for c in ["t", *(f"q{k}" for k in range(1, n + 1))] if c not in names]
     if n == 0 or missing:
         raise InputError(f"{src} line 1: missing column(s) {', '.join(missing) or 'q1'}; a "
                          "torque log needs t, q1..qn and tau1..taun (or i1..in)")
-    present = []
-    for prefix in GROUPS:
-        cols = [c for c in names if (_split_name(c) or ("", 0))[0] == prefix]
-        want = [f"{prefix}{k}" for k in range(1, n + 1)]
-        extra = sorted(set(cols) - set(want))
-        if extra:
-            raise InputError(f"{src} line 1: column(s) {', '.join(extra)} beyond the {n} joints "
-                             f"of q1..q{n}")
-        if cols and len(cols) != n:
-            raise InputError(f"{src} line 1: {prefix}1..{prefix}{n} must all be given; got "
-                             f"only {', '.join(c for c in want if c in cols)}")
-        if cols:
-            present.append(prefix)
+    present = tuple(p for p in GROUPS if _group_present(names, p, n, src))
     if "tau" not in present and "i" not in present:
         raise InputError(f"{src} line 1: no torques: give tau1..tau{n} (N m) or the motor "
                          f"currents i1..i{n} (A) with a torque constant")
-    return n, tuple(present)
+    return n, present
 
 
 def _layout(header: list[str], src: str) -> _Layout:
