@@ -148,9 +148,9 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
 
 def arm_from_manipulator(model: Manipulator, inertia: str = "puma560") -> Arm:
     """A ZRP manipulator built into MuJoCo (:func:`mjcf.build`) with ``inertia`` ("puma560"
-    or "rods") and no servos."""
+    or "rods") and no servos; the payload sits at its end-effector site."""
     built = build(model, MJCFOptions(inertia=inertia))
     spec = built.spec
     for act in list(spec.actuators):
         spec.delete(act)
-    return _from_spec(spec, model.name, None, f"manipulator {model.name}")
+    return _from_spec(spec, model.name, built.site_name, f"manipulator {model.name}")

@@ -185,20 +185,21 @@ def _check_inputs(arm: Arm, log: TorqueLog) -> None:
                          f"model {arm.name!r} has {arm.n}")
 
 
-def _feasible(arm: Arm, beta: F64) -> tuple[bool, float, dict[int, F64]]:
+def _feasible(arm: Arm, beta: F64, basis: tuple[F64, F64]
+              ) -> tuple[bool, float, dict[int, F64]]:
     """Whether the inertial correction is physical (eq. R5); if not, the largest fraction of
     it (bisection toward the model's feasible values) that is."""
-    phi = inertial_correction(arm, beta)
+    phi = inertial_correction(arm, beta, basis)
     if all(pseudo_inertia_ok(p) for p in phi.values()):
         return True, 1.0, phi
     lo, hi = 0.0, 1.0
     for _ in range(30):
         mid = 0.5 * (lo + hi)
-        if all(pseudo_inertia_ok(p) for p in inertial_correction(arm, mid * beta).values()):
+        if all(pseudo_inertia_ok(p) for p in inertial_correction(arm, mid * beta, basis).values()):
             lo = mid
         else:
             hi = mid
-    return False, lo, inertial_correction(arm, lo * beta)
+    return False, lo, inertial_correction(arm, lo * beta, basis)
 
 
 def diagnose_dynamics(arm: Arm, log: TorqueLog, options: DynamicsOptions | None = None
@@ -227,7 +228,7 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     for i, (e, sl) in enumerate(zip(chosen, d.slices, strict=True)):
         theta = fit.theta[sl]
         if e.name == "inertial":
-            feasible, shrink, phi = _feasible(arm, theta)
+            feasible, shrink, phi = _feasible(arm, theta, e.basis)
         found.append(FoundEffect(e.key, e.name, e.joint, e.detail,
                                  _params(e, theta, fit.cov[sl, sl], fit.at_bound[sl]),
                                  steps[i].chi2 - steps[i + 1].chi2))

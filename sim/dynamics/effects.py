@@ -61,6 +61,7 @@ class Effect:
     lower: F64
     upper: F64
     detail: str = ""
+    basis: tuple[F64, F64] | None = None  # "inertial": (V, scale) of eq. R4
 
     @property
     def key(self) -> str:
@@ -139,15 +140,16 @@ def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,
         yb = (y * scale) @ v
         r = v.shape[1]
         out.append(Effect("inertial", None, yb, tuple(f"beta{i + 1}" for i in range(r)),
-                          ("(scaled)",) * r, np.full(r, -inf), np.full(r, inf)))
+                          ("(scaled)",) * r, np.full(r, -inf), np.full(r, inf),
+                          basis=(v, scale)))
     return out
 
 
-def inertial_correction(arm: Arm, beta: F64) -> dict[int, F64]:
+def inertial_correction(arm: Arm, beta: F64, basis: tuple[F64, F64]) -> dict[int, F64]:
     """phi_b of each moving body after the fitted base combination ``beta`` (eq. R4: the
     minimum-norm change in scaled parameters; directions the arm cannot show keep the
     model's values)."""
-    v, scale = base_directions(arm)
+    v, scale = basis
     dphi = scale * (v @ beta)
     out = {}
     for i, b in enumerate(arm.moving_bodies()):

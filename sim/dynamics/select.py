@@ -8,7 +8,11 @@ with theta_(-seg) fitted without the time segment the sample lies in (and a guar
 filter window on each side). It is 1 when the model explains the torques down to the noise.
 Each step adds the candidate that lowers it most, if the drop is at least ``min_rel`` of the
 current chi2 and ``min_abs`` (noise variances): smaller drops are what a wrong friction law or
-the acceleration filter leave, not evidence of an effect. One Stribeck speed a joint.
+the acceleration filter leave, not evidence of an effect. Parsimony: among the candidates whose
+drop is within ``occam`` (10 %) of the largest, the one with the fewest parameters is taken (a
+payload is also a change of the tool link's inertias; the four payload parameters are
+preferred to the forty link combinations when both explain the torques). One Stribeck speed a
+joint.
 """
 
 from __future__ import annotations
@@ -40,9 +44,20 @@ def _family(e: Effect) -> tuple[str, int | None]:
     return e.name, e.joint
 
 
+def _parsimonious(scored: list[tuple[float, Effect, F64]], chi2: float, occam: float
+                  ) -> tuple[float, Effect, F64] | None:
+    """The candidate with the fewest parameters among those within ``occam`` of the best
+    drop (ties: the lower chi2)."""
+    if not scored:
+        return None
+    top = min(c for c, _, _ in scored)
+    near = [s for s in scored if chi2 - s[0] >= (1.0 - occam) * (chi2 - top)]
+    return min(near, key=lambda s: (s[1].columns.shape[-1], s[0]))
+
+
 def forward_select(effects: list[Effect], b: F64, b_raw: F64, sigma: F64, *, folds: int,
-                   guard: int, min_rel: float, min_abs: float, max_effects: int
-                   ) -> tuple[list[Effect], list[Step], F64]:
+                   guard: int, min_rel: float, min_abs: float, max_effects: int,
+                   occam: float = 0.1) -> tuple[list[Effect], list[Step], F64]:
     """The chosen effects, the steps (first: the nominal model, key "nominal") and the
     out-of-segment prediction of the final set (S, n)."""
     cv = CVGram(effects, b, sigma, folds, guard)
@@ -52,14 +67,9 @@ def forward_select(effects: list[Effect], b: F64, b_raw: F64, sigma: F64, *, fol
     steps = [Step("nominal", chi2)]
     while len(chosen) < max_effects:
         taken = {_family(e) for e in chosen}
-        best: tuple[float, Effect, F64] | None = None
-        for e in effects:
-            if _family(e) in taken:
-                continue
-            p = cv.predict([c.key for c in (*chosen, e)])
-            c = chi2_of(b_raw, p, sigma)
-            if best is None or c < best[0]:
-                best = (c, e, p)
+        scored = [(chi2_of(b_raw, p, sigma), e, p) for e in effects if _family(e) not in taken
+                  for p in [cv.predict([c.key for c in (*chosen, e)])]]
+        best = _parsimonious(scored, chi2, occam)
         if best is None or chi2 - best[0] < max(min_rel * chi2, min_abs):
             break
         chi2, e, pred = best
