@@ -87,6 +87,18 @@ class FoundEffect:
 
 
 @dataclass(frozen=True)
+class Samples:
+    """The states and residuals at the fit rate, for plots: q, qd, and measured (raw) minus
+    model torques before and after (withheld), each (S, n)."""
+
+    t: F64
+    q: F64
+    qd: F64
+    before: F64
+    after: F64
+
+
+@dataclass(frozen=True)
 class DynamicDiagnosis:
     """The result (all torques in N m, per joint arrays of shape (n,)).
 
@@ -118,6 +130,7 @@ class DynamicDiagnosis:
     inertial_shrink: float = 1.0
     inertial_phi: dict[int, F64] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
+    samples: Samples | None = None
 
     def effect(self, name: str, joint: int | None = None) -> FoundEffect | None:
         for e in self.effects:
@@ -243,4 +256,4 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
         np.sqrt(np.mean((b_raw - pred) ** 2, 0)), steps, found,
         _cannot_tell([e for e in effects if e.name in JOINT_EFFECTS], sigma, opt.collinear),
         {"before": regime_rms(b_raw, masks), "after": regime_rms(b_raw - pred, masks)},
-        feasible, shrink, phi, notes)
+        feasible, shrink, phi, notes, Samples(s.t, s.q, s.qd, b_raw, b_raw - pred))

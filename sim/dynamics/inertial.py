@@ -156,11 +156,13 @@ def base_directions(arm: Arm, n_states: int = 60, seed: int = 0, rtol: float = 1
     qdd = rng.normal(0.0, 3.0, (n_states, n))
     y, _ = regressor(arm, q, qd, qdd)
     y = y.reshape(-1, y.shape[-1])
-    scale = np.linalg.norm(y, axis=0)
-    scale[scale == 0.0] = 1.0
-    _, s, vt = np.linalg.svd(y / scale, full_matrices=False)
+    norm = np.linalg.norm(y, axis=0)
+    # a parameter that moves no joint torque (to rounding) is left out: 1/norm would be noise
+    absent = norm <= 1e-10 * norm.max()
+    inv = np.where(absent, 0.0, 1.0 / np.where(absent, 1.0, norm))
+    _, s, vt = np.linalg.svd(y * inv, full_matrices=False)
     r = int(np.sum(s > rtol * s[0]))
-    return vt[:r].T, 1.0 / scale
+    return vt[:r].T, inv
 
 
 def _ranges(arm: Arm) -> tuple[F64, F64]:
