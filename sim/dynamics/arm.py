@@ -22,7 +22,7 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["Arm", "arm_from_manipulator", "load_arm"]
+__all__ = ["Arm", "arm_from_manipulator", "load_arm", "resolve_arm"]
 
 _DOF = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
 
@@ -154,3 +154,16 @@ def arm_from_manipulator(model: Manipulator, inertia: str = "puma560") -> Arm:
     for act in list(spec.actuators):
         spec.delete(act)
     return _from_spec(spec, model.name, built.site_name, f"manipulator {model.name}")
+
+
+def resolve_arm(model: str, *, end_link: str | None = None, tool_site: str | None = None
+                ) -> Arm:
+    """The arm of a command line's ``--model``: an MJCF (.xml) or URDF (.urdf) file, else a
+    ZRP model (builtin name or .toml) built with PUMA 560 inertias (6R) or rods."""
+    if Path(model).suffix.lower() in (".xml", ".urdf", ".mjcf"):
+        return load_arm(model, end_link=end_link, tool_site=tool_site)
+    from zrp.model.files import load_model
+
+    m = load_model(model)
+    six_r = m.n == 6 and not np.asarray(m.prismatic).any()
+    return arm_from_manipulator(m, "puma560" if six_r else "rods")
