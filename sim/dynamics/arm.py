@@ -20,6 +20,7 @@ import numpy as np
 from mjcf import MJCFOptions, build
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["Arm", "arm_from_manipulator", "load_arm", "resolve_arm"]
@@ -162,8 +163,6 @@ def resolve_arm(model: str, *, end_link: str | None = None, tool_site: str | Non
     ZRP model (builtin name or .toml) built with PUMA 560 inertias (6R) or rods."""
     if Path(model).suffix.lower() in (".xml", ".urdf", ".mjcf"):
         return load_arm(model, end_link=end_link, tool_site=tool_site)
-    from zrp.model.files import load_model
-
     m = load_model(model)
     six_r = m.n == 6 and not np.asarray(m.prismatic).any()
     return arm_from_manipulator(m, "puma560" if six_r else "rods")

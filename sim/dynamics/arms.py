@@ -14,6 +14,7 @@ import numpy as np
 from sim.dynamics.arm import Arm, arm_from_manipulator, load_arm
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.model.files import load_model
 
 __all__ = ["BENCH_ARMS", "BenchArm", "available_arms"]
 
@@ -25,8 +26,6 @@ def _ur5e() -> Arm:
 
 
 def _puma() -> Arm:
-    from zrp import load_model
-
     return arm_from_manipulator(load_model("puma"))
 
 

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.dynamics.arm import Arm
-from sim.dynamics.fourier import Fourier, random_fourier, scale_into
+from sim.dynamics.fourier import Fourier, _rest_projector, random_fourier, scale_into
 from sim.dynamics.inertial import V_EPS, base_directions, inverse_dynamics, regressor
 from zrp.arrays import F64
 from zrp.errors import InputError
@@ -145,8 +145,6 @@ def design_excitation(arm: Arm, q0: F64, q_amp: F64 | float, qd_max: F64 | float
 
 def _project(a: F64, b: F64, like: Fourier) -> tuple[F64, F64]:
     """(a, b) projected onto the start-at-rest conditions of eq. X1."""
-    from sim.dynamics.fourier import _rest_projector
-
     L = a.shape[1]
     coef = np.concatenate([a, b], axis=1) @ _rest_projector(like.omegas).T
     return coef[:, :L], coef[:, L:]

@@ -9,7 +9,7 @@ first effect named is the hidden one, on the right joint, and the withheld torqu
 <= 1.5x the true noise on every joint.
 
 Run: python3 tests/benchmarks/bench_dynamics.py [--reps 2] [--seed 1] [--arms ur5e puma panda]
-[--out FILE.md] [--force]   (writes renders/benchmarks/bench_dynamics.md and .json)
+[--quick] [--out FILE.md] [--force]   (writes renders/benchmarks/bench_dynamics.md and .json)
 """
 
 from __future__ import annotations
@@ -31,13 +31,18 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--seconds", type=float, default=20.0, help="log length, s")
     ap.add_argument("--arms", nargs="*", default=None, help="default: every installed arm")
+    ap.add_argument("--quick", action="store_true",
+                    help="PUMA only, coulomb/payload/none, one 10 s log each (a smoke run)")
     add_output_arguments(ap, "bench_dynamics")
     args = ap.parse_args()
     out = output_path(args)
     arms = args.arms or available_arms()
+    kinds = KINDS
+    if args.quick:
+        arms, kinds, args.reps, args.seconds = ["puma"], ("coulomb", "payload", "none"), 1, 10.0
     rows = []
     with tempfile.TemporaryDirectory() as work:
-        for sc in bm.draw_scenarios(arms, KINDS, args.reps, args.seed, args.seconds):
+        for sc in bm.draw_scenarios(arms, kinds, args.reps, args.seed, args.seconds):
             r = bm.run_scenario(sc, Path(work))
             print(f"{sc.name:24} named {r.named:14} ok={r.success} ratio "
                   f"{r.withheld_ratio:.2f}", flush=True)

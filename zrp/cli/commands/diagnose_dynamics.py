@@ -44,7 +44,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from sim.dynamics.cli import run_diagnosis
+    # sim loads MuJoCo: only when this command runs.
+    from zrp.cli.dynamics_runs import run_diagnosis
 
     out = Path(args.out) if args.out else DEFAULT_OUT / Path(args.data).stem
     payload, text = run_diagnosis(args, out)

@@ -33,7 +33,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from sim.dynamics.cli import run_benchmark
+    # sim loads MuJoCo: only when this command runs.
+    from zrp.cli.dynamics_runs import run_benchmark
 
     out = Path(args.out) if args.out else DEFAULT_OUT
     if args.out is None:

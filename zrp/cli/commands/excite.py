@@ -42,7 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from sim.dynamics.cli import run_excite
+    # sim loads MuJoCo: only when this command runs.
+    from zrp.cli.dynamics_runs import run_excite
 
     payload, text = run_excite(args, Path(args.out))
     emit(args, payload, text)

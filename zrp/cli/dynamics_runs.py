@@ -1,25 +1,32 @@
-"""The command lines' work for ``zrp diagnose-dynamics``, ``zrp excite`` and
+"""The work of ``zrp diagnose-dynamics``, ``zrp excite`` and
 ``zrp dynamics-benchmark`` (arguments parsed in :mod:`zrp.cli.commands`)."""
 
 from __future__ import annotations
 
 import argparse
+import tempfile
+from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
 import mujoco
 import numpy as np
 
+from sim.dynamics import benchmark as bm
 from sim.dynamics.arm import Arm, resolve_arm
+from sim.dynamics.arms import available_arms
 from sim.dynamics.corrected import corrected_spec, corrections, tracking_gap
 from sim.dynamics.diagnosis import DynamicDiagnosis, DynamicsOptions, diagnose_dynamics
+from sim.dynamics.excitation import design_excitation
 from sim.dynamics.report import diagnosis_json, write_report
+from sim.dynamics.scenarios import KINDS
 from sim.dynamics.truth import Servo
 from zrp.errors import InputError
 from zrp.gap.dynamics.data import TorqueLog, load_torque_log
-from zrp.output import write_text
+from zrp.jsonio import to_jsonable
+from zrp.output import OutputDir, atomic_path, write_text
 
-__all__ = ["run_diagnosis"]
+__all__ = ["run_benchmark", "run_diagnosis", "run_excite"]
 
 
 def _servo(arm: Arm, log: TorqueLog, kp: list[float] | None, kv: list[float] | None
@@ -87,8 +94,6 @@ def run_diagnosis(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
 
 def run_excite(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
     """Design the exciting command and write it as t, qc1..qcn."""
-    from sim.dynamics.excitation import design_excitation
-    from zrp.output import atomic_path
 
     arm = resolve_arm(args.model, end_link=args.end_link)
     if len(args.q0) != arm.n:
@@ -114,8 +119,6 @@ def run_excite(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
                "peak_acceleration_rad_s2": dqdd, "peak_torque_nm": e.peak_torque,
                "q0": e.command.q0, "f0_hz": e.command.f0_hz, "a": e.command.a,
                "b": e.command.b}
-    from zrp.jsonio import to_jsonable
-
     text = (f"condition number {e.kappa:.4g} (best random start {e.kappa_start:.4g}); peak "
             f"torque per joint {np.array2string(e.peak_torque, precision=3)} N m\nwrote {out}")
     return to_jsonable(payload), text
@@ -123,14 +126,6 @@ def run_excite(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
 
 def run_benchmark(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
     """The blind benchmark; summary.json and summary.md in ``out``."""
-    import tempfile
-    from dataclasses import asdict
-
-    from sim.dynamics import benchmark as bm
-    from sim.dynamics.arms import available_arms
-    from sim.dynamics.scenarios import KINDS
-    from zrp.output import OutputDir
-
     arms = args.arms or available_arms()
     kinds = tuple(args.effects or KINDS)
     rows = []
