@@ -76,7 +76,7 @@ def _inertial(arm: Arm, rng: np.random.Generator) -> dict[int, F64]:
 def draw_hidden(arm: Arm, command: Fourier, kind: str, seed: int
                 ) -> tuple[HiddenDynamics, F64, dict]:
     """The hidden effect of a scenario, the torque noise sigma (n,) and a description."""
-    rng = np.random.default_rng(seed + 1000)
+    rng = np.random.default_rng([seed, 1000 + KINDS.index(kind)])  # joints differ by kind
     t = np.linspace(0.0, 1.0 / command.f0_hz, 2000, endpoint=False)
     q, qd, qdd = command.evaluate(t)
     scale = np.sqrt(np.mean(inverse_dynamics(arm.model, q, qd, qdd) ** 2, axis=0))
