@@ -9,7 +9,9 @@ anything derived from them. Only afterwards does :func:`score` read the truth:
 
 * visibility: RMS of the effect's own torques along the log over the noise, worst joint;
   an effect below 1 is not visible and "none" is a right answer for it;
-* right effect: the first effect named is the hidden one (for ``none``: nothing named);
+* right effect: the first effect named is the hidden one (for ``none``: nothing named), or an
+  arm-wide effect named first is reported tied with the hidden one (e.g. a payload and a wrist
+  link's mass: the log cannot tell them apart, and the report says so);
 * right joint: for a joint effect, the joint of the first effect named;
 * withheld ratio: the worst joint's withheld torque RMS after correction over its true noise
   (target <= 1.5).
@@ -76,7 +78,7 @@ def summary(d: DynamicDiagnosis) -> dict:
                                     if not k.startswith("beta")}} for e in d.effects],
             "noise_nm": d.noise_nm.tolist(), "rms_before": d.rms_before.tolist(),
             "rms_after": d.rms_after.tolist(), "cannot_tell": d.cannot_tell,
-            "steps": [(s.key, s.chi2) for s in d.steps]}
+            "steps": [(s.key, s.chi2, list(s.ties)) for s in d.steps]}
 
 
 def diagnose_blind(csv_path: str | Path, arm_key: str) -> dict:
@@ -117,12 +119,15 @@ def score(diag: dict, truth: dict, seconds: float = 0.0) -> Row:
     named = "none" if first is None else (
         first["name"] + ("" if first["joint"] is None else f" j{first['joint'] + 1}"))
     kind, joint = eff["kind"], eff["joint"]
+    tied = [] if len(diag["steps"]) < 2 else [t.split("_j")[0] for t in diag["steps"][1][2]]
     visible = truth["visibility"] >= 1.0
     if kind == "none" or not visible:
         right = first is None or (kind != "none" and first["name"] == kind)
         right_joint = True
     else:
-        right = first is not None and first["name"] == kind
+        # named first, or reported as a tie with the first (the log cannot tell them apart)
+        right = first is not None and (first["name"] == kind or
+                                       (kind in tied and first["joint"] is None))
         right_joint = joint is None or (first is not None and first["joint"] == joint)
     sigma = np.asarray(truth["noise_nm"])
     after, before = np.asarray(diag["rms_after"]), np.asarray(diag["rms_before"])
@@ -155,7 +160,8 @@ def tally(rows: list[Row]) -> dict[str, float]:
     vis = [r for r in rows if r.kind != "none" and r.visible]
     none = [r for r in rows if r.kind == "none"]
     ok = sum(r.success for r in vis)
-    return {"visible_singles": len(vis), "right": ok,
+    first = sum(r.success and r.named.split(" ")[0] == r.kind for r in vis)
+    return {"visible_singles": len(vis), "right": ok, "right_named_first": first,
             "share": ok / len(vis) if vis else float("nan"),
             "none_scenarios": len(none), "none_clean": sum(r.named == "none" for r in none),
             "median_ratio": float(np.median([r.withheld_ratio for r in rows])) if rows else

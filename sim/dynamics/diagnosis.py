@@ -248,12 +248,15 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     masks = regime_masks(s.qd, gravity_torques(arm.model, s.q), guard)
     notes = [f"accelerations by Savitzky-Golay, window {s.window_s:.3g} s; fit at "
              f"{1.0 / (stride * log.dt):.4g} Hz"]
+    ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
+            "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
     if shrink < 1.0:
         notes.append(f"the fitted link inertias were not physical; shrunk to {shrink:.0%} of "
                      "the correction (the largest that is)")
     return DynamicDiagnosis(
         arm.name, arm.joint_names, sigma, np.sqrt(np.mean(b_raw**2, 0)),
         np.sqrt(np.mean((b_raw - pred) ** 2, 0)), steps, found,
-        _cannot_tell([e for e in effects if e.name in JOINT_EFFECTS], sigma, opt.collinear),
+        ties + _cannot_tell([e for e in effects if e.name in JOINT_EFFECTS], sigma,
+                            opt.collinear),
         {"before": regime_rms(b_raw, masks), "after": regime_rms(b_raw - pred, masks)},
         feasible, shrink, phi, notes, Samples(s.t, s.q, s.qd, b_raw, b_raw - pred))

@@ -30,10 +30,12 @@ __all__ = ["Step", "chi2_of", "forward_select"]
 
 @dataclass(frozen=True)
 class Step:
-    """One accepted effect and the withheld chi2 after it."""
+    """One accepted effect, the withheld chi2 after it, and the other candidates whose drop
+    was within the parsimony window of the best (the log cannot tell them from it)."""
 
     key: str
     chi2: float
+    ties: tuple[str, ...] = ()
 
 
 def chi2_of(b_raw: F64, pred: F64, sigma: F64) -> float:
@@ -45,14 +47,16 @@ def _family(e: Effect) -> tuple[str, int | None]:
 
 
 def _parsimonious(scored: list[tuple[float, Effect, F64]], chi2: float, occam: float
-                  ) -> tuple[float, Effect, F64] | None:
+                  ) -> tuple[tuple[float, Effect, F64] | None, tuple[str, ...]]:
     """The candidate with the fewest parameters among those within ``occam`` of the best
-    drop (ties: the lower chi2)."""
+    drop (ties: the lower chi2), and the other families within that window."""
     if not scored:
-        return None
+        return None, ()
     top = min(c for c, _, _ in scored)
     near = [s for s in scored if chi2 - s[0] >= (1.0 - occam) * (chi2 - top)]
-    return min(near, key=lambda s: (s[1].columns.shape[-1], s[0]))
+    best = min(near, key=lambda s: (s[1].columns.shape[-1], s[0]))
+    others = {s[1].key.split("@")[0] for s in near if _family(s[1]) != _family(best[1])}
+    return best, tuple(sorted(others))
 
 
 def forward_select(effects: list[Effect], b: F64, b_raw: F64, sigma: F64, *, folds: int,
@@ -69,10 +73,10 @@ def forward_select(effects: list[Effect], b: F64, b_raw: F64, sigma: F64, *, fol
         taken = {_family(e) for e in chosen}
         scored = [(chi2_of(b_raw, p, sigma), e, p) for e in effects if _family(e) not in taken
                   for p in [cv.predict([c.key for c in (*chosen, e)])]]
-        best = _parsimonious(scored, chi2, occam)
+        best, ties = _parsimonious(scored, chi2, occam)
         if best is None or chi2 - best[0] < max(min_rel * chi2, min_abs):
             break
         chi2, e, pred = best
         chosen.append(e)
-        steps.append(Step(e.key, chi2))
+        steps.append(Step(e.key, chi2, ties))
     return chosen, steps, pred

@@ -53,6 +53,7 @@ def main() -> None:
         ["visible single effects", t["visible_singles"], ""],
         ["right effect, joint and withheld <= 1.5 sigma", f"{t['right']} ({t['share']:.0%})",
          ">= 90 %"],
+        ["of them named first (not as a reported tie)", t["right_named_first"], ""],
         ["'none' scenarios with nothing named", f"{t['none_clean']} of {t['none_scenarios']}",
          "all"],
         ["median withheld ratio (worst joint)", f"{t['median_ratio']:.2f}", "<= 1.5"]])
