@@ -73,16 +73,22 @@ def _body_name(m: mujoco.MjModel, b: int) -> str:
 
 
 def _set_inertial(body: mujoco.MjsBody, phi: F64) -> None:
+    """Write phi_b (eq. R1) as mass, centre, principal inertias and their frame."""
     mass = float(phi[0])
     c = phi[1:4] / mass
     io = np.array([[phi[4], phi[7], phi[8]], [phi[7], phi[5], phi[9]],
                    [phi[8], phi[9], phi[6]]])
-    ic = io - mass * (float(c @ c) * np.eye(3) - np.outer(c, c))
+    w, v = np.linalg.eigh(io - mass * (float(c @ c) * np.eye(3) - np.outer(c, c)))
+    if np.linalg.det(v) < 0:
+        v[:, 0] = -v[:, 0]
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, v.ravel())
     body.explicitinertial = True
     body.mass = mass
     body.ipos = c
-    body.iquat = [1.0, 0.0, 0.0, 0.0]
-    body.fullinertia = [ic[0, 0], ic[1, 1], ic[2, 2], ic[0, 1], ic[0, 2], ic[1, 2]]
+    body.iquat = quat
+    body.inertia = w
+    body.fullinertia = [np.nan, 0.0, 0.0, 0.0, 0.0, 0.0]  # "not given" (the default)
 
 
 def corrected_spec(arm: Arm, fix: Corrections) -> mujoco.MjSpec:

@@ -14,8 +14,8 @@ Steps:
 4. candidate effects (:mod:`sim.dynamics.effects`) chosen by forward selection on the
    out-of-segment chi^2 (:mod:`sim.dynamics.select`, eq. S1);
 5. the chosen effects refitted on the whole log with physical bounds and 95 % intervals
-   (:mod:`sim.dynamics.fit`, eq. F2); link inertial parameters checked for physical
-   consistency (eq. R5) and, if not, shrunk toward the model's until they are;
+   (:mod:`sim.dynamics.fit`, eq. F2); link inertial parameters made physically consistent
+   (eq. R5) through the directions the log cannot see (:mod:`sim.dynamics.feasible`);
 6. "cannot tell": a joint effect whose regressor column is (almost) a multiple of another's
    on the same joint along this log (e.g. Coulomb friction and a torque offset when the joint
    never reverses), or (almost) zero (the joint never moves or accelerates).
@@ -29,9 +29,10 @@ import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
 
 from sim.dynamics.arm import Arm
-from sim.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, inertial_correction
+from sim.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects
+from sim.dynamics.feasible import feasible_inertias
 from sim.dynamics.fit import design, solve
-from sim.dynamics.inertial import gravity_torques, inverse_dynamics, pseudo_inertia_ok
+from sim.dynamics.inertial import gravity_torques, inverse_dynamics
 from sim.dynamics.regimes import regime_masks, regime_rms
 from sim.dynamics.select import Step, forward_select
 from zrp.arrays import F64
@@ -198,23 +199,6 @@ def _check_inputs(arm: Arm, log: TorqueLog) -> None:
                          f"model {arm.name!r} has {arm.n}")
 
 
-def _feasible(arm: Arm, beta: F64, basis: tuple[F64, F64]
-              ) -> tuple[bool, float, dict[int, F64]]:
-    """Whether the inertial correction is physical (eq. R5); if not, the largest fraction of
-    it (bisection toward the model's feasible values) that is."""
-    phi = inertial_correction(arm, beta, basis)
-    if all(pseudo_inertia_ok(p) for p in phi.values()):
-        return True, 1.0, phi
-    lo, hi = 0.0, 1.0
-    for _ in range(30):
-        mid = 0.5 * (lo + hi)
-        if all(pseudo_inertia_ok(p) for p in inertial_correction(arm, mid * beta, basis).values()):
-            lo = mid
-        else:
-            hi = mid
-    return False, lo, inertial_correction(arm, lo * beta, basis)
-
-
 def diagnose_dynamics(arm: Arm, log: TorqueLog, options: DynamicsOptions | None = None
                       ) -> DynamicDiagnosis:
     """Diagnose the dynamic gap of ``arm`` along ``log`` (module docstring); one BLAS thread
@@ -241,7 +225,7 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     for i, (e, sl) in enumerate(zip(chosen, d.slices, strict=True)):
         theta = fit.theta[sl]
         if e.name == "inertial":
-            feasible, shrink, phi = _feasible(arm, theta, e.basis)
+            feasible, shrink, phi = feasible_inertias(arm, theta, e.basis)
         found.append(FoundEffect(e.key, e.name, e.joint, e.detail,
                                  _params(e, theta, fit.cov[sl, sl], fit.at_bound[sl]),
                                  steps[i].chi2 - steps[i + 1].chi2))
@@ -250,9 +234,11 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
              f"{1.0 / (stride * log.dt):.4g} Hz"]
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
             "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
-    if shrink < 1.0:
-        notes.append(f"the fitted link inertias were not physical; shrunk to {shrink:.0%} of "
-                     "the correction (the largest that is)")
+    if feasible is False:
+        notes.append("the minimum-norm link inertias were not physical; made so through the "
+                     "parameter directions the log cannot see" + (
+                         "" if shrink == 1.0 else f", then shrunk to {shrink:.0%} of the "
+                         "correction (no physical set found otherwise)"))
     return DynamicDiagnosis(
         arm.name, arm.joint_names, sigma, np.sqrt(np.mean(b_raw**2, 0)),
         np.sqrt(np.mean((b_raw - pred) ** 2, 0)), steps, found,

@@ -36,6 +36,9 @@ __all__ = ["JOINT_EFFECTS", "STRIBECK_SPEEDS", "Effect", "candidate_effects"]
 #: Stribeck speeds tried, rad/s (each a separate candidate; the diagnosis picks by data).
 STRIBECK_SPEEDS = (0.03, 0.1, 0.3)
 
+#: Relative singular value below which a base combination counts as not excited (eq. R6).
+EXCITED = 1e-2
+
 JOINT_EFFECTS = ("coulomb", "viscous", "stribeck", "armature", "offset", "gain")
 
 
@@ -137,6 +140,12 @@ def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,
     if inertial:
         v, scale = base_directions(arm)
         y, _ = regressor(arm, q, qd, qdd)
+        # only the combinations this log excites (eq. R6): directions of the base whose
+        # singular value along the log is below EXCITED of the largest would be fitted to
+        # noise (and make the links unphysical); they keep the model's values
+        _, sv, wt = np.linalg.svd(((y * scale) @ v).reshape(-1, v.shape[1]),
+                                  full_matrices=False)
+        v = v @ wt[sv > EXCITED * sv[0]].T
         yb = (y * scale) @ v
         r = v.shape[1]
         out.append(Effect("inertial", None, yb, tuple(f"beta{i + 1}" for i in range(r)),
