@@ -6,7 +6,9 @@ Steps:
 
 1. states: q, qd, qdd and the torques by the zero-phase Savitzky-Golay filter
    (:func:`zrp.gap.dynamics.derive_states`), then taken at ``fit_rate_hz``;
-2. the model's torques tau0 = ``mj_inverse`` along the states (eq. R2);
+2. the model's torques tau0 = ``mj_inverse`` along the states (eq. R2), plus the logged
+   payload (the log's ``payload`` column, a point mass at the tool point) when there is one:
+   a payload found is then what the log does not declare;
 3. the torque noise sigma_k of each joint (eq. N1): the RMS of the raw torque minus its
    Savitzky-Golay smoothing, divided by sqrt(1 - h0) (h0: the smoother's centre weight; the
    smoothing removes the noise, not the trajectory's torques, which lie far below its cut-off);
@@ -29,7 +31,7 @@ import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
 
 from sim.dynamics.arm import Arm
-from sim.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects
+from sim.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, payload_columns
 from sim.dynamics.feasible import feasible_inertias
 from sim.dynamics.fit import design, solve
 from sim.dynamics.inertial import gravity_torques, inverse_dynamics
@@ -213,6 +215,10 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     sigma = torque_noise(log, opt.window_s)
     s, stride = _decimated(log, opt)
     tau0 = inverse_dynamics(arm.model, s.q, s.qd, s.qdd)
+    if log.payload is not None and np.any(log.payload > 0.0):
+        # the logged (known) payload is part of the model: a point mass at the tool point
+        known = log.payload[::stride][:, None]
+        tau0 = tau0 + payload_columns(arm, s.q, s.qd, s.qdd)[..., 0] * known
     b, b_raw = s.tau - tau0, s.tau_raw - tau0
     effects = candidate_effects(arm, s.q, s.qd, s.qdd, tau0, inertial=opt.inertial)
     guard = max(1, round(0.5 * opt.window_s * opt.fit_rate_hz))

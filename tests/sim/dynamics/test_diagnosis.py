@@ -60,3 +60,15 @@ def test_cannot_tell_coulomb_from_offset_without_reversals(ur5e):
     log = TorqueLog(t, q, qd, np.random.default_rng(0).normal(0, 0.05, q.shape))
     d = diagnose_dynamics(ur5e, log)
     assert any(s.startswith("joint 1: coulomb from offset") for s in d.cannot_tell)
+
+
+@pytest.mark.slow
+def test_declared_payload_is_part_of_the_model(ur5e, ur5e_command):
+    import dataclasses
+
+    log = simulate(ur5e, HiddenDynamics(payload_kg=1.2), ur5e_command, 15.0,
+                   noise_nm=UR5E_NOISE, seed=2)
+    declared = dataclasses.replace(log, payload=np.full(log.n_samples, 1.0))
+    d = diagnose_dynamics(ur5e, declared)
+    e = d.effect("payload")
+    assert e is not None and e.params["mass"].low <= 0.2 <= e.params["mass"].high
