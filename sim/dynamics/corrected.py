@@ -1,0 +1,153 @@
+"""The corrected model: the arm's MJCF with the identified effects written in, and the
+re-simulation of the logged command through it (the same servo) to show the tracking gap.
+
+Written into the MJCF: Coulomb friction (``frictionloss``), viscous friction (``damping``),
+armature (``armature``), each added to the model's own value; a payload (a child body of the
+tool body, a point mass at the fitted centre); link inertial parameters (``mass``, ``ipos``,
+``fullinertia`` of each moving body). Not written, because MJCF has no place for them: a
+Stribeck bump, a torque sensor's offset and gain (they are listed in
+:attr:`Corrections.not_in_model` and reported).
+"""
+
+from __future__ import annotations
+
+import copy
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import mujoco
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from sim.dynamics.arm import Arm
+from sim.dynamics.diagnosis import DynamicDiagnosis
+from sim.dynamics.truth import Servo, run_servo
+from zrp.arrays import F64
+from zrp.errors import InputError
+from zrp.gap.dynamics.data import TorqueLog
+from zrp.output import write_text
+
+__all__ = ["Corrections", "SampledCommand", "corrected_spec", "corrections", "tracking_gap",
+           "write_corrected_mjcf"]
+
+_JOINT_FIELDS = {"coulomb": "frictionloss", "viscous": "damping", "armature": "armature"}
+
+
+@dataclass(frozen=True)
+class Corrections:
+    """What goes into the MJCF: per joint additions (n,), the payload, body inertias."""
+
+    frictionloss: F64
+    damping: F64
+    armature: F64
+    payload_kg: float = 0.0
+    payload_pos_m: F64 = field(default_factory=lambda: np.zeros(3))
+    inertial: dict[int, F64] = field(default_factory=dict)
+    not_in_model: list[str] = field(default_factory=list)
+
+
+def corrections(arm: Arm, diag: DynamicDiagnosis) -> Corrections:
+    """The model changes of a diagnosis."""
+    add = {f: np.zeros(arm.n) for f in _JOINT_FIELDS.values()}
+    payload, pos, skipped = 0.0, np.array(arm.tool_point, dtype=float), []
+    for e in diag.effects:
+        if e.name in _JOINT_FIELDS and e.joint is not None:
+            add[_JOINT_FIELDS[e.name]][e.joint] += e.params[e.name].value
+        elif e.name == "payload":
+            payload = e.params["mass"].value
+            if payload > 0.0:
+                pos = pos + np.array([e.params[k].value for k in ("m*dx", "m*dy", "m*dz")]) \
+                    / payload
+        elif e.name != "inertial":
+            skipped.append(e.label)
+    return Corrections(add["frictionloss"], add["damping"], add["armature"], payload, pos,
+                       dict(diag.inertial_phi), skipped)
+
+
+def _body_name(m: mujoco.MjModel, b: int) -> str:
+    name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)
+    if not name:
+        raise InputError(f"model: body {b} has no name; the corrected MJCF needs named bodies")
+    return name
+
+
+def _set_inertial(body: mujoco.MjsBody, phi: F64) -> None:
+    """Write phi_b (eq. R1) as mass, centre, principal inertias and their frame."""
+    mass = float(phi[0])
+    c = phi[1:4] / mass
+    io = np.array([[phi[4], phi[7], phi[8]], [phi[7], phi[5], phi[9]],
+                   [phi[8], phi[9], phi[6]]])
+    w, v = np.linalg.eigh(io - mass * (float(c @ c) * np.eye(3) - np.outer(c, c)))
+    if np.linalg.det(v) < 0:
+        v[:, 0] = -v[:, 0]
+    quat = np.empty(4)
+    mujoco.mju_mat2Quat(quat, v.ravel())
+    body.explicitinertial = True
+    body.mass = mass
+    body.ipos = c
+    body.iquat = quat
+    body.inertia = w
+    body.fullinertia = [np.nan, 0.0, 0.0, 0.0, 0.0, 0.0]  # "not given" (the default)
+
+
+def corrected_spec(arm: Arm, fix: Corrections) -> mujoco.MjSpec:
+    """A copy of the arm's spec with ``fix`` written in (module docstring)."""
+    spec = arm.spec.copy()
+    m = arm.model
+    for k, name in enumerate(arm.joint_names):
+        j = spec.joint(name)
+        j.frictionloss = float(m.dof_frictionloss[k] + fix.frictionloss[k])
+        damping = np.array(j.damping, dtype=float).ravel()  # MuJoCo 4: [linear, higher...]
+        damping[0] = m.dof_damping[k] + fix.damping[k]
+        j.damping = damping
+        j.armature = float(m.dof_armature[k] + fix.armature[k])
+    for b, phi in fix.inertial.items():
+        _set_inertial(spec.body(_body_name(m, b)), phi)
+    if fix.payload_kg > 0.0:
+        tool = spec.body(_body_name(m, arm.tool_body))
+        load = tool.add_body(name="identified_payload", pos=list(fix.payload_pos_m))
+        # a small sphere of the payload's mass (MJCF keeps a geom's mass; no collisions)
+        load.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.005, 0.0, 0.0],
+                      mass=fix.payload_kg, contype=0, conaffinity=0, group=3)
+    return spec
+
+
+def write_corrected_mjcf(arm: Arm, diag: DynamicDiagnosis, path: str | os.PathLike[str], *,
+                         overwrite: bool = False) -> Path:
+    """Write the corrected MJCF (loads in MuJoCo as is); an existing file only with
+    ``overwrite``."""
+    spec = corrected_spec(arm, corrections(arm, diag))
+    spec.compile()
+    return write_text(path, spec.to_xml(), overwrite=overwrite)
+
+
+@dataclass(frozen=True)
+class SampledCommand:
+    """A logged command (t, qc) as a cubic spline, with its derivatives."""
+
+    t: F64
+    qc: F64
+
+    @property
+    def q0(self) -> F64:
+        return self.qc[0]
+
+    def evaluate(self, t: F64) -> tuple[F64, F64, F64]:
+        sp = CubicSpline(self.t - self.t[0], self.qc, axis=0)
+        return sp(t), sp(t, 1), sp(t, 2)
+
+
+def tracking_gap(model: mujoco.MjModel, nominal: mujoco.MjModel, log: TorqueLog, servo: Servo,
+                 command: object | None = None) -> F64:
+    """RMS of (re-simulated minus logged) joint positions per joint (n,), ``model`` driven by
+    ``servo`` (feed-forward from ``nominal``, as the real controller) along the log's
+    commanded positions (or ``command``, an object with ``evaluate(t)``)."""
+    if command is None:
+        if log.qc is None:
+            raise InputError(f"{log.source}: no commanded positions qc1..qcn; the "
+                             "re-simulation drives them")
+        command = SampledCommand(log.t, log.qc)
+    run = run_servo(copy.deepcopy(model), nominal, servo, command,
+                    log.n_samples / (1.0 / log.dt), 1.0 / log.dt)
+    return np.sqrt(np.mean((run.q - log.q) ** 2, axis=0))

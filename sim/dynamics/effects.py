@@ -1,0 +1,166 @@
+"""The candidate effects of the dynamic gap: each a block of regressor columns, linear in its
+parameters, added to the nominal model's torques (eq. E1: tau = tau0 + sum_e Y_e theta_e).
+
+Per joint k (column only on joint k's torque; w = qd_k):
+
+* ``coulomb``:  tanh(w / V_EPS)                                  [N m]    (MJCF frictionloss)
+* ``viscous``:  w                                                [N m s/rad] (MJCF damping)
+* ``stribeck``: tanh(w / V_EPS) exp(-(w / v_s)^2), v_s in :data:`STRIBECK_SPEEDS` [N m]
+* ``armature``: qdd_k                                            [kg m^2] (MJCF armature)
+* ``offset``:   1 (a torque sensor's zero offset)                [N m]
+* ``gain``:     tau0_k (a torque sensor's or torque constant's scale error) [1]
+
+Arm-wide:
+
+* ``payload``: a mass m at the tool point p plus its first moment m d about p (eq. E2: the
+  inertial regressor of the tool body at phi = [m, m (p + d), m |p|^2 ...], by linearity of
+  eq. R2 in the point mass): columns [m, m d_x, m d_y, m d_z]; [kg, kg m x3].
+* ``inertial``: the identifiable combinations of all link inertial parameters (eq. R4).
+
+Bounds keep the corrected model physical: the model's own friction, damping and armature plus
+the correction stay >= 0, a Stribeck bump and a payload mass are >= 0, a gain is > -1.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.dynamics.arm import Arm
+from sim.dynamics.inertial import V_EPS, base_directions, body_params, regressor
+from zrp.arrays import F64
+
+__all__ = ["JOINT_EFFECTS", "STRIBECK_SPEEDS", "Effect", "candidate_effects"]
+
+#: Stribeck speeds tried, rad/s (each a separate candidate; the diagnosis picks by data).
+STRIBECK_SPEEDS = (0.03, 0.1, 0.3)
+
+#: Relative singular value below which a base combination counts as not excited (eq. R6).
+EXCITED = 1e-2
+
+JOINT_EFFECTS = ("coulomb", "viscous", "stribeck", "armature", "offset", "gain")
+
+
+@dataclass(frozen=True)
+class Effect:
+    """One candidate effect: its regressor block and parameter bounds.
+
+    Attributes:
+        name: one of :data:`JOINT_EFFECTS`, "payload" or "inertial".
+        joint: 0-based joint for a joint effect, None for an arm-wide one.
+        columns: shape (S, n, p).
+        params: the parameter names (p).
+        units: their units.
+        lower, upper: bounds, shape (p,).
+        detail: a fixed setting (the Stribeck speed) or "".
+    """
+
+    name: str
+    joint: int | None
+    columns: F64
+    params: tuple[str, ...]
+    units: tuple[str, ...]
+    lower: F64
+    upper: F64
+    detail: str = ""
+    basis: tuple[F64, F64] | None = None  # "inertial": (V, scale) of eq. R4
+
+    @property
+    def key(self) -> str:
+        j = "" if self.joint is None else f"_j{self.joint + 1}"
+        return f"{self.name}{j}{'@' + self.detail if self.detail else ''}"
+
+    @property
+    def label(self) -> str:
+        where = "arm" if self.joint is None else f"joint {self.joint + 1}"
+        return f"{self.name} ({where}{', ' + self.detail if self.detail else ''})"
+
+
+def _on_joint(col: F64, k: int, n: int) -> F64:
+    out = np.zeros((col.shape[0], n, 1))
+    out[:, k, 0] = col
+    return out
+
+
+def _joint_effects(arm: Arm, qd: F64, qdd: F64, tau0: F64) -> list[Effect]:
+    m, n = arm.model, arm.n
+    out: list[Effect] = []
+    inf = np.inf
+    for k in range(n):
+        w = qd[:, k]
+        sgn = np.tanh(w / V_EPS)
+        spec = [("coulomb", sgn, "N m", -float(m.dof_frictionloss[k]), inf, ""),
+                ("viscous", w, "N m s/rad", -float(m.dof_damping[k]), inf, ""),
+                ("armature", qdd[:, k], "kg m^2", -float(m.dof_armature[k]), inf, ""),
+                ("offset", np.ones_like(w), "N m", -inf, inf, ""),
+                ("gain", tau0[:, k], "1", -1.0 + 1e-6, inf, "")]
+        spec += [("stribeck", sgn * np.exp(-(w / vs) ** 2), "N m", 0.0, inf, f"v_s={vs:g} rad/s")
+                 for vs in STRIBECK_SPEEDS]
+        for name, col, unit, lo, hi, detail in spec:
+            out.append(Effect(name, k, _on_joint(col, k, n), (name,), (unit,), np.array([lo]),
+                              np.array([hi]), detail))
+    return out
+
+
+def payload_columns(arm: Arm, q: F64, qd: F64, qdd: F64) -> F64:
+    """The payload block (eq. E2), shape (S, n, 4)."""
+    y, labels = regressor(arm, q, qd, qdd, [arm.tool_body])
+    p = arm.tool_point
+    ym, yh = y[..., 0], y[..., 1:4]
+    yi = y[..., 4:10]
+    # a point mass m at p + d: phi = m [1, p + d, |p+d|^2 - (p+d)_i^2 ..., -(p+d)_i (p+d)_j]
+    # to first order in d; exact in m for d = 0 (the mass column), linear in m d.
+    pp = float(p @ p)
+    inert_m = np.array([pp - p[0] ** 2, pp - p[1] ** 2, pp - p[2] ** 2,
+                        -p[0] * p[1], -p[0] * p[2], -p[1] * p[2]])
+    col_m = ym + yh @ p + yi @ inert_m
+    # d(phi_I)/d(m d) at d = 0: the first moments' own columns plus the inertia's
+    # linear terms 2 p.d - 2 p_i d_i (diagonal) and -(p_i d_j + d_i p_j) (off-diagonal)
+    cols = [col_m]
+    for a in range(3):
+        e = np.zeros(3)
+        e[a] = 1.0
+        di = np.array([2 * p @ e - 2 * p[0] * e[0], 2 * p @ e - 2 * p[1] * e[1],
+                       2 * p @ e - 2 * p[2] * e[2], -(p[0] * e[1] + e[0] * p[1]),
+                       -(p[0] * e[2] + e[0] * p[2]), -(p[1] * e[2] + e[1] * p[2])])
+        cols.append(yh[..., a] + yi @ di)
+    del labels
+    return np.stack(cols, axis=-1)
+
+
+def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,
+                      inertial: bool = True) -> list[Effect]:
+    """Every candidate effect along the states (module docstring)."""
+    out = _joint_effects(arm, qd, qdd, tau0)
+    inf = np.inf
+    out.append(Effect("payload", None, payload_columns(arm, q, qd, qdd),
+                      ("mass", "m*dx", "m*dy", "m*dz"), ("kg", "kg m", "kg m", "kg m"),
+                      np.array([0.0, -inf, -inf, -inf]), np.full(4, inf)))
+    if inertial:
+        v, scale = base_directions(arm)
+        y, _ = regressor(arm, q, qd, qdd)
+        # only the combinations this log excites (eq. R6): directions of the base whose
+        # singular value along the log is below EXCITED of the largest would be fitted to
+        # noise (and make the links unphysical); they keep the model's values
+        _, sv, wt = np.linalg.svd(((y * scale) @ v).reshape(-1, v.shape[1]),
+                                  full_matrices=False)
+        v = v @ wt[sv > EXCITED * sv[0]].T
+        yb = (y * scale) @ v
+        r = v.shape[1]
+        out.append(Effect("inertial", None, yb, tuple(f"beta{i + 1}" for i in range(r)),
+                          ("(scaled)",) * r, np.full(r, -inf), np.full(r, inf),
+                          basis=(v, scale)))
+    return out
+
+
+def inertial_correction(arm: Arm, beta: F64, basis: tuple[F64, F64]) -> dict[int, F64]:
+    """phi_b of each moving body after the fitted base combination ``beta`` (eq. R4: the
+    minimum-norm change in scaled parameters; directions the arm cannot show keep the
+    model's values)."""
+    v, scale = basis
+    dphi = scale * (v @ beta)
+    out = {}
+    for i, b in enumerate(arm.moving_bodies()):
+        out[b] = body_params(arm.model, b) + dphi[10 * i:10 * i + 10]
+    return out

@@ -1,0 +1,82 @@
+"""Forward selection of effects by the withheld torque error (eq. S1).
+
+The score of a set of effects is the out-of-segment chi^2 (eq. S1)::
+
+    chi2 = mean over samples and joints of ((tau_raw - tau0 - Y theta_(-seg)) / sigma_k)^2
+
+with theta_(-seg) fitted without the time segment the sample lies in (and a guard of half a
+filter window on each side). It is 1 when the model explains the torques down to the noise.
+Each step adds the candidate that lowers it most, if the drop is at least ``min_rel`` of the
+current chi2 and ``min_abs`` (noise variances): smaller drops are what a wrong friction law or
+the acceleration filter leave, not evidence of an effect. Parsimony: among the candidates whose
+drop is within ``occam`` (10 %) of the largest, the one with the fewest parameters is taken (a
+payload is also a change of the tool link's inertias; the four payload parameters are
+preferred to the forty link combinations when both explain the torques). One Stribeck speed a
+joint.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from sim.dynamics.cvgram import CVGram
+from sim.dynamics.effects import Effect
+from zrp.arrays import F64
+
+__all__ = ["Step", "chi2_of", "forward_select"]
+
+
+@dataclass(frozen=True)
+class Step:
+    """One accepted effect, the withheld chi2 after it, and the other candidates whose drop
+    was within the parsimony window of the best (the log cannot tell them from it)."""
+
+    key: str
+    chi2: float
+    ties: tuple[str, ...] = ()
+
+
+def chi2_of(b_raw: F64, pred: F64, sigma: F64) -> float:
+    return float(np.mean(((b_raw - pred) / sigma) ** 2))
+
+
+def _family(e: Effect) -> tuple[str, int | None]:
+    return e.name, e.joint
+
+
+def _parsimonious(scored: list[tuple[float, Effect, F64]], chi2: float, occam: float
+                  ) -> tuple[tuple[float, Effect, F64] | None, tuple[str, ...]]:
+    """The candidate with the fewest parameters among those within ``occam`` of the best
+    drop (ties: the lower chi2), and the other families within that window."""
+    if not scored:
+        return None, ()
+    top = min(c for c, _, _ in scored)
+    near = [s for s in scored if chi2 - s[0] >= (1.0 - occam) * (chi2 - top)]
+    best = min(near, key=lambda s: (s[1].columns.shape[-1], s[0]))
+    others = {s[1].key.split("@")[0] for s in near if _family(s[1]) != _family(best[1])}
+    return best, tuple(sorted(others))
+
+
+def forward_select(effects: list[Effect], b: F64, b_raw: F64, sigma: F64, *, folds: int,
+                   guard: int, min_rel: float, min_abs: float, max_effects: int,
+                   occam: float = 0.1) -> tuple[list[Effect], list[Step], F64]:
+    """The chosen effects, the steps (first: the nominal model, key "nominal") and the
+    out-of-segment prediction of the final set (S, n)."""
+    cv = CVGram(effects, b, sigma, folds, guard)
+    chosen: list[Effect] = []
+    pred = np.zeros_like(b)
+    chi2 = chi2_of(b_raw, pred, sigma)
+    steps = [Step("nominal", chi2)]
+    while len(chosen) < max_effects:
+        taken = {_family(e) for e in chosen}
+        scored = [(chi2_of(b_raw, p, sigma), e, p) for e in effects if _family(e) not in taken
+                  for p in [cv.predict([c.key for c in (*chosen, e)])]]
+        best, ties = _parsimonious(scored, chi2, occam)
+        if best is None or chi2 - best[0] < max(min_rel * chi2, min_abs):
+            break
+        chi2, e, pred = best
+        chosen.append(e)
+        steps.append(Step(e.key, chi2, ties))
+    return chosen, steps, pred

@@ -1,0 +1,53 @@
+"""``zrp diagnose-dynamics``: the dynamic gap of a MuJoCo model along a joint torque log."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from zrp.cli.app import emit
+from zrp.cli.options import DURATION, real
+
+DEFAULT_OUT = Path("renders") / "dynamics"
+GAIN = real(0.0, 1e9, open_lo=True)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "diagnose-dynamics", help="where a MuJoCo model's joint torques miss a torque log, and why",
+        description="Diagnose the dynamic gap (sim/dynamics/README.md): inverse dynamics "
+        "(mj_inverse) along the logged states against the logged torques; which effect "
+        "(friction, armature, payload, link inertias, torque sensor offset/gain) on which "
+        "joint, its size with an interval, the withheld torque error before and after. "
+        "Writes report.html/.md, the residual plots, diagnosis.json and corrected.xml.")
+    p.add_argument("--model", required=True, metavar="M.xml|M.urdf|NAME",
+                   help="MJCF or URDF (with inertials) of the arm, or a ZRP model")
+    p.add_argument("--data", required=True, metavar="LOG.csv", help="the torque log")
+    p.add_argument("--end-link", metavar="LINK", help="URDF: the arm's last link")
+    p.add_argument("--tool-site", metavar="SITE", help="MJCF site where a payload sits")
+    p.add_argument("--torque-constant", type=GAIN, nargs="+", metavar="KT",
+                   help="N m/A per joint, when the log has currents i1..in")
+    p.add_argument("--window", type=real(0.0, 10.0, open_lo=True, unit="s"), default=0.1,
+                   help="Savitzky-Golay window for the accelerations, s (default 0.1)")
+    p.add_argument("--no-inertial", action="store_true",
+                   help="do not fit link inertial parameters")
+    p.add_argument("--kp", type=GAIN, nargs="+", help="servo stiffness per joint (N m/rad) "
+                   "for the re-simulation; default: a 4 Hz servo from the model")
+    p.add_argument("--kv", type=GAIN, nargs="+", help="servo damping per joint (N m s/rad)")
+    p.add_argument("--seconds", type=DURATION, default=None,
+                   help="re-simulate only the first SECONDS of the log")
+    p.add_argument("--out", metavar="DIR", help=f"output folder (default {DEFAULT_OUT}/LOG)")
+    p.add_argument("--force", action="store_true", help="replace outputs in --out")
+    p.add_argument("--json", action="store_true", help="print diagnosis.json")
+    p.set_defaults(func=_run, api_names={"torque_constant": "--torque-constant",
+                                         "window_s": "--window"})
+
+
+def _run(args: argparse.Namespace) -> int:
+    # sim loads MuJoCo: only when this command runs.
+    from zrp.cli.dynamics_runs import run_diagnosis
+
+    out = Path(args.out) if args.out else DEFAULT_OUT / Path(args.data).stem
+    payload, text = run_diagnosis(args, out)
+    emit(args, payload, text)
+    return 0
