@@ -12,6 +12,7 @@ from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
 from mjcf.gravity import gravity_torques
 from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
 from mjcf.inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
+from mjcf.shipped import load_shipped
 from mjcf.writer import mjcf_xml, save_mjcf
 from zrp.packages import DISTRIBUTION
 
@@ -34,6 +35,7 @@ __all__ = [
     "gravity_torques",
     "inverse_dynamics_torques",
     "load_mujoco_model",
+    "load_shipped",
     "manipulator_from_mujoco",
     "metres_per_unit",
     "mjcf_xml",
