@@ -6,6 +6,7 @@
 """
 
 from mjcf import _env  # noqa: F401 (checks MUJOCO_GL before any module imports mujoco)
+from mjcf.arm_dynamics import ArmDynamics, arm_dynamics
 from mjcf.builder import BuiltArm, MJCFOptions, build, build_spec
 from mjcf.dynamics import inverse_dynamics_torques, mode_terms
 from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
@@ -23,12 +24,14 @@ from zrp.units import LENGTH_UNITS, metres_per_unit
 __all__ = [
     "INERTIA_MODELS",
     "LENGTH_UNITS",
+    "ArmDynamics",
     "BodyInertia",
     "BuiltArm",
     "MJCFCompileError",
     "MJCFImportError",
     "MJCFOptions",
     "MJCFOutputError",
+    "arm_dynamics",
     "build",
     "build_spec",
     "from_mjcf",

