@@ -21,7 +21,7 @@ import numpy as np
 from mjcf.arm_dynamics import ArmDynamics
 from mjcf.inertia import BodyInertia
 from sim.robot.effects import HiddenEffects, finite
-from sim.robot.servo import ServoGains, tune_servos
+from sim.robot.servo import ServoGains, rotor_armature, tune_servos
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.sampling import default_limits
@@ -220,8 +220,14 @@ def _add_drives(spec: mujoco.MjSpec, chain: _Chain, load_friction: F64) -> None:
 def _tune(spec: mujoco.MjSpec, chain: _Chain, effects: HiddenEffects,
           options: RealRobotOptions, lower: F64, upper: F64) -> ServoGains:
     """The servo gains and time step from the inertia each servo sees (eqs S1-S5 of
-    :mod:`sim.robot.servo`), set on the actuators; the play joints' limits and bearing
-    friction get constraint time constants of 2 dt."""
+    :mod:`sim.robot.servo`; with the arm's own dynamics, its rotor inertias first, eq S0),
+    set on the actuators; the play joints' limits and bearing friction get constraint time
+    constants of 2 dt."""
+    if options.dynamics is not None and options.inertia in ("auto", "own"):
+        arm = rotor_armature(spec.compile(), chain.motor, options.dynamics.armature, lower,
+                             upper)
+        for name, a in zip(chain.motor, arm, strict=True):
+            spec.joint(name).armature = float(a)
     gains = tune_servos(spec.compile(), chain.motor, effects.joint_compliance,
                         options.servo_bandwidth, options.damping_ratio, lower, upper,
                         options.timestep)

@@ -12,6 +12,17 @@ robot is commanded to:
     ki_k = min(0.15 sqrt(kp_k / I_k), 0.5 kv_k / I_k)                         (eq S4)
     dt  = min(1 ms, 0.4 min_k sqrt(min_q M_kk(q) / kp_k))                     (eq S5)
 
+An arm read from its own file often gives no rotor inertia (URDF has no such field) or a
+placeholder, yet a geared drive reflects a rotor inertia of the order of its link's (the PUMA
+560's drives: 0.2-1.6x their links' at joints 1-3, more at the wrist), and the motor side of a
+joint with backlash needs it (with 1e-3 kg m^2 against a UR5 shoulder's 5 kg m^2 the motor
+chatters on the flank and never settles). So for such arms
+
+    armature_k = max(given_k, ROTOR_SHARE max_q M_kk,link(q))                 (eq S0)
+
+with M_kk,link the link-side inertia (the diagonal without the armature); eqs S1-S5 then see
+it.
+
 omega (rad/s) is the chosen servo bandwidth and zeta the damping ratio: with I_k the largest
 inertia, every posture has a natural frequency >= omega and a damping ratio >= zeta. ki is the
 integral rate (1/s: trim += ki dt error); the servo I s^3 + kv s^2 + kp s + kp ki is stable for
@@ -29,10 +40,13 @@ import numpy as np
 
 from zrp.arrays import F64
 
-__all__ = ["INTEGRAL_SHARE", "ServoGains", "servo_inertias", "tune_servos"]
+__all__ = ["INTEGRAL_SHARE", "ROTOR_SHARE", "ServoGains", "rotor_armature", "servo_inertias",
+           "tune_servos"]
 
 #: ki / sqrt(kp / I) of eq S4 (the integral action's speed relative to the servo's).
 INTEGRAL_SHARE = 0.15
+#: the least rotor inertia of eq S0 as a share of the link-side inertia.
+ROTOR_SHARE = 0.5
 
 
 @dataclass(frozen=True, eq=False)
@@ -75,6 +89,16 @@ def servo_inertias(probe: mujoco.MjModel, motor: Sequence[str], lower: F64, uppe
         mujoco.mj_fullM(probe, d, full)
         out[i] = full[dof, dof]
     return out
+
+
+def rotor_armature(probe: mujoco.MjModel, motor: Sequence[str], given: F64, lower: F64,
+                   upper: F64) -> F64:
+    """Eq S0: each motor joint's armature, kg m^2 (kg), shape (n,), from the compiled
+    ``probe`` (whose motor joints carry their current armature) and the file's ``given``."""
+    ids = [mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm) for nm in motor]
+    current = probe.dof_armature[[probe.jnt_dofadr[j] for j in ids]]
+    link = servo_inertias(probe, motor, lower, upper).max(axis=0) - current
+    return np.maximum(np.asarray(given, dtype=float), ROTOR_SHARE * link)
 
 
 def tune_servos(probe: mujoco.MjModel, motor: Sequence[str], compliance: Mapping[int, float],

@@ -96,7 +96,7 @@ def test_a_payload_adds_its_potential_energy_gradient():
 
 
 def test_servo_gains_follow_the_bandwidth_rule():
-    """kp_k = omega^2 max_q M_kk(q), kv_k = 2 zeta sqrt(kp_k I_k) (eqs S1-S3), recomputed
+    """kp_k = omega^2 max_q M_kk(q), kv_k = 2 zeta sqrt(kp_k I_k) (eqs S0-S3), recomputed
     from the compiled robot's mass matrix."""
     path, model = shipped_arm("panda")
     robot = _own_robot(path, model, servo_bandwidth=120.0, damping_ratio=0.8)
@@ -106,7 +106,10 @@ def test_servo_gains_follow_the_bandwidth_rule():
     np.testing.assert_allclose(robot.servo_stiffness, 120.0**2 * i_max, rtol=1e-9)
     np.testing.assert_allclose(robot.describe()["servo_kv_Nms_per_rad"],
                                2 * 0.8 * 120.0 * i_max, rtol=1e-9)
-    assert i_max[0] > 5 * robot.model.dof_armature[0]  # the arm's own inertia, not a floor
+    # eq S0: the rotor inertia is the file's, at least half the link-side inertia
+    arm = robot.model.dof_armature[:model.n]
+    given = mjcf.arm_dynamics(path, model).armature
+    np.testing.assert_allclose(arm, np.maximum(given, 0.5 * (i_max - arm)), rtol=1e-9)
 
 
 def test_no_inertias_falls_back_announced():
