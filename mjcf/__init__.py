@@ -6,13 +6,13 @@
 """
 
 from mjcf import _env  # noqa: F401 (checks MUJOCO_GL before any module imports mujoco)
-from mjcf.arm_dynamics import ArmDynamics, arm_dynamics
 from mjcf.builder import BuiltArm, MJCFOptions, build, build_spec
 from mjcf.dynamics import inverse_dynamics_torques, mode_terms
 from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
 from mjcf.gravity import gravity_torques
 from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
 from mjcf.inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
+from mjcf.own_dynamics import ArmDynamics, arm_dynamics
 from mjcf.shipped import load_shipped
 from mjcf.writer import mjcf_xml, save_mjcf
 from zrp.packages import DISTRIBUTION

@@ -23,7 +23,9 @@ import numpy as np
 from mjcf.inertia import BodyInertia, puma560_inertias, rod_inertias
 from sim.robot.model import RealRobotOptions
 from zrp.errors import ZRPWarning
+from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
+from zrp.units import metres_per_unit
 
 __all__ = ["DynamicsFallbackWarning", "RobotMass", "is_paper_puma", "link_inertias", "robot_mass"]
 
@@ -70,9 +72,6 @@ def robot_mass(model: Manipulator, options: RealRobotOptions) -> RobotMass:
 def is_paper_puma(model: Manipulator) -> bool:
     """True for the paper's Table 1 PUMA (the built-in ``puma``, in any length unit): its own
     inertias are the PUMA 560 literature values."""
-    from zrp.model.files import load_model
-    from zrp.units import metres_per_unit
-
     puma = load_model("puma")
     if model.n != puma.n or model.prismatic.any():
         return False

@@ -18,8 +18,8 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from mjcf.arm_dynamics import ArmDynamics
 from mjcf.inertia import BodyInertia
+from mjcf.own_dynamics import ArmDynamics
 from sim.robot.effects import HiddenEffects, finite
 from sim.robot.servo import ServoGains, rotor_armature, tune_servos
 from zrp.arrays import F64

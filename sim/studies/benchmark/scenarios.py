@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from mjcf.arm_dynamics import ArmDynamics, arm_dynamics
+from mjcf.own_dynamics import ArmDynamics, arm_dynamics
 from sim.robot.effects import EFFECT_NAMES, HiddenEffects, default_tool_points
 from sim.robot.instrument import TRACKER_NOISE_RANGE_MM
 from sim.robot.mass import DynamicsFallbackWarning, is_paper_puma
