@@ -131,3 +131,48 @@ def test_a_file_of_another_arm_is_refused_by_joint():
         mjcf.arm_dynamics(path, ur5)
     with pytest.raises(MJCFImportError, match=r"joint 1 .*no joint of that name"):
         mjcf.arm_dynamics(path, random_arm(1))
+
+
+@pytest.mark.parametrize("name", ["ur10", "panda"])
+def test_diagnose_takes_the_shipped_urdf_as_mjcf(name, tmp_path, capsys):
+    """zrp diagnose --mjcf <the arm's URDF> (package:// meshes, a Panda's finger joints): the
+    joint compliance the robot hides is named, its gravity torques from the shipped file."""
+    from sim.robot.instrument import Instrument
+    from sim.robot.measurement import measure, write_measurements
+    from zrp.cli.app import main
+
+    path, model = shipped_arm(name)
+    toml = zrp.save_model(model, tmp_path / "arm.toml")
+    robot = _own_robot(path, model, effects=HiddenEffects(joint_compliance={2: 4e-5}))
+    rng = np.random.default_rng(6)
+    run = measure(robot, reachable_poses(model, 60, rng), Instrument(noise_sigma=0.01), rng)
+    csv = write_measurements(run, tmp_path / "d.csv")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rc = main(["diagnose", "--model", str(toml), "--mjcf", str(path), "--data", str(csv),
+                   "--out", str(tmp_path / "out"), "--no-plots", "--no-progress", "--json"])
+    assert rc == 0, capsys.readouterr().err
+    import json
+
+    doc = json.loads((tmp_path / "out" / "diagnosis.json").read_text(encoding="utf-8"))
+    assert doc["steps"][0]["effect"] == "joint_compliance", doc["steps"][0]
+
+
+def test_measure_takes_the_arms_file(tmp_path, capsys):
+    """zrp measure --arm: the truth file says the robot had the arm's own inertias; without
+    it the fallback is announced in the truth file."""
+    import json
+
+    from zrp.cli.app import main
+
+    path, model = shipped_arm("xarm7")
+    toml = zrp.save_model(model, tmp_path / "arm.toml")
+    base = ["measure", "--model", str(toml), "--poses", "8", "--seed", "1"]
+    assert main([*base, "--arm", str(path), "--out", str(tmp_path / "own.csv")]) == 0
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynamicsFallbackWarning)
+        assert main([*base, "--out", str(tmp_path / "fb.csv")]) == 0
+    own = json.loads((tmp_path / "own.truth.json").read_text(encoding="utf-8"))["robot"]
+    fb = json.loads((tmp_path / "fb.truth.json").read_text(encoding="utf-8"))["robot"]
+    assert own["inertia"] == "own" and "xarm7.urdf" in own["dynamics"]
+    assert fb["dynamics_fallback"] is True and fb["inertia"] == "rods"
