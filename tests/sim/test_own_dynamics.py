@@ -96,20 +96,37 @@ def test_a_payload_adds_its_potential_energy_gradient():
 
 
 def test_servo_gains_follow_the_bandwidth_rule():
-    """kp_k = omega^2 max_q M_kk(q), kv_k = 2 zeta sqrt(kp_k I_k) (eqs S0-S3), recomputed
-    from the compiled robot's mass matrix."""
+    """kp_k = omega^2 max_q M_kk(q), kv_k = 2 zeta sqrt(kp_k I_k) - d_k (eqs S0-S3),
+    recomputed from the compiled robot's mass matrix."""
     path, model = shipped_arm("panda")
     robot = _own_robot(path, model, servo_bandwidth=120.0, damping_ratio=0.8)
     motor = [f"q{k + 1}" for k in range(model.n)]
     lim = zrp.kinematics.sampling.default_limits(model)
     i_max = servo_inertias(robot.model, motor, lim[:, 0], lim[:, 1]).max(axis=0)
+    own = mjcf.arm_dynamics(path, model).damping  # the file's 0.003 N m s/rad
     np.testing.assert_allclose(robot.servo_stiffness, 120.0**2 * i_max, rtol=1e-9)
     np.testing.assert_allclose(robot.describe()["servo_kv_Nms_per_rad"],
-                               2 * 0.8 * 120.0 * i_max, rtol=1e-9)
+                               2 * 0.8 * 120.0 * i_max - own, rtol=1e-9)
     # eq S0: the rotor inertia is the file's, at least half the link-side inertia
     arm = robot.model.dof_armature[:model.n]
     given = mjcf.arm_dynamics(path, model).armature
     np.testing.assert_allclose(arm, np.maximum(given, 0.5 * (i_max - arm)), rtol=1e-9)
+
+
+def test_a_heavily_damped_joint_gets_the_stiffness_of_its_damping_ratio():
+    """Eq S2: the xArm7's wrist (d = 2 N m s/rad) is stiffened so that its own damping alone
+    gives the damping ratio zeta; its rate gain adds nothing (eq S3)."""
+    path, model = shipped_arm("xarm7")
+    robot = _own_robot(path, model)
+    motor = [f"q{k + 1}" for k in range(model.n)]
+    lim = zrp.kinematics.sampling.default_limits(model)
+    i_max = servo_inertias(robot.model, motor, lim[:, 0], lim[:, 1]).max(axis=0)
+    d = mjcf.arm_dynamics(path, model).damping
+    heavy = d > 2 * 150.0 * i_max
+    assert heavy[-1]
+    np.testing.assert_allclose(robot.servo_stiffness[heavy], (d[heavy] / 2) ** 2 / i_max[heavy],
+                               rtol=1e-9)
+    assert np.all(np.asarray(robot.describe()["servo_kv_Nms_per_rad"])[heavy] == 0)
 
 
 def test_no_inertias_falls_back_announced():
