@@ -7,10 +7,10 @@ and payload included), sampled at q = 0 and at seeded random postures within the
 robot is commanded to:
 
     I_k = max_q M_kk(q)                                                       (eq S1)
-    kp_k = max(omega^2 I_k, (d_k / (2 zeta))^2 / I_k)
+    kp_k = max(omega^2 I_k, omega d_k)
                                 (1 / c_k for a joint with compliance c_k)     (eq S2)
     kv_k = max(0, 2 zeta sqrt(kp_k I_k) - d_k)                                (eq S3)
-    ki_k = min(0.15 sqrt(kp_k / I_k), 0.5 (kv_k + d_k) / I_k)                 (eq S4)
+    ki_k = min(0.15 omega, 0.5 (kv_k + d_k) / I_k)                            (eq S4)
     dt  = min(1 ms, 0.4 min_k sqrt(min_q M_kk(q) / kp_k))                     (eq S5)
 
 An arm read from its own file often gives no rotor inertia (URDF has no such field) or a
@@ -27,9 +27,12 @@ it.
 omega (rad/s) is the chosen servo bandwidth and zeta the damping ratio: with I_k the largest
 inertia, every posture has a natural frequency >= omega and a damping ratio >= zeta. The
 joint's own viscous damping d_k (the file's) is part of the servo's damping: the rate gain
-supplies the rest, and a joint damped more than 2 zeta omega I_k gets the stiffness that
-makes its damping ratio zeta (without it, an xArm7 wrist with d = 2 N m s/rad against
-I = 0.003 kg m^2 crept to its target over seconds). ki is the
+supplies the rest, and a joint whose own damping is heavier than omega I_k gets the stiffness
+omega d_k, so that its slow (overdamped) pole d_k / kp_k is still at omega (without it, an
+xArm7 wrist with d = 2 N m s/rad against I ~ 1e-3 kg m^2 crept to its target over seconds).
+The integral rate is 0.15 omega for every joint (the servo's own speed for a joint tuned by
+omega^2 I_k; a stiffened joint's sqrt(kp / I) would make the integral, updated every control
+period, unstable). ki is the
 integral rate (1/s: trim += ki dt error); the servo I s^3 + kv s^2 + kp s + kp ki is stable for
 ki < kv / I (Routh), so eq S4 keeps half of that margin at every posture (I <= I_k). The
 explicit integrator is stable for dt well below sqrt(I / kp) (eq S5).
@@ -48,7 +51,7 @@ from zrp.arrays import F64
 __all__ = ["INTEGRAL_SHARE", "ROTOR_SHARE", "ServoGains", "rotor_armature", "servo_inertias",
            "tune_servos"]
 
-#: ki / sqrt(kp / I) of eq S4 (the integral action's speed relative to the servo's).
+#: ki / omega of eq S4 (the integral action's speed relative to the servo's).
 INTEGRAL_SHARE = 0.15
 #: the least rotor inertia of eq S0 as a share of the link-side inertia.
 ROTOR_SHARE = 0.5
@@ -123,12 +126,12 @@ def tune_servos(probe: mujoco.MjModel, motor: Sequence[str], compliance: Mapping
     i_max, i_min = inertia.max(axis=0), inertia.min(axis=0)
     ids = [mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm) for nm in motor]
     own = probe.dof_damping[[probe.jnt_dofadr[j] for j in ids]]
-    kp = np.maximum(bandwidth**2 * i_max, (own / (2.0 * damping_ratio))**2 / i_max)
+    kp = np.maximum(bandwidth**2 * i_max, bandwidth * own)
     for k, c in compliance.items():
         kp[k - 1] = 1.0 / c
     total = 2.0 * damping_ratio * np.sqrt(kp * i_max)
     kv = np.maximum(0.0, total - own)
-    ki = np.minimum(INTEGRAL_SHARE * np.sqrt(kp / i_max), 0.5 * (kv + own) / i_max)
+    ki = np.minimum(INTEGRAL_SHARE * bandwidth, 0.5 * (kv + own) / i_max)
     dt = timestep if timestep is not None else \
         float(min(1e-3, 0.4 * np.min(np.sqrt(i_min / kp))))
     return ServoGains(kp, kv, ki, i_max, i_min, dt)
