@@ -353,15 +353,17 @@ def _check_new(path: str | os.PathLike[str], overwrite: bool) -> Path:
 
 
 def write_measurements(run: MeasurementRun, path: str | os.PathLike[str], *, deg: bool = False,
-                       overwrite: bool = False) -> Path:
-    """Write the measurement CSV (the diagnosis's format; q in deg with ``deg``) atomically;
-    an existing file is replaced only with ``overwrite=True``."""
+                       overwrite: bool = False, model: Manipulator | None = None) -> Path:
+    """Write the measurement CSV (the diagnosis's format; q in deg with ``deg``, declared in
+    the header: ``q1[deg]``; ``model`` tells the prismatic joints, kept in its length unit)
+    atomically; an existing file is replaced only with ``overwrite=True``."""
     path = _check_new(path, overwrite)
     meas = run.measurements
     n = meas.n_joints
-    q = np.degrees(meas.q) if deg else meas.q
-    cols = ["pose", "point", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z", "t", "temp",
-            "load"]
+    rev = np.ones(n, bool) if model is None else ~np.asarray(model.prismatic)
+    q = np.where(rev, np.degrees(meas.q), meas.q) if deg else meas.q
+    cols = ["pose", "point", *[f"q{k}{'[deg]' if deg and rev[k - 1] else ''}"
+                               for k in range(1, n + 1)], "x", "y", "z", "t", "temp", "load"]
     if run.direction is not None:
         cols += [f"dir{k}" for k in range(1, n + 1)]
     with atomic_path(path, overwrite=overwrite) as tmp, \

@@ -2,8 +2,9 @@
 
 Each frame shows the perturbed ("actual") arm (orange links), the nominal arm as a translucent
 white ghost, the desired path (nominal direct kinematics, green), the actual path (magenta) and
-the current deviation vector (yellow arrow with a ball at its tip), both magnified about the
-desired path by one stated factor for the whole video, a colour legend, a text block with the
+the current deviation vector (a yellow arrow painted over the image, named in the legend only
+on frames where it is painted), both magnified about the desired path by one stated factor for
+the whole video, a colour legend, a text block with the
 perturbation, delta_p, delta_R (eq 15) and theta (values below :data:`NOISE_FLOOR` print as 0,
 and the floor is stated), and a live plot of delta_p(t). In a video of several segments (a
 sweep over levels) the actual paths of the earlier segments stay drawn, dimmed.
@@ -33,21 +34,22 @@ from numpy.typing import ArrayLike
 
 from mjcf import BuiltArm, MJCFOptions, build
 from sim.robot.dynamics import check_timed_q
-from sim.view.framing import frame_on_path
+from sim.view.framing import frame_on_path, projected_fractions
 from sim.view.gl import _check_name
 from sim.view.magnify import exaggerated_model as exaggerated_model
 from sim.view.magnify import nice_factor as nice_factor
 from sim.view.overlays import (
     ACTUAL_RGBA,
     ARM_RGBA,
-    ARROW_RGBA,
     DESIRED_RGBA,
     EARLIER_RGBA,
     GHOST_RGBA,
-    LEGEND,
+    MIN_ARROW_PX,
     NOISE_FLOOR,
     PANEL_PX,
     delta_p_figure,
+    legend_text,
+    paint_arrow,
     shown_value,
 )
 from sim.view.playback import kinematic_playback
@@ -235,8 +237,6 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
     magnified = _magnified(seg, magnify)
     stride = max(1, math.ceil((n_frames - 1) / opts.trace_segments))
     idx_all = np.unique(np.r_[np.arange(0, n_frames, stride), n_frames - 1])
-    path_size = float(np.linalg.norm(seg.p_des.max(axis=0) - seg.p_des.min(axis=0))) or 0.1
-    arrow_r = 0.006 * max(path_size, 0.1)
     fig = delta_p_figure(seg.t, seg.delta_p, opts.plot, unit, plot_top)
     max_pts = len(fig.linedata[0]) // 2 if opts.plot else 0
     plot_idx = np.linspace(0, n_frames - 1, min(n_frames, max_pts)).astype(int) if opts.plot \
@@ -244,7 +244,7 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
     pw, ph = int(opts.width * 0.36), int(opts.height * 0.27)
     col = max(pw, PANEL_PX)   # the right-hand column: legend, numbers, plot
     numbers = (opts.width - col - 4, ph + 8, col, max(1, opts.height - ph - 8))
-    legend = LEGEND.format(m=magnify, arm=f", errors x{magnify:g}" if seg.drawn else "")
+    size = np.array([opts.width, opts.height], dtype=float)
     for f in range(n_frames):
         d_a.qpos[drawn.qpos_adr] = drawn.qpos(seg.q[f])
         d_n.qpos[seg.nominal.qpos_adr] = seg.nominal.qpos(seg.q[f])
@@ -259,9 +259,8 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
             done = np.r_[done, f]
         if len(done) > 1:
             r.add_polyline(magnified[done], ACTUAL_RGBA, 2.5)
-        if np.linalg.norm(magnified[f] - seg.p_des[f]) > 1e-9:
-            r.add_arrow(seg.p_des[f], magnified[f], ARROW_RGBA, arrow_r)
-            r.add_sphere(magnified[f], 2.5 * arrow_r, ARROW_RGBA)
+        ends = projected_fractions(r.scene, [seg.p_des[f], magnified[f]], size[0] / size[1])
+        ends_px = np.stack([ends[:, 0], 1.0 - ends[:, 1]], axis=1) * size  # from the top left
         r.render()
         r.text(f"{title}\n{seg.label}",
                corner=mujoco.mjtGridPos.mjGRID_TOPLEFT)
@@ -269,7 +268,9 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
                f"{seg.t[f]:.2f} s\n{shown_value(seg.delta_p[f], '.4g')} {unit}\n"
                f"{shown_value(seg.delta_r[f], '.3e')}\n{shown_value(seg.theta[f], '.3e')} rad\n",
                corner=mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport=numbers)
-        r.text(legend, corner=mujoco.mjtGridPos.mjGRID_TOPRIGHT)
+        arrow = bool(np.linalg.norm(ends_px[1] - ends_px[0]) >= MIN_ARROW_PX)
+        r.text(legend_text(magnify, seg.drawn is not None, arrow),
+               corner=mujoco.mjtGridPos.mjGRID_TOPRIGHT)
         if opts.plot:
             shown = plot_idx[plot_idx <= f]
             fig.linepnt[0] = len(shown)
@@ -277,7 +278,10 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
                 fig.linedata[0][0:2 * len(shown):2] = seg.t[shown]
                 fig.linedata[0][1:2 * len(shown):2] = seg.delta_p[shown]
             r.figure(fig, opts.width - pw - 4, 4, pw, ph)
-        yield r.read()
+        image = r.read()
+        if arrow:
+            paint_arrow(image, ends_px[0], ends_px[1])
+        yield image
 
 
 @dataclass(frozen=True, eq=False)

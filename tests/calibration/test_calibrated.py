@@ -137,6 +137,12 @@ def test_never_commands_beyond_a_limit(geometric):
     lim = LIM.copy()
     lim[0] = [qt[:, 0].min() + 1e-6, 2.5]  # the lowest joint-1 target needs more than this
     i = int(np.argmin(qt[:, 0]))
+    seed = np.clip(qt, lim[:, 0], lim[:, 1])  # every seed within the limits
     with pytest.raises(InputError, match=rf"target t{i}: .*joint 1 .*beyond its limit"):
+        compensate(cal, y, seed, point="s1", frame="instrument", limits=lim,
+                   target_ids=tuple(f"t{k}" for k in range(20)))
+    # a seed (program row) outside a limit is refused before any solve, naming row and joint
+    with pytest.raises(InputError, match=rf"target t{i}: the seed \(program\) value of joint 1 "
+                       r"is .* outside its limit"):
         compensate(cal, y, qt, point="s1", frame="instrument", limits=lim,
                    target_ids=tuple(f"t{k}" for k in range(20)))

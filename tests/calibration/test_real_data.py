@@ -13,6 +13,8 @@ from zrp.calibration import (
     read_calibration,
     write_calibration,
 )
+from zrp.calibration.validation import implausible_values
+from zrp.gap.model.domains import ImplausibleValueError
 
 # IRB 120 datasheet joint ranges (deg); joint 6 is +-400 deg
 LIMITS = np.radians([[-165, 165], [-110, 110], [-110, 70], [-160, 160], [-120, 120],
@@ -24,8 +26,27 @@ def real(irb120_real):
     return irb120_real.diagnosis
 
 
+def test_real_implausible_values_never_reach_a_file(real, tmp_path):
+    """The last gate: a value outside its physical domain (the IRB 120's final model had four
+    negative backlash values) is refused by the writer, naming each; nothing is written."""
+    cal = CalibratedRobot.from_diagnosis(real)
+    bad = implausible_values(cal)
+    if not bad:
+        write_calibration(cal, tmp_path / "calibrated.toml", tmp_path / "compensation.json")
+        return
+    with pytest.raises(ImplausibleValueError) as err:
+        write_calibration(cal, tmp_path / "calibrated.toml", tmp_path / "compensation.json")
+    for msg in bad:
+        assert msg.split(" = ")[0] + " = " in str(err.value)
+    assert not list(tmp_path.iterdir())
+    print(f"IRB 120: refused {len(bad)} implausible values: {bad}")
+
+
 def test_real_round_trip_and_program(real, withheld_residual, tmp_path):
     cal = CalibratedRobot.from_diagnosis(real)
+    if implausible_values(cal):
+        pytest.skip("the diagnosis's final model carries values outside their physical "
+                    "domain (refused by the writer, tested above)")
     _, c = write_calibration(cal, tmp_path / "calibrated.toml", tmp_path / "compensation.json")
     back = read_calibration(c)
     r = withheld_residual(back, real)

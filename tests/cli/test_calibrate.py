@@ -61,15 +61,17 @@ def test_compensate_program_and_limits(calibrated, tmp_path, capsys):
     assert rc == 0
     rows = list(csv.DictReader(open(out)))
     ref = compensate_program(read_calibration(comp_json), q)
-    got = np.radians([[float(r[f"q{k}"]) for k in range(1, 7)] for r in rows])
+    got = np.radians([[float(r[f"q{k}[deg]"]) for k in range(1, 7)] for r in rows])
     assert np.allclose(got, ref.q_command, atol=1e-12)
     assert all(r["converged"] == "1" for r in rows)
-    lo1 = np.degrees(q[:, 0].min()) + 1e-3   # the lowest joint-1 target needs more
+    i = int(np.argmin(q[:, 0]))
+    lo1 = np.degrees(q[i, 0]) + 1e-3   # the lowest joint-1 program row is below this limit
     lim = ",".join([f"{lo1}:180"] + ["-180:180"] * 5)
     rc = main(["compensate", "--calibration", str(comp_json), "--targets", str(tfile),
                "--deg", "--out", str(tmp_path / "c2.csv"), f"--limits={lim}"])
     err = capsys.readouterr().err
-    assert rc == 2 and "target T" in err and "beyond its limit" in err
+    assert rc == 2 and f"target T{i}: " in err and "joint 1 " in err
+    assert "outside its limit" in err
 
 
 def test_plan_cli(tmp_path, capsys):

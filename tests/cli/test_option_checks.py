@@ -164,7 +164,7 @@ def test_study_joints_in_degrees_refused(tmp_path, capsys):
     for cmd in (["study", "--params", "LE2", "--xi", "0.1"], ["tolerance", "--robots", "100",
                                                                 "--no-progress"]):
         _refused(capsys, [*cmd, "--joints", str(tmp_path / "j.csv")],
-                 "line 2: q2 is 10, more than 2 pi rad: the joint values look like degrees")
+                 "line 2: column q2 is 10, beyond 6.283 rad")
 
 
 def test_diagnose_large_file_subsampled_with_notice(tmp_path, capsys, measured_csv):

@@ -131,3 +131,19 @@ def test_cli_paper_study_tolerance(tmp_path, capsys):
     assert main(["study", "--params", "LE2", "--xi", "0.05", "0.1", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)  # strict JSON: no NaN for the missing - side
     assert out["linearity_delta_p"]["LE2"]["slope_neg"] is None
+
+
+def test_figures_2_3_say_why_the_curves_miss_the_squares(example):
+    """The sentence under Figures 2-3 (in the figure, not only in comparison.md) states the
+    joint angles of both runs, from the example's own checks."""
+    from dataclasses import replace
+
+    from zrp.paper.figures import why_apart
+
+    ours = max(v["max_abs_q_deg"] for v in example.checks["table3_closed_form"].values())
+    paper = min(v["deg_min"] for v in implied_joint_angles().values())
+    text = why_apart(example)
+    assert f"at most {ours:.0f} deg" in text and f"implies {paper:.0f}-180 deg" in text
+    assert ours < paper   # the reason holds: our joints turn less than the paper's
+    assert "go through the squares" in why_apart(replace(example, circle="recovered"))
+    assert why_apart(replace(example, cells=[])) == ""

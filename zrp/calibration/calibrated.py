@@ -28,6 +28,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from zrp.arrays import F64
+from zrp.calibration.conditions import Conditions
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
@@ -38,8 +39,12 @@ from zrp.gap.results import Diagnosis
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import skew
 
-__all__ = ["CalibratedRobot", "PoseConditions", "chain"]
+__all__ = ["CalibratedRobot", "PoseConditions", "chain", "rotation_about"]
 
+
+def rotation_about(u: F64, angle: float) -> F64:
+    """Rotation about unit axis u (3,) by ``angle`` (rad), shape (3, 3) (Rodrigues)."""
+    return _rot(np.asarray(u, dtype=float), np.array([angle]))[0]
 
 
 def _rot(u: F64, q: F64) -> F64:
@@ -122,6 +127,11 @@ class CalibratedRobot:
         gravity_side_weights: without MJCF torques, the lumped masses (per joint and mass
             point, shape (n, J)) whose gravity torque decides the loaded flank of the backlash
             (the diagnosis's lumped-mass compliance fit), or None.
+        conditions: what the data were measured under (payloads, tool points, temperature
+            range, units, joint limits, instrument, data file hash; :mod:`.conditions`), or
+            None (unknown: nothing can be enforced).
+        widen: physical domains widened by the user (domain key -> upper bound,
+            :mod:`zrp.gap.model.domains`), or None.
     """
 
     model: Manipulator
@@ -142,6 +152,8 @@ class CalibratedRobot:
     compliance_model: str = "lumped_masses"
     withheld_rms: float | None = None
     gravity_side_weights: F64 | None = None
+    conditions: Conditions | None = None
+    widen: dict[str, float] | None = None
 
     def __post_init__(self) -> None:
         n = self.model.n
@@ -159,6 +171,9 @@ class CalibratedRobot:
             raise InputError(f"joint_offsets: expected shape ({n},)")
         if self.frame not in ("instrument", "base"):
             raise InputError(f"frame: expected 'instrument' or 'base', got {self.frame!r}")
+        if self.conditions is not None and len(self.conditions.joint_limits) != n:
+            raise InputError(f"conditions.joint_limits: {len(self.conditions.joint_limits)} "
+                             f"entries for {n} joints")
         bad = [t.name for t in self.terms if not 1 <= t.joint <= n]
         if bad:
             raise InputError(f"terms {bad}: joint outside 1..{n}")
@@ -205,7 +220,40 @@ class CalibratedRobot:
                    tuple(ctx.harmonics), ctx.meas.frame,
                    "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
                    float(diag.nominal.rms if registration_only else diag.final.rms),
-                   _side_weights(ctx))
+                   _side_weights(ctx), Conditions.from_measurements(ctx.meas, ctx.model))
+
+    @classmethod
+    def from_corrections(cls, nominal: Manipulator, joint_offsets: ArrayLike,
+                         axes: ArrayLike | None = None, bodies: ArrayLike | None = None
+                         ) -> CalibratedRobot:
+        """A purely geometric calibrated robot (base frame, no tool points, no joint map):
+        ``nominal`` with corrected axes (n, 3) and bodies (n + 1, 3) (default: the nominal's)
+        and revolute joint offsets delta (n,) folded in (e.g. a simulated calibration)."""
+        delta = np.asarray(joint_offsets, dtype=float)
+        if delta.shape != (nominal.n,):
+            raise InputError(f"joint_offsets: expected shape ({nominal.n},), got {delta.shape}")
+        u = np.asarray(nominal.axes if axes is None else axes, dtype=float)
+        b = np.asarray(nominal.bodies if bodies is None else bodies, dtype=float)
+        if u.shape != (nominal.n, 3) or b.shape != (nominal.n + 1, 3):
+            raise InputError(f"axes, bodies: expected shapes ({nominal.n}, 3) and "
+                             f"({nominal.n + 1}, 3), got {u.shape} and {b.shape}")
+        folded, tools = _fold(nominal, u / np.linalg.norm(u, axis=1, keepdims=True), b,
+                              np.where(nominal.prismatic, 0.0, delta), np.zeros((0, 3)))
+        return cls(folded, nominal, np.eye(3), np.zeros(3), (), tools,
+                   np.where(nominal.prismatic, 0.0, delta), frame="base")
+
+    def fold_rotations(self) -> F64:
+        """R_k(delta) per joint, shape (n, 3, 3): the rotation the folded offsets of joints
+        1..k give everything after joint k (identity without offsets); the identified axes are
+        u_k = R_{k-1}(delta)^T u'_k."""
+        r = np.eye(3)
+        out = np.empty((self.n, 3, 3))
+        for k in range(self.n):
+            u = r.T @ np.asarray(self.model.axes[k])
+            if not self.model.prismatic[k]:
+                r = r @ rotation_about(u, float(self.joint_offsets[k]))
+            out[k] = r
+        return out
 
     # ---- prediction -----------------------------------------------------------------------
     def context(self, q: ArrayLike, cond: PoseConditions | None = None) -> Context:
@@ -315,5 +363,6 @@ def _fold(model: Manipulator, u: F64, bodies: F64, delta: F64, tools: F64
         axes / np.linalg.norm(axes, axis=1, keepdims=True), new_b, axial=r @ ee.axial,
         transverse=r @ ee.transverse, types=model.joint_types,
         name=f"{model.name} (calibrated)", length_unit=model.length_unit,
-        joint_names=[j.name for j in model.joints])
+        joint_names=[j.name for j in model.joints], limits=[j.limits for j in model.joints],
+        velocity_limits=[j.velocity_limit for j in model.joints])
     return folded, tools @ r.T

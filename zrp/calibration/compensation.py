@@ -26,12 +26,20 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.arrays import F64
 from zrp.calibration.calibrated import CalibratedRobot, PoseConditions, chain
+from zrp.calibration.conditions import (
+    ConditionWarning,
+    MissingConditionError,
+    check_joint_limits,
+    missing_conditions,
+    out_of_range,
+)
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import hand_frame
 from zrp.rotations import er_from_matrix, rotvec_from_er
 
-__all__ = ["Compensation", "ThermalWarning", "compensate", "compensate_program"]
+__all__ = ["Compensation", "ConditionWarning", "ThermalWarning", "compensate",
+           "compensate_program", "joint_limits"]
 
 GravityFn = Callable[[F64], F64]
 
@@ -171,14 +179,8 @@ def _newton(cal: CalibratedRobot, q: F64, cond: PoseConditions, tg: _Targets, to
     return q
 
 
-def _check_limits(q: F64, limits: ArrayLike | None, margin: float, ids: tuple[str, ...]
+def _check_limits(q: F64, lim: F64, margin: float, ids: tuple[str, ...]
                   ) -> NDArray[np.bool_]:
-    if limits is None:
-        return np.zeros(len(q), dtype=bool)
-    lim = np.asarray(limits, dtype=float)
-    if lim.shape != (q.shape[1], 2) or np.any(lim[:, 0] >= lim[:, 1]):
-        raise InputError(f"limits: expected shape ({q.shape[1]}, 2) with lower < upper, got "
-                         f"{lim.shape}")
     out = (q < lim[:, 0]) | (q > lim[:, 1])
     if out.any():
         i, k = map(int, np.argwhere(out)[0])
@@ -217,14 +219,35 @@ def _checked_targets(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike,
     return y, q0, ids, rot
 
 
-def _warn_thermal(cal: CalibratedRobot, base: PoseConditions) -> None:
+def _warn_conditions(cal: CalibratedRobot, base: PoseConditions) -> None:
     """Warn (at the caller of :func:`compensate`) when thermal expansion was identified but
-    the targets' temperature is not given."""
+    the targets' temperature is not given, when a payload-dependent joint map identified with
+    a payload gets none, and when a temperature or payload lies outside the measured range."""
     if cal.kappa != 0.0 and base.temp is None:
         warnings.warn(f"the calibration found thermal expansion (kappa = {cal.kappa:.3g} "
                       f"1/degC) but no temperature was given (conditions=PoseConditions("
                       f"temp=...)): the commands are for the reference temperature "
                       f"{cal.t_ref:.4g} degC", ThermalWarning, stacklevel=3)
+    try:
+        missing_conditions(cal.terms, cal.compliance_model, 0.0, cal.conditions,
+                           temp=base.temp, load=base.load)
+    except MissingConditionError as exc:
+        warnings.warn(f"{exc} (conditions=PoseConditions(load=...)); the commands are for "
+                      "no payload", ConditionWarning, stacklevel=3)
+    for msg in out_of_range(cal.conditions, temp=base.temp, load=base.load):
+        warnings.warn(msg, ConditionWarning, stacklevel=3)
+
+
+def joint_limits(cal: CalibratedRobot, limits: ArrayLike | None) -> F64:
+    """The limits to enforce, shape (n, 2): ``limits`` when given, else the calibrated
+    model's own (+-inf for a joint without)."""
+    if limits is None:
+        return np.stack([cal.model.lower, cal.model.upper], axis=1)
+    lim = np.asarray(limits, dtype=float)
+    if lim.shape != (cal.n, 2) or np.any(~(lim[:, 0] < lim[:, 1])):
+        raise InputError(f"limits: expected shape ({cal.n}, 2) with lower < upper, got "
+                         f"{lim.shape}")
+    return lim
 
 
 def _solve(cal: CalibratedRobot, q0: F64, cond: PoseConditions, base: PoseConditions,
@@ -266,24 +289,34 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
         conditions: temperatures, loads, explicit approach directions (default: directions
             from the order of the commands, re-evaluated on the solution).
         gravity_torque: for MJCF compliance, a function q (T, n) -> torques (T, n) (N m).
-        limits: joint limits, shape (n, 2) (rad / length unit), or None.
+        limits: joint limits, shape (n, 2) (rad / length unit), or None: the calibrated
+            model's own (from the model file; none for a joint without). Every seed (the
+            program) and every command is checked against them.
         limit_margin: a command closer than this to a limit is flagged.
         singular_tol: sigma_min below this is flagged near-singular.
         tol: convergence tolerance on the error (length unit; orientation scaled by L).
 
+    Warns:
+        ThermalWarning: thermal expansion identified and no temperature given.
+        ConditionWarning: a payload-dependent joint map identified with a payload and no
+            load given; a temperature or payload outside the measured range.
+
     Raises:
-        InputError: bad shapes or a command beyond a limit (naming the target and joint).
+        InputError: bad shapes, or a seed or command beyond a joint limit (naming the target
+            and joint).
     """
     y, q0, ids, rot = _checked_targets(cal, targets, seed, orientations, frame, target_ids)
+    lim = joint_limits(cal, limits)
+    check_joint_limits(q0, lim, ids, "the seed (program) value")
     tg = _Targets(y, rot, cal.tool_offset(point))
     base = conditions or PoseConditions()
-    _warn_thermal(cal, base)
+    _warn_conditions(cal, base)
     cond = _conditions(base, gravity_torque, q0)
     e0, _, _ = _errors(cal, q0, cond, tg)
     q, cond = _solve(cal, q0, cond, base, gravity_torque, tg, tol, max_iter, max_rounds)
     e, _, full = _errors(cal, q, cond, tg)
     ok = np.linalg.norm(e, axis=1) < tol
-    near_limit = _check_limits(q, limits, limit_margin, ids)
+    near_limit = _check_limits(q, lim, limit_margin, ids)
     smin = np.linalg.svd(full, compute_uv=False)[:, -1]
     L = cal.model.characteristic_length
     return Compensation(ids, q, q0, y + e[:, :3], np.linalg.norm(e[:, :3], axis=1),

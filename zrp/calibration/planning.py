@@ -3,7 +3,8 @@
 Criterion: D-optimality of the identification Jacobian of the gap diagnosis's corrected model
 (:class:`zrp.gap.model.problem.Problem`: registration + the chosen effects, evaluated at the nominal
 parameters), i.e. maximise log det(J^T J) over N poses drawn from a candidate set (uniform in
-the joint limits, above a floor keep-out). Selection: DETMAX-style exchange (Mitchell 1974):
+the joint limits, within the model's own, above a floor keep-out). Selection: DETMAX-style
+exchange (Mitchell 1974):
 from a random start, add the candidate that raises log det most, then drop the design pose
 whose removal lowers it least, until the pose added is the one dropped. With A_i the rows of
 pose i (3 per tool point) and M = J^T J (Eq: matrix determinant lemma)
@@ -36,13 +37,18 @@ from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.effects import effect_parameters, registration_parameters
 from zrp.gap.model.problem import Problem
 from zrp.kinematics.forward import forward_kinematics
-from zrp.kinematics.sampling import uniform_joint_values
+from zrp.kinematics.sampling import default_limits, uniform_joint_values
 from zrp.model.manipulator import Manipulator
 from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
 __all__ = ["Plan", "PlanWarning", "design_std", "plan_poses"]
 
-ALIAS_TOL = 1e-6
+#: A parameter is aliased when less than this fraction of its column stays after projection on
+#: the columns before it: its predicted std would be inflated more than 1 / ALIAS_TOL times by
+#: the others (the variance inflation of a near-alias). 1e-3, not the fit's 1e-6: a URDF's
+#: rounded angles (rpy 1.5708 for pi/2, 3.7e-6 rad off) leave exact aliases 1e-6 apart, which
+#: planned as independent printed stds of 1e3 mm (xArm7's b2.y..b5.y).
+ALIAS_TOL = 1e-3
 
 
 class PlanWarning(ZRPWarning):
@@ -126,13 +132,25 @@ def _jacobian(model: Manipulator, q: F64, direction: F64, tool: F64, effects: Se
     return specs, J.reshape(C, M * 3, len(specs))
 
 
-def _identifiable(J: F64) -> NDArray[np.bool_]:
-    """Columns of J (R, p) that keep > ALIAS_TOL of their norm after projection on the
-    columns kept before them (Gram-Schmidt in column order)."""
-    A = J / np.maximum(np.linalg.norm(J, axis=0), 1e-300)
+#: A column is numerically zero below this fraction of the largest column of its unit (a
+#: parameter that moves no point: q6.offset with the tool point on joint 6's axis).
+ZERO_TOL = 1e-8
+
+
+def _identifiable(J: F64, units: Sequence[str]) -> NDArray[np.bool_]:
+    """Columns of J (R, p) that are not numerically zero (:data:`ZERO_TOL` of the largest
+    column in the same unit: normalising rounding noise would make it look independent) and
+    keep > ALIAS_TOL of their norm after projection on the columns kept before them
+    (Gram-Schmidt in column order)."""
+    norm = np.linalg.norm(J, axis=0)
+    scale = np.array([max(norm[[i for i, v in enumerate(units) if v == u]]) for u in units])
+    live = norm > ZERO_TOL * scale
+    A = J / np.maximum(norm, 1e-300)
     keep = np.zeros(A.shape[1], dtype=bool)
     Q = np.zeros((A.shape[0], 0))
     for j in range(A.shape[1]):
+        if not live[j]:
+            continue
         r = A[:, j] - Q @ (Q.T @ A[:, j])
         r -= Q @ (Q.T @ r)
         nr = np.linalg.norm(r)
@@ -185,7 +203,9 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
         n_poses: poses to measure (N).
         effects: effects to identify (of :data:`zrp.gap.EFFECTS`, not thermal_expansion).
         rng: draws the candidates, their approach directions and the start.
-        limits: joint limits, shape (n, 2) (default +-2.5 rad).
+        limits: joint limits, shape (n, 2), within the model's own (default
+            :func:`zrp.kinematics.sampling.default_limits`: +-2.5 rad within the model's
+            limits, slides within theirs).
         tool_points: tool offsets t_j (zero-reference base frame, length unit), shape (M, 3).
         floor_z: candidates with any joint point or tool point below this z (base frame) are
             excluded (None: no keep-out).
@@ -198,11 +218,11 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
             joint's direction to the plan (drawn at random per candidate).
 
     Raises:
-        InputError: too few poses for the parameters, invalid arguments.
+        InputError: too few poses for the parameters, limits beyond the model's (naming the
+            joint), invalid arguments.
     """
     tool = np.atleast_2d(np.asarray(tool_points, dtype=float))
-    lim = (np.tile([-2.5, 2.5], (model.n, 1)) if limits is None
-           else np.asarray(limits, dtype=float))
+    lim = _within_model(model, limits)
     q = _candidates(model, candidates, rng, lim, tool, floor_z)
     d = rng.choice([-1.0, 1.0], size=q.shape)
     if direction_fn is not None:
@@ -213,11 +233,12 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
         d = np.where(imposed != 0.0, imposed, d)
     tau = None if gravity_torque_fn is None else np.asarray(gravity_torque_fn(q))  # type: ignore[operator]
     specs, J = _jacobian(model, q, d, tool, effects, tau)
-    keep = _identifiable(J.reshape(-1, len(specs)))
+    keep = _identifiable(J.reshape(-1, len(specs)), [s.unit for s in specs])
     lost = tuple(s.name for s, k in zip(specs, keep, strict=True) if not k)
     if lost:
         warnings.warn(f"{len(lost)} parameter(s) stay unidentifiable with any of these poses "
-                      f"(aliased with others) and are left out: {', '.join(lost)}",
+                      f"(aliased with others, or moving no measured point) and are left out: "
+                      f"{', '.join(lost)}",
                       PlanWarning, stacklevel=2)
     specs = [s for s, k in zip(specs, keep, strict=True) if k]
     J = J[:, :, keep]
@@ -264,11 +285,27 @@ def design_std(model: Manipulator, q: ArrayLike, direction: ArrayLike, effects: 
         warnings.simplefilter("ignore", PlanWarning)
         specs, J = _jacobian(model, qa, da, tool, effects, tau)
     J = J.reshape(-1, len(specs))
-    keep = _identifiable(J)
+    keep = _identifiable(J, [s.unit for s in specs])
     Jk = J[:, keep] / np.linalg.norm(J[:, keep], axis=0)
     Mi = np.linalg.inv(Jk.T @ Jk) / np.outer(*(2 * [np.linalg.norm(J[:, keep], axis=0)]))
     names = tuple(s.name for s, k in zip(specs, keep, strict=True) if k)
     return names, _noise(model, noise_sigma) * np.sqrt(np.diag(Mi))
+
+
+def _within_model(model: Manipulator, limits: ArrayLike | None) -> F64:
+    """The planning limits: ``limits`` checked against the model's own, or its defaults."""
+    if limits is None:
+        return default_limits(model)
+    lim = np.asarray(limits, dtype=float)
+    if lim.shape != (model.n, 2):
+        raise InputError(f"limits: expected shape ({model.n}, 2), got {lim.shape}")
+    out = (lim[:, 0] < model.lower - 1e-12) | (lim[:, 1] > model.upper + 1e-12)
+    if out.any():
+        k = int(np.argmax(out))
+        raise InputError(f"limits: joint {k + 1} ({model.joint_names[k]}) planned over "
+                         f"[{lim[k, 0]:.6g}, {lim[k, 1]:.6g}], beyond the model's limits "
+                         f"[{model.lower[k]:.6g}, {model.upper[k]:.6g}] (rad or length unit)")
+    return lim
 
 
 def _noise(model: Manipulator, noise_sigma: float | None) -> float:

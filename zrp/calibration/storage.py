@@ -16,17 +16,20 @@ from typing import Any
 import numpy as np
 
 from zrp.calibration.calibrated import CalibratedRobot
+from zrp.calibration.conditions import Conditions
 from zrp.calibration.jointmap import Term
-from zrp.errors import InputError
+from zrp.calibration.validation import validate_calibration
+from zrp.errors import InputError, ZRPError
 from zrp.gap.fit.fullpose import FullPoseFit
 from zrp.jsonio import dumps
 from zrp.model.files import dumps_model, load_model, loads_model
+from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
 from zrp.rotations import er_from_matrix, rotvec_from_er
 from zrp.version import __version__
 
-__all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "read_calibration",
-           "write_calibration"]
+__all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "model_file_path",
+           "read_calibration", "write_calibration"]
 
 SCHEMA_VERSION = 1
 
@@ -74,10 +77,28 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "gravity_side_weights": (None if cal.gravity_side_weights is None
                                  else np.asarray(cal.gravity_side_weights).tolist()),
         "full_pose": full_pose_document(full_pose),
+        "conditions": None if cal.conditions is None else cal.conditions.to_dict(),
+        "domains_widened": cal.widen,
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
                   "= R_b (p'(x) + R'_n(x) t'_j) + t_b with p', R'_n the forward kinematics of "
                   "model_file, bodies scaled by 1 + kappa (temp - t_ref)"),
     }
+
+
+def _toml_header(cal: CalibratedRobot) -> str:
+    """Comment lines heading the model TOML: the version and the conditions (the model format
+    has no keys for them; compensation.json carries them as data)."""
+    lines = [f"# written by zrp-accuracy {__version__}"]
+    c = cal.conditions
+    if c is not None:
+        lines += ["# calibrated under (compensation.json 'conditions'):",
+                  f"#   payloads_kg = {list(c.payloads_kg) if c.payloads_kg is not None else None}"
+                  f"; tool_points = {list(c.tool_points)}",
+                  f"#   temp_range_degC = {c.temp_range_degC}; length_unit = {c.length_unit};"
+                  f" angle_unit = {c.angle_unit}",
+                  f"#   instrument = {c.instrument}; data_file = {c.data_file}; "
+                  f"data_sha256 = {c.data_sha256}"]
+    return "\n".join(lines) + "\n"
 
 
 def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: str | Path, *,
@@ -85,15 +106,25 @@ def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: s
                       ) -> tuple[Path, Path]:
     """Write the calibrated model (TOML) and the compensation file (JSON), atomically; both
     names are checked before either is written. ``full_pose``: the full-pose fit of ``cal``
-    (its probe rotation and orientation noise go to the file's ``full_pose``).
+    (its probe rotation and orientation noise go to the file's ``full_pose``). The model file
+    must sit in the compensation file's folder or below it (``model_file`` is relative).
 
     Raises:
         OutputExistsError: a file exists and ``overwrite`` is False.
+        ImplausibleValueError: a value outside its physical domain
+            (:func:`zrp.calibration.validation.validate_calibration`); nothing is written.
     """
+    validate_calibration(cal, cal.widen, "write_calibration")
     check_writable([model_path, comp_path], overwrite)
-    doc = calibration_document(cal, Path(model_path).name, full_pose)
-    m = write_text(model_path, f"# written by zrp-accuracy {__version__}\n"
-                   + dumps_model(cal.model), overwrite=overwrite)
+    folder = Path(comp_path).resolve().parent
+    try:
+        rel = Path(model_path).resolve().relative_to(folder).as_posix()
+    except ValueError:
+        raise InputError(f"model_path: {model_path} is not in the folder of {comp_path} (or "
+                         "below it); the compensation file names its model relative to "
+                         "itself") from None
+    doc = calibration_document(cal, rel, full_pose)
+    m = write_text(model_path, _toml_header(cal) + dumps_model(cal.model), overwrite=overwrite)
     c = write_text(comp_path, dumps(doc), overwrite=overwrite)
     return m, c
 
@@ -104,29 +135,82 @@ def _get(doc: dict[str, Any], key: str, src: str) -> Any:
     return doc[key]
 
 
-def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
-                     ) -> CalibratedRobot:
-    """Read a calibrated robot back (``model_path`` default: the ``model_file`` named in the
-    compensation file, beside it).
+def model_file_path(comp_path: str | Path, model_file: object, *,
+                    allow_outside: bool = False) -> Path:
+    """The model file named by a compensation file: ``model_file`` relative to the
+    compensation file's folder. An absolute path, or one that leaves that folder (``..``, a
+    symbolic link out), is refused unless ``allow_outside``.
 
     Raises:
-        InputError: unreadable file, wrong schema or missing keys (naming the file and key).
+        InputError: naming the compensation file, the path and why it is refused.
+    """
+    src = str(comp_path)
+    if not isinstance(model_file, str) or not model_file.strip() or "\0" in model_file:
+        raise InputError(f"{src}: model_file: expected a file name relative to the "
+                         f"compensation file, got {model_file!r}")
+    folder = Path(comp_path).parent
+    path = Path(model_file)
+    if allow_outside:
+        return path if path.is_absolute() else folder / path
+    if path.is_absolute() or path.drive or path.root:
+        raise InputError(f"{src}: model_file {model_file!r} is an absolute path; it must be "
+                         "relative to the compensation file's folder (pass the model file "
+                         "explicitly, model_path= (--model-file on the command line), or "
+                         "allow_outside=True to accept it)")
+    full = folder / path
+    try:
+        full.resolve().relative_to(folder.resolve())
+    except (ValueError, OSError, RuntimeError):
+        raise InputError(f"{src}: model_file {model_file!r} leaves the compensation file's "
+                         "folder; it must stay in it or below (pass the model file "
+                         "explicitly, model_path= (--model-file on the command line), or "
+                         "allow_outside=True to accept it)") from None
+    return full
+
+
+def read_calibration(comp_path: str | Path, model_path: str | Path | None = None, *,
+                     allow_outside: bool = False) -> CalibratedRobot:
+    """Read a calibrated robot back (``model_path`` default: the ``model_file`` named in the
+    compensation file, relative to it, :func:`model_file_path`), validated like a written one.
+
+    Raises:
+        InputError: unreadable file, wrong schema, missing or malformed keys (naming the file
+            and key), a model_file outside the compensation file's folder.
+        ImplausibleValueError: a value outside its physical domain.
     """
     src = str(comp_path)
     try:
         doc = json.loads(Path(comp_path).read_text(encoding="utf-8"))
     except (OSError, ValueError) as exc:
         raise InputError(f"{src}: cannot read the compensation file: {exc}") from exc
+    if not isinstance(doc, dict):
+        raise InputError(f"{src}: expected a JSON object")
     if doc.get("schema_version") != SCHEMA_VERSION:
         raise InputError(f"{src}: schema_version {doc.get('schema_version')!r}, expected "
                          f"{SCHEMA_VERSION}")
-    mpath = (Path(comp_path).parent / _get(doc, "model_file", src) if model_path is None
-             else Path(model_path))
+    mpath = (model_file_path(comp_path, _get(doc, "model_file", src),
+                             allow_outside=allow_outside)
+             if model_path is None else Path(model_path))
+    model = load_model(mpath)
+    try:
+        cal = _robot(doc, model, src)
+    except (KeyError, TypeError, ValueError, IndexError, AttributeError, OverflowError) as exc:
+        if isinstance(exc, ZRPError):
+            raise
+        raise InputError(f"{src}: malformed compensation file ({type(exc).__name__}: "
+                         f"{exc})") from None
+    validate_calibration(cal, cal.widen, src)
+    return cal
+
+
+def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot:
     tools = _get(doc, "tool_points", src)
     bl = _get(doc, "backlash", src)
     th = _get(doc, "thermal", src)
+    cond = doc.get("conditions")
+    widen = doc.get("domains_widened")
     return CalibratedRobot(
-        load_model(mpath), loads_model(_get(doc, "nominal_model", src), f"{src}: nominal_model"),
+        model, loads_model(str(_get(doc, "nominal_model", src)), f"{src}: nominal_model"),
         np.array(_get(doc, "base_rotation", src), dtype=float),
         np.array(_get(doc, "base_translation", src), dtype=float), tuple(tools),
         np.array([tools[k] for k in tools], dtype=float).reshape(-1, 3),
@@ -134,8 +218,14 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
         tuple(Term.from_dict(t, f"{src}: joint_map[{i}]")
               for i, t in enumerate(_get(doc, "joint_map", src))),
         float(th["kappa"]), float(th["t_ref_degC"]),
-        None if bl["switch"] is None else tuple(bl["switch"]), float(bl["payload_kg"]),
-        tuple(_get(doc, "gravity_dir", src)), tuple(_get(doc, "harmonics", src)),
-        _get(doc, "frame", src), _get(doc, "compliance_model", src), doc.get("withheld_rms"),
+        None if bl["switch"] is None else tuple(None if v is None else float(v)
+                                                for v in bl["switch"]),
+        float(bl["payload_kg"]),
+        tuple(float(v) for v in _get(doc, "gravity_dir", src)),
+        tuple(int(h) for h in _get(doc, "harmonics", src)),
+        str(_get(doc, "frame", src)), str(_get(doc, "compliance_model", src)),
+        None if doc.get("withheld_rms") is None else float(doc["withheld_rms"]),
         None if doc.get("gravity_side_weights") is None
-        else np.array(doc["gravity_side_weights"], dtype=float))
+        else np.array(doc["gravity_side_weights"], dtype=float),
+        None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
+        None if widen is None else {str(k): float(v) for k, v in dict(widen).items()})

@@ -4,7 +4,9 @@ Targets CSV, one row per target, in program order: ``target`` (id), ``q1``..``qn
 program's joint values, rad or deg with ``deg=True``; the seed of the solve), and optionally
 ``x, y, z`` (desired tool-point position; without them the target is the nominal model's pose
 at q: a joint program) and ``qw, qx, qy, qz`` (desired hand orientation in the base frame, a
-unit quaternion, with x, y, z). Errors name the file, line and column.
+unit quaternion, with x, y, z). A joint or position column may declare its unit
+(``q1[deg]``, ``x[m]``; the rule and checks of :mod:`zrp.units`: seeds in degrees read as
+radians are refused). Errors name the file, line and column.
 """
 
 from __future__ import annotations
@@ -20,10 +22,22 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.calibration.compensation import Compensation
 from zrp.errors import InputError
+from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.rotations import matrix_from_er
+from zrp.units import (
+    angle_bounds,
+    joint_column_units,
+    joint_values_to_rad,
+    length_scale,
+    split_unit,
+)
 
-__all__ = ["Targets", "load_targets", "write_commands"]
+__all__ = ["Commands", "Targets", "load_commands", "load_targets", "write_commands"]
+
+#: The columns :func:`write_commands` writes besides target and q1..qn.
+COMMAND_FLAGS = ("residual", "orientation_residual", "uncompensated", "sigma_min",
+                 "near_singular", "near_limit", "converged")
 
 
 
@@ -70,21 +84,48 @@ def _columns(header: list[str], n: int, src: str) -> tuple[list[str], bool, bool
     return cols, has_xyz, has_quat
 
 
-def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
-    """Read a targets CSV for a robot with ``n`` joints (see the module doc).
+def _read_rows(path: str | Path, what: str) -> list[list[str]]:
+    """The non-empty CSV records of ``path``; a header and a row at least."""
+    src = str(path)
+    try:
+        rows = list(csv.reader(io.StringIO(Path(path).read_text(encoding="utf-8"))))
+    except (OSError, UnicodeDecodeError, csv.Error) as exc:
+        raise InputError(f"{src}: cannot read the {what} file: {exc}") from None
+    rows = [r for r in rows if r]
+    if len(rows) < 2:
+        raise InputError(f"{src}: no {what} (a header and at least one row expected)")
+    return rows
+
+
+def _header(rows: list[list[str]], src: str) -> tuple[list[str], dict[str, str | None]]:
+    """The column names and the unit each declares (zrp.units.split_unit)."""
+    parsed = [split_unit(h, f"{src}, line 1") for h in rows[0]]
+    return [h for h, _ in parsed], dict(parsed)
+
+
+def _positions(xyz: F64, unit: dict[str, str | None], model: Manipulator | None, src: str
+               ) -> F64:
+    """x, y, z in the model's length unit (a declared unit converted)."""
+    if all(unit[c] is None for c in "xyz"):
+        return xyz
+    if model is None:
+        raise InputError(f"{src}, line 1: x, y, z declare a unit; the model is needed to "
+                         "convert it")
+    return xyz * [length_scale(unit[c], model.length_unit, f"{src} column {c}") for c in "xyz"]
+
+
+def load_targets(path: str | Path, n: int, *, deg: bool = False,
+                 model: Manipulator | None = None) -> Targets:
+    """Read a targets CSV for a robot with ``n`` joints (see the module doc); ``model`` (with
+    n joints) tells the prismatic joints, the joint limits and the length unit (None: all
+    revolute, positions in the model's unit, unit-less).
 
     Raises:
         InputError: unreadable file, bad header, field count, non-numbers (file, line, column).
     """
     src = str(path)
-    try:
-        rows = list(csv.reader(io.StringIO(Path(path).read_text(encoding="utf-8"))))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise InputError(f"{src}: cannot read the targets file: {exc}") from exc
-    rows = [r for r in rows if r]
-    if len(rows) < 2:
-        raise InputError(f"{src}: no targets (a header and at least one row expected)")
-    header = [h.strip() for h in rows[0]]
+    rows = _read_rows(path, "targets")
+    header, unit = _header(rows, src)
     cols, has_xyz, has_quat = _columns(header, n, src)
     ids, vals = [], []
     for i, r in enumerate(rows[1:], start=2):
@@ -96,8 +137,8 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
     if len(set(ids)) != len(ids):
         raise InputError(f"{src}: repeated target ids")
     a = np.array(vals, dtype=float)
-    q = np.radians(a[:, :n]) if deg else a[:, :n]
-    xyz = a[:, n:n + 3] if has_xyz else None
+    q = _joints(a[:, :n], [unit[f"q{k}"] for k in range(1, n + 1)], deg, model, src)
+    xyz = _positions(a[:, n:n + 3], unit, model, src) if has_xyz else None
     rot = None
     if has_quat:
         quat = a[:, n + 3:n + 7]
@@ -108,6 +149,64 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False) -> Targets:
                              f"(norm {norm[bad[0]]:.6g})")
         rot = matrix_from_er(quat / norm[:, None])
     return Targets(tuple(ids), q, xyz, rot)
+
+
+def _joints(q: F64, declared: list[str | None], deg: bool, model: Manipulator | None,
+            src: str) -> F64:
+    """Program joint values to rad by the rule and checks of :mod:`zrp.units`."""
+    n = q.shape[1]
+    rev = np.ones(n, bool) if model is None else ~np.asarray(model.prismatic)
+    names = [f"q{k}" for k in range(1, n + 1)]
+    angle, scale = joint_column_units(declared, rev, deg, src=src, names=names,
+                                      length_unit="mm" if model is None else model.length_unit)
+    bounds = None if model is None else angle_bounds(model.lower, model.upper)
+    return joint_values_to_rad(q, rev, angle, src=src, names=names,
+                               lines=np.arange(2, len(q) + 2), bounds=bounds) * scale
+
+
+@dataclass(frozen=True, eq=False)
+class Commands:
+    """A commands CSV read back (T rows): ``ids``, ``q`` (rad, (T, n)) and ``converged``
+    (T,) bool."""
+
+    ids: tuple[str, ...]
+    q: F64
+    converged: np.ndarray
+
+
+def _check_command_columns(header: list[str], joints: list[str], src: str) -> None:
+    missing = [c for c in ["target", *joints, "converged"] if c not in header]
+    unknown = [c for c in header if c not in ("target", *joints, *COMMAND_FLAGS)]
+    if missing or unknown:
+        raise InputError(f"{src}, line 1: expected the columns of zrp compensate's output "
+                         f"(target, q1..q{len(joints)}, {', '.join(COMMAND_FLAGS)}); missing "
+                         f"{missing}, unknown {unknown}")
+
+
+def load_commands(path: str | Path, model: Manipulator, *, deg: bool = False) -> Commands:
+    """Read the commands CSV of ``zrp compensate`` (:func:`write_commands`) for ``model``;
+    joint columns by the unit rule of :mod:`zrp.units` (``q1[deg]`` declared, or ``deg``).
+
+    Raises:
+        InputError: unreadable file, missing or unknown columns, non-numbers (file, line,
+            column); UnitError: a unit mix-up.
+    """
+    src = str(path)
+    rows = _read_rows(path, "commands")
+    header, unit = _header(rows, src)
+    n = model.n
+    joints = [f"q{k}" for k in range(1, n + 1)]
+    _check_command_columns(header, joints, src)
+    col = {c: i for i, c in enumerate(header)}
+    ids, vals, conv = [], [], []
+    for i, r in enumerate(rows[1:], start=2):
+        if len(r) != len(header):
+            raise InputError(f"{src}, line {i}: {len(r)} fields, expected {len(header)}")
+        ids.append(r[col["target"]].strip())
+        vals.append([_number(r[col[c]], src, i, c) for c in joints])
+        conv.append(_number(r[col["converged"]], src, i, "converged") == 1.0)
+    q = _joints(np.array(vals), [unit[c] for c in joints], deg, model, src)
+    return Commands(tuple(ids), q, np.array(conv))
 
 
 def write_commands(comp: Compensation, path: str | Path, *, deg: bool = False,
@@ -121,7 +220,8 @@ def write_commands(comp: Compensation, path: str | Path, *, deg: bool = False,
     q = np.degrees(comp.q_command) if deg else comp.q_command
     buf = io.StringIO()
     w = csv.writer(buf)
-    w.writerow(["target", *[f"q{k}" for k in range(1, n + 1)], "residual",
+    w.writerow(["target", *[f"q{k}{'[deg]' if deg else ''}" for k in range(1, n + 1)],
+                "residual",
                 "orientation_residual", "uncompensated", "sigma_min", "near_singular",
                 "near_limit", "converged"])
     ori = comp.orientation_residual

@@ -12,8 +12,12 @@ import argparse
 import math
 from collections.abc import Callable
 
+import numpy as np
+
 from zrp.arguments import MAX_SEED
-from zrp.model.manipulator import MAX_LENGTH
+from zrp.errors import InputError
+from zrp.model.manipulator import MAX_LENGTH, Manipulator
+from zrp.units import angle_bounds, joint_values_to_rad
 
 __all__ = [
     "DURATION",
@@ -28,6 +32,8 @@ __all__ = [
     "PERCENT",
     "SEED",
     "TOLERANCE",
+    "add_deg",
+    "joint_angles",
     "real",
     "whole",
 ]
@@ -97,3 +103,29 @@ PERCENT = real(-1.0, 1.0, open_lo=True, open_hi=True, unit="%")
 FRACTION = real(0.0, 1.0)
 #: A duration, s.
 DURATION = real(0.0, 1e6, open_lo=True, unit="s")
+
+
+#: The help of ``--deg``, the same in every command (the rule of zrp/units.py).
+DEG_HELP = ("angles in degrees: the values typed, the joint columns read that declare no unit, "
+            "and the files written (declared q1[deg]); default rad")
+
+
+def add_deg(p: argparse.ArgumentParser | argparse._ArgumentGroup) -> None:
+    """``--deg``: one flag meaning the same in every command (:data:`DEG_HELP`)."""
+    p.add_argument("--deg", action="store_true", help=DEG_HELP)
+
+
+def joint_angles(model: Manipulator, values: list[float] | np.ndarray, deg: bool,
+                 option: str) -> np.ndarray:
+    """Joint values typed after ``option`` (n values, or (n, 2) limits) to rad for the
+    revolute joints (prismatic ones stay in the length unit), checked by zrp.units: a value
+    that cannot be an angle in rad names ``option`` and suggests ``--deg``."""
+    q = np.asarray(values, dtype=float)
+    if q.shape[0] != model.n:
+        raise InputError(f"{option}: expected {model.n} values for {model.name!r} "
+                         f"({', '.join(model.joint_names)}), got {q.shape[0]}")
+    rows = q if q.ndim == 1 else q.reshape(model.n, -1).T  # limits: a row of lows, of highs
+    out = joint_values_to_rad(rows, ~np.asarray(model.prismatic), "deg" if deg else "rad",
+                              src=option, bounds=angle_bounds(model.lower, model.upper),
+                              flag="--deg", header=False)
+    return out if q.ndim == 1 else out.T.reshape(q.shape)

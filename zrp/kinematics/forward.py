@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from zrp.arrays import F64
+from zrp.arrays import F64, recycled_empty
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import all_in_range, joint_limits
@@ -29,6 +29,7 @@ from zrp.rotations.rodrigues import (
     er_rotate,
     matrix_from_er,
 )
+from zrp.units import length_scale
 
 __all__ = ["FKResult", "check_q", "end_effector_pose", "forward_kinematics", "jacobian"]
 
@@ -174,12 +175,30 @@ def _one(q: object) -> bool:
     return type(q) is np.ndarray and q.ndim == 1 and q.dtype is _F64  # type: ignore[union-attr]
 
 
+def _length_scale(model: Manipulator, length_unit: str | None) -> float:
+    """Factor from the model's length unit to ``length_unit`` (None: 1, the model's own)."""
+    return 1.0 if length_unit is None else 1.0 / length_scale(length_unit, model.length_unit,
+                                                                "length_unit")
+
+
+def _q_in_model_unit(model: Manipulator, q: ArrayLike, s: float) -> ArrayLike:
+    """Prismatic joint values given in ``length_unit`` (model unit times ``s``) back in the
+    model's unit; q as it is when nothing changes."""
+    if s == 1.0 or not np.any(model.prismatic):
+        return q
+    return np.where(model.prismatic, np.asarray(q, dtype=float) / s, q)
+
+
 def end_effector_pose(model: Manipulator, q: ArrayLike, *,
-                      out: F64 | None = None) -> tuple[F64, F64]:
+                      out: F64 | None = None, length_unit: str | None = None
+                      ) -> tuple[F64, F64]:
     """Fast forward kinematics of the end effector only.
 
     Args:
-        q: joint values, shape (..., n).
+        q: joint values, shape (..., n) (rad; prismatic ones in ``length_unit``).
+        length_unit: the unit of lengths in and out (``"m"``: metres, as Pinocchio and the
+            Robotics Toolbox use; :data:`zrp.units.LENGTH_UNITS`); None: the model's own. The
+            same kernel, its result scaled.
         out: optional buffer for the result, float64, C-contiguous, shape (..., 7) with the
             batch shape of ``q`` (position, then Euler-Rodrigues parameters). Reusing one
             buffer over many calls spares the allocation of a fresh result, which for large
@@ -193,6 +212,11 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
         InputError: q out of range or malformed, or ``out`` not a float64 C-contiguous
             array of shape (..., 7) matching q's batch shape.
     """
+    if length_unit is not None:
+        s = _length_scale(model, length_unit)
+        p, er = end_effector_pose(model, _q_in_model_unit(model, q, s), out=out)
+        p *= s
+        return p, er
     if out is None and _one(q):  # one pose: ~1 us per call (one kernel call, three arguments)
         res = np.empty(7)
         if K.fk_pose_packed(q, _packed(model), res):
@@ -208,7 +232,7 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
 def _out_buffer(out: object, shape: tuple[int, ...]) -> F64:
     """``out`` checked as the result buffer of :func:`end_effector_pose` (or a new one)."""
     if out is None:
-        return np.empty(shape)
+        return recycled_empty(shape)  # a fresh 56 MB costs a third of the kernel (zero-fill)
     if not (isinstance(out, np.ndarray) and out.dtype == np.float64
             and out.flags.c_contiguous and out.flags.writeable and out.shape == shape):
         got = (f"{type(out).__name__} {getattr(out, 'dtype', '')} shape "
@@ -218,18 +242,33 @@ def _out_buffer(out: object, shape: tuple[int, ...]) -> F64:
     return out
 
 
-def jacobian(model: Manipulator, q: ArrayLike) -> F64:
+def jacobian(model: Manipulator, q: ArrayLike, *, rows: str = "wv",
+             length_unit: str | None = None) -> F64:
     """Eq (7): J with J qdot = [omega_h; V_p], shape (..., 6, n).
 
     Revolute column k: [u_k; u_k x (p - p_k)]; prismatic column k: [0; u_k]. Rows 0-2 are in
-    rad per joint unit, rows 3-5 in length unit per joint unit.
+    rad per joint unit, rows 3-5 in length unit per joint unit (base frame).
+
+    Options for the conventions other libraries use (the same kernel, its result reordered
+    and scaled): ``rows="vw"`` gives [V_p; omega_h], the row order of Pinocchio's
+    ``getFrameJacobian(..., LOCAL_WORLD_ALIGNED)`` and the Robotics Toolbox's ``jacob0``;
+    ``length_unit="m"`` gives V_p in m/rad (prismatic joint values in m).
     """
+    if rows not in ("wv", "vw"):
+        raise InputError(f"rows: expected 'wv' ([omega; v], eq 7) or 'vw' ([v; omega], "
+                         f"Pinocchio/RTB), got {rows!r}")
+    if rows == "vw" or length_unit is not None:
+        s = _length_scale(model, length_unit)
+        jac = jacobian(model, _q_in_model_unit(model, q, s))
+        jac[..., 3:, :] *= np.where(model.prismatic, 1.0, s)  # m/m stays for a slide
+        return np.concatenate([jac[..., 3:, :], jac[..., :3, :]], axis=-2) if rows == "vw" \
+            else jac
     if _one(q):  # one pose: one kernel call, three arguments
         jac = np.empty((6, model.n))
         if K.jac_packed(q, _packed(model), jac):
             return jac
     qf, batch = _flat(model, q)
-    jac = np.empty((qf.shape[0], 6, model.n))
+    jac = recycled_empty((qf.shape[0], 6, model.n))
     if not K.jac_batch(qf, *_karrays(model), joint_limits(model), np.empty((0, 7)), jac):
         _range_error(model, q)
     return jac.reshape(*batch, 6, model.n)

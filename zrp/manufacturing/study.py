@@ -39,6 +39,7 @@ from zrp.manufacturing.perturb import (
 from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.rotations.rodrigues import er_angle, er_conjugate, er_multiply
+from zrp.units import angle_bounds, joint_column_units, joint_values_to_rad, split_unit
 
 __all__ = [
     "PAPER_PARAMETERS",
@@ -98,22 +99,38 @@ class JointPath:
                    float(ik.orientation_error.max()))
 
 
-def _check_radians(q: F64, model: Manipulator, p: Path) -> None:
-    """Refuse revolute values beyond 2 pi: the file is most likely in degrees."""
+def _time_and_joints(rows: list[list[str]], n: int, p: Path) -> F64:
+    """t and q1..qn of each data row (after the header), finite numbers, shape (R, 1 + n)."""
+    data = []
+    for i, row in enumerate(rows[1:], start=2):
+        if len(row) < n + 1:
+            raise InputError(f"{p}, line {i}: expected at least {n + 1} columns (t, "
+                             f"q1..q{n}), got {len(row)}")
+        try:
+            data.append([float(x) for x in row[:n + 1]])
+        except ValueError as exc:
+            raise InputError(f"{p}, line {i}: not a number: {exc}") from exc
+        if not all(math.isfinite(v) for v in data[-1]):
+            raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:n + 1]}")
+    return np.array(data)
+
+
+def _joints_to_rad(q: F64, declared: list[str | None], model: Manipulator, deg: bool,
+                   src: str) -> F64:
+    """Joint columns by the unit rule of :mod:`zrp.units` (declared, or ``deg``), checked."""
     rev = ~np.asarray(model.prismatic)
-    big = np.abs(q[:, rev]) > 2.0 * math.pi + 1e-6
-    if big.any():
-        i, k = (int(v) for v in np.argwhere(big)[0])
-        kk = int(np.flatnonzero(rev)[k])
-        raise InputError(f"{p}, line {i + 2}: q{kk + 1} is {q[i, kk]:g}, more than 2 pi rad: the "
-                         "joint values look like degrees; a joint trajectory is in rad (as "
-                         "`zrp ik` writes it): convert it with numpy.radians")
+    declared = declared + [None] * (model.n - len(declared))
+    angle, scale = joint_column_units(declared, rev, deg, src=src, length_unit=model.length_unit)
+    return joint_values_to_rad(q, rev, angle, src=src, lines=np.arange(2, len(q) + 2),
+                               bounds=angle_bounds(model.lower, model.upper)) * scale
 
 
-def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
+def load_joint_csv(path: str | Path, model: Manipulator, *, deg: bool = False) -> JointPath:
     """Read a joint trajectory CSV: a header row, time (s) in the first column and the n joint
-    values in the next n columns (the layout ``zrp ik`` writes; rad / length unit). The IK
-    errors are taken from ``position_error`` / ``orientation_error_rad`` columns if present."""
+    values in the next n columns (the layout ``zrp ik`` writes; rad / length unit, or degrees
+    with ``deg``, or the unit a column declares, ``q1[deg]``: the rule and checks of
+    :mod:`zrp.units`). The IK errors are taken from ``position_error`` /
+    ``orientation_error_rad`` columns if present."""
     p = Path(path)
     try:
         with p.open(newline="", encoding="utf-8-sig") as fh:
@@ -124,20 +141,11 @@ def load_joint_csv(path: str | Path, model: Manipulator) -> JointPath:
         raise InputError(f"{p}: not a CSV text file in UTF-8 ({exc})") from None
     if len(rows) < 3:
         raise InputError(f"{p}: expected a header and at least 2 rows of t, q1..q{model.n}")
-    data = []
-    for i, row in enumerate(rows[1:], start=2):
-        if len(row) < model.n + 1:
-            raise InputError(f"{p}, line {i}: expected at least {model.n + 1} columns (t, "
-                             f"q1..q{model.n}), got {len(row)}")
-        try:
-            data.append([float(x) for x in row[:model.n + 1]])
-        except ValueError as exc:
-            raise InputError(f"{p}, line {i}: not a number: {exc}") from exc
-        if not all(math.isfinite(v) for v in data[-1]):
-            raise InputError(f"{p}, line {i}: expected finite numbers, got {row[:model.n + 1]}")
-    _check_radians(np.array(data)[:, 1:], model, p)
-    arr = np.array(data)
-    header = [h.strip() for h in rows[0]]
+    arr = _time_and_joints(rows, model.n, p)
+    parsed = [split_unit(h, f"{p}, line 1") for h in rows[0]]
+    header = [h for h, _ in parsed]
+    arr[:, 1:] = _joints_to_rad(arr[:, 1:], [u for _, u in parsed[1:model.n + 1]], model, deg,
+                                str(p))
     errs: list[float | None] = []
     for col in ("position_error", "orientation_error_rad"):
         if col in header:  # written by `zrp ik` (IKResult.save_csv)

@@ -8,7 +8,9 @@ ones ``continuous``; prismatic joints carry their limits when they have them. No
 written, and each moving link gets a nominal 1 g mass only so that MuJoCo loads the file (a
 kinematic description; a ``<mujoco>`` element keeps MuJoCo from fusing the tool link).
 :func:`zrp.model.urdf.import_urdf` reads it back exactly; Pinocchio and MuJoCo give the same
-forward kinematics.
+forward kinematics. For a robot that came from a URDF, :func:`zrp.model.urdf_patch.patch_urdf`
+writes that file back with the new geometry instead (its links, names, inertias and meshes
+kept).
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ from zrp.paper.comparison import kind_columns
 from zrp.paper.example import PaperExample
 from zrp.paper.published import LIKELY_TYPOS, PUBLISHED_ROWS, PUBLISHED_TABLE2, PUBLISHED_TABLE3
 
-__all__ = ["FIGURES", "coincident_with", "figure_names", "paper_figures"]
+__all__ = ["FIGURES", "coincident_with", "figure_names", "paper_figures", "why_apart"]
 
 #: One line style and marker per series, so that no series hides another.
 LINESTYLES = ("-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1)))
@@ -58,6 +58,45 @@ def _labels(name: str, unit: str, typos_noted: bool) -> tuple[str, str]:
         "fig7_le_position_time.png": (
             pos, "Fig. 7: link-dimension perturbations, positional deviation vs time"),
     }[name]
+
+
+def why_apart(ex: PaperExample) -> str:
+    """The sentence Figures 2-3 print under the axes when they show the published squares:
+    on the default circle, why the joint-axis curves sit below them (the joint angles the
+    paper's Table 3 implies against ours, ``ex.checks``); on the recovered circle, that they
+    meet. Empty without published values (another model or a custom trajectory)."""
+    if not ex.cells:
+        return ""
+    if ex.circle == "recovered":
+        return ("On the circle recovered from the published Tables 2-3 the curves go through "
+                "the squares (comparison.md).")
+    imp = ex.checks.get("paper_implied_max_abs_q_deg") or {}
+    ours = ex.checks.get("table3_closed_form") or {}
+    if not imp or not ours:
+        return ""
+    lo = min(v["deg_min"] for v in imp.values())
+    hi = max(v["max_abs_q_deg"] for v in ours.values())
+    return (f"Why the curves sit below the squares: the paper does not publish its circle. On "
+            f"this documented circle the joints turn at most {hi:.0f} deg from the zero "
+            f"reference; the published Table 3 implies {lo:.0f}-180 deg, and a joint-axis "
+            "error grows with 2 |sin(q_k / 2)|.\nOn the circle recovered from the published "
+            "tables (`zrp paper --circle recovered`) the curves go through the squares; "
+            "comparison.md gives every cell.")
+
+
+def _caption(ex: PaperExample, kind: str, style: str) -> str:
+    """The sentence under a figure: :func:`why_apart` for Figures 2-3, else none."""
+    return why_apart(ex) if kind == "JE" and style == "sweep" else ""
+
+
+def _draw_caption(fig: Any, caption: str) -> float:
+    """Draw ``caption`` under the axes (what the reader must know, in the figure itself);
+    returns the bottom margin the axes leave for it (fraction of the figure height)."""
+    if not caption:
+        return 0.03
+    fig.text(0.01, 0.045, caption, ha="left", va="bottom", fontsize=8, color="darkred",
+             wrap=True)
+    return 0.13
 
 
 def coincident_with(data: F64, names: list[str], rtol: float = 1e-2) -> dict[str, str]:
@@ -154,7 +193,8 @@ def paper_figures(ex: PaperExample, out: OutputDir, *, suffix: str = "",
         if not params or (only is not None and name not in only):
             continue
         ylabel, title = _labels(name, st.unit, bool(pubs))
-        fig, ax = plt.subplots(figsize=(9.5, 4.8))
+        caption = _caption(ex, kind, style)
+        fig, ax = plt.subplots(figsize=(9.5, 4.8 + 0.6 * bool(caption)))
         try:
             if style == "sweep":
                 _sweep(ax, ex, params, getattr(st, quantity), pubs.get(table), table, colors)
@@ -171,7 +211,7 @@ def paper_figures(ex: PaperExample, out: OutputDir, *, suffix: str = "",
                     if style == "sweep" and pubs else "")
             fig.text(0.99, 0.01, f"{note}{conv}; {ex.path.label}", ha="right", va="bottom",
                      fontsize=7, color="0.4")
-            fig.tight_layout(rect=(0, 0.03, 1, 1))
+            fig.tight_layout(rect=(0, _draw_caption(fig, caption), 1, 1))
             files.append(out.savefig(name.replace(".png", f"{suffix}.png"), fig, dpi=110))
         finally:
             plt.close(fig)

@@ -1,6 +1,10 @@
 """``index.html``: one page linking every output in a folder (``renders/``) with one sentence
 each on what it shows; images shown inline, videos playable.
 
+The page opens with a "start here" path for a student (:func:`start_here_html`): the executed
+teaching notebooks in order (``notebooks/*.html``, written by ``zrp notebooks``), then the
+paper's figures, the videos and the reports; every file follows, one sentence each.
+
 A sentence comes from, in order: a ``descriptions.json`` in the file's folder (file name ->
 sentence; the lessons write one), the :data:`CATALOGUE` of known outputs (shell patterns on
 the path relative to the root), else a plain statement that no description is registered.
@@ -18,7 +22,8 @@ from pathlib import Path
 from zrp.errors import InputError
 from zrp.output import LOCK_NAME, OutputDir, write_text
 
-__all__ = ["CATALOGUE", "INDEX_NAME", "index_entries", "index_html", "write_index"]
+__all__ = ["CATALOGUE", "INDEX_NAME", "START_HERE", "index_entries", "index_html",
+           "start_here_html", "write_index"]
 
 INDEX_NAME = "index.html"
 DESCRIPTIONS = "descriptions.json"
@@ -129,18 +134,59 @@ def _preview(rel: str) -> str:
     return ""
 
 
+#: The student's path: (section title, what it is for, patterns of the files it lists, in
+#: order; the first pattern a file matches places it). Sections with no file are left out,
+#: except the notebooks, which say how to make them.
+START_HERE: tuple[tuple[str, str, tuple[str, ...]], ...] = (
+    ("Notebooks, in order", "Run them top to bottom in Jupyter (sources: "
+     "sim/lessons/notebooks/), or read them executed here.", ("notebooks/[0-9]*.html",)),
+    ("The paper's figures", "Figures 2-7 of the paper's example, ours beside the published "
+     "values; comparison.md says cell by cell why they differ.",
+     ("fig[2-7]_*[!d].png", "fig[2-7]_*_recovered.png", "comparison.md")),
+    ("Videos", "The arm drawing the circle, deviations magnified by a stated factor.",
+     ("*.mp4", "*.gif")),
+    ("Reports", "Summaries of the benchmarks and studies.",
+     ("*summary.md", "benchmarks/bench_*.md", "lessons/index.html")),
+)
+_NO_NOTEBOOKS = ("not executed yet: <code>zrp notebooks</code> (with the notebooks extra, "
+                 "<code>pip install 'zrp-accuracy[notebooks]'</code>) writes them here; the "
+                 "sources are in <code>sim/lessons/notebooks/</code>.")
+
+
+def start_here_html(entries: list[tuple[str, str]]) -> list[str]:
+    """The "start here" section of the page for :func:`index_entries` ``entries``."""
+    lines = ['<section id="start-here">', "<h2>Start here</h2>", "<ol>"]
+    for i, (title, purpose, patterns) in enumerate(START_HERE):
+        files = [(rel, sentence) for pat in patterns for rel, sentence in entries
+                 if fnmatch(rel, pat)]
+        files = list(dict.fromkeys(files))
+        if not files and i > 0:
+            continue
+        lines.append(f"<li><strong>{html.escape(title)}</strong>: {html.escape(purpose)}")
+        if files:
+            lines += ["<ol>", *(f'<li><a href="{html.escape(rel, quote=True)}">'
+                                f"{html.escape(rel)}</a>: {html.escape(sentence)}</li>"
+                                for rel, sentence in files), "</ol>"]
+        else:
+            lines.append(f"<br>{_NO_NOTEBOOKS}")
+        lines.append("</li>")
+    return [*lines, "</ol>", "</section>"]
+
+
 def index_html(root: str | os.PathLike[str], title: str = "zrp outputs") -> str:
     """The page (HTML5): one list item per :func:`index_entries` entry."""
+    entries = index_entries(root)
     items = [f'<li><a href="{html.escape(rel, quote=True)}">{html.escape(rel)}</a>: '
              f"{html.escape(sentence)}{_preview(rel)}</li>"
-             for rel, sentence in index_entries(root)]
+             for rel, sentence in entries]
     return "\n".join([
         "<!DOCTYPE html>", '<html lang="en">', "<head>", '<meta charset="utf-8">',
         f"<title>{html.escape(title)}</title>",
         "<style>body{font-family:sans-serif;max-width:60em;margin:2em auto}"
         "li{margin:0 0 1.2em}</style>", "</head>", "<body>", f"<h1>{html.escape(title)}</h1>",
+        *start_here_html(entries), '<section id="all-files">', "<h2>All files</h2>",
         f"<p>{len(items)} files, each with one sentence on what it shows.</p>",
-        "<ul>", *items, "</ul>", "</body>", "</html>", ""])
+        "<ul>", *items, "</ul>", "</section>", "</body>", "</html>", ""])
 
 
 def write_index(out: str | os.PathLike[str] | OutputDir, *, overwrite: bool = False) -> Path:

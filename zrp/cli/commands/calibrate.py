@@ -5,15 +5,19 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 from pathlib import Path
 
 from zrp.calibration import CalibratedRobot, write_calibration
+from zrp.calibration.conditions import Conditions
 from zrp.calibration.fullpose import FullPoseCalibration, full_pose_calibration
 from zrp.calibration.storage import calibration_document
 from zrp.cli.app import emit
-from zrp.cli.options import LENGTH, SEED, real, whole
+from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
+from zrp.errors import InputError
 from zrp.gap import diagnose, load_measurements
 from zrp.gap.model.context import EFFECTS
+from zrp.gap.model.domains import DOMAINS, ImplausibleValueError
 from zrp.gap.report import OUTPUT_FILES, write_outputs
 from zrp.model.files import load_model
 from zrp.output import OutputDir
@@ -31,7 +35,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", required=True, metavar="M.toml", help="model TOML or built-in")
     p.add_argument("--mjcf", metavar="M.xml", help="MJCF with inertias (gravity torques)")
     p.add_argument("--data", required=True, metavar="D.csv", help="measurement CSV")
-    p.add_argument("--deg", action="store_true", help="joint values are in degrees")
+    add_deg(p)
     p.add_argument("--frame", choices=("instrument", "base"), default="instrument",
                    help="frame of x, y, z (default instrument)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")
@@ -47,6 +51,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "(default: estimated from the residuals)")
     p.add_argument("--no-orientation", action="store_true",
                    help="ignore measured orientations (qw..qz): positions only")
+    p.add_argument("--instrument", metavar="NAME",
+                   help="the measuring instrument (recorded in the calibration's conditions)")
+    p.add_argument("--widen", action="append", default=[], metavar="DOMAIN=BOUND",
+                   help="raise a physical domain's upper bound (zrp/gap/model/domains.py: "
+                   f"{', '.join(DOMAINS)}), e.g. --widen axis_tilt=0.02, for an arm known "
+                   "to need it; repeatable")
     p.add_argument("--json", action="store_true", help="print the compensation file")
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "seed": "--seed",
                                          "effects": "--effects", "max_steps": "--max-steps",
@@ -54,10 +64,28 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          "orientation_sigma": "--orientation-sigma"})
 
 
+def _widen(items: list[str]) -> dict[str, float] | None:
+    out: dict[str, float] = {}
+    for item in items:
+        key, _, val = item.partition("=")
+        if key not in DOMAINS:
+            raise InputError(f"--widen: {key!r} is not a domain; expected one of "
+                             f"{', '.join(DOMAINS)}")
+        try:
+            out[key] = float(val)
+        except ValueError:
+            raise InputError(f"--widen: expected DOMAIN=BOUND, got {item!r}") from None
+        if not DOMAINS[key].upper <= out[key] < float("inf"):
+            raise InputError(f"--widen: {item!r}: the bound must be finite and at least "
+                             f"{DOMAINS[key].upper:g}")
+    return out or None
+
+
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s): only when this command runs
     from mjcf.gravity import gravity_torques
 
+    widen = _widen(args.widen)
     model = load_model(args.model)
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)
     tau = None if args.mjcf is None else gravity_torques(
@@ -75,10 +103,18 @@ def _run(args: argparse.Namespace) -> int:
             if diag.full_pose is not None:
                 full = full_pose_calibration(diag, args.orientation_sigma)
                 cal = full.robot
+            cal = dataclasses.replace(cal, widen=widen, conditions=Conditions.from_measurements(
+                meas, model, data_path=args.data, data_angle_unit="deg" if args.deg else "rad",
+                instrument=args.instrument))
             files = write_outputs(diag, out, plots=False)
-            files += list(write_calibration(cal, out_dir / FILES[0], out_dir / FILES[1],
-                                            overwrite=True,
-                                            full_pose=None if full is None else full.fit))
+            try:
+                files += list(write_calibration(cal, out_dir / FILES[0], out_dir / FILES[1],
+                                                overwrite=True,
+                                                full_pose=None if full is None else full.fit))
+            except ImplausibleValueError as exc:
+                raise ImplausibleValueError(
+                    f"{exc}. No calibration file was written; the diagnosis outputs in "
+                    f"{out_dir} show the fit") from None
     except BaseException:
         if created:
             with contextlib.suppress(OSError):

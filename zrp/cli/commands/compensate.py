@@ -8,10 +8,12 @@ import numpy as np
 
 from zrp.calibration import PoseConditions, compensate_program, read_calibration
 from zrp.calibration import compensate as compensate_targets
+from zrp.calibration.conditions import missing_conditions
 from zrp.calibration.targets import load_targets, write_commands
 from zrp.cli.app import emit
-from zrp.cli.options import real
+from zrp.cli.options import add_deg, joint_angles, real
 from zrp.errors import InputError
+from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable
 
 
@@ -23,50 +25,55 @@ def register(sub: argparse._SubParsersAction) -> None:
         "the predicted residual and flags per target (zrp/calibration/README.md).")
     p.add_argument("--calibration", required=True, metavar="C.json",
                    help="compensation file (its model_file beside it)")
+    p.add_argument("--model-file", metavar="M.toml",
+                   help="the calibrated model file (default: the compensation file's "
+                   "model_file, which must lie in its folder)")
     p.add_argument("--targets", required=True, metavar="T.csv", help="targets CSV")
     p.add_argument("--out", required=True, metavar="OUT.csv", help="commands CSV")
     p.add_argument("--force", action="store_true", help="overwrite the output file")
-    p.add_argument("--deg", action="store_true", help="joint values (in and out) in degrees")
+    add_deg(p)
     p.add_argument("--point", help="tool point the x, y, z targets are for (default: the "
                    "model's end point)")
     p.add_argument("--frame", choices=("base", "instrument"), default="base",
                    help="frame of x, y, z (default base)")
     p.add_argument("--limits", metavar="LO:HI,...",
                    help="joint limits, one LO:HI per joint, comma-separated (deg with --deg), "
-                   "e.g. --limits=-165:165,-110:110,...")
+                   "e.g. --limits=-165:165,-110:110,... (default: the calibrated model's own); "
+                   "every target row and every command is checked against them")
     p.add_argument("--mjcf", metavar="M.xml", help="MJCF or the arm's URDF with inertias "
                    "(needed when the compliance was identified with MJCF torques)")
     p.add_argument("--temp", type=real(-100.0, 500.0), metavar="DEGC",
                    help="robot temperature when the commands run, deg C (required when the "
                    "calibration found thermal expansion)")
     p.add_argument("--load", type=real(0.0, 1e4), metavar="KG",
-                   help="payload when the commands run, kg (default none)")
+                   help="payload when the commands run, kg (required when the calibration's "
+                   "joint map depends on a payload measured in the data)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=_run, api_names={"limits": "--limits", "point": "--point",
                                          "gravity_torque": "--mjcf", "temp": "--temp",
                                          "load": "--load"})
 
 
-def _limits(args: argparse.Namespace, n: int) -> np.ndarray | None:
+def _limits(args: argparse.Namespace, model: Manipulator) -> np.ndarray | None:
     if args.limits is None:
         return None
     pairs = args.limits.split(",")
-    if len(pairs) != n:
-        raise InputError(f"--limits: expected {n} LO:HI pairs, got {len(pairs)}")
+    if len(pairs) != model.n:
+        raise InputError(f"--limits: expected {model.n} LO:HI pairs, got {len(pairs)}")
     try:
         lim = np.array([[float(v) for v in s.split(":")] for s in pairs], dtype=float)
     except ValueError:
         raise InputError(f"--limits: expected LO:HI numbers, got {args.limits}") from None
-    if lim.shape != (n, 2):
+    if lim.shape != (model.n, 2):
         raise InputError(f"--limits: expected LO:HI pairs, got {args.limits}")
-    return np.radians(lim) if args.deg else lim
+    return joint_angles(model, lim, args.deg, "--limits")
 
 
 def _run(args: argparse.Namespace) -> int:
     check_writable([args.out], args.force)
-    cal = read_calibration(args.calibration)
-    tg = load_targets(args.targets, cal.n, deg=args.deg)
-    lim = _limits(args, cal.n)
+    cal = read_calibration(args.calibration, args.model_file)
+    tg = load_targets(args.targets, cal.n, deg=args.deg, model=cal.model)
+    lim = _limits(args, cal.model)
     grav = None
     if args.mjcf is not None:
         # mjcf loads MuJoCo (+0.25 s): only when asked for
@@ -79,10 +86,8 @@ def _run(args: argparse.Namespace) -> int:
             t.name.endswith(".compliance") for t in cal.terms):
         raise InputError("--mjcf: the calibration's compliance was identified with MJCF "
                          "gravity torques; pass the MJCF")
-    if cal.kappa != 0.0 and args.temp is None:
-        raise InputError(f"--temp: the calibration found thermal expansion (kappa = "
-                         f"{cal.kappa:.3g} 1/degC, reference {cal.t_ref:.4g} degC); give the "
-                         "robot temperature at which the commands will run")
+    missing_conditions(cal.terms, cal.compliance_model, cal.kappa, cal.conditions,
+                       temp=args.temp, load=args.load)
     T = len(tg.q)
     cond = PoseConditions(temp=None if args.temp is None else np.full(T, args.temp),
                           load=None if args.load is None else np.full(T, args.load))

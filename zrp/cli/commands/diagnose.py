@@ -12,7 +12,7 @@ from typing import TextIO
 
 from zrp.cli.app import emit
 from zrp.cli.fleet import add_fleet_options, is_fleet, refuse_fleet_options, run_fleet
-from zrp.cli.options import LENGTH, SEED, real, whole
+from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
 from zrp.gap import diagnose as run_diagnosis
 from zrp.gap import load_measurements
@@ -40,7 +40,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "hinge/slide joint per model joint, same order and zero)")
     p.add_argument("--data", required=True, metavar="D.csv",
                    help="measurement CSV, or a quoted glob ('fleet/*.csv') for a fleet")
-    p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
+    add_deg(p)
     p.add_argument("--frame", choices=("instrument", "base"), default="instrument",
                    help="frame of x, y, z (default instrument: the base frame is estimated)")
     p.add_argument("--out", required=True, metavar="DIR", help="output directory")

@@ -9,7 +9,16 @@ from pathlib import Path
 import numpy as np
 
 from zrp.cli.app import emit
-from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, real, whole
+from zrp.cli.options import (
+    DURATION,
+    FINITE,
+    LENGTH,
+    MAX_STEPS,
+    add_deg,
+    joint_angles,
+    real,
+    whole,
+)
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.ik import CORRECTIONS, track_trajectory
@@ -23,23 +32,15 @@ from zrp.paper.scenario import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM, is_
 from zrp.rotations.rodrigues import er_angle
 
 
-def _joint_values(model: Manipulator, values: list[float], rad: bool, name: str) -> np.ndarray:
-    if len(values) != model.n:
-        raise InputError(f"{name}: expected {model.n} values for {model.name!r} "
-                         f"({', '.join(model.joint_names)}), got {len(values)}")
-    q = np.array(values, dtype=float)
-    if not rad:
-        q = np.where(model.prismatic, q, np.radians(q))
-    return q
+def _joint_values(model: Manipulator, values: list[float], deg: bool, name: str) -> np.ndarray:
+    return joint_angles(model, values, deg, name)
 
 
 def _add_model(p: argparse.ArgumentParser) -> None:
     p.add_argument("--model", default="puma", metavar="FILE",
                    help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
                         "; default puma)")
-    p.add_argument("--rad", action="store_true",
-                   help="joint angles are given in rad (default: deg); prismatic values are "
-                        "always in the model's length unit")
+    add_deg(p)
     p.add_argument("--json", action="store_true", help="print JSON")
 
 
@@ -107,7 +108,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _fk(args: argparse.Namespace) -> int:
     model = load_model(args.model)
-    q = _joint_values(model, args.q, args.rad, "--q")
+    q = _joint_values(model, args.q, args.deg, "--q")
     fk = forward_kinematics(model, q)
     payload = {
         "model": model.name, "length_unit": model.length_unit, "q_rad_or_length": q,
@@ -135,9 +136,9 @@ def _ik(args: argparse.Namespace) -> int:
                 f"--q0: required for {model.name!r} ({model.n} joints): the default start "
                 f"configuration ({' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg) is the "
                 f"paper's, for its PUMA only; give --q0 with {model.n} values")
-        q0 = _joint_values(model, list(PUMA_Q0_DEG), False, "--q0")
+        q0 = _joint_values(model, list(PUMA_Q0_DEG), True, "--q0")
     else:
-        q0 = _joint_values(model, args.q0, args.rad, "--q0")
+        q0 = _joint_values(model, args.q0, args.deg, "--q0")
     if args.target is not None:
         return _ik_target(args, model, q0)
     stem = Path(args.model).stem
@@ -189,8 +190,8 @@ def _ik_target(args: argparse.Namespace, model: Manipulator, q0: np.ndarray) -> 
     sol = solve_pose(model, np.array(args.target), args.target_er, q0=q0)
     s = sol.summary()
     s["joint_names"] = list(model.joint_names)
-    shown = np.where(model.prismatic, sol.q, sol.q if args.rad else np.degrees(sol.q))
-    unit = "rad" if args.rad else "deg"
+    shown = np.where(model.prismatic, sol.q, np.degrees(sol.q) if args.deg else sol.q)
+    unit = "deg" if args.deg else "rad"
     s["q_shown"], s["q_shown_unit"] = shown.tolist(), unit
     text = "\n".join([
         f"{model.name}: target {args.target} {model.length_unit} reached "

@@ -8,13 +8,15 @@ from pathlib import Path
 
 import numpy as np
 
+from zrp.calibration.planfile import read_plan
 from zrp.cli.app import emit
-from zrp.cli.options import SEED, real, whole
+from zrp.cli.options import SEED, add_deg, real, whole
 from zrp.errors import InputError
 from zrp.gap.motion import write_trajectory
 from zrp.jsonio import dumps
 from zrp.kinematics import reachable_poses
 from zrp.model.files import builtin_models, load_model
+from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
 from zrp.units import TRACKER_NOISE_MM, units_per_mm
 
@@ -57,8 +59,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "thermal_expansion=12ppm/K")
     p.add_argument("--payload", type=real(0.0, 1e4, unit="kg"), default=0.0, metavar="KG",
                    help="payload at the tool point, kg (logged in the load column)")
-    p.add_argument("--poses", type=whole(1, 100_000),
-                   default=200, help="number of poses (default 200)")
+    p.add_argument("--poses", type=_count_or_plan, default=200, metavar="N|PLAN.csv",
+                   help="number of poses (default 200), or a plan file of zrp plan: its poses "
+                        "and approach directions, in its order")
     p.add_argument("--trajectory", choices=("random", "circle", "moves"), default="random",
                    help="random reachable poses (default) or poses along the PUMA circle; with "
                         "--stream: the circle or random joint moves, executed in motion")
@@ -69,19 +72,18 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="with --stream, a hidden motion effect, repeatable: sync_delay=2ms, "
                         "servo_lag:2=5ms, reversal_friction:2=15Nm, "
                         "dynamic_compliance:3=20urad/Nm, residual_vibration:2=8Hz")
-    p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
+    p.add_argument("--approach", choices=("gravity", "random", "order"), default=None,
                    help="final approach against gravity for the joints that carry a "
                         "gravity torque, the others from a random side (default; written as "
                         "dir columns), every joint from a random side, or straight moves in "
-                        "measurement order")
+                        "measurement order (default with a plan file: the plan's directions)")
     p.add_argument("--noise", type=real(0.0, 1e3), default=None, metavar="SIGMA",
                    help="tracker noise per coordinate, model length unit (default 0.02 mm in "
                         "the model's unit)")
     p.add_argument("--temp-rise", type=real(-100.0, 100.0, unit="K"), default=10.0, metavar="K",
                    help="warm-up of the robot during the session, K (default 10)")
     p.add_argument("--seed", type=SEED, default=0, help="seed of poses, noise and instrument")
-    p.add_argument("--deg", action="store_true", help="write q in degrees (then diagnose "
-                                                      "with --deg)")
+    add_deg(p)
     p.add_argument("--force", action="store_true",
                    help="replace --out and --truth if they exist (refused otherwise, before "
                         "anything is simulated)")
@@ -91,13 +93,41 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          "rate_hz": "--stream"})
 
 
+_COUNT = whole(1, 100_000)
+
+
+def _count_or_plan(text: str) -> int | str:
+    """--poses: a whole number of poses, or the name of a plan file (anything else)."""
+    return _COUNT(text) if text.strip().lstrip("+-").isdigit() else text
+
+
+def _poses(args: argparse.Namespace, model: Manipulator, rng: np.random.Generator
+           ) -> tuple[np.ndarray, np.ndarray | None]:
+    """The poses to measure and the planned approach directions (None: the procedure's)."""
+    from sim.studies.trajectories import circle_poses  # with sim: MuJoCo only when run
+
+    if isinstance(args.poses, str):
+        if args.trajectory != "random":
+            raise InputError("--trajectory: a plan file gives the poses; drop --trajectory")
+        plan = read_plan(args.poses, model, deg=args.deg)
+        if len(plan.q) < 8:
+            raise InputError(f"--poses: the plan has {len(plan.q)} poses; at least 8 expected")
+        if args.approach is None:
+            args.approach = "random"  # the plan's sides (0: a random side)
+            return plan.q, np.where(plan.direction != 0, plan.direction,
+                                    rng.choice([-1.0, 1.0], size=plan.q.shape))
+        return plan.q, None
+    if args.poses < 8:
+        raise InputError(f"--poses: expected at least 8 poses, got {args.poses}")
+    q = (reachable_poses(model, args.poses, rng) if args.trajectory == "random"
+         else circle_poses(model, args.poses))
+    return q, None
+
+
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo (+0.1-0.2 s measured): only when this command runs, not for every `zrp`.
     import sim
-    from sim.studies.trajectories import circle_poses  # with sim, for the same reason
 
-    if args.poses < 8:
-        raise InputError(f"--poses: expected at least 8 poses, got {args.poses}")
     if args.noise is not None and not args.noise > 0:
         raise InputError(f"--noise: expected a positive sigma (model length unit), got "
                          f"{args.noise}")
@@ -112,23 +142,27 @@ def _run(args: argparse.Namespace) -> int:
     if args.noise is None:  # a laser tracker's 20 um, whatever the model's unit
         args.noise = TRACKER_NOISE_MM * units_per_mm(model.length_unit, "model.length_unit")
     if args.stream is not None:
+        if isinstance(args.poses, str):
+            raise InputError("--poses: a plan file is measured at rest; drop --stream")
         return _stream(args, model, out, truth)
     effects = sim.parse_effects(args.effect, model, args.payload, field="--effect")
     rng = np.random.default_rng(args.seed)
-    q = (reachable_poses(model, args.poses, rng) if args.trajectory == "random"
-         else circle_poses(model, args.poses))
+    q, directions = _poses(args, model, rng)
+    args.approach = args.approach or "gravity"
     inst = sim.random_instrument(model, rng, args.noise)
     t0 = time.perf_counter()
     robot = sim.RealRobot(model, effects, _robot_options(args.arm, model))
     procedure = sim.Procedure(approach=args.approach, temp_rise=args.temp_rise)
-    run = sim.measure(robot, q, inst, rng, procedure, progress=args.progress)
+    run = sim.measure(robot, q, inst, rng, procedure, progress=args.progress,
+                      directions=directions)
     wall = time.perf_counter() - t0
-    sim.write_measurements(run, out, deg=args.deg, overwrite=args.force)
+    sim.write_measurements(run, out, deg=args.deg, overwrite=args.force, model=model)
     sim.write_truth(run, truth, overwrite=args.force)
     payload = {"measurements": str(out), "truth": str(truth), "poses": len(q),
                "points": run.measurements.n_rows, "effects": list(effects.active),
                "payload_kg": effects.payload, "noise_sigma": args.noise,
-               "approach": args.approach, "trajectory": args.trajectory, "wall_s": wall}
+               "approach": args.approach, "wall_s": wall,
+               "trajectory": "plan" if isinstance(args.poses, str) else args.trajectory}
     text = (f"measured {len(q)} poses ({run.measurements.n_rows} points) of the real "
             f"{model.name} with hidden effects: {', '.join(effects.active) or 'none'}; "
             f"noise {args.noise:g} {model.length_unit} per coordinate; {wall:.1f} s\n"

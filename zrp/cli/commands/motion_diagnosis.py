@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.cli.options import LENGTH, SEED, real, whole
+from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
 from zrp.gap.model.context import EFFECTS
 from zrp.gap.motion import MOTION_EFFECTS, diagnose_motion, load_trajectory
@@ -27,7 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml", help="model file or built-in name")
     p.add_argument("--data", required=True, metavar="D.csv", help="trajectory CSV")
-    p.add_argument("--deg", action="store_true", help="revolute joint values are in degrees")
+    add_deg(p)
     p.add_argument("--mjcf", metavar="M.xml", help="MJCF with the inertias (inverse-dynamics "
                    "torques for dynamic_compliance, the arm's own stiffness and damping for "
                    "residual_vibration; one hinge/slide joint per model joint)")

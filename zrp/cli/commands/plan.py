@@ -3,19 +3,19 @@
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 import warnings
 
 import numpy as np
 
 from zrp.calibration import plan_poses
+from zrp.calibration.planfile import write_plan
 from zrp.cli.app import emit
-from zrp.cli.options import FINITE, LENGTH, SEED, whole
+from zrp.cli.options import FINITE, LENGTH, SEED, add_deg, joint_angles, whole
 from zrp.errors import InputError
 from zrp.gap.model.context import EFFECTS
 from zrp.model.files import load_model
-from zrp.output import check_writable, write_text
+from zrp.model.manipulator import Manipulator
+from zrp.output import check_writable
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -23,8 +23,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "plan", help="plan the measurement poses of a calibration (D-optimal)",
         description="Choose N poses within the joint limits (above a floor) that make the "
         "chosen effects identifiable (D-optimal, DETMAX-style exchange); print the predicted "
-        "standard deviation of every parameter and warn about unidentifiable ones. Writes "
-        "OUT.csv: pose, q1..qn, dir1..dirn (zrp/calibration/README.md).")
+        "standard deviation of every parameter and list the unidentifiable ones. Writes "
+        "OUT.csv: pose, q1..qn, dir1..dirn, which zrp measure --poses OUT.csv measures "
+        "(zrp/calibration/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml", help="model TOML or built-in")
     p.add_argument("--poses", type=whole(1, 100_000), required=True, metavar="N",
                    help="poses to measure")
@@ -32,9 +33,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="effects to identify (registration is always included)")
     p.add_argument("--out", required=True, metavar="OUT.csv", help="planned poses CSV")
     p.add_argument("--force", action="store_true", help="overwrite the output file")
-    p.add_argument("--deg", action="store_true", help="limits and output in degrees")
+    add_deg(p)
     p.add_argument("--limits", metavar="LO:HI,...", help="joint limits, one LO:HI per joint, "
-                   "comma-separated (default +-2.5 rad)")
+                   "comma-separated, within the model's (default: the model's limits, at most "
+                   "+-2.5 rad)")
     p.add_argument("--floor", type=FINITE, metavar="Z", help="keep every joint and tool point "
                    "above z = Z (base frame, length unit)")
     p.add_argument("--tool", nargs=3, type=FINITE, action="append", metavar=("X", "Y", "Z"),
@@ -51,7 +53,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                                          "noise_sigma": "--noise"})
 
 
-def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
+def _limits(text: str | None, model: Manipulator, deg: bool) -> np.ndarray | None:
     if text is None:
         return None
     pairs = text.split(",")
@@ -59,9 +61,9 @@ def _limits(text: str | None, n: int, deg: bool) -> np.ndarray | None:
         lim = np.array([[float(v) for v in s.split(":")] for s in pairs], dtype=float)
     except ValueError:
         raise InputError(f"--limits: expected LO:HI numbers, got {text!r}") from None
-    if lim.shape != (n, 2):
-        raise InputError(f"--limits: expected {n} LO:HI pairs, got {text!r}")
-    return np.radians(lim) if deg else lim
+    if lim.shape != (model.n, 2):
+        raise InputError(f"--limits: expected {model.n} LO:HI pairs, got {text!r}")
+    return joint_angles(model, lim, deg, "--limits")
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -70,22 +72,16 @@ def _run(args: argparse.Namespace) -> int:
     with warnings.catch_warnings(record=True) as wl:
         warnings.simplefilter("always")
         plan = plan_poses(model, args.poses, args.effects, rng=np.random.default_rng(args.seed),
-                          limits=_limits(args.limits, model.n, args.deg),
+                          limits=_limits(args.limits, model, args.deg),
                           tool_points=args.tool or ((0.0, 0.0, 0.0),), floor_z=args.floor,
                           noise_sigma=args.noise,  # None: a tracker's 20 um in the model's unit
                           candidates=args.candidates)
-    n = model.n
-    buf = io.StringIO()
-    w = csv.writer(buf)
-    w.writerow(["pose", *[f"q{k}" for k in range(1, n + 1)], *[f"dir{k}" for k in
-                                                               range(1, n + 1)]])
-    q = np.degrees(plan.q) if args.deg else plan.q
-    for i in range(len(q)):
-        w.writerow([f"P{i + 1:03d}", *(repr(float(v)) for v in q[i]),
-                    *(int(v) for v in plan.direction[i])])
-    path = write_text(args.out, buf.getvalue(), overwrite=args.force)
+    path = write_plan(plan, model, args.out, deg=args.deg, overwrite=args.force)
     lines = [f"{p}: predicted std {s:.3g} {u}"
              for p, s, u in zip(plan.names, plan.std, plan.units, strict=True)]
+    lines += [f"{p}: unidentifiable with these tool points (moves no point, or aliased with "
+              "others, in every pose); not planned"
+              for p in plan.unidentifiable]
     lines += [f"warning: {w.message}" for w in wl]
     lines += [f"log det per pose: {plan.log_det:.4g} (random start {plan.log_det_random:.4g})",
               f"wrote {path}"]

@@ -6,7 +6,11 @@ import argparse
 import re
 from pathlib import Path
 
+from zrp.calibration import read_calibration
+from zrp.calibration.export import export_urdf, side_document
 from zrp.cli.app import emit
+from zrp.errors import InputError
+from zrp.jsonio import dumps
 from zrp.model.dh_table import dumps_dh, to_dh
 from zrp.model.files import builtin_models, dumps_model, load_model
 from zrp.model.manipulator import Manipulator
@@ -27,13 +31,32 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", default="puma", metavar="FILE",
                    help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
                         "; default puma)")
+    p.add_argument("--calibration", metavar="C.json",
+                   help="export a calibrated robot (compensation.json of zrp calibrate; "
+                   "checked against the physical domains) instead of --model, with a side "
+                   "file of the terms the format cannot hold (OUT.calibration.json)")
+    p.add_argument("--urdf", metavar="SRC.urdf",
+                   help="with --calibration --to urdf: the URDF the robot was imported from; "
+                   "the export patches it (same links, names, types, limits, inertias, "
+                   "meshes; only the calibrated origins and axes change)")
+    p.add_argument("--mjcf", metavar="SRC.xml",
+                   help="with --calibration --to mjcf: the MJCF the robot was imported from; "
+                   "the export patches it (only the chain's body poses, joint axes and the end "
+                   "site change)")
+    p.add_argument("--site", metavar="NAME", help="with --mjcf: the end site, as given to "
+                   "zrp import")
+    p.add_argument("--base", metavar="LINK",
+                   help="with --urdf: the chain's base link, as given to zrp import")
+    p.add_argument("--end", metavar="LINK",
+                   help="with --urdf: the chain's end link, as given to zrp import")
     p.add_argument("--to", choices=tuple(FORMATS), required=True, help="output format")
     p.add_argument("--out", default=None, metavar="FILE",
                    help="file to write (default renders/<model><suffix>)")
     p.add_argument("--force", action="store_true",
                    help="replace --out if it exists (refused otherwise, before the work)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.set_defaults(func=_run)
+    p.set_defaults(func=_run, api_names={"end_link": "--end", "base_link": "--base",
+                                         "site": "--site", "body": "--end"})
 
 
 def _text(model: Manipulator, fmt: str) -> str:
@@ -49,13 +72,52 @@ def _text(model: Manipulator, fmt: str) -> str:
     return mjcf.mjcf_xml(mjcf.build(model))
 
 
+def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]:
+    """Export the calibration of --calibration: the patched --urdf or the format, and the
+    side file; (the calibrated model, the side file)."""
+    side = out.with_name(out.name.split(".")[0] + ".calibration.json")
+    check_writable([out, side], args.force)
+    cal = read_calibration(args.calibration)
+    if args.mjcf is not None:
+        if args.to != "mjcf":
+            raise InputError("--mjcf: patches an MJCF file; use it with --to mjcf")
+        # mjcf loads MuJoCo: only for this export
+        from mjcf.patch import export_mjcf
+
+        export_mjcf(cal, args.mjcf, out, side, site=args.site, body=args.end,
+                    overwrite=args.force)
+        return cal.model, side
+    if args.urdf is not None:
+        if args.to != "urdf":
+            raise InputError("--urdf: patches a URDF; use it with --to urdf")
+        export_urdf(cal, args.urdf, out, side, base_link=args.base,
+                    end_link=args.end, overwrite=args.force)
+        return cal.model, side
+    write_text(out, _text(cal.model, args.to), overwrite=args.force)
+    write_text(side, dumps(side_document(cal, out.name, "", None, None)),
+               overwrite=args.force)
+    return cal.model, side
+
+
 def _run(args: argparse.Namespace) -> int:
-    stem = re.sub(r"[^A-Za-z0-9]+", "_", Path(args.model).stem).strip("_").lower() or "model"
+    if args.calibration is None and (args.urdf or args.mjcf or args.base or args.end
+                                     or args.site):
+        raise InputError("--urdf, --mjcf: patch the robot's file with a calibration; give "
+                         "--calibration C.json")
+    src = args.calibration or args.model
+    stem = re.sub(r"[^A-Za-z0-9]+", "_", Path(src).stem).strip("_").lower() or "model"
     out = Path(args.out or f"renders/{stem}{FORMATS[args.to]}")
-    check_writable([out], args.force)
-    model = load_model(args.model)
-    write_text(out, _text(model, args.to), overwrite=args.force)
+    side = None
+    if args.calibration is not None:
+        model, side = _calibrated(args, out)
+    else:
+        check_writable([out], args.force)
+        model = load_model(args.model)
+        write_text(out, _text(model, args.to), overwrite=args.force)
     payload = {"written": str(out), "format": args.to, "model": model.name, "joints": model.n,
                "joint_names": list(model.joint_names), "length_unit": model.length_unit}
-    emit(args, payload, f"wrote {out}: {model.name} as {args.to} ({model.n} joints)")
+    if side is not None:
+        payload["side_file"] = str(side)
+    emit(args, payload, f"wrote {out}: {model.name} as {args.to} ({model.n} joints)"
+         + ("" if side is None else f"\nwrote {side} (the terms {args.to} cannot hold)"))
     return 0

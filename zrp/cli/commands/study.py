@@ -11,7 +11,16 @@ import warnings
 import numpy as np
 
 from zrp.cli.app import emit
-from zrp.cli.options import DURATION, FINITE, LENGTH, MAX_STEPS, PERCENT, whole
+from zrp.cli.options import (
+    DURATION,
+    FINITE,
+    LENGTH,
+    MAX_STEPS,
+    PERCENT,
+    add_deg,
+    joint_angles,
+    whole,
+)
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.trajectory import TIME_LAWS
 from zrp.manufacturing.perturb import PAPER_SIGN_ZERO
@@ -40,12 +49,15 @@ def add_path_options(p: argparse.ArgumentParser, steps: int = 360) -> None:
                         "; default puma)")
     g = p.add_argument_group("trajectory (nominal inverse kinematics of a circle, or a file)")
     g.add_argument("--joints", metavar="CSV", default=None,
-                   help="joint trajectory CSV: header, then t (s) and q1..qn (rad / length unit)"
+                   help="joint trajectory CSV: header, then t (s) and q1..qn (rad, --deg or "
+                        "q1[deg]; prismatic: length unit)"
                         " per row, e.g. written by `zrp ik`; replaces the circle")
-    g.add_argument("--q0", nargs="+", type=FINITE, metavar="DEG", default=None,
-                   help="start configuration in deg (prismatic joints in the length unit); "
-                        f"default {' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} for the paper's "
-                        "PUMA (the built-in puma), required for every other model")
+    g.add_argument("--q0", nargs="+", type=FINITE, metavar="Q", default=None,
+                   help="start configuration, rad (deg with --deg; prismatic joints in the "
+                        "length unit); "
+                        f"default {' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg for the "
+                        "paper's PUMA (the built-in puma), required for every other model")
+    add_deg(g)
     g.add_argument("--radius", type=LENGTH, default=125.0,
                    help="circle radius, length unit (default 125)")
     g.add_argument("--normal", nargs=3, type=FINITE, default=None, metavar=("X", "Y", "Z"),
@@ -69,8 +81,9 @@ def check_path_options(args: argparse.Namespace, model: Manipulator) -> None:
             raise InputError(
                 f"--q0: required for {model.name!r} ({model.n} joints): the default start "
                 f"configuration ({' '.join(f'{v:g}' for v in PUMA_Q0_DEG)} deg) is the paper's,"
-                f" for its PUMA only; give --q0 with {model.n} values in deg (prismatic joints "
-                f"in {model.length_unit}), or a joint trajectory with --joints CSV")
+                f" for its PUMA only; give --q0 with {model.n} values (rad, or deg with --deg;"
+                f" prismatic joints in {model.length_unit}), or a joint trajectory with "
+                "--joints CSV")
     elif len(args.q0) != model.n:
         raise InputError(f"--q0: expected {model.n} values for {model.name!r}, got "
                          f"{len(args.q0)}")
@@ -80,8 +93,8 @@ def path_from_args(args: argparse.Namespace, model: Manipulator) -> JointPath:
     """The nominal joint trajectory the options describe."""
     check_path_options(args, model)
     if args.joints:
-        return load_joint_csv(args.joints, model)
-    q0 = None if args.q0 is None else np.where(model.prismatic, args.q0, np.radians(args.q0))
+        return load_joint_csv(args.joints, model, deg=args.deg)
+    q0 = None if args.q0 is None else joint_angles(model, args.q0, args.deg, "--q0")
     with warnings.catch_warnings():
         warnings.simplefilter("default", ZRPWarning)
         return circle_joint_path(model, q0=q0, radius=args.radius, duration=args.duration,

@@ -5,9 +5,11 @@ One row per measured point, rows in measurement order. Columns (header names, an
 * ``pose`` (required): an id; all rows of a pose share the same joint values.
 * ``point`` (optional): which target on the tool (e.g. one of several reflectors); default "p".
 * ``q1`` .. ``qn`` (required): joint values, rad (deg with ``deg=True``) for revolute joints,
-  the model's length unit for prismatic ones.
-* ``x``, ``y``, ``z`` (required): measured position in the model's length unit, in the
-  instrument's frame (or the robot's base frame with ``frame="base"``).
+  the model's length unit for prismatic ones, unless the header declares the unit
+  (``q1[deg]``, ``q3[mm]``: the rule of :mod:`zrp.units`, checked there).
+* ``x``, ``y``, ``z`` (required): measured position in the model's length unit (or the unit
+  the header declares, ``x[m]``), in the instrument's frame (or the robot's base frame with
+  ``frame="base"``).
 * ``qw``, ``qx``, ``qy``, ``qz`` (optional, all four): measured orientation (loaded and checked;
   the diagnosis chooses effects from positions only and says so with a warning; zrp calibrate
   and zrp.gap.fit.fullpose use them).
@@ -31,7 +33,6 @@ record: a form feed or U+2028 inside a quoted field stays in the field.
 from __future__ import annotations
 
 import csv
-import math
 import os
 import warnings
 from collections.abc import Iterable, Iterator
@@ -47,6 +48,7 @@ from zrp.errors import InputError
 from zrp.gap.data.csvrows import Accumulator, Columns, Header, check_header, parse_row
 from zrp.gap.data.measurements import FRAMES, DataWarning, Measurements
 from zrp.model.manipulator import Manipulator
+from zrp.units import angle_bounds, joint_column_units, joint_values_to_rad, length_scale
 
 __all__ = ["MAX_ROWS", "load_measurements"]
 
@@ -176,20 +178,16 @@ def _read(path: Path, src: str, model: Manipulator, progress: bool, max_rows: in
     return header, h, acc.columns(h)
 
 
-def _joint_units(q: F64, model: Manipulator, deg: bool, lines: NDArray[np.int64], src: str
-                 ) -> None:
-    """Revolute joint values to rad (in place) with ``deg``; else refuse values > 2 pi."""
+def _units(c: Columns, h: Header, model: Manipulator, deg: bool, src: str) -> None:
+    """Joint columns to rad (revolute) and the model's length unit (prismatic), positions to
+    the model's length unit, in place, by the rule and checks of :mod:`zrp.units`."""
     rev = ~np.asarray(model.prismatic)
-    if deg:
-        q[:, rev] = np.radians(q[:, rev])
-        return
-    big = np.abs(q[:, rev]) > 2.0 * math.pi + 1e-6
-    if big.any():
-        i, k = (int(v) for v in np.argwhere(big)[0])
-        kk = int(np.flatnonzero(rev)[k])
-        raise InputError(
-            f"{src} line {lines[i]}: column q{kk + 1} is {q[i, kk]:g}, more than 2 pi rad: "
-            "the joint values look like degrees; pass deg=True (--deg on the command line)")
+    angle, scale = joint_column_units([h.units[q] for q in h.qcols], rev, deg, src=src,
+                                      length_unit=model.length_unit, names=h.qcols)
+    c.q[:] = joint_values_to_rad(c.q, rev, angle, src=src, names=h.qcols, lines=c.lines,
+                                 bounds=angle_bounds(model.lower, model.upper)) * scale
+    for k, x in enumerate("xyz"):
+        c.xyz[:, k] *= length_scale(h.units[x], model.length_unit, f"{src} column {x}")
 
 
 def _check_scalars(scalars: dict[str, F64], lines: NDArray[np.int64], src: str) -> None:
@@ -238,11 +236,11 @@ def load_measurements(path: str | os.PathLike[str], model: Manipulator, *, deg: 
     if not path.is_file():
         raise InputError(f"{src}: no such file")
     try:
-        _, _, c = _read(path, src, model, progress,
+        _, h, c = _read(path, src, model, progress,
                         None if max_rows is None else check_int(max_rows, "max_rows", 1))
     except OSError as exc:
         raise InputError(f"{src}: cannot read ({exc.strerror or exc})") from exc
-    _joint_units(c.q, model, deg, c.lines, src)
+    _units(c, h, model, deg, src)
     _check_scalars(c.scalars, c.lines, src)
     if c.quat is not None:
         warnings.warn(f"{src}: measured orientations (qw..qz) are loaded; the diagnosis chooses "

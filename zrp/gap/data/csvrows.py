@@ -16,6 +16,7 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import OPTIONAL_SCALARS, QUAT_COLUMNS
 from zrp.model.manipulator import Manipulator
+from zrp.units import split_unit
 
 __all__ = ["Accumulator", "Columns", "Header", "check_header", "parse_row"]
 
@@ -31,6 +32,8 @@ class Header:
     scalars: list[str]
     quat: bool
     dirs: bool
+    #: the unit each column declares (``q1[deg]``, ``x[mm]``), None where it declares none
+    units: dict[str, str | None]
 
     @property
     def n_fields(self) -> int:
@@ -94,6 +97,14 @@ def _complete_group(header: list[str], src: str, group: list[str], what: str) ->
 
 
 def check_header(header: list[str], src: str, model: Manipulator) -> Header:
+    """The header checked: names (each may declare its unit, ``q1[deg]``; zrp.units)."""
+    parsed = [split_unit(c, f"{src} line 1") for c in header]
+    header = [name for name, _ in parsed]
+    declared = dict(parsed)
+    for c, u in parsed:
+        if u is not None and not (c in "xyz" or (c.startswith("q") and c[1:].isdigit())):
+            raise InputError(f"{src} line 1: column {c}[{u}]: only joint (q1..) and position "
+                             "(x, y, z) columns take a unit")
     n = model.n
     qcols = [f"q{k}" for k in range(1, n + 1)]
     dcols = [f"dir{k}" for k in range(1, n + 1)]
@@ -103,7 +114,8 @@ def check_header(header: list[str], src: str, model: Manipulator) -> Header:
     quat = _complete_group(header, src, list(QUAT_COLUMNS), "orientation needs")
     dirs = _complete_group(header, src, dcols, "approach directions need")
     col = {c: i for i, c in enumerate(header)}
-    return Header(col, qcols, dcols, [c for c in OPTIONAL_SCALARS if c in col], quat, dirs)
+    return Header(col, qcols, dcols, [c for c in OPTIONAL_SCALARS if c in col], quat, dirs,
+                  declared)
 
 
 def _label(rec: list[str], i: int, name: str, what: str, src: str, lineno: int) -> str:

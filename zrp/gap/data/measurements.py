@@ -284,14 +284,16 @@ class Measurements:
     def to_csv(self, path: str | os.PathLike[str], *, deg: bool = False,
                overwrite: bool = False) -> Path:
         """Write in the CSV format :func:`~zrp.gap.load_measurements` reads (q in deg with
-        ``deg``), atomically; an existing file is replaced only with ``overwrite``.
+        ``deg``, declared in the header, ``q1[deg]``: read back with or without deg=True),
+        atomically; an existing file is replaced only with ``overwrite``.
 
         Raises:
             OutputExistsError: ``path`` exists and ``overwrite`` is False.
         """
         n = self.n_joints
         q = np.degrees(self.q) if deg else self.q
-        cols = ["pose", "point", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z"]
+        unit = "[deg]" if deg else ""
+        cols = ["pose", "point", *[f"q{k}{unit}" for k in range(1, n + 1)], "x", "y", "z"]
         extra = [c for c in OPTIONAL_SCALARS if getattr(self, c) is not None]
         quat = ["qw", "qx", "qy", "qz"] if self.quat is not None else []
         buf = io.StringIO()

@@ -30,6 +30,7 @@ from zrp.errors import InputError
 from zrp.gap.motion.data import Trajectory
 from zrp.model.manipulator import Manipulator
 from zrp.output import atomic_path
+from zrp.units import angle_bounds, joint_values_to_rad
 
 __all__ = ["load_trajectory", "write_trajectory"]
 
@@ -96,10 +97,9 @@ def _assemble(a: np.ndarray, numeric: list[str], points: list[str], lines: np.nd
               model: Manipulator, deg: bool, frame: str, name: str) -> Trajectory:
     n = model.n
     t = a[:, 0]
-    q = a[:, 1:1 + n].copy()
-    if deg:
-        rev = ~np.asarray(model.prismatic)
-        q[:, rev] = np.radians(q[:, rev])
+    q = joint_values_to_rad(a[:, 1:1 + n], ~np.asarray(model.prismatic),
+                            "deg" if deg else "rad", src=name, lines=lines,
+                            bounds=angle_bounds(model.lower, model.upper), header=False)
     xyz = a[:, 1 + n:4 + n]
     back = np.flatnonzero(np.diff(t) < 0)
     if back.size:
