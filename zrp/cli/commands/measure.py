@@ -25,9 +25,8 @@ def _robot_options(arm: str | None, model: object) -> object:
     """The real robot's options: the arm's own dynamics from ``--arm`` (None: the default)."""
     if arm is None:
         return None
-    # mjcf and sim load MuJoCo: only when this command runs
-    import mjcf
-    import sim
+    import mjcf  # loads MuJoCo: only when this command runs
+    import sim  # the same (sim imports MuJoCo)
 
     return sim.RealRobotOptions(dynamics=mjcf.arm_dynamics(arm, model))  # type: ignore[arg-type]
 
