@@ -12,6 +12,8 @@ from mjcf.errors import MJCFCompileError, MJCFImportError, MJCFOutputError
 from mjcf.gravity import gravity_torques
 from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
 from mjcf.inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
+from mjcf.own_dynamics import ArmDynamics, arm_dynamics
+from mjcf.shipped import load_shipped
 from mjcf.writer import mjcf_xml, save_mjcf
 from zrp.packages import DISTRIBUTION
 
@@ -22,18 +24,21 @@ from zrp.units import LENGTH_UNITS, metres_per_unit
 __all__ = [
     "INERTIA_MODELS",
     "LENGTH_UNITS",
+    "ArmDynamics",
     "BodyInertia",
     "BuiltArm",
     "MJCFCompileError",
     "MJCFImportError",
     "MJCFOptions",
     "MJCFOutputError",
+    "arm_dynamics",
     "build",
     "build_spec",
     "from_mjcf",
     "gravity_torques",
     "inverse_dynamics_torques",
     "load_mujoco_model",
+    "load_shipped",
     "manipulator_from_mujoco",
     "metres_per_unit",
     "mjcf_xml",

@@ -66,6 +66,9 @@ _EXPORTS = {
         "Instrument",
         "random_instrument",
     ),
+    "robot.mass": (
+        "DynamicsFallbackWarning",
+    ),
     "robot.measurement": (
         "MeasurementRun",
         "Procedure",
@@ -81,6 +84,9 @@ _EXPORTS = {
         "Reading",
         "RealRobot",
         "Session",
+    ),
+    "robot.servo": (
+        "tune_servos",
     ),
     "view.frames": (
         "VideoOptions",

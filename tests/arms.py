@@ -35,3 +35,40 @@ def perturbed_puma() -> zrp.Manipulator:
     axes[1] = np.array([1e-3, 1.0 + 1e-3, 1e-3]) / np.linalg.norm([1e-3, 1.0 + 1e-3, 1e-3])
     bodies[2] *= 1.001
     return m.with_arrays(axes=axes, bodies=bodies, name="puma perturbed")
+
+
+# ---- real arms as shipped (example-robot-data, the Menagerie UR5e) -------------------------
+
+#: name -> (file under example-robot-data's robots folder, end link or None: the deepest)
+SHIPPED_URDFS = {
+    "ur5": ("ur_description/urdf/ur5_robot.urdf", "tool0"),
+    "ur10": ("ur_description/urdf/ur10_robot.urdf", "tool0"),
+    "panda": ("panda_description/urdf/panda.urdf", "panda_hand"),
+    "xarm7": ("xarm_description/urdf/xarm7.urdf", None),
+    "kinova": ("kinova_description/robots/kinova.urdf", None),
+    "z1": ("z1_description/urdf/z1.urdf", "link06"),
+}
+
+
+def erd_root():
+    """example-robot-data's robots folder (installed beside Pinocchio), or skip the test."""
+    import os
+    from pathlib import Path
+
+    import pytest
+
+    pin = pytest.importorskip("pinocchio", reason="optional: pip install pin")
+    base = Path(os.path.dirname(pin.__file__))
+    for up in (4, 3):
+        root = base.parents[up - 1] / "share" / "example-robot-data" / "robots"
+        if root.is_dir():
+            return root
+    pytest.skip("optional: pip install example-robot-data")
+    return None
+
+
+def shipped_arm(name: str):
+    """(the shipped URDF's path, its ZRP model in mm) of :data:`SHIPPED_URDFS` ``name``."""
+    rel, end = SHIPPED_URDFS[name]
+    path = erd_root() / rel
+    return path, zrp.import_urdf(path, end_link=end).model

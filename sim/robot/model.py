@@ -19,7 +19,9 @@ import mujoco
 import numpy as np
 
 from mjcf.inertia import BodyInertia
+from mjcf.own_dynamics import ArmDynamics
 from sim.robot.effects import HiddenEffects, finite
+from sim.robot.servo import ServoGains, rotor_armature, tune_servos
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.sampling import default_limits
@@ -42,11 +44,15 @@ class RealRobotOptions:
     """How the real robot is built and driven.
 
     Attributes:
-        inertia: "auto" (PUMA 560 values for a 6R arm, rods otherwise), "puma560" or "rods".
-        servo_kp: stiffness of the servos of joints without compliance, N m/rad (N/m); their
-            integral action removes the steady-state error whatever it is.
-        damping_ratio: servo damping ratio (kv from kp and the joint's inertia at q = 0; the
-            integral gain is capped for stability at the largest inertia, see ``_tune``).
+        inertia: "auto" (the arm's own inertias when ``dynamics`` is given; else the
+            fallback, announced: PUMA 560 values for a 6R arm, rods otherwise), "own",
+            "puma560" or "rods" (:mod:`sim.robot.mass`).
+        dynamics: the arm's own mass properties, damping and friction, read from its shipped
+            URDF/MJCF (:func:`mjcf.arm_dynamics`); needed by ``inertia="own"``.
+        servo_bandwidth: omega of the servo tuning, rad/s (eqs S1-S5 of
+            :mod:`sim.robot.servo`: kp = omega^2 max_q M_kk(q) for joints without compliance;
+            their integral action removes the steady-state error whatever it is).
+        damping_ratio: zeta of the servo tuning (:mod:`sim.robot.servo`).
         load_friction: Coulomb friction of each load-side hinge (backlash joints only), N m,
             shape (n,); None: :data:`PUMA560_LOAD_FRICTION` for the PUMA, 1 N m otherwise.
         tool_points: reflector offsets from the end-effector point, zero-reference base frame,
@@ -57,7 +63,8 @@ class RealRobotOptions:
     """
 
     inertia: str = "auto"
-    servo_kp: float = 2.0e4
+    dynamics: ArmDynamics | None = None
+    servo_bandwidth: float = 150.0
     damping_ratio: float = 1.0
     load_friction: tuple[float, ...] | None = None
     tool_points: tuple[tuple[float, float, float], ...] | None = None
@@ -66,9 +73,16 @@ class RealRobotOptions:
     timestep: float | None = None
 
     def __post_init__(self) -> None:
-        if self.inertia not in ("auto", "puma560", "rods"):
-            raise InputError(f"inertia: {self.inertia!r}; expected 'auto', 'puma560' or 'rods'")
-        for name, unit in (("servo_kp", "N m/rad"), ("damping_ratio", "1")):
+        if self.inertia not in ("auto", "own", "puma560", "rods"):
+            raise InputError(f"inertia: {self.inertia!r}; expected 'auto', 'own', 'puma560' "
+                             "or 'rods'")
+        if self.dynamics is not None and not isinstance(self.dynamics, ArmDynamics):
+            raise InputError(f"dynamics: expected mjcf.ArmDynamics, got "
+                             f"{type(self.dynamics).__name__}")
+        if self.inertia == "own" and self.dynamics is None:
+            raise InputError("inertia: 'own' needs dynamics= (mjcf.arm_dynamics of the arm's "
+                             "URDF/MJCF)")
+        for name, unit in (("servo_bandwidth", "rad/s"), ("damping_ratio", "1")):
             object.__setattr__(self, name, _positive(getattr(self, name), name, unit))
         if self.load_friction is not None:
             object.__setattr__(self, "load_friction", _load_friction(self.load_friction))
@@ -183,9 +197,9 @@ def _add_tool(spec: mujoco.MjSpec, last: Any, tip: F64, tool_points: F64, scale:
         pl.fullinertia = [i0, i0, i0, 0.0, 0.0, 0.0]
 
 
-def _add_drives(spec: mujoco.MjSpec, chain: _Chain, kps: F64, load_friction: F64) -> None:
+def _add_drives(spec: mujoco.MjSpec, chain: _Chain, load_friction: F64) -> None:
     """Bearing friction tendons of the play joints, then a position and a rate servo per joint
-    (the rate gains are set by :func:`_tune` once the inertias are known)."""
+    (their gains are set by :func:`_tune` once the inertias are known)."""
     for k, name in enumerate(chain.play):
         if name is None:
             continue
@@ -196,60 +210,28 @@ def _add_drives(spec: mujoco.MjSpec, chain: _Chain, kps: F64, load_friction: F64
     for k, name in enumerate(chain.motor):
         act = spec.add_actuator(name=f"servo{k + 1}", target=name,
                                 trntype=mujoco.mjtTrn.mjTRN_JOINT)
-        act.set_to_position(kp=float(kps[k]), kv=0.0)
+        act.set_to_position(kp=1.0, kv=0.0)
     for k, name in enumerate(chain.motor):
         act = spec.add_actuator(name=f"servo{k + 1}_rate", target=name,
                                 trntype=mujoco.mjtTrn.mjTRN_JOINT)
         act.set_to_velocity(kv=1.0)
 
 
-def _servo_inertias(probe: mujoco.MjModel, chain: _Chain, lower: F64, upper: F64,
-                    poses: int = 64) -> F64:
-    """The inertia each servo sees (diagonal of the joint-space inertia at its motor joint),
-    at q = 0 (row 0) and at ``poses - 1`` seeded random poses within ``lower``..``upper``
-    (rad, m), shape (poses, n), kg m^2."""
-    d = mujoco.MjData(probe)
-    adr = [probe.jnt_qposadr[mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm)]
-           for nm in chain.motor]
-    dof = [probe.jnt_dofadr[mujoco.mj_name2id(probe, mujoco.mjtObj.mjOBJ_JOINT, nm)]
-           for nm in chain.motor]
-    rng = np.random.default_rng(0)
-    full = np.zeros((probe.nv, probe.nv))
-    out = np.empty((poses, len(adr)))
-    for i in range(poses):
-        d.qpos[:] = probe.qpos0
-        if i:
-            d.qpos[adr] = rng.uniform(lower, upper)
-        mujoco.mj_forward(probe, d)
-        mujoco.mj_fullM(probe, d, full)
-        out[i] = full[dof, dof]
-    return out
-
-
-def _tune(spec: mujoco.MjSpec, chain: _Chain, kps: F64, options: RealRobotOptions,
-          lower: F64, upper: F64) -> tuple[F64, F64]:
-    """Damping, integral gain, time step and constraint stiffness from the inertia each servo
-    sees.
-
-    kv = 2 zeta sqrt(kp I_0) with I_0 the inertia at q = 0; the integral gain
-    ki = 0.15 sqrt(kp / I_0), capped at half of kv / I_max: the servo with integral action,
-    I s^3 + kv s^2 + kp s + kp ki = 0, is stable only for ki < kv / I (Routh), and an arm
-    folded upright at q = 0 (a Panda: joint 1 sees 45x more inertia stretched out) would
-    otherwise diverge. The time step is 0.4 sqrt(I_min / kp) at most (1 ms), I_min over the
-    same poses. On the PUMA, IRB 120, UR5e and Stanford arms neither the cap nor I_min
-    changes a gain or the step (their inertias vary by less than 3.4x).
-
-    Returns:
-        (rate gains kv, integral gains ki), shape (n,) each.
-    """
-    probe = spec.compile()
-    inertia = _servo_inertias(probe, chain, lower, upper)
-    i0 = inertia[0]
-    kvs = 2.0 * options.damping_ratio * np.sqrt(kps * i0)
-    kis = np.minimum(0.15 * np.sqrt(kps / i0), 0.5 * kvs / inertia.max(axis=0))
-    dt = options.timestep
-    if dt is None:
-        dt = float(min(1e-3, 0.4 * np.min(np.sqrt(inertia.min(axis=0) / kps))))
+def _tune(spec: mujoco.MjSpec, chain: _Chain, effects: HiddenEffects,
+          options: RealRobotOptions, lower: F64, upper: F64) -> ServoGains:
+    """The servo gains and time step from the inertia each servo sees (eqs S1-S5 of
+    :mod:`sim.robot.servo`; with the arm's own dynamics, its rotor inertias first, eq S0),
+    set on the actuators; the play joints' limits and bearing friction get constraint time
+    constants of 2 dt."""
+    if options.dynamics is not None and options.inertia in ("auto", "own"):
+        arm = rotor_armature(spec.compile(), chain.motor, options.dynamics.armature, lower,
+                             upper)
+        for name, a in zip(chain.motor, arm, strict=True):
+            spec.joint(name).armature = float(a)
+    gains = tune_servos(spec.compile(), chain.motor, effects.joint_compliance,
+                        options.servo_bandwidth, options.damping_ratio, lower, upper,
+                        options.timestep)
+    dt = gains.timestep
     spec.option.timestep = dt
     for k, name in enumerate(chain.play):
         if name is not None:
@@ -260,8 +242,20 @@ def _tune(spec: mujoco.MjSpec, chain: _Chain, kps: F64, options: RealRobotOption
             ten.solref_friction = [2.0 * dt, 1.0]
             ten.solimp_friction = [0.99999, 0.99999, 0.001, 0.5, 2.0]
     for k in range(len(chain.motor)):
-        spec.actuator(f"servo{k + 1}_rate").set_to_velocity(kv=float(kvs[k]))
-    return kvs, kis
+        spec.actuator(f"servo{k + 1}").set_to_position(kp=float(gains.kp[k]), kv=0.0)
+        spec.actuator(f"servo{k + 1}_rate").set_to_velocity(kv=float(gains.kv[k]))
+    return gains
+
+
+def _joint_dynamics(spec: mujoco.MjSpec, chain: _Chain, dynamics: ArmDynamics | None) -> None:
+    """The file's own viscous damping and Coulomb friction on the motor joints (where the file
+    gives them)."""
+    if dynamics is None:
+        return
+    for k, name in enumerate(chain.motor):
+        j = spec.joint(name)
+        j.damping = [float(dynamics.damping[k]), 0.0, 0.0]  # linear term only
+        j.frictionloss = float(dynamics.friction[k])
 
 
 def build_robot_model(true_model: Manipulator, effects: HiddenEffects,
@@ -277,7 +271,8 @@ def build_robot_model(true_model: Manipulator, effects: HiddenEffects,
         tool_points: reflector offsets from the end-effector point, model unit, shape (M, 3).
         load_friction: Coulomb friction of each load hinge, N m, shape (n,).
         scale: metres per model length unit.
-        options: servo gain, damping ratio, gravity, time step.
+        options: servo bandwidth, damping ratio, the file's joint damping and friction,
+            gravity, time step.
 
     Returns:
         the compiled model and the indices, gains and reference positions the controller
@@ -293,17 +288,16 @@ def build_robot_model(true_model: Manipulator, effects: HiddenEffects,
     chain, last = _add_chain(spec, true_model, effects, inertias, scale)
     tip = np.asarray(true_model.bodies)[n] * scale
     _add_tool(spec, last, tip, tool_points, scale, effects.payload)
-    kps = np.full(n, options.servo_kp)
-    for k, c in effects.joint_compliance.items():
-        kps[k - 1] = 1.0 / c
-    _add_drives(spec, chain, kps, load_friction)
+    _joint_dynamics(spec, chain, options.dynamics if options.inertia in ("auto", "own")
+                    else None)
+    _add_drives(spec, chain, load_friction)
     # the poses random measurements command (zrp.kinematics.sampling.default_limits), slides
     # from the model's length unit to m
     lim = default_limits(true_model) * np.where(true_model.prismatic, scale, 1.0)[:, None]
-    kvs, kis = _tune(spec, chain, kps, options, lim[:, 0], lim[:, 1])
+    g = _tune(spec, chain, effects, options, lim[:, 0], lim[:, 1])
     compiled = spec.compile()
     return compiled, _indices(compiled, chain, effects, len(tool_points), tip,
-                              {"kp": kps, "kv": kvs, "ki": kis})
+                              {"kp": g.kp, "kv": g.kv, "ki": g.ki})
 
 
 def _indices(m: mujoco.MjModel, chain: _Chain, eff: HiddenEffects, points: int, tip: F64,

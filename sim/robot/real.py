@@ -25,9 +25,10 @@ the nominal model does not know about, each switched on with a magnitude in
 * ``payload``: a point mass (kg) at the end-effector point (it matters through the servo
   stiffness and the backlash).
 
-Link inertias: the PUMA 560 literature values (:func:`mjcf.puma560_inertias`, Armstrong,
-Khatib & Burdick 1986 via Corke & Armstrong-Hélouvry 1994) for 6R PUMA-type models, uniform
-rods otherwise (:func:`mjcf.rod_inertias`). The effects themselves are :mod:`sim.robot.effects`; the
+Link inertias: the arm's own, from its shipped URDF/MJCF (``RealRobotOptions.dynamics``);
+without them an announced fallback, the PUMA 560 literature values for a 6R arm, uniform rods
+otherwise (:mod:`sim.robot.mass`). Servo gains are tuned from the arm's inertia over its
+workspace (:mod:`sim.robot.servo`). The effects themselves are :mod:`sim.robot.effects`; the
 MuJoCo model is assembled in :mod:`sim.robot.model` (layout as in :mod:`mjcf.builder`).
 
 Units: joint values rad (model length unit for prismatic joints), positions in the model's
@@ -44,7 +45,7 @@ import mujoco
 import numpy as np
 from numpy.typing import ArrayLike
 
-from mjcf.inertia import BodyInertia, puma560_inertias, rod_inertias
+from mjcf.inertia import BodyInertia
 from sim.robot.effects import (
     HiddenEffects,
     default_tool_points,
@@ -53,6 +54,7 @@ from sim.robot.effects import (
     motor_map,
     true_geometry,
 )
+from sim.robot.mass import link_inertias, robot_mass
 from sim.robot.model import PUMA560_LOAD_FRICTION, RealRobotOptions, build_robot_model
 from zrp.arrays import F64
 from zrp.errors import InputError
@@ -118,29 +120,24 @@ class RealRobot:
         tp = (default_tool_points(model) if self.options.tool_points is None
               else np.asarray(self.options.tool_points, dtype=float))
         self.tool_points = freeze(tp)
+        self.mass = robot_mass(model, self.options)
+        if self.options.dynamics is not None and len(self.options.dynamics.inertias) != n:
+            raise InputError(f"dynamics: {len(self.options.dynamics.inertias)} links, but the "
+                             f"model has {n} joints")
         fr = self.options.load_friction
         if fr is None:
-            fr = PUMA560_LOAD_FRICTION if self._inertia_kind() == "puma560" else (1.0,) * n
+            fr = PUMA560_LOAD_FRICTION if self.mass.kind == "puma560" else (1.0,) * n
         if len(fr) != n:
             raise InputError(f"load_friction: expected {n} values (one per joint), got {len(fr)}")
         self.load_friction = freeze(fr)
         self.model, self._ids = self._build()
 
     # ---- construction ---------------------------------------------------------------------
-    def _inertia_kind(self) -> str:
-        kind = self.options.inertia
-        if kind == "auto":
-            m = self.nominal
-            kind = "puma560" if m.n == 6 and not m.prismatic.any() else "rods"
-        return kind
-
     def _true_geometry(self) -> Manipulator:
         return true_geometry(self.nominal, self.effects)
 
     def _inertias(self) -> list[BodyInertia]:
-        if self._inertia_kind() == "puma560":
-            return puma560_inertias(self.true_model, self.scale)
-        return rod_inertias(self.true_model, self.scale)
+        return link_inertias(self.mass, self.true_model, self.options, self.scale)
 
 
     def _build(self) -> tuple[mujoco.MjModel, dict[str, Any]]:
@@ -206,7 +203,8 @@ class RealRobot:
                 "servo_kv_Nms_per_rad": self._ids["kv"].tolist(),
                 "integral_trim": self._ids["trim"].tolist(),
                 "load_friction_Nm": self.load_friction.tolist(),
-                "inertia": self._inertia_kind(), "t_ref_degC": self.options.t_ref,
+                "inertia": self.mass.kind, "dynamics": self.mass.note,
+                "dynamics_fallback": self.mass.fallback, "t_ref_degC": self.options.t_ref,
                 "tool_points": self.tool_points.tolist(),
                 "true_axes": np.asarray(self.true_model.axes).tolist(),
                 "true_bodies": np.asarray(self.true_model.bodies).tolist(),

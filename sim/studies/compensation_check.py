@@ -162,7 +162,8 @@ def compensate_and_measure(robot: RealRobot, instrument: Instrument, diag: Diagn
                           load=np.full(len(q_prog), robot.effects.payload))
 
     def tau(q: F64) -> F64:
-        return gravity_torques(mjcf_path, q)
+        return gravity_torques(mjcf_path, q,
+                               joint_names=[j.name for j in robot.nominal.joints])
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")

@@ -14,8 +14,8 @@ import zrp
 from sim.robot.effects import HiddenEffects
 from sim.robot.instrument import Instrument
 from sim.robot.measurement import measure
-from sim.robot.model import _servo_inertias
 from sim.robot.real import RealRobot
+from sim.robot.servo import servo_inertias
 from sim.studies.benchmark import BenchmarkConfig
 from sim.studies.benchmark.scenarios import DEFAULT_NOISE_MM, draw_scenarios, pose_limits
 from zrp.cli import main
@@ -42,11 +42,9 @@ def test_servo_gains_are_stable_at_every_pose_of_a_7_axis_arm():
     names = [mujoco.mj_id2name(robot.model, mujoco.mjtObj.mjOBJ_JOINT, j)
              for j in range(robot.model.njnt)]
 
-    class Chain:  # the motor joints, as the builder named them
-        motor = [nm for nm in names if nm is not None and "play" not in nm][:7]
-
+    motor = [nm for nm in names if nm is not None and "play" not in nm][:7]
     m = robot.nominal
-    inertia = _servo_inertias(robot.model, Chain, m.lower, m.upper)
+    inertia = servo_inertias(robot.model, motor, m.lower, m.upper)
     assert inertia.max(axis=0)[0] > 10 * inertia[0, 0]  # the hostile case is really there
     kv, ki = robot._ids["kv"], robot._ids["ki"]
     assert np.all(ki < kv / inertia.max(axis=0))

@@ -312,8 +312,8 @@ def test_bad_robot_and_procedure_options(puma):
         RealRobot(puma, HiddenEffects(backlash={7: 1e-3}))
     with pytest.raises(InputError, match=r"bodies 1\.\.7"):
         RealRobot(puma, HiddenEffects(link_length={8: (0.0, 0.0, 1.0)}))
-    with pytest.raises(InputError, match="servo_kp"):
-        RealRobotOptions(servo_kp=-1.0)
+    with pytest.raises(InputError, match="servo_bandwidth"):
+        RealRobotOptions(servo_bandwidth=-1.0)
     with pytest.raises(InputError, match="load_friction"):
         RealRobot(puma, options=RealRobotOptions(load_friction=(1.0, 2.0)))
     with pytest.raises(InputError, match="approach"):

@@ -3,7 +3,8 @@
 :func:`simulate_scenario` sees the truth: it builds the real robot of a scenario, measures it
 and writes the measurement CSV and a SEPARATE truth file. :func:`diagnose_blind` is the only
 place the benchmark calls the diagnosis; it receives the CSV path, the nominal model and the
-nominal MJCF - never the scenario, the truth file or anything derived from them.
+nominal MJCF (or the arm's own URDF/MJCF) - never the scenario, the truth file or anything
+derived from them.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 
 from mjcf.gravity import gravity_torques
 from sim.robot.instrument import random_instrument
+from sim.robot.mass import DynamicsFallbackWarning
 from sim.robot.measurement import Procedure, measure, write_measurements, write_truth
 from sim.robot.real import RealRobot
 from sim.studies.benchmark.scenarios import BenchmarkConfig, Scenario, pose_limits
@@ -39,8 +41,10 @@ def simulate_scenario(model: Manipulator, scenario: Scenario, config: BenchmarkC
          if config.poses_from == "random"
          else circle_poses(model, config.poses))
     inst = random_instrument(model, rng, scenario.noise_sigma)
-    robot = RealRobot(model, scenario.effects, config.robot_options(model))
-    run = measure(robot, q, inst, rng, Procedure(approach=config.approach))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynamicsFallbackWarning)  # the run's report says it
+        robot = RealRobot(model, scenario.effects, config.robot_options(model))
+        run = measure(robot, q, inst, rng, Procedure(approach=config.approach))
     run.truth["scenario"] = {"index": scenario.index, "seed": scenario.seed,
                              "kind": scenario.kind, "labels": list(scenario.labels)}
     name = f"scenario_{scenario.index:03d}"
@@ -68,5 +72,6 @@ def diagnose_blind_result(csv_path: str | Path, model: Manipulator, *,
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         meas = load_measurements(csv_path, model)
-        tau = None if mjcf_path is None else gravity_torques(mjcf_path, meas.q_pose)
+        tau = None if mjcf_path is None else gravity_torques(
+            mjcf_path, meas.q_pose, joint_names=[j.name for j in model.joints])
         return diagnose(model, meas, gravity_torque=tau, seed=seed)

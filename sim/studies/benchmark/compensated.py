@@ -13,12 +13,15 @@ same tracker measures again) and the hidden effects of the robot being commanded
 
 from __future__ import annotations
 
+import dataclasses
+import warnings
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from sim.robot.instrument import Instrument
+from sim.robot.mass import DynamicsFallbackWarning
 from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
 from sim.studies.benchmark.scenarios import Scenario
@@ -35,8 +38,8 @@ COMPENSATED_KEYS = ("comp_targets", "comp_rms_before", "comp_rms_after", "comp_r
 
 
 def compensated_column(model: Manipulator, scenario: Scenario, truth: dict[str, Any],
-                       diagnosis: Diagnosis, mjcf_path: Path | None, targets: int
-                       ) -> dict[str, Any]:
+                       diagnosis: Diagnosis, mjcf_path: Path | None, targets: int,
+                       options: RealRobotOptions | None = None) -> dict[str, Any]:
     """Compensate ``targets`` fresh random targets (and ``targets // 2`` circle points for a
     6-joint arm) with the scenario's diagnosis, command and measure them (module doc).
 
@@ -50,7 +53,10 @@ def compensated_column(model: Manipulator, scenario: Scenario, truth: dict[str, 
     inst = Instrument(float(ins["noise_sigma"]), tuple(ins["rotvec"]),
                       tuple(ins["translation"]))
     tool = tuple(tuple(float(x) for x in r) for r in truth["robot"]["tool_points"])
-    robot = RealRobot(model, scenario.effects, RealRobotOptions(tool_points=tool))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynamicsFallbackWarning)  # the run's report says it
+        robot = RealRobot(model, scenario.effects, dataclasses.replace(
+            options or RealRobotOptions(), tool_points=tool))
     rng = np.random.default_rng([scenario.seed, 11])
     n_circle = targets // 2 if model.n == 6 and targets // 2 >= 8 else 0
     nan = float("nan")

@@ -76,7 +76,8 @@ def _intro(result: BenchmarkResult) -> list[str]:
             f"{_noise_text(cfg)} per coordinate, MJCF inertias "
             f"{'given' if cfg.use_mjcf else 'not given'} to the diagnosis. Visible: signature "
             f"after registration >= {cfg.excitation_threshold:g} x noise RMS. Target: withheld "
-            f"RMS after correction <= {cfg.ratio_target:g} x noise RMS."]
+            f"RMS after correction <= {cfg.ratio_target:g} x noise RMS.", "",
+            f"Simulated robot's dynamics: {result.dynamics or 'not recorded'}."]
 
 
 def _summary_section(cfg: BenchmarkConfig, rows: list[dict[str, Any]]) -> list[str]:

@@ -30,11 +30,14 @@ class BenchmarkResult:
     workdir: str
     failures: tuple[TaskFailure, ...] = ()
     resumed: int = 0
+    dynamics: str = ""
 
     def to_dict(self) -> dict[str, Any]:
         cfg = {k: (list(v) if isinstance(v, tuple) else v)
                for k, v in self.config.__dict__.items()}
-        return {"model": self.model_name, "config": cfg, "wall_s": self.wall_s,
+        return {"model": self.model_name, "config": cfg, "dynamics": self.dynamics,
+                "dynamics_fallback": self.dynamics.startswith("FALLBACK"),
+                "wall_s": self.wall_s,
                 "sim_s": self.sim_s, "diag_s": self.diag_s, "workdir": self.workdir,
                 "summary": summary_rows(self), "confusion": confusion_matrix(self),
                 "scenarios": [s.to_dict() for s in self.scores],
@@ -61,17 +64,24 @@ def _pct(ok: int, n: int) -> str:
     return "-" if n == 0 else f"{100.0 * ok / n:.0f} % ({ok}/{n})"
 
 
-def _group(scores: Sequence[ScenarioScore], target: float) -> dict[str, Any]:
+def _counts(scores: Sequence[ScenarioScore], target: float) -> dict[str, str]:
+    """The scenario counts of a group (named first, or tied; joints; ratio; both; all)."""
     n = len(scores)
-    ratios = [s.ratio for s in scores if math.isfinite(s.ratio)]
-    shr = [s.shrink for s in scores if math.isfinite(s.shrink)]
-    return {"n": n,
-            "top": _pct(sum(s.top_correct for s in scores), n),
+    return {"top": _pct(sum(s.top_correct for s in scores), n),
             "top_or_tie": _pct(sum(s.top_correct or any(e in s.tied for e in s.expected)
                                    for s in scores), n),
             "top_and_joints": _pct(sum(s.top_correct and s.joints_correct for s in scores), n),
             "ratio_ok": _pct(sum(s.ratio <= target for s in scores), n),
-            "all_three": _pct(sum(s.success for s in scores), n),
+            "named_and_corrected": _pct(sum(s.top_correct and s.ratio <= target
+                                            for s in scores), n),
+            "all_three": _pct(sum(s.success for s in scores), n)}
+
+
+def _group(scores: Sequence[ScenarioScore], target: float) -> dict[str, Any]:
+    n = len(scores)
+    ratios = [s.ratio for s in scores if math.isfinite(s.ratio)]
+    shr = [s.shrink for s in scores if math.isfinite(s.shrink)]
+    return {"n": n, **_counts(scores, target),
             "median_ratio": float(np.median(ratios)) if ratios else math.nan,
             "median_shrink": float(np.median(shr)) if shr else math.nan,
             **coverage(scores)}

@@ -81,7 +81,7 @@ def run_scenario(task: ScenarioTask) -> ScenarioScore:
     values = dict(sc.values)
     if config.compensate and result is not None:
         values.update(compensated_column(model, scn, truth, result, task.mjcf_path,
-                                         config.compensate))
+                                         config.compensate, config.robot_options(model)))
     return ScenarioScore(**{**sc.__dict__, "sim_s": sim_s, "diag_s": diag_s,
                             "values": values})
 
@@ -192,7 +192,10 @@ def run_benchmark(model: Manipulator, config: BenchmarkConfig,
             for old in (work / "scores").glob("*.json"):
                 old.unlink()
         cfg = _config_dict(model, config)
-        mjcf_path = _nominal_mjcf(model, work / "nominal.xml") if config.use_mjcf else None
+        config.robot_options(model)  # the arm file read and matched to the model now
+        mjcf_path = (None if not config.use_mjcf else Path(config.arm_file)
+                     if config.arm_file is not None else
+                     _nominal_mjcf(model, work / "nominal.xml"))
         t0 = time.perf_counter()
         scenarios = draw_scenarios(model, config)
         done = _previous(work, scenarios, cfg) if resume else {}
@@ -202,4 +205,5 @@ def run_benchmark(model: Manipulator, config: BenchmarkConfig,
         wall = time.perf_counter() - t0
     return BenchmarkResult(config, model.name, tuple(scores), wall,
                            sum(s.sim_s for s in scores), sum(s.diag_s for s in scores),
-                           str(work), tuple(failures), len(done))
+                           str(work), tuple(failures), len(done),
+                           config.dynamics_note(model))

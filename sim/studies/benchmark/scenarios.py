@@ -9,19 +9,24 @@ simulation (:mod:`sim.studies.benchmark.blind`) and to the scorer, never to the 
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from mjcf.own_dynamics import ArmDynamics, arm_dynamics
 from sim.robot.effects import EFFECT_NAMES, HiddenEffects, default_tool_points
 from sim.robot.instrument import TRACKER_NOISE_RANGE_MM
+from sim.robot.mass import DynamicsFallbackWarning, is_paper_puma
 from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.kinematics.sampling import default_limits
+from zrp.model.files import dumps_model
 from zrp.model.manipulator import Manipulator
 from zrp.units import metres_per_unit, units_per_mm
 
@@ -31,6 +36,7 @@ __all__ = [
     "BenchmarkConfig",
     "Scenario",
     "draw_scenarios",
+    "own_dynamics",
     "pose_limits",
     "typical_gravity_torque",
 ]
@@ -66,6 +72,10 @@ class BenchmarkConfig:
         reflectors: reflectors on the tool, 1-3 (the first of
             :func:`sim.robot.effects.default_tool_points`); with one there are no rigid links,
             so the diagnosis has no noise floor unless poses repeat.
+        arm_file: the arm's shipped URDF/MJCF: the simulated robot has its inertias, damping,
+            friction and tool (:func:`mjcf.arm_dynamics`) and the diagnosis gets the file as
+            its MJCF (as ``zrp diagnose --mjcf``); None: the announced fallback
+            (:mod:`sim.robot.mass`) and the nominal MJCF built with it.
         compensate: fresh random targets (plus half as many circle points for a 6-joint arm)
             compensated with each scenario's diagnosis, commanded and measured (the
             "compensated" column, :mod:`sim.studies.benchmark.compensated`); 0: no column.
@@ -86,6 +96,7 @@ class BenchmarkConfig:
     ratio_target: float = 1.5
     compensate: int = 0
     reflectors: int = 3
+    arm_file: str | None = None
 
     def __post_init__(self) -> None:
         for name, lo, hi in (("scenarios", 1, None), ("poses", 16, None),
@@ -95,6 +106,10 @@ class BenchmarkConfig:
                 or self.seed < 0:
             raise InputError(f"seed: expected an integer >= 0, got {self.seed!r}")
         _check_fractions(self)
+        if self.arm_file is not None and not (isinstance(self.arm_file, str)
+                                              and Path(self.arm_file).is_file()):
+            raise InputError(f"arm_file: no such file {self.arm_file!r} (the arm's URDF or "
+                             "MJCF)")
         object.__setattr__(self, "effects", _checked_effects(self.effects, self.pair_fraction))
         if self.noise is not None:
             object.__setattr__(self, "noise", _checked_noise(self.noise))
@@ -110,9 +125,21 @@ class BenchmarkConfig:
 
     def robot_options(self, model: Manipulator) -> RealRobotOptions:
         """How the benchmark builds the real robot: the first :attr:`reflectors` default
-        reflectors."""
+        reflectors, the arm's own dynamics from :attr:`arm_file`."""
         tp = default_tool_points(model)[:self.reflectors]
-        return RealRobotOptions(tool_points=tuple(tuple(float(x) for x in r) for r in tp))
+        dyn = None if self.arm_file is None else own_dynamics(self.arm_file, model)
+        return RealRobotOptions(tool_points=tuple(tuple(float(x) for x in r) for r in tp),
+                                dynamics=dyn)
+
+    def dynamics_note(self, model: Manipulator) -> str:
+        """One line: whose dynamics the simulated robot has (the fallback announced)."""
+        if self.arm_file is not None:
+            return own_dynamics(self.arm_file, model).summary()
+        if is_paper_puma(model):
+            return "PUMA 560 literature inertias (the arm's own)"
+        kind = "PUMA 560" if model.n == 6 and not model.prismatic.any() else "uniform-rod"
+        return (f"FALLBACK: {kind} inertias (no inertias given for this arm; pass its "
+                "URDF/MJCF, --arm)")
 
     def noise_range(self, model: Manipulator) -> tuple[float, float]:
         """(low, high) tracker noise sigma per coordinate in ``model``'s length unit:
@@ -196,11 +223,25 @@ def pose_limits(model: Manipulator) -> F64:
     return default_limits(model)
 
 
+_OWN: dict[tuple[str, str], ArmDynamics] = {}
+
+
+def own_dynamics(path: str, model: Manipulator) -> ArmDynamics:
+    """:func:`mjcf.arm_dynamics` of ``path`` for ``model``, read once per process."""
+    key = (str(path), dumps_model(model))
+    if key not in _OWN:
+        _OWN[key] = arm_dynamics(path, model)
+    return _OWN[key]
+
+
 def typical_gravity_torque(model: Manipulator, payload: float,
-                           rng: np.random.Generator, count: int = 64) -> F64:
+                           rng: np.random.Generator, count: int = 64,
+                           options: RealRobotOptions | None = None) -> F64:
     """RMS over random poses of the static torque each joint carries (arm and payload), N m,
-    shape (n,) (nominal model, PUMA 560 or rod inertias)."""
-    robot = RealRobot(model, HiddenEffects(payload=payload))
+    shape (n,) (nominal model, with ``options``' inertias: the arm's own or the fallback)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", DynamicsFallbackWarning)  # the run announces it
+        robot = RealRobot(model, HiddenEffects(payload=payload), options)
     lim = pose_limits(model)
     tau = robot.static_torque(rng.uniform(lim[:, 0], lim[:, 1], (count, model.n)))
     return np.sqrt(np.mean(tau**2, axis=0))
@@ -324,7 +365,8 @@ def draw_scenarios(model: Manipulator, config: BenchmarkConfig) -> list[Scenario
 
         def tau_rms(p: float = payload) -> F64:
             if p not in tau_cache:
-                tau_cache[p] = typical_gravity_torque(model, p, np.random.default_rng(0))
+                tau_cache[p] = typical_gravity_torque(model, p, np.random.default_rng(0),
+                                                      options=config.robot_options(model))
             return tau_cache[p]
 
         kw: dict[str, Any] = {}

@@ -92,7 +92,8 @@ def _run(args: argparse.Namespace) -> int:
     widen = _widen(args.widen)
     model = load_model(args.model)
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)
-    tau = None if args.mjcf is None else gravity_torques(args.mjcf, meas.q_pose, field="--mjcf")
+    tau = None if args.mjcf is None else gravity_torques(
+        args.mjcf, meas.q_pose, field="--mjcf", joint_names=[j.name for j in model.joints])
     out_dir = Path(args.out)
     created = not out_dir.exists()
     try:

@@ -39,8 +39,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="joint limits, one LO:HI per joint, comma-separated (deg with --deg), "
                    "e.g. --limits=-165:165,-110:110,... (default: the calibrated model's own); "
                    "every target row and every command is checked against them")
-    p.add_argument("--mjcf", metavar="M.xml", help="MJCF with inertias (needed when the "
-                   "compliance was identified with MJCF torques)")
+    p.add_argument("--mjcf", metavar="M.xml", help="MJCF or the arm's URDF with inertias "
+                   "(needed when the compliance was identified with MJCF torques)")
     p.add_argument("--temp", type=real(-100.0, 500.0), metavar="DEGC",
                    help="robot temperature when the commands run, deg C (required when the "
                    "calibration found thermal expansion)")
@@ -92,7 +92,8 @@ def _run(args: argparse.Namespace) -> int:
         from mjcf.gravity import gravity_torques
 
         def grav(q: np.ndarray) -> np.ndarray:
-            return gravity_torques(args.mjcf, q, field="--mjcf")
+            return gravity_torques(args.mjcf, q, field="--mjcf",
+                                   joint_names=[j.name for j in cal.model.joints])
     elif cal.compliance_model == "mjcf" and any(
             t.name.endswith(".compliance") for t in cal.terms):
         raise InputError("--mjcf: the calibration's compliance was identified with MJCF "

@@ -26,8 +26,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", required=True, metavar="M.toml",
                    help="model TOML file or built-in name")
     p.add_argument("--mjcf", metavar="M.xml",
-                   help="MJCF with the robot's inertias (gravity torques for joint_compliance; "
-                        "one hinge/slide joint per model joint, same order and zero)")
+                   help="MJCF, or the arm's shipped URDF, with the robot's inertias (gravity "
+                        "torques for joint_compliance; its joints named as the model's, or one "
+                        "hinge/slide joint per model joint, same order and zero)")
     p.add_argument("--data", required=True, metavar="D.csv",
                    help="measurement CSV, or a quoted glob ('fleet/*.csv') for a fleet")
     add_deg(p)
@@ -107,7 +108,8 @@ def _run(args: argparse.Namespace) -> int:
     progress = args.progress and sys.stderr.isatty()
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame,
                              progress=progress, max_rows=args.max_rows)
-    tau = None if args.mjcf is None else gravity_torques(args.mjcf, meas.q_pose, field="--mjcf")
+    tau = None if args.mjcf is None else gravity_torques(
+        args.mjcf, meas.q_pose, field="--mjcf", joint_names=[j.name for j in model.joints])
     out_dir = Path(args.out)
     created = not out_dir.exists()
     try:

@@ -19,6 +19,16 @@ from zrp.model.builtin import builtin_models
 from zrp.output import check_writable, write_text
 
 
+def _robot_options(arm: str | None, model: object) -> object:
+    """The real robot's options: the arm's own dynamics from ``--arm`` (None: the default)."""
+    if arm is None:
+        return None
+    import mjcf  # loads MuJoCo: only when this command runs
+    import sim  # the same (sim imports MuJoCo)
+
+    return sim.RealRobotOptions(dynamics=mjcf.arm_dynamics(arm, model))  # type: ignore[arg-type]
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "measure", help="simulate a laser-tracker measurement of a MuJoCo 'real' robot",
@@ -30,6 +40,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", default="puma", metavar="M.toml",
                    help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
                         "; default puma)")
+    p.add_argument("--arm", default=None, metavar="FILE",
+                   help="the arm's shipped URDF or MJCF (joints named as the model's): the "
+                        "simulated robot takes its inertias, damping, friction and tool; "
+                        "without it an arm with no inertias of its own borrows the PUMA "
+                        "560's (6R) or rods' (announced)")
     p.add_argument("--out", required=True, metavar="D.csv", help="measurement CSV to write")
     p.add_argument("--truth", metavar="T.json",
                    help="truth file to write (default: next to --out, D.truth.json)")
@@ -142,7 +157,7 @@ def _run(args: argparse.Namespace) -> int:
     args.approach = args.approach or "gravity"
     inst = sim.random_instrument(model, rng, args.noise)
     t0 = time.perf_counter()
-    robot = sim.RealRobot(model, effects)
+    robot = sim.RealRobot(model, effects, _robot_options(args.arm, model))
     procedure = sim.Procedure(approach=args.approach, temp_rise=args.temp_rise)
     run = sim.measure(robot, q, inst, rng, procedure, progress=args.progress,
                       directions=directions)

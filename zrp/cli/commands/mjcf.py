@@ -36,7 +36,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "8-12, paper sign(0) convention)")
     p.add_argument("--inertia", choices=("none", "rods", "puma560"), default="none",
                    help="mass properties: none (kinematic), rods, or puma560 (literature "
-                        "values, 6R PUMA-type only)")
+                        "values, 6R PUMA-type only). Another real arm's own inertias are in its "
+                        "shipped URDF/MJCF: give that file to --mjcf of diagnose/calibrate")
     p.add_argument("--actuators", action="store_true",
                    help="add PD servos (position + rate actuators) per joint")
     p.add_argument("--kp", type=real(0.0, 1e12, open_lo=True),

@@ -65,7 +65,8 @@ def diagnose_robot(task: RobotTask) -> dict[str, Any]:
     from zrp.gap.report import diagnosis_document, write_outputs  # on use: keeps --help quick
 
     meas = load_measurements(task.data, task.model, **task.read)
-    tau = None if task.mjcf is None else gravity_torques(task.mjcf, meas.q_pose, field="--mjcf")
+    tau = None if task.mjcf is None else gravity_torques(
+        task.mjcf, meas.q_pose, field="--mjcf", joint_names=[j.name for j in task.model.joints])
     with warnings.catch_warnings(record=True):  # kept in the diagnosis's own warnings list
         warnings.simplefilter("always")
         diag = diagnose(task.model, meas, gravity_torque=tau, **task.options)
