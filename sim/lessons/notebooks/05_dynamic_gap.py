@@ -37,7 +37,8 @@ def show(fig: plt.Figure) -> None:
 
 bench = BENCH_ARMS["puma"]   # the PUMA 560 with its literature link inertias
 arm = bench.load()           # the nominal model: what the diagnosis knows
-print(arm.name, "joints", arm.joint_names, "link masses (kg)", arm.model.body_mass[2:].round(2))
+print(arm.name, "joints", arm.joint_names)
+print("link masses (kg)", [f"{m:.3g}" for m in arm.model.body_mass[arm.moving_bodies()]])
 
 # %% [markdown]
 # ## The sealed envelope (the teacher may change it; students read it at the end)
@@ -73,10 +74,12 @@ print(f"{log.n_samples} samples at {1 / log.dt:.0f} Hz, {log.n_joints} joints")
 # ## Where the model's torques miss
 #
 # The model's torques along the log are MuJoCo's inverse dynamics, tau = M(q) qdd +
-# c(q, qd) + g(q) (`mj_inverse`), at the logged positions with velocities and
+# c(q, qd) + g(q) (`mj_inverse`; eq. R2 of `sim.dynamics.inertial` writes it linear in the
+# link inertias), at the logged positions with velocities and
 # accelerations from a zero-phase Savitzky-Golay filter (differentiating raw encoder
-# readings twice would amplify their noise a millionfold). The residual, measured minus
-# model, plotted against each joint's velocity is where an engineer looks first:
+# readings twice would multiply their noise by 1/dt^2, a million at 1 kHz). The residual,
+# measured minus model, plotted against each joint's velocity is where an engineer looks
+# first:
 #
 # * a **step** at zero velocity (the sign flips when the joint reverses): Coulomb friction;
 # * a **slope** through the origin: viscous friction;
@@ -144,8 +147,8 @@ for k in range(n):
 # The withheld residual after the correction, against velocity: what is left is noise,
 # except on joint 2 near zero speed. The real arm's dry friction is MuJoCo's
 # `frictionloss` constraint, which holds the joint still at a reversal (stiction); the
-# diagnosis's smooth Coulomb law cannot take that instant, and says so in its regime
-# table (`zrp diagnose-dynamics` writes it).
+# diagnosis's smooth Coulomb law cannot take that instant. Its table of residuals per
+# regime (the report of `zrp diagnose-dynamics` has it for every joint) shows where.
 
 # %%
 s = diag.samples
@@ -161,6 +164,11 @@ for k, ax in enumerate(axes.flat):
 axes.flat[0].legend(markerscale=5)
 fig.tight_layout()
 show(fig)
+print("joint 2, RMS residual per regime (N m):")
+for regime, before in diag.regimes["before"].items():
+    after = diag.regimes["after"][regime]
+    if before[1] is not None:
+        print(f"    {regime:15s} {before[1]:6.3f} -> {after[1]:6.3f}")
 
 # %% [markdown]
 # ## The corrected MJCF
@@ -235,9 +243,9 @@ print("found :", [e.label for e in diag.effects])
 # %% [markdown]
 # ## Try this
 #
-# * Hide a torque sensor `offset` on joint 4 instead of the friction. Joint 4 reverses
-#   often: can the diagnosis tell an offset from Coulomb friction? Shorten the command's
-#   amplitude until joint 4 no longer reverses, and read `diag.cannot_tell`.
+# * Hide a torque sensor `offset` on joint 4 instead of the friction. How can the
+#   diagnosis tell an offset from Coulomb friction (what happens at a reversal)? Log 1 s
+#   only: can it still? Read `diag.cannot_tell`.
 # * Add a Stribeck bump (`stribeck=..., stribeck_speed=0.08`): what does MJCF have no
 #   place for, and what does the corrected model then miss?
 # * Log 3 s instead of 10 s: how do the intervals change?
