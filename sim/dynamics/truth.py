@@ -25,7 +25,8 @@ from sim.dynamics.inertial import V_EPS, body_params, set_body_params
 from zrp.arrays import F64
 from zrp.gap.dynamics.data import TorqueLog
 
-__all__ = ["HiddenDynamics", "Servo", "add_point_mass", "simulate", "true_model"]
+__all__ = ["HiddenDynamics", "Run", "Servo", "add_point_mass", "run_servo", "simulate",
+           "true_model"]
 
 #: Velocity scale of the hidden Stribeck bump's sign, rad/s (not the diagnosis's V_EPS).
 TRUTH_V_EPS = 0.02

@@ -42,8 +42,10 @@ NOTEBOOKS: tuple[tuple[str, str, str, str], ...] = (
     ("gap", "04_sim_to_real_gap", "The sim-to-real gap: measure, diagnose, compensate",
      "Measure a simulated robot with hidden effects, let the diagnosis name them, compensate "
      "the commands and measure the gap shrink."),
-    # Notebook 5, the dynamic gap (the robot in motion), goes here: ("dynamic",
-    # "05_dynamic_gap", ...), once that capability lands.
+    ("dynamic", "05_dynamic_gap", "The dynamic gap: where the model's torques miss",
+     "Log a moving arm with hidden friction, rotor inertia and a payload, see where the "
+     "model's inverse dynamics miss the torques, let the diagnosis name the effects, and "
+     "re-simulate the corrected MJCF."),
 )
 NAMES = tuple(n[0] for n in NOTEBOOKS)
 #: A notebook must run top to bottom within this many seconds (the laptop goal is two

@@ -86,27 +86,47 @@ def _runner_installed() -> None:
         pytest.importorskip(mod)
 
 
+class Renders:
+    """A renders-like folder (``notebooks/`` beside a figure and a video), as ``zrp
+    notebooks`` writes it; each notebook executed into it once, when a test first asks for
+    it (``pytest -k dynamic`` runs one notebook only)."""
+
+    def __init__(self, root: Path) -> None:
+        self.root = root
+        self.runs: dict = {}
+
+    def run(self, name: str):
+        if name not in self.runs:
+            with OutputDir(self.root / "notebooks", names=notebook_file_names([name])) as out:
+                self.runs[name] = run_notebooks(out, [name], timeout_s=TIME_LIMIT_S)[0]
+        return self.runs[name]
+
+    def with_index(self) -> tuple[Path, dict]:
+        """Every notebook executed, and the index written."""
+        for name in NAMES:
+            self.run(name)
+        if not (self.root / "index.html").is_file():
+            with OutputDir(self.root / "notebooks", names=[DESCRIPTIONS]) as out:
+                out.write_text(DESCRIPTIONS, "{}")
+            for f in ("fig2_je_max_position.png", "puma_circle_JE2_0.1pct.mp4",
+                      "comparison.md"):
+                (self.root / f).write_bytes(b"")
+            write_index(self.root)
+        return self.root, self.runs
+
+
 @pytest.fixture(scope="module")
-def executed(tmp_path_factory, backend):
-    """Every notebook executed once into a renders-like folder (``notebooks/`` beside a
-    figure and a video), as ``zrp notebooks`` writes it, with the index written."""
+def renders(tmp_path_factory, backend):
     _runner_installed()
-    root = tmp_path_factory.mktemp("renders")
-    with OutputDir(root / "notebooks", names=[*notebook_file_names(), DESCRIPTIONS]) as out:
-        runs = run_notebooks(out, timeout_s=TIME_LIMIT_S)
-        out.write_text(DESCRIPTIONS, "{}")
-    for f in ("fig2_je_max_position.png", "puma_circle_JE2_0.1pct.mp4", "comparison.md"):
-        (root / f).write_bytes(b"")
-    write_index(root)
-    return root, {r.name: r for r in runs}
+    return Renders(tmp_path_factory.mktemp("renders"))
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("name", NAMES)
-def test_notebook_runs_and_shows_mediapy_output(executed, name):
+def test_notebook_runs_and_shows_mediapy_output(renders, name):
     import nbformat
 
-    run = executed[1][name]
+    run = renders.run(name)
     assert run.seconds < TIME_LIMIT_S
     nb = nbformat.read(run.ipynb, as_version=4)
     outputs = [o for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", [])]
@@ -138,10 +158,10 @@ BROWSER = next((b for b in ("chromium", "chromium-browser", "google-chrome")
 
 @pytest.mark.slow
 @pytest.mark.skipif(BROWSER is None, reason="no Chromium installed")
-def test_index_opens_with_the_student_path_in_chromium(executed, tmp_path):
+def test_index_opens_with_the_student_path_in_chromium(renders, tmp_path):
     from tests.gap.test_report_html import _browse
 
-    root, runs = executed
+    root, runs = renders.with_index()
     index = root / "index.html"
     console, _, dom = _browse(index, tmp_path)
     assert console == [], console
@@ -198,3 +218,21 @@ def test_the_time_limit_is_the_whole_notebooks(tmp_path):
         execute_notebook(slow, timeout_s=4)
     with pytest.raises(InputError, match="source: no notebook text"):
         execute_notebook(tmp_path / "missing.py")
+
+
+@pytest.mark.slow
+def test_the_dynamic_gap_notebook_finds_what_its_envelope_hides(renders):
+    """Notebook 5's envelope hides armature on joint 1, Coulomb friction on joint 2, viscous
+    friction on joint 3 and a payload; its last cell prints what the diagnosis found."""
+    import nbformat
+
+    nb = nbformat.read(renders.run("dynamic").ipynb, as_version=4)
+    text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code"
+                   for o in c.get("outputs", []) if o.get("name") == "stdout")
+    found = re.search(r"found : \[(.*)\]", text)
+    assert found, "the notebook no longer prints what it found"
+    assert sorted(re.findall(r"'([^']+)'", found.group(1))) == [
+        "armature (joint 1)", "coulomb (joint 2)", "payload (arm)", "viscous (joint 3)"]
+    gaps = [(float(a), float(b)) for a, b in
+            re.findall(r"tracking gap +([\d.]+) -> +([\d.]+) mrad", text)]
+    assert len(gaps) == 6 and max(b for _, b in gaps) < 0.1 * max(a for a, _ in gaps)

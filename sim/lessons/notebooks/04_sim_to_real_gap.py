@@ -142,4 +142,5 @@ print("found :", [(st.effect, list(st.joints)) for st in diag.steps])
 #
 # ## Next: the dynamic gap
 #
-# Notebook 5 (the robot in motion) will follow here.
+# Notebook 5 (`05_dynamic_gap.py`) puts the robot in motion: where the model's torques
+# miss (friction, rotor inertia, a payload) and how the corrected MJCF moves like the arm.
