@@ -176,7 +176,8 @@ def si_factor(kind: str, unit: str | None, field: str = "column") -> float:
     table = QUANTITY_UNITS[kind]
     key = unit.strip().lower()
     if key not in table:
-        shown = ", ".join(sorted({SI_UNITS[kind], *table}))
+        si = SI_UNITS[kind]
+        shown = ", ".join([si, *sorted(k for k in table if k != si.lower())])
         raise UnitError(f"{field} has unit [{unit}]; a {kind} column takes one of {shown}")
     return table[key]
 
