@@ -102,22 +102,25 @@ BLOCK_COLUMNS = ["arm", "visible singles", "right", "named first (not tied)",
 
 def _per_arm(rows: list[bm.Row], arms: list[str]) -> list[list[object]]:
     """The README's table: per arm and for all, the tally (:func:`bm.tally`) and ranges."""
-    out = []
-    for arm in [*arms, "all"] if len(arms) > 1 else arms:
-        sel = [r for r in rows if arm in ("all", r.arm)]
-        if not sel:
-            continue
-        t = bm.tally(sel)
-        vis = [r for r in sel if r.kind != "none" and r.visible]
-        ratio = [r.withheld_ratio for r in vis]
-        out.append([arm, t["visible_singles"],
-                    f"{t['right']} ({t['share']:.0%})" if vis else "-",
-                    t["right_named_first"], f"{t['none_clean']} of {t['none_scenarios']}",
-                    f"{np.median(ratio):.2f} ({max(ratio):.2f})" if vis else "-",
-                    f"{min(r.visibility for r in vis):.1f} to {max(r.visibility for r in vis):.0f}"
-                    if vis else "-",
-                    f"{min(r.seconds for r in sel):.1f} to {max(r.seconds for r in sel):.1f}"])
-    return out
+    keys = [*arms, "all"] if len(arms) > 1 else arms
+    return [_arm_row(key, sel) for key in keys
+            if (sel := [r for r in rows if key in ("all", r.arm)])]
+
+
+def _span(values: list[float], fmt: str) -> str:
+    return f"{min(values):{fmt}} to {max(values):{fmt}}" if values else "-"
+
+
+def _arm_row(key: str, sel: list[bm.Row]) -> list[object]:
+    t = bm.tally(sel)
+    vis = [r for r in sel if r.kind != "none" and r.visible]
+    ratio = [r.withheld_ratio for r in vis]
+    lo_vis = f"{min(r.visibility for r in vis):.1f}" if vis else ""
+    return [key, t["visible_singles"], f"{t['right']} ({t['share']:.0%})" if vis else "-",
+            t["right_named_first"], f"{t['none_clean']} of {t['none_scenarios']}",
+            f"{np.median(ratio):.2f} ({max(ratio):.2f})" if vis else "-",
+            f"{lo_vis} to {max(r.visibility for r in vis):.0f}" if vis else "-",
+            _span([r.seconds for r in sel], ".1f")]
 
 
 def _per_effect(rows: list[bm.Row]) -> list[list[object]]:
