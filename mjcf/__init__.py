@@ -13,7 +13,7 @@ from mjcf.gravity import gravity_torques
 from mjcf.importer import from_mjcf, load_mujoco_model, manipulator_from_mujoco
 from mjcf.inertia import INERTIA_MODELS, BodyInertia, puma560_inertias, rod_inertias
 from mjcf.own_dynamics import ArmDynamics, arm_dynamics
-from mjcf.shipped import load_shipped
+from mjcf.shipped import load_shipped, load_shipped_spec
 from mjcf.writer import mjcf_xml, save_mjcf
 from zrp.packages import DISTRIBUTION
 
@@ -39,6 +39,7 @@ __all__ = [
     "inverse_dynamics_torques",
     "load_mujoco_model",
     "load_shipped",
+    "load_shipped_spec",
     "manipulator_from_mujoco",
     "metres_per_unit",
     "mjcf_xml",

@@ -25,7 +25,8 @@ import mujoco
 from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
 
-__all__ = ["MESH_SUFFIXES", "load_shipped", "resolve_mesh", "shipped_urdf_xml"]
+__all__ = ["MESH_SUFFIXES", "load_shipped", "load_shipped_spec", "resolve_mesh",
+           "shipped_urdf_xml"]
 
 #: Mesh file types MuJoCo reads; others (Collada .dae, ...) are dropped from a URDF.
 MESH_SUFFIXES = (".stl", ".obj", ".msh")
@@ -85,13 +86,7 @@ def shipped_urdf_xml(path: str | os.PathLike[str]) -> tuple[str, list[str]]:
     return ET.tostring(root, encoding="unicode"), dropped
 
 
-def load_shipped(path: str | os.PathLike[str]) -> mujoco.MjModel:
-    """Compile an arm's shipped ``.urdf`` or MJCF ``.xml`` into MuJoCo (module docstring).
-
-    Raises:
-        MJCFImportError: no such file, not URDF/MJCF, or MuJoCo refuses it (its message
-            kept, e.g. an inertia that violates the triangle inequality).
-    """
+def _shipped_file(path: str | os.PathLike[str]) -> Path:
     if not isinstance(path, (str, os.PathLike)):
         raise InputError(f"path: expected a .urdf or MJCF .xml file name, got "
                          f"{type(path).__name__}")
@@ -99,6 +94,17 @@ def load_shipped(path: str | os.PathLike[str]) -> mujoco.MjModel:
     if not p.is_file():
         raise MJCFImportError(f"source: no such file {str(p)!r} (expected a .urdf or an MJCF "
                               ".xml)")
+    return p
+
+
+def load_shipped(path: str | os.PathLike[str]) -> mujoco.MjModel:
+    """Compile an arm's shipped ``.urdf`` or MJCF ``.xml`` into MuJoCo (module docstring).
+
+    Raises:
+        MJCFImportError: no such file, not URDF/MJCF, or MuJoCo refuses it (its message
+            kept, e.g. an inertia that violates the triangle inequality).
+    """
+    p = _shipped_file(path)
     try:
         if p.suffix.lower() == ".urdf":
             text, _ = shipped_urdf_xml(p)
@@ -107,3 +113,24 @@ def load_shipped(path: str | os.PathLike[str]) -> mujoco.MjModel:
     except ValueError as exc:
         raise MJCFImportError(f"source {str(p)!r}: MuJoCo could not compile it: {exc}"
                               ) from exc
+
+
+def load_shipped_spec(path: str | os.PathLike[str]) -> mujoco.MjSpec:
+    """The editable :class:`mujoco.MjSpec` of an arm's shipped ``.urdf`` or MJCF ``.xml``,
+    read as :func:`load_shipped` reads it (``spec.compile()`` gives the same model), for a
+    caller that edits the model and writes it out: an MJCF's ``meshdir`` is made absolute
+    (a URDF's meshes already are), so the written copy loads from any folder.
+
+    Raises:
+        MJCFImportError: as :func:`load_shipped` (MuJoCo's parse errors here; its compile
+            errors come from ``spec.compile()``).
+    """
+    p = _shipped_file(path)
+    try:
+        if p.suffix.lower() == ".urdf":
+            return mujoco.MjSpec.from_string(shipped_urdf_xml(p)[0])
+        spec = mujoco.MjSpec.from_file(str(p))
+    except ValueError as exc:
+        raise MJCFImportError(f"source {str(p)!r}: MuJoCo could not read it: {exc}") from exc
+    spec.meshdir = str((p.parent / (spec.meshdir or "")).resolve())
+    return spec

@@ -16,6 +16,11 @@ applies it to joint values):
   ``[rad]`` column read with ``--deg`` is an error (the two disagree);
 * a value that cannot be an angle in its unit is a named :class:`~zrp.errors.UnitError`
   (:func:`joint_values_to_rad` states exactly what can and cannot be told).
+
+**Time-series quantities** (the joint torque log, :mod:`zrp.gap.dynamics.data`): a column
+holds one kind of :data:`QUANTITY_UNITS` (time, position, velocity, effort, current, mass),
+declared the same way (``tau3[mNm]``, or with a space, ``tau3 [mNm]``); :func:`si_factor`
+gives the factor of its unit to the SI unit of its kind (:data:`SI_UNITS`).
 """
 
 from __future__ import annotations
@@ -32,8 +37,10 @@ __all__ = [
     "ANGLE_UNITS",
     "G_STANDARD",
     "LENGTH_UNITS",
+    "QUANTITY_UNITS",
     "RADIAN_LOOK_MIN",
     "RADIAN_LOOK_ROWS",
+    "SI_UNITS",
     "TRACKER_NOISE_MM",
     "angle_bounds",
     "canonical_angle_unit",
@@ -42,6 +49,7 @@ __all__ = [
     "joint_values_to_rad",
     "length_scale",
     "metres_per_unit",
+    "si_factor",
     "split_unit",
     "units_per_mm",
 ]
@@ -137,6 +145,41 @@ def split_unit(column: str, field: str = "column") -> tuple[str, str | None]:
         raise UnitError(f"{field}: {column!r} is not NAME or NAME[UNIT] (e.g. q1[deg], "
                         "x[mm])")
     return m.group(1), m.group(2)
+
+
+#: Per kind of time-series quantity, unit name (lower case) -> factor to SI (value * factor).
+#: Joint values are rad (hinges) or m (slides); efforts N m (hinges) or N (slides).
+QUANTITY_UNITS: dict[str, dict[str, float]] = {
+    "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6},
+    "position": {**ANGLE_UNITS, **LENGTH_UNITS},
+    "velocity": {"rad/s": 1.0, "deg/s": math.pi / 180.0, "m/s": 1.0, "mm/s": 1e-3},
+    "effort": {"nm": 1.0, "n m": 1.0, "n.m": 1.0, "mnm": 1e-3, "n": 1.0},
+    "current": {"a": 1.0, "ma": 1e-3},
+    "mass": {"kg": 1.0, "g": 1e-3},
+}
+
+#: The unit of each kind a column without a declared unit is in (hinge joints; slides: m,
+#: m/s, N).
+SI_UNITS = {"time": "s", "position": "rad", "velocity": "rad/s", "effort": "Nm",
+            "current": "A", "mass": "kg"}
+
+
+def si_factor(kind: str, unit: str | None, field: str = "column") -> float:
+    """The factor to SI (:data:`SI_UNITS`) of ``unit``, a unit of ``kind`` (a key of
+    :data:`QUANTITY_UNITS`); None (no unit declared): 1.
+
+    Raises:
+        UnitError: an unknown unit, naming ``field`` and listing the units of ``kind``.
+    """
+    if unit is None:
+        return 1.0
+    table = QUANTITY_UNITS[kind]
+    key = unit.strip().lower()
+    if key not in table:
+        si = SI_UNITS[kind]
+        shown = ", ".join([si, *sorted(k for k in table if k != si.lower())])
+        raise UnitError(f"{field} has unit [{unit}]; a {kind} column takes one of {shown}")
+    return table[key]
 
 
 def length_scale(unit: str | None, model_unit: str, field: str = "column") -> float:

@@ -1,23 +1,23 @@
 """The arm whose dynamics are diagnosed: a MuJoCo model with one hinge/slide joint per logged
 joint, its editable spec (for the corrected model) and the tool body (where a payload sits).
 
-Sources: an MJCF file, a URDF file with inertials (MuJoCo reads URDF directly; its meshes are
-stripped here, as the dynamics need only the inertials, and joints off the chain to
-``end_link`` are made fixed, e.g. a gripper's fingers), a :class:`mujoco.MjSpec`, or a ZRP
-manipulator built with PUMA 560 inertias (:func:`arm_from_manipulator`).
+Sources: an MJCF file, a URDF file with inertials (both read by
+:func:`mjcf.load_shipped_spec`: inertials, limits, damping and friction kept, ``package://``
+meshes resolved or dropped; joints off the chain to ``end_link`` are made fixed, e.g. a
+gripper's fingers), a :class:`mujoco.MjSpec`, or a ZRP manipulator built with PUMA 560
+inertias (:func:`arm_from_manipulator`).
 """
 
 from __future__ import annotations
 
 import os
-import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from mjcf import MJCFOptions, build
+from mjcf import MJCFImportError, MJCFOptions, build, load_shipped_spec
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.files import load_model
@@ -89,33 +89,24 @@ def _from_spec(spec: mujoco.MjSpec, name: str, tool_site: str | None, field: str
     return Arm(name, spec, m, body, point)
 
 
-def _chain_links(root: ET.Element, end_link: str) -> set[str]:
-    """Links from the URDF root to ``end_link``."""
-    parent = {j.find("child").get("link"): j.find("parent").get("link")
-              for j in root.iter("joint") if j.find("child") is not None}
-    if end_link not in parent and end_link not in {lk.get("name") for lk in root.iter("link")}:
-        raise InputError(f"end_link: no link {end_link!r} in the URDF")
-    chain = {end_link}
-    while end_link in parent:
-        end_link = parent[end_link]
-        chain.add(end_link)
-    return chain
-
-
-def strip_urdf(text: str, end_link: str | None = None) -> str:
-    """The URDF without visual/collision elements (no meshes to resolve) and, with
-    ``end_link``, with every joint off the chain to it made fixed."""
-    root = ET.fromstring(text)
-    for link in root.iter("link"):
-        for tag in ("visual", "collision"):
-            for el in link.findall(tag):
-                link.remove(el)
-    if end_link is not None:
-        chain = _chain_links(root, end_link)
-        for j in root.iter("joint"):
-            if j.find("child").get("link") not in chain:
-                j.set("type", "fixed")
-    return ET.tostring(root, encoding="unicode")
+def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> None:
+    """Make every joint off the chain from the root to body ``end_link`` fixed (delete it:
+    its body is then welded to its parent), with the equality constraints on it (a URDF
+    ``<mimic>``, e.g. a gripper's second finger)."""
+    end = spec.body(end_link)
+    if end is None:
+        raise InputError(f"end_link: no link (body) {end_link!r} in the model")
+    chain = {end.name}
+    while end.parent is not None and end.parent.name != end.name:
+        end = end.parent
+        chain.add(end.name)
+    off = {j.name for j in spec.joints if j.parent.name not in chain}
+    for eq in list(spec.equalities):
+        if eq.name1 in off or eq.name2 in off:
+            spec.delete(eq)
+    for j in list(spec.joints):
+        if j.name in off:
+            spec.delete(j)
 
 
 def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | None = None,
@@ -124,7 +115,7 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
 
     Args:
         source: MJCF (.xml) or URDF (.urdf) path, or a :class:`mujoco.MjSpec`.
-        end_link: URDF only: the last link of the arm (joints off its chain are fixed).
+        end_link: the last link (body) of the arm: joints off its chain are fixed.
         tool_site: the site where a payload sits; None: the last joint's body origin.
         name: for reports (default: the file's stem).
     """
@@ -135,15 +126,16 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
         raise InputError(f"model: no such file {str(path)!r} (an MJCF .xml or a URDF)")
     field = f"model {path.name}"
     try:
-        if path.suffix.lower() == ".urdf":
-            spec = mujoco.MjSpec.from_string(strip_urdf(path.read_text(encoding="utf-8"),
-                                                        end_link))
-        else:
-            spec = mujoco.MjSpec.from_file(str(path))
-    except (ValueError, ET.ParseError, OSError) as exc:
+        spec = load_shipped_spec(path)
+    except MJCFImportError as exc:
         raise InputError(f"{field}: cannot load: {exc}") from exc
-    if path.suffix.lower() != ".urdf":
-        spec.meshdir = str((path.parent / (spec.meshdir or "")).resolve())
+    if end_link is not None:
+        _fix_off_chain(spec, end_link)
+    if path.suffix.lower() == ".urdf":
+        # one body per moving link (MuJoCo's URDF default): links on fixed joints (a flange,
+        # a hand, fingers made fixed) fuse into their parent, as the inertial regressor has
+        # one set of 10 parameters per body
+        spec.compiler.fusestatic = True
     return _from_spec(spec, name or path.stem, tool_site, field)
 
 

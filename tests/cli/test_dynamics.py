@@ -68,7 +68,7 @@ def test_excite_writes_a_command(tmp_path, capsys):
     assert code == 0
     payload = json.loads(capsys.readouterr().out)
     assert np.isfinite(payload["condition_number"])
-    from zrp.gap.dynamics.units import split_unit
+    from zrp.units import split_unit
 
     header = out.read_text().splitlines()[0].split(",")
     assert [split_unit(h, "x") for h in header][:2] == [("t", "s"), ("qc1", "rad")]

@@ -17,7 +17,13 @@ from zrp.errors import UnitError
 from zrp.gap import load_measurements
 from zrp.gap.motion import load_trajectory
 from zrp.manufacturing.study import load_joint_csv
-from zrp.units import RADIAN_LOOK_MIN, RADIAN_LOOK_ROWS, joint_values_to_rad, split_unit
+from zrp.units import (
+    RADIAN_LOOK_MIN,
+    RADIAN_LOOK_ROWS,
+    joint_values_to_rad,
+    si_factor,
+    split_unit,
+)
 
 PUMA = zrp.load_model("puma")
 Q_RAD = np.array([[0.1, -0.4, 0.6, 1.2, -0.9, 2.0], [0.5, 0.2, -1.1, 0.3, 0.8, -2.5],
@@ -41,6 +47,18 @@ def test_split_unit():
     for bad in ("q1[deg", "q1]", "q1[]", "[deg]"):
         with pytest.raises(UnitError, match="NAME"):
             split_unit(bad)
+
+
+def test_si_factor_against_scipy_constants():
+    assert si_factor("velocity", "deg/s") == pytest.approx(constants.degree)
+    assert si_factor("position", "in") == pytest.approx(constants.inch)
+    assert si_factor("time", "us") == pytest.approx(constants.micro)
+    assert si_factor("effort", "mNm") == pytest.approx(constants.milli)
+    assert si_factor("mass", "g") == pytest.approx(constants.gram)
+    assert si_factor("current", None) == 1.0
+    with pytest.raises(UnitError, match=r"column i1 has unit \[kA\]; a current column takes "
+                                        r"one of A, ma$"):
+        si_factor("current", "kA", "column i1")
 
 
 def test_measurements_degrees_in_a_radian_column(tmp_path):

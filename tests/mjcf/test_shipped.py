@@ -139,3 +139,20 @@ def test_menagerie_ur5e_mjcf_loads_with_its_inertias():
     for name, mass in written.items():
         assert m.body_mass[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, name)] == mass
     assert mjcf.load_shipped is load_shipped
+
+
+def test_load_shipped_spec_compiles_to_load_shipped_and_writes_out(tmp_path):
+    from mjcf.shipped import load_shipped_spec
+
+    path = _toy(tmp_path)
+    spec = load_shipped_spec(path)
+    a, b = spec.compile(), load_shipped(path)
+    assert (a.nbody, a.ngeom, a.nmesh) == (b.nbody, b.ngeom, b.nmesh)
+    np.testing.assert_array_equal(a.body_mass, b.body_mass)
+    # written elsewhere, the copy still finds its mesh
+    out = tmp_path / "elsewhere" / "copy.xml"
+    out.parent.mkdir()
+    out.write_text(spec.to_xml())
+    assert mujoco.MjModel.from_xml_path(str(out)).nmesh == 1
+    with pytest.raises(MJCFImportError, match="no such file"):
+        load_shipped_spec(tmp_path / "none.urdf")

@@ -48,6 +48,18 @@ def test_declared_units_convert(tmp_path):
     assert log.payload[0] == pytest.approx(0.5)
 
 
+def test_header_units_are_zrp_units(tmp_path):
+    """One header syntax with every CSV of ZRP (zrp.units.split_unit): ``q1[deg]`` as
+    ``q1 [deg]``; a slide's position in any length unit of zrp.units."""
+    p = _write(tmp_path / "v.csv", "t[ms],q1[deg],q2[cm],tau1[Nm],tau2[N]",
+               [[0, 90, 5, 1, 1], [10, 45, 2, 1, 1], [20, 0, 0, 1, 1]])
+    log = load_torque_log(p)
+    assert log.t[1] == pytest.approx(0.01)
+    np.testing.assert_allclose(log.q[0], [math.pi / 2, 0.05])
+    with pytest.raises(InputError, match=r"line 1: 'q1\[deg' is not NAME or NAME\[UNIT\]"):
+        load_torque_log(_write(tmp_path / "w.csv", "t,q1[deg,tau1", [[0, 0, 0]]))
+
+
 def test_missing_units_warn(tmp_path):
     p = _write(tmp_path / "s.csv", "t,q1,tau1", [[0, 0, 0], [1, 0, 0], [2, 0, 0]])
     with pytest.warns(Warning, match="no unit declared for t, q1, tau1"):

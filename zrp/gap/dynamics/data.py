@@ -1,7 +1,9 @@
 """The joint torque log: a strict reader (:func:`load_torque_log`) and the writer.
 
 One row per sample, rows in time order, constant rate (any rate). Columns (header names, any
-order; a unit may be declared in brackets, ``q1 [deg]``; without one a column is SI):
+order; a unit may be declared in brackets, ``q1 [deg]`` or ``q1[deg]``, read by
+:func:`zrp.units.split_unit` with the units of :data:`zrp.units.QUANTITY_UNITS`; without one a
+column is SI):
 
 * ``t`` (required): time stamp; s (``ms``, ``us``).
 * ``q1`` .. ``qn`` (required): joint positions; rad (``deg``) for hinges, m (``mm``) for slides.
@@ -38,8 +40,8 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import DataWarning
-from zrp.gap.dynamics.units import SI, split_unit, unit_factor
 from zrp.output import atomic_path
+from zrp.units import SI_UNITS, si_factor, split_unit
 
 __all__ = ["GROUPS", "MAX_ROWS", "TorqueLog", "load_torque_log", "write_torque_log"]
 
@@ -155,14 +157,15 @@ def _groups(names: list[str], src: str) -> tuple[int, tuple[str, ...]]:
 
 
 def _layout(header: list[str], src: str) -> _Layout:
-    parsed = [split_unit(h, src) for h in header]
+    parsed = [split_unit(h, f"{src} line 1") for h in header]
     names = [p[0] for p in parsed]
     dup = sorted({c for c in names if names.count(c) > 1})
     if dup:
         raise InputError(f"{src} line 1: column(s) {', '.join(dup)} appear more than once")
     kinds = [_kind(c, src) for c in names]
     n, groups = _groups(names, src)
-    factor = {c: unit_factor(k, u, c, src) for (c, u), k in zip(parsed, kinds, strict=True)}
+    factor = {c: si_factor(k, u, f"{src} line 1: column {c}")
+              for (c, u), k in zip(parsed, kinds, strict=True)}
     defaulted = tuple(c for (c, u) in parsed if u is None)
     return _Layout(n, {c: i for i, c in enumerate(names)}, factor, groups, defaulted)
 
@@ -312,7 +315,7 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
                              "expected a mass >= 0 kg")
     if lay.defaulted:
         warnings.warn(f"{src}: no unit declared for {', '.join(lay.defaulted)}; taken as SI "
-                      f"({', '.join(f'{k} {u}' for k, u in SI.items())}; m, m/s, N for "
+                      f"({', '.join(f'{k} {u}' for k, u in SI_UNITS.items())}; m, m/s, N for "
                       "slides)", DataWarning, stacklevel=2)
     return TorqueLog(t, _block(a, lay, "q"), _block(a, lay, "qd") if "qd" in lay.groups
                      else None, tau, _block(a, lay, "qc") if "qc" in lay.groups else None,
