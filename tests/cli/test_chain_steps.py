@@ -87,7 +87,7 @@ def test_measure_reads_a_plan_and_refuses_a_broken_one(tmp_path, capsys):
     err = _json(capsys, ["measure", "--model", path, "--poses", str(rad_as_deg), "--out",
                          str(tmp_path / "m3.csv")], code=2)
     assert "look like radians in a degree column" in err
-    with pytest.raises(InputError, match="none.csv: no such file"):
+    with pytest.raises(InputError, match=r"none\.csv: no such file"):
         read_plan(tmp_path / "none.csv", m)
 
 
