@@ -14,9 +14,11 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import (
     special,  # chdtrc/fdtrc: the chi2/F survival functions without scipy.stats (1 s import)
 )
+from scipy.spatial.transform import Rotation
 
 from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
+from zrp.gap.fit.orientation import pose_rotations, stacked
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.problem import Evaluation, Problem
@@ -71,6 +73,9 @@ class FitResult:
             (:mod:`zrp.gap.fit.wellposed`).
         stop_reason: why the solver stopped, in words.
         iterations: its Gauss-Newton iterations.
+        probe_rotation: R_t identified with the orientations (3, 3), or None when the fit
+            used positions only. ``residual``, ``jac`` and the statistics built on them are
+            the positions' in both cases; ``cov`` is the fit's (with orientations: of both).
     """
 
     specs: tuple[ParamSpec, ...]
@@ -84,6 +89,7 @@ class FitResult:
     held: tuple[HeldDirection, ...] = ()
     stop_reason: str = ""
     iterations: int = 0
+    probe_rotation: F64 | None = None
 
     def __post_init__(self) -> None:
         p = len(self.specs)
@@ -194,7 +200,8 @@ def orthonormal_basis(a: F64, rtol: float = 1e-10) -> F64:
 
 
 def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: ArrayLike,
-        base_rotation: ArrayLike, *, start: Evaluation | None = None) -> FitResult:
+        base_rotation: ArrayLike, *, start: Evaluation | None = None,
+        orientation: bool = True) -> FitResult:
     """Least squares with the analytic Jacobian of :class:`~zrp.gap.model.problem.Problem`:
     the scaled truncated-SVD Gauss-Newton solver of :mod:`zrp.gap.fit.wellposed` (eqs. W1-W3),
     which keeps the combinations the data cannot pin at their nominal values (the effect
@@ -207,6 +214,8 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
         base_rotation: R_b0, shape (3, 3).
         start: the evaluation at theta0 when already known (used only when its poses and
             theta equal ``poses`` and ``theta0``).
+        orientation: use the measured orientations when ``ctx.orientation`` says how they
+            weigh (False: positions only, whatever the context).
     """
     prob = Problem(ctx, specs, poses, base_rotation)
     theta0 = np.asarray(theta0, dtype=float)
@@ -221,6 +230,8 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
     else:
         at0 = prob.residual_and_jacobian(theta0)
     scales = parameter_scales(ctx, specs, at0[1])
+    if orientation and ctx.orientation is not None:
+        return _fit_with_orientation(ctx, prob, theta0, scales)
     sol = solve(prob.residual_and_jacobian, prob.residual, theta0, prior_values(specs, theta0),
                 scales, [s.name for s in specs], start=at0)
     if not sol.converged:
@@ -229,6 +240,33 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
     return FitResult(tuple(specs), sol.theta, sol.cov, sol.residual, sol.jac,
                      np.asarray(base_rotation), np.asarray(poses, dtype=np.int64),
                      sol.converged, sol.held, sol.reason, sol.iterations)
+
+
+def _fit_with_orientation(ctx: Context, prob: Problem, theta0: F64, scales: F64) -> FitResult:
+    """The fit of :func:`fit` from positions and orientations, each block weighted by its
+    noise (``ctx.orientation``; the objective of :mod:`zrp.gap.fit.fullpose`, eqs. O1-O2),
+    the probe rotation refined from ``ctx.orientation.probe_rotation`` with the parameters."""
+    w = ctx.orientation
+    assert w is not None
+    specs, p = prob.specs, prob.size
+    measured = pose_rotations(ctx)[prob.poses]
+    rt0 = np.asarray(w.probe_rotation, dtype=float)
+
+    def both(v: F64) -> tuple[F64, F64]:
+        return stacked(prob, measured, rt0, w.sigma_position, w.sigma_orientation, v)
+
+    names = [s.name for s in specs] + ["probe.rx", "probe.ry", "probe.rz"]
+    sol = solve(both, lambda v: both(v)[0], np.concatenate([theta0, np.zeros(3)]),
+                np.concatenate([prior_values(specs, theta0), np.zeros(3)]),
+                np.concatenate([scales, np.ones(3)]), names)
+    if not sol.converged:
+        warnings.warn(f"least squares with {len(names)} parameters (positions and "
+                      f"orientations): {sol.reason}", FitWarning, stacklevel=3)
+    theta = sol.theta[:p]
+    r, J = prob.residual_and_jacobian(theta)
+    rt = Rotation.from_rotvec(sol.theta[p:]).as_matrix() @ rt0
+    return FitResult(tuple(specs), theta, sol.cov[:p, :p], r, J, prob.base_rotation,
+                     prob.poses, sol.converged, sol.held, sol.reason, sol.iterations, rt)
 
 
 @dataclass(frozen=True)
