@@ -14,11 +14,10 @@ from numpy.typing import ArrayLike, NDArray
 from scipy import (
     special,  # chdtrc/fdtrc: the chi2/F survival functions without scipy.stats (1 s import)
 )
-from scipy.spatial.transform import Rotation
 
 from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
-from zrp.gap.fit.orientation import pose_rotations, stacked
+from zrp.gap.fit.orientation import alias_jacobian, solve_with_orientation
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.problem import Evaluation, Problem
@@ -243,29 +242,15 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
 
 
 def _fit_with_orientation(ctx: Context, prob: Problem, theta0: F64, scales: F64) -> FitResult:
-    """The fit of :func:`fit` from positions and orientations, each block weighted by its
-    noise (``ctx.orientation``; the objective of :mod:`zrp.gap.fit.fullpose`, eqs. O1-O2),
-    the probe rotation refined from ``ctx.orientation.probe_rotation`` with the parameters."""
-    w = ctx.orientation
-    assert w is not None
-    specs, p = prob.specs, prob.size
-    measured = pose_rotations(ctx)[prob.poses]
-    rt0 = np.asarray(w.probe_rotation, dtype=float)
-
-    def both(v: F64) -> tuple[F64, F64]:
-        return stacked(prob, measured, rt0, w.sigma_position, w.sigma_orientation, v)
-
-    names = [s.name for s in specs] + ["probe.rx", "probe.ry", "probe.rz"]
-    sol = solve(both, lambda v: both(v)[0], np.concatenate([theta0, np.zeros(3)]),
-                np.concatenate([prior_values(specs, theta0), np.zeros(3)]),
-                np.concatenate([scales, np.ones(3)]), names)
+    """:func:`fit` from positions and orientations (:func:`~zrp.gap.fit.orientation.
+    solve_with_orientation`); residual, jac: the positions' at the solution."""
+    sol, rt = solve_with_orientation(ctx, prob, theta0, scales)
     if not sol.converged:
-        warnings.warn(f"least squares with {len(names)} parameters (positions and "
+        warnings.warn(f"least squares with {sol.theta.size} parameters (positions and "
                       f"orientations): {sol.reason}", FitWarning, stacklevel=3)
-    theta = sol.theta[:p]
-    r, J = prob.residual_and_jacobian(theta)
-    rt = Rotation.from_rotvec(sol.theta[p:]).as_matrix() @ rt0
-    return FitResult(tuple(specs), theta, sol.cov[:p, :p], r, J, prob.base_rotation,
+    p = prob.size
+    r, J = prob.residual_and_jacobian(sol.theta[:p])
+    return FitResult(prob.specs, sol.theta[:p], sol.cov[:p, :p], r, J, prob.base_rotation,
                      prob.poses, sol.converged, sol.held, sol.reason, sol.iterations, rt)
 
 
@@ -318,10 +303,12 @@ def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[Param
     prob = Problem(ctx, specs, poses, base.base_rotation)
     theta = np.concatenate([base.theta, np.zeros(len(candidates))])
     r, J = prob.residual_and_jacobian(theta)
-    norms = np.linalg.norm(J, axis=0)
+    Jt, probe = alias_jacobian(ctx, prob, theta, J)  # with orientations: their rows too
+    norms = np.linalg.norm(Jt, axis=0)
     nb = len(base.specs)
-    A = J[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
-    Q = orthonormal_basis(A)
+    A = Jt[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
+    Q = orthonormal_basis(np.hstack([A, probe / np.linalg.norm(probe, axis=0)])
+                          if probe.shape[1] else A)
     names = [s.name for s in specs]
     accepted_cols = list(range(nb))
     keep: list[ParamSpec] = []
@@ -329,10 +316,10 @@ def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[Param
     # every candidate projected off the base span at once (two passes, one matrix product each
     # instead of one matrix-vector product per candidate), then, in order, off the candidates
     # accepted before it: the same projection onto span(base, accepted)
-    C = J[:, nb:] / np.where(norms[nb:] > 0, norms[nb:], 1.0)
+    C = Jt[:, nb:] / np.where(norms[nb:] > 0, norms[nb:], 1.0)
     P = C - Q @ (Q.T @ C)
     P = P - Q @ (Q.T @ P)
-    Qa = np.empty((J.shape[0], len(candidates)))  # the accepted candidates' directions
+    Qa = np.empty((Jt.shape[0], len(candidates)))  # the accepted candidates' directions
     na = 0
     for i, spec in enumerate(candidates):
         nrm = norms[nb + i]
@@ -347,7 +334,7 @@ def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[Param
             rr = rr - qa @ (qa.T @ rr)
         frac = float(np.linalg.norm(rr))
         if frac < WEAK_TOL:
-            acc = J[:, accepted_cols] / np.where(norms[accepted_cols] > 0,
+            acc = Jt[:, accepted_cols] / np.where(norms[accepted_cols] > 0,
                                                  norms[accepted_cols], 1.0)
             corr = np.abs(acc.T @ c)  # cosines between normalised columns
             order = np.argsort(-corr)

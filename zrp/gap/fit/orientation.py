@@ -12,12 +12,14 @@ from scipy.spatial.transform import Rotation
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.fit.wellposed import Solution, prior_values, solve
 from zrp.gap.model.context import Context, OrientationWeights
 from zrp.gap.model.problem import Problem
 from zrp.rotations import left_jacobian
 
-__all__ = ["OrientationWeights", "orientation_residual", "pose_rotations", "probe_start",
-           "stacked"]
+__all__ = ["OrientationWeights", "alias_jacobian", "orientation_residual", "pose_rotations",
+           "probe_start",
+           "solve_with_orientation", "stacked"]
 
 
 def pose_rotations(ctx: Context) -> F64:
@@ -105,3 +107,49 @@ def stacked(prob: Problem, measured: F64, rt0: F64, sigma_position: float,
     jp = np.hstack([jp, np.zeros((jp.shape[0], 3))])
     return (np.concatenate([rp / sigma_position, eo.ravel() / sigma_orientation]),
             np.vstack([jp / sigma_position, jo.reshape(-1, p + 3) / sigma_orientation]))
+
+
+def solve_with_orientation(ctx: Context, prob: Problem, theta0: F64, scales: F64
+                           ) -> tuple[Solution, F64]:
+    """Identify the parameters of ``prob`` from positions and orientations, each block
+    weighted by its noise (``ctx.orientation``; the objective of :mod:`zrp.gap.fit.fullpose`),
+    by the well-posed solver (:func:`zrp.gap.fit.wellposed.solve`), the probe rotation refined
+    by psi from ``ctx.orientation.probe_rotation`` with them.
+
+    Args:
+        ctx: the context (its ``orientation`` set); prob: the position problem.
+        theta0: start and prior of the registration (p,); scales: the parameters' d_j (p,).
+
+    Returns:
+        the solution in (theta, psi), shape (p + 3,), and R_t = exp([psi]) R_t0.
+    """
+    w = ctx.orientation
+    if w is None:
+        raise InputError("solve_with_orientation: the context carries no orientation weights")
+    measured = pose_rotations(ctx)[prob.poses]
+    rt0 = np.asarray(w.probe_rotation, dtype=float)
+
+    def both(v: F64) -> tuple[F64, F64]:
+        return stacked(prob, measured, rt0, w.sigma_position, w.sigma_orientation, v)
+
+    names = [s.name for s in prob.specs] + ["probe.rx", "probe.ry", "probe.rz"]
+    sol = solve(both, lambda v: both(v)[0], np.concatenate([theta0, np.zeros(3)]),
+                np.concatenate([prior_values(prob.specs, theta0), np.zeros(3)]),
+                np.concatenate([scales, np.ones(3)]), names)
+    return sol, Rotation.from_rotvec(sol.theta[prob.size:]).as_matrix() @ rt0
+
+
+def alias_jacobian(ctx: Context, prob: Problem, theta: F64, jac: F64) -> tuple[F64, F64]:
+    """The Jacobian that decides which parameters the data can identify: the positions' ``jac``
+    (3R, p) alone, or, with ``ctx.orientation``, stacked over the orientation rows, each block
+    divided by its noise (3R + 3S, p); and the probe rotation's columns (the same rows; none
+    without orientations), which every full-pose fit carries beside the parameters."""
+    w = ctx.orientation
+    if w is None:
+        return jac, np.zeros((jac.shape[0], 0))
+    measured = pose_rotations(ctx)[prob.poses]
+    _, jo = orientation_residual(prob, theta, np.zeros(3), w.probe_rotation, measured)
+    jo = jo.reshape(-1, prob.size + 3) / w.sigma_orientation
+    top = np.zeros((jac.shape[0], 3))
+    return (np.vstack([jac / w.sigma_position, jo[:, :prob.size]]),
+            np.vstack([top, jo[:, prob.size:]]))
