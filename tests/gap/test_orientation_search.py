@@ -125,6 +125,11 @@ def test_withheld_orientation_error_of_the_final_model_is_reported(both):
     noise = np.sqrt(3.0) * SIGMA_O  # RMS angle of the orientation noise
     assert fp.withheld_orientation_final <= 1.3 * noise < fp.withheld_orientation_nominal
     doc = diagnosis_document(six)
+    weights = doc["settings"]["orientation_weights"]
+    assert weights["sigma_orientation_rad"] == pytest.approx(SIGMA_O, rel=0.25)
+    assert weights["sigma_position"] == pytest.approx(0.02, rel=0.25)
+    assert weights["source"] == "estimated" and "orientation_weights" not in diagnosis_document(
+        pos)["settings"]
     assert doc["full_pose"]["withheld_orientation_rms_final_model_rad"] == pytest.approx(
         fp.withheld_orientation_final)
     assert f"{1e3 * fp.withheld_orientation_final:.3g} mrad withheld orientation" in doc[

@@ -188,6 +188,11 @@ def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosi
                                or diag.assessment.baseline.fit is diag.final_fit
                                else diag.assessment.baseline.fit)
     settings = {**diag.settings, "orientation": used, "orientation_sigma_rad": sigma}
+    w = diag.context.orientation
+    if w is not None:  # the weights every fit of the search and the baseline used
+        settings["orientation_weights"] = {"sigma_position": w.sigma_position,
+                                           "sigma_orientation_rad": w.sigma_orientation,
+                                           "source": w.source}
     return dataclasses.replace(diag, full_pose=full, settings=settings)
 
 
