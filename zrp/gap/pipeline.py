@@ -26,7 +26,7 @@ from zrp.arrays import F64
 from zrp.blas import blas_threads
 from zrp.errors import InputError
 from zrp.gap.analysis.assessment import Assessment, compliance_units, remainder_evidence
-from zrp.gap.analysis.baseline import GeometricBaseline, geometric_baseline
+from zrp.gap.analysis.baseline import GeometricBaseline, geometric_baseline, geometric_specs
 from zrp.gap.analysis.checks import (
     GapWarning,
     check_gravity_torque,
@@ -43,6 +43,7 @@ from zrp.gap.data.measurements import Measurements
 from zrp.gap.data.noise import noise_floor
 from zrp.gap.data.split import split_poses
 from zrp.gap.data.subsample import MAX_POINTS, subsample_poses
+from zrp.gap.fit.fullpose import orientation_weights
 from zrp.gap.fit.leastsq import FitResult, fit, initial_registration
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.fit.profiles import with_gravity_side
@@ -100,9 +101,11 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         max_points: most measured points used; beyond it a seeded random subsample of whole
             poses (the rule in :mod:`zrp.gap.data.subsample`, announced in a warning and in the
             diagnosis's ``warnings``); None uses every point.
-        use_orientation: when the measurements carry ``qw..qz``, refit the final model
-            with positions and orientations together (:mod:`zrp.gap.search.posefit`; the result's
-            ``full_pose``); False: positions only.
+        use_orientation: when the measurements carry ``qw..qz``, identify from positions and
+            orientations together: every fit of the search and of the geometric baseline
+            (each block weighted by its noise, :func:`zrp.gap.fit.fullpose.orientation_weights`),
+            then the full-pose refit of the final model (:mod:`zrp.gap.search.posefit`; the
+            result's ``full_pose``); False: positions only.
         orientation_sigma: orientation noise per component (rad) weighting the orientation
             residuals; None: estimated from them. Needs measured orientations.
         max_tilt_rad: the largest axis tilt a fitted model may carry (rad; the domain of
@@ -142,7 +145,9 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         if kept is not None and gravity_torque is not None:
             gravity_torque = _kept_rows(gravity_torque, kept, n_poses)
         with blas_threads(1):  # small dense problems: one BLAS thread is ~3x faster (zrp.blas)
-            result = run_diagnosis(model, measurements, gravity_torque, opts, rng)
+            result = run_diagnosis(model, measurements, gravity_torque, opts, rng,
+                                   use_orientation=bool(use_orientation),
+                                   orientation_sigma=orientation_sigma)
             result = _with_full_pose(result, bool(use_orientation), orientation_sigma)
     # raised again, every one at the caller's line (whatever the stage that found it)
     caller = sys._getframe(1)
@@ -183,6 +188,11 @@ def _with_full_pose(diag: Diagnosis, use: bool, sigma: float | None) -> Diagnosi
                                or diag.assessment.baseline.fit is diag.final_fit
                                else diag.assessment.baseline.fit)
     settings = {**diag.settings, "orientation": used, "orientation_sigma_rad": sigma}
+    w = diag.context.orientation
+    if w is not None:  # the weights every fit of the search and the baseline used
+        settings["orientation_weights"] = {"sigma_position": w.sigma_position,
+                                           "sigma_orientation_rad": w.sigma_orientation,
+                                           "source": w.source}
     return dataclasses.replace(diag, full_pose=full, settings=settings)
 
 
@@ -255,15 +265,19 @@ def _settings(ctx: Context, opts: DiagnosisOptions) -> dict:
 
 
 def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayLike | None,
-                  opts: DiagnosisOptions, rng: np.random.Generator) -> Diagnosis:
+                  opts: DiagnosisOptions, rng: np.random.Generator, *,
+                  use_orientation: bool = False,
+                  orientation_sigma: float | None = None) -> Diagnosis:
     """The stages of :func:`diagnose` (warnings are raised, not collected: ``warnings`` of
-    the result is empty)."""
+    the result is empty). With ``use_orientation`` and measured orientations the search and
+    the geometric baseline fit them too (:func:`_with_orientation`)."""
     prep = _prepare(model, meas, gravity_torque, opts, rng)
     regd = _register(prep)
-    reg = regd.fit
     floor = noise_floor(meas, prep.fitting, opts.noise_sigma)
-    where_nominal = where_analysis(prep.ctx, reg)
-    ctx = prep.ctx
+    where_nominal = where_analysis(prep.ctx, regd.fit)
+    ctx, reg = prep.ctx, regd.fit
+    if use_orientation and meas.quat is not None:
+        ctx, reg = _with_orientation(ctx, reg, prep.fitting, regd.rb0, orientation_sigma)
     if "backlash" in opts.effects and ctx.gravity_torque is None:
         ctx = with_gravity_side(ctx, reg, prep.fitting, regd.rb0, opts.alpha)
     specs_of = {e: effect_parameters(ctx, e) for e in opts.effects}
@@ -287,10 +301,21 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
     assessment = _assess(ctx, baseline, choice, final_fit, len(reg.specs),
                          where.after_final_model or where_nominal, resolution)
     return Diagnosis(model.name, model.length_unit, Metrics.of(regd.withheld_residual),
-                     regd.fitting, parameter_estimates(reg, 0), found.steps, final, floor,
-                     unexplained, _split_ids(meas, prep, opts), where, found.aliased, (), reg,
+                     regd.fitting, parameter_estimates(regd.fit, 0), found.steps, final, floor,
+                     unexplained, _split_ids(meas, prep, opts), where, found.aliased, (),
+                     regd.fit,
                      final_fit, regd.withheld_residual, after, ctx, prep.fitting,
                      prep.withheld, _settings(ctx, opts), assessment)
+
+
+def _with_orientation(ctx: Context, reg: FitResult, fitting: NDArray[np.int64], rb0: F64,
+                      sigma: float | None) -> tuple[Context, FitResult]:
+    """The context whose fits use the measured orientations (weights from the full-pose fit
+    of the complete geometric calibration, :func:`~zrp.gap.fit.fullpose.orientation_weights`)
+    and the registration refitted in it (the search's start)."""
+    specs = list(reg.specs) + geometric_specs(ctx, reg)
+    ctx = dataclasses.replace(ctx, orientation=orientation_weights(ctx, specs, fitting, sigma))
+    return ctx, fit(ctx, reg.specs, fitting, reg.theta, rb0)
 
 
 def _assess(ctx: Context, baseline: GeometricBaseline, choice: FinalChoice, final: FitResult,

@@ -6,7 +6,10 @@ poses identify (column-pivoted Gram-Schmidt on the normalised Jacobian, :func:`~
 check_identifiable`: a QR reduction), fitted on the fitting poses and judged on the withheld
 ones. Then the non-geometric effects of the final model are added on top of it, which answers
 the question "what do the non-geometric effects add beyond a full geometric calibration, on
-withheld poses?".
+withheld poses?". When the measurements carry orientations (and they are used), every fit here
+identifies the parameters from positions and orientations together, each weighted by its noise
+(``Context.orientation``, :func:`zrp.gap.fit.leastsq.fit`): a direction that positions alone
+cannot pin (a common tilt of parallel axes) is then estimated, not held at its nominal.
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.model.problem import Problem
 
-__all__ = ["KINEMATIC", "GeometricBaseline", "geometric_baseline"]
+__all__ = ["KINEMATIC", "GeometricBaseline", "geometric_baseline", "geometric_specs"]
 
 #: The effects of a standard complete kinematic calibration (an encoder scale is a drive
 #: property and counts as non-geometric here).
@@ -89,12 +92,23 @@ def _on_top(ctx: Context, base: FitResult, extra: list[ParamSpec], fitting: NDAr
     return f, len(keep), len(extra) - len(keep)
 
 
+def geometric_specs(ctx: Context, reg: FitResult) -> list[ParamSpec]:
+    """The geometric parameters (:data:`KINEMATIC`) identifiable on top of ``reg`` with its
+    poses (the base set the baseline fits)."""
+    geo: list[ParamSpec] = []
+    for e in KINEMATIC:
+        geo += effect_parameters(ctx, e)[0]
+    return identifiable_start(ctx, reg, geo)[0]
+
+
 def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
                        fitting: NDArray[np.int64], withheld: NDArray[np.int64],
                        folds: list[NDArray[np.int64]], rb0: F64
                        ) -> GeometricBaseline:
     """Fit the complete geometric calibration on top of the registration ``reg`` and then the
-    final model's non-geometric parameters on top of it (see the module docstring)."""
+    final model's non-geometric parameters on top of it (see the module docstring). With
+    ``ctx.orientation`` the fits use the measured orientations too
+    (:func:`zrp.gap.fit.leastsq.fit`); the withheld errors are the positions'."""
     geo: list[ParamSpec] = []
     for e in KINEMATIC:
         geo += effect_parameters(ctx, e)[0]

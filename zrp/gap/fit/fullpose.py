@@ -38,79 +38,20 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.constrained import n_registration
 from zrp.gap.fit.leastsq import FitResult, FitWarning, fit, initial_registration
+from zrp.gap.fit.orientation import (
+    orientation_residual,
+    pose_rotations,
+    probe_start,
+    stacked,
+)
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
-from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.context import Context, OrientationWeights, ParamSpec
 from zrp.gap.model.domains import domain_violations
 from zrp.gap.model.problem import Problem
-from zrp.rotations import left_jacobian
 
-__all__ = ["FullPoseFit", "fit_full_pose", "orientation_residual", "pose_rotations",
-           "probe_start"]
+__all__ = ["FullPoseFit", "fit_full_pose", "orientation_residual", "orientation_weights",
+           "pose_rotations", "probe_start"]
 
-
-
-def pose_rotations(ctx: Context) -> F64:
-    """Measured orientation per pose (its first row's quaternion, scalar first), shape
-    (P, 3, 3).
-
-    Raises:
-        InputError: the measurements carry no ``qw, qx, qy, qz`` columns.
-    """
-    quat = ctx.meas.quat
-    if quat is None:
-        raise InputError("measurements: no qw, qx, qy, qz columns; full-pose identification "
-                         "needs measured orientations")
-    q = np.asarray(quat, dtype=float)[ctx.meas.first_row]
-    return Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()
-
-
-def _left_jacobians(e: F64) -> F64:
-    return np.stack([left_jacobian(v) for v in e])
-
-
-def orientation_residual(prob: Problem, theta: ArrayLike, psi: ArrayLike, rt0: ArrayLike,
-                         measured: ArrayLike) -> tuple[F64, F64]:
-    """Orientation residuals (O1) and their Jacobian (O2) on the poses of ``prob``.
-
-    Args:
-        prob: the position problem (its parameters and poses).
-        theta: its parameters, shape (p,); psi: probe rotation correction, rad, shape (3,).
-        rt0: R_t0, shape (3, 3); measured: R_meas per pose of ``prob``, shape (S, 3, 3).
-
-    Returns:
-        e, shape (S, 3) (rad), and d e / d(theta, psi), shape (S, 3, p + 3).
-    """
-    theta = np.asarray(theta, dtype=float)
-    psi = np.asarray(psi, dtype=float)
-    ch = prob._chain(theta)
-    n = prob.ctx.model.n
-    rn = ch.rprev[:, n]
-    rb, _ = prob.base(theta)
-    rt = Rotation.from_rotvec(psi).as_matrix() @ np.asarray(rt0, dtype=float)
-    pred = rb @ rn @ rt
-    e = Rotation.from_matrix(pred @ np.swapaxes(np.asarray(measured), 1, 2)).as_rotvec()
-    S = len(e)
-    cols = np.zeros((S, 3, prob.size + 3))
-    if prob.instrument:
-        cols[:, :, prob.idx["rot"]] = left_jacobian(theta[prob.idx["rot"]])
-    rev = ~np.asarray(prob.ctx.model.prismatic)
-    if prob.idx["dq"].size:
-        cols[:, :, prob.idx["dq"]] = np.einsum("ij,skj,skp->sip", rb, ch.ucur * rev[None, :,
-                                                                                    None], prob.B)
-    tang = prob.ctx.tangents
-    for i in prob.idx["tilt"]:
-        s = prob.specs[i]
-        k = s.joint - 1
-        if not rev[k]:
-            continue
-        uk = ch.u[k]
-        du = (tang[k, s.comp] - uk * (uk @ tang[k, s.comp])) / np.linalg.norm(ch.v[k])
-        loc = (np.sin(ch.q[:, k])[:, None] * du
-               + (1.0 - np.cos(ch.q[:, k]))[:, None] * np.cross(uk, du))
-        cols[:, :, i] = np.einsum("ij,sjk,sk->si", rb, ch.rprev[:, k], loc)
-    cols[:, :, prob.size:] = rb @ rn @ left_jacobian(psi)
-    jinv = np.linalg.inv(_left_jacobians(e))
-    return e, jinv @ cols
 
 
 @dataclass(frozen=True, eq=False)
@@ -165,15 +106,6 @@ class FullPoseFit:
         return names.index(name)
 
 
-def probe_start(prob: Problem, theta: F64, measured: F64) -> F64:
-    """R_t0: the rotation closest to the mean of (R_b R_n)^T R_meas over the poses."""
-    n = prob.ctx.model.n
-    rb, _ = prob.base(theta)
-    a = np.swapaxes(rb @ prob._chain(theta).rprev[:, n], 1, 2) @ measured
-    u, _, vt = np.linalg.svd(a.mean(axis=0))
-    return u @ np.diag([1.0, 1.0, np.linalg.det(u @ vt)]) @ vt
-
-
 def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
                   orientation: bool = True, orientation_sigma: float | None = None,
                   passes: int = 3) -> FullPoseFit:
@@ -216,7 +148,7 @@ def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
     """
     poses = np.asarray(poses, dtype=np.int64)
     theta0, rb0 = initial_registration(ctx, specs, poses)
-    pos = fit(ctx, specs, poses, theta0, rb0)
+    pos = fit(ctx, specs, poses, theta0, rb0, orientation=False)
     sp = pos.sigma
     nan = float("nan")
     if not orientation:
@@ -236,11 +168,7 @@ def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
           else float(np.sqrt(np.mean(e ** 2))) or 1e-9)
 
     def both(v: F64, so: float) -> tuple[F64, F64]:
-        rp, jp = prob.residual_and_jacobian(v[:p])
-        eo, jo = orientation_residual(prob, v[:p], v[p:], rt0, measured)
-        jp = np.hstack([jp, np.zeros((jp.shape[0], 3))])
-        return (np.concatenate([rp / sp, eo.ravel() / so]),
-                np.vstack([jp / sp, jo.reshape(-1, p + 3) / so]))
+        return stacked(prob, measured, rt0, sp, so, v)
 
     start = prob.residual_and_jacobian(pos.theta)[1]
     scales = np.concatenate([parameter_scales(ctx, specs, start), np.ones(3)])
@@ -265,3 +193,15 @@ def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
     ang = float(np.sqrt(np.mean(np.sum(e ** 2, axis=1))))
     return FullPoseFit(tuple(specs), x[:p], se, rt, sp, so, ang, pos, True,
                        orientation_sigma is not None, sol.converged, sol.reason, sol.held)
+
+
+def orientation_weights(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike,
+                        orientation_sigma: float | None = None) -> OrientationWeights:
+    """The weights with which the orientations enter every fit of a diagnosis: sigma_p and
+    sigma_o of the full-pose fit of ``specs`` (the complete geometric calibration, the most
+    complete standard model) on ``poses``: sigma_p its position-only residual sigma, sigma_o
+    ``orientation_sigma`` when given, else estimated from its orientation residuals (the passes
+    of :func:`fit_full_pose`); R_t0 its probe rotation."""
+    fp = fit_full_pose(ctx, specs, poses, orientation_sigma=orientation_sigma)
+    return OrientationWeights(fp.sigma_position, fp.sigma_orientation, fp.probe_rotation,
+                              "given" if orientation_sigma is not None else "estimated")

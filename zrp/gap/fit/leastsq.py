@@ -17,6 +17,7 @@ from scipy import (
 
 from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
+from zrp.gap.fit.orientation import alias_jacobian, solve_with_orientation
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.problem import Evaluation, Problem
@@ -71,6 +72,9 @@ class FitResult:
             (:mod:`zrp.gap.fit.wellposed`).
         stop_reason: why the solver stopped, in words.
         iterations: its Gauss-Newton iterations.
+        probe_rotation: R_t identified with the orientations (3, 3), or None when the fit
+            used positions only. ``residual``, ``jac`` and the statistics built on them are
+            the positions' in both cases; ``cov`` is the fit's (with orientations: of both).
     """
 
     specs: tuple[ParamSpec, ...]
@@ -84,6 +88,7 @@ class FitResult:
     held: tuple[HeldDirection, ...] = ()
     stop_reason: str = ""
     iterations: int = 0
+    probe_rotation: F64 | None = None
 
     def __post_init__(self) -> None:
         p = len(self.specs)
@@ -194,7 +199,8 @@ def orthonormal_basis(a: F64, rtol: float = 1e-10) -> F64:
 
 
 def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: ArrayLike,
-        base_rotation: ArrayLike, *, start: Evaluation | None = None) -> FitResult:
+        base_rotation: ArrayLike, *, start: Evaluation | None = None,
+        orientation: bool = True) -> FitResult:
     """Least squares with the analytic Jacobian of :class:`~zrp.gap.model.problem.Problem`:
     the scaled truncated-SVD Gauss-Newton solver of :mod:`zrp.gap.fit.wellposed` (eqs. W1-W3),
     which keeps the combinations the data cannot pin at their nominal values (the effect
@@ -207,6 +213,8 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
         base_rotation: R_b0, shape (3, 3).
         start: the evaluation at theta0 when already known (used only when its poses and
             theta equal ``poses`` and ``theta0``).
+        orientation: use the measured orientations when ``ctx.orientation`` says how they
+            weigh (False: positions only, whatever the context).
     """
     prob = Problem(ctx, specs, poses, base_rotation)
     theta0 = np.asarray(theta0, dtype=float)
@@ -221,6 +229,8 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
     else:
         at0 = prob.residual_and_jacobian(theta0)
     scales = parameter_scales(ctx, specs, at0[1])
+    if orientation and ctx.orientation is not None:
+        return _fit_with_orientation(ctx, prob, theta0, scales)
     sol = solve(prob.residual_and_jacobian, prob.residual, theta0, prior_values(specs, theta0),
                 scales, [s.name for s in specs], start=at0)
     if not sol.converged:
@@ -229,6 +239,19 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
     return FitResult(tuple(specs), sol.theta, sol.cov, sol.residual, sol.jac,
                      np.asarray(base_rotation), np.asarray(poses, dtype=np.int64),
                      sol.converged, sol.held, sol.reason, sol.iterations)
+
+
+def _fit_with_orientation(ctx: Context, prob: Problem, theta0: F64, scales: F64) -> FitResult:
+    """:func:`fit` from positions and orientations (:func:`~zrp.gap.fit.orientation.
+    solve_with_orientation`); residual, jac: the positions' at the solution."""
+    sol, rt = solve_with_orientation(ctx, prob, theta0, scales)
+    if not sol.converged:
+        warnings.warn(f"least squares with {sol.theta.size} parameters (positions and "
+                      f"orientations): {sol.reason}", FitWarning, stacklevel=3)
+    p = prob.size
+    r, J = prob.residual_and_jacobian(sol.theta[:p])
+    return FitResult(prob.specs, sol.theta[:p], sol.cov[:p, :p], r, J, prob.base_rotation,
+                     prob.poses, sol.converged, sol.held, sol.reason, sol.iterations, rt)
 
 
 @dataclass(frozen=True)
@@ -280,10 +303,12 @@ def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[Param
     prob = Problem(ctx, specs, poses, base.base_rotation)
     theta = np.concatenate([base.theta, np.zeros(len(candidates))])
     r, J = prob.residual_and_jacobian(theta)
-    norms = np.linalg.norm(J, axis=0)
+    Jt, probe = alias_jacobian(ctx, prob, theta, J)  # with orientations: their rows too
+    norms = np.linalg.norm(Jt, axis=0)
     nb = len(base.specs)
-    A = J[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
-    Q = orthonormal_basis(A)
+    A = Jt[:, :nb] / np.where(norms[:nb] > 0, norms[:nb], 1.0)
+    Q = orthonormal_basis(np.hstack([A, probe / np.linalg.norm(probe, axis=0)])
+                          if probe.shape[1] else A)
     names = [s.name for s in specs]
     accepted_cols = list(range(nb))
     keep: list[ParamSpec] = []
@@ -291,10 +316,10 @@ def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[Param
     # every candidate projected off the base span at once (two passes, one matrix product each
     # instead of one matrix-vector product per candidate), then, in order, off the candidates
     # accepted before it: the same projection onto span(base, accepted)
-    C = J[:, nb:] / np.where(norms[nb:] > 0, norms[nb:], 1.0)
+    C = Jt[:, nb:] / np.where(norms[nb:] > 0, norms[nb:], 1.0)
     P = C - Q @ (Q.T @ C)
     P = P - Q @ (Q.T @ P)
-    Qa = np.empty((J.shape[0], len(candidates)))  # the accepted candidates' directions
+    Qa = np.empty((Jt.shape[0], len(candidates)))  # the accepted candidates' directions
     na = 0
     for i, spec in enumerate(candidates):
         nrm = norms[nb + i]
@@ -309,7 +334,7 @@ def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[Param
             rr = rr - qa @ (qa.T @ rr)
         frac = float(np.linalg.norm(rr))
         if frac < WEAK_TOL:
-            acc = J[:, accepted_cols] / np.where(norms[accepted_cols] > 0,
+            acc = Jt[:, accepted_cols] / np.where(norms[accepted_cols] > 0,
                                                  norms[accepted_cols], 1.0)
             corr = np.abs(acc.T @ c)  # cosines between normalised columns
             order = np.argsort(-corr)

@@ -30,6 +30,7 @@ __all__ = [
     "MIN_EXCITATION_RAD",
     "REGISTRATION",
     "Context",
+    "OrientationWeights",
     "ParamSpec",
 ]
 
@@ -77,6 +78,35 @@ class ParamSpec:
 
 
 @dataclass(frozen=True, eq=False)
+class OrientationWeights:
+    """How the measured orientations enter a fit beside the positions.
+
+    Attributes:
+        sigma_position: position noise per coordinate (length unit), the weight of the
+            position block.
+        sigma_orientation: orientation noise per component (rad), the weight of the
+            orientation block.
+        probe_rotation: R_t0, the starting probe rotation (3, 3); each fit refines it by a
+            rotation vector psi (eq. O1).
+        source: how sigma_orientation was obtained ("given" or "estimated").
+    """
+
+    sigma_position: float
+    sigma_orientation: float
+    probe_rotation: F64
+    source: str = "estimated"
+
+    def __post_init__(self) -> None:
+        for name in ("sigma_position", "sigma_orientation"):
+            v = getattr(self, name)
+            if not (np.isfinite(v) and v > 0):
+                raise InputError(f"OrientationWeights.{name}: expected a positive number, "
+                                 f"got {v!r}")
+        if np.shape(self.probe_rotation) != (3, 3):
+            raise InputError("OrientationWeights.probe_rotation: expected shape (3, 3)")
+
+
+@dataclass(frozen=True, eq=False)
 class Context:
     """Everything the effects need about the data, per pose (P poses, n joints).
 
@@ -103,6 +133,8 @@ class Context:
             the backlash flank; the diagnosis profiles it).
         max_tilt_rad: the largest axis tilt a fit may accept (the domain of
             ``axis_misalignment``, :mod:`zrp.gap.model.domains`).
+        orientation: with measured orientations, how they weigh in every fit
+            (:func:`zrp.gap.fit.leastsq.fit`); None: positions only.
     """
 
     model: Manipulator
@@ -116,6 +148,7 @@ class Context:
     backlash_switch_weights: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None = None
     payload_kg: float = 0.0
     max_tilt_rad: float = DEFAULT_MAX_TILT_RAD
+    orientation: OrientationWeights | None = None
 
     def __post_init__(self) -> None:
         if self.meas.n_joints != self.model.n:

@@ -363,6 +363,10 @@ def _full_pose(diag: Diagnosis) -> list[str]:
          f"({1e3 * b:.3g} mrad), full pose {a:.3g} rad ({1e3 * a:.3g} mrad)",
          f"- withheld position RMS: position-only {fp.withheld_rms_position_only:.4g} {u}, "
          f"full pose {fp.withheld_rms:.4g} {u}\n"]
+    if math.isfinite(fp.withheld_orientation_final):
+        L.insert(-1, f"- the final model as diagnosed (its fits used the orientations too): "
+                     f"withheld orientation error {1e3 * fp.withheld_orientation_final:.3g} "
+                     f"mrad beside its withheld position RMS {diag.final.rms:.4g} {u}")
     for a in fp.added:
         L.append(f"Added by the orientation search (score test p = {a.p_value:.2g}, "
                  f"{a.n_tried} groups tried): {a.effect} on joint {a.joint} "

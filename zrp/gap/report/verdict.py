@@ -234,12 +234,16 @@ def full_pose_text(diag: Diagnosis) -> str:
             f" (the complete geometric calibration from positions and orientations: "
             f"{1e3 * fp.baseline_withheld[0]:.3g} mrad, {fp.baseline_withheld[1]:.4g} "
             f"{diag.length_unit})")
+    final = ("" if not np.isfinite(fp.withheld_orientation_final) else
+             f" The final model, whose fits used the orientations too: "
+             f"{1e3 * fp.withheld_orientation_final:.3g} mrad withheld orientation error, "
+             f"{diag.final.rms:.4g} {diag.length_unit} withheld position RMS.")
     return (f"Measured orientations (noise {1e3 * fp.sigma_orientation:.3g} mrad, {src}) "
             f"add: {std}; withheld orientation error {nominal}"
             f"{1e3 * fp.withheld_orientation_before:.3g} -> "
             f"{1e3 * fp.withheld_orientation_after:.3g} mrad, withheld position RMS "
             f"{fp.withheld_rms_position_only:.4g} -> {fp.withheld_rms:.4g} {diag.length_unit}"
-            f"{base}." + reveal)
+            f"{base}." + reveal + final)
 
 
 def verdict_text(diag: Diagnosis) -> str:

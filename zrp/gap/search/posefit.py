@@ -98,6 +98,9 @@ class FullPoseResult:
             nominal model), rad; NaN when not computed.
         baseline_withheld: withheld (orientation RMS rad, position RMS length unit) of the
             complete geometric calibration refitted from positions and orientations, or None.
+        withheld_orientation_final: the same RMS angle for the diagnosis's final model as it
+            is (identified from positions and orientations when the search used them, with
+            its own probe rotation), rad; NaN when not computed.
     """
 
     fit: FullPoseFit
@@ -112,6 +115,7 @@ class FullPoseResult:
     added: tuple[OrientationStep, ...] = ()
     withheld_orientation_nominal: float = float("nan")
     baseline_withheld: tuple[float, float] | None = None
+    withheld_orientation_final: float = float("nan")
 
     def __post_init__(self) -> None:
         vals = (self.sigma_orientation, self.withheld_orientation_before,
@@ -149,6 +153,7 @@ class FullPoseResult:
                 "withheld_rms": {"position_only": self.withheld_rms_position_only,
                                  "full_pose": self.withheld_rms},
                 "withheld_orientation_rms_nominal_rad": self.withheld_orientation_nominal,
+                "withheld_orientation_rms_final_model_rad": self.withheld_orientation_final,
                 "baseline_full_pose_withheld": None if self.baseline_withheld is None else {
                     "orientation_rms_rad": self.baseline_withheld[0],
                     "rms": self.baseline_withheld[1]},
@@ -224,15 +229,17 @@ def refit_full_pose(ctx: Context, final: FitResult, fitting: NDArray[np.int64],
     prob0 = Problem(ctx, start.specs, w, start.base_rotation)
     return FullPoseResult(fp, fp.sigma_orientation, fp.sigma_orientation_given,
                           fp.probe_rotation, before, ori, _rms(prob0, start.theta), pos_rms,
-                          params, added, nom, base)
+                          params, added, nom, base,
+                          _position_only_orientation(ctx, final, fitting, w, meas_rot))
 
 
 def _position_only_orientation(ctx: Context, f: FitResult, fitting: NDArray[np.int64],
                                withheld: NDArray[np.int64], meas_rot: F64) -> float:
-    """Withheld RMS orientation error (rad) of a position-only fit, its probe rotation taken
-    from the fitting poses (:func:`~zrp.gap.fit.fullpose.probe_start`)."""
-    rt0 = probe_start(Problem(ctx, f.specs, fitting, f.base_rotation), f.theta,
-                      meas_rot[fitting])
+    """Withheld RMS orientation error (rad) of a fit: its own probe rotation when it was
+    identified with the orientations, else (a position-only fit) the one that fits it best on
+    the fitting poses (:func:`~zrp.gap.fit.fullpose.probe_start`)."""
+    rt0 = f.probe_rotation if f.probe_rotation is not None else probe_start(
+        Problem(ctx, f.specs, fitting, f.base_rotation), f.theta, meas_rot[fitting])
     prob = Problem(ctx, f.specs, withheld, f.base_rotation)
     e, _ = orientation_residual(prob, f.theta, np.zeros(3), rt0, meas_rot[withheld])
     return _angle_rms(e)
