@@ -242,5 +242,12 @@ def test_calibrated_robot_keeps_the_tilt_only_orientations_reveal(tilted_wrist, 
     _, comp = write_calibration(full.robot, tmp_path / "c.toml", tmp_path / "c.json",
                                 full_pose=full.fit)
     doc = json.loads(comp.read_text())["full_pose"]
-    np.testing.assert_allclose(doc["probe_rotation"], full.fit.probe_rotation)
+    # the file's probe rotation is in the calibrated model's hand frame (offsets folded in):
+    # with it, the calibrated model predicts the measured orientations as the fit did
+    np.testing.assert_allclose(doc["probe_rotation"],
+                               full.robot.fold_rotations()[-1] @ full.fit.probe_rotation)
+    r = full.robot.predict_rotation(q) @ np.asarray(doc["probe_rotation"])
+    e = Rotation.from_matrix(r @ np.swapaxes(meas, 1, 2)).as_rotvec()
+    assert float(np.sqrt(np.mean(np.sum(e ** 2, axis=1)))) == pytest.approx(
+        diag.full_pose.withheld_orientation_after, rel=1e-6)
     assert doc["sigma_orientation_rad"] == diag.full_pose.sigma_orientation

@@ -14,6 +14,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.conditions import Conditions
@@ -35,12 +36,21 @@ __all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "mode
 SCHEMA_VERSION = 1
 
 
-def full_pose_document(fp: FullPoseFit | None) -> dict[str, Any] | None:
-    """The ``full_pose`` entry: the probe rotation R_t (probe frame in the hand frame) and the
-    noise weights of a full-pose fit (:mod:`zrp.gap.fit.fullpose`); None without one."""
+def full_pose_document(fp: FullPoseFit | None,
+                       fold: ArrayLike | None = None) -> dict[str, Any] | None:
+    """The ``full_pose`` entry: the probe rotation R_t (probe frame in the calibrated model's
+    hand frame) and the noise weights of a full-pose fit (:mod:`zrp.gap.fit.fullpose`); None
+    without one.
+
+    ``fold``: R_fold, shape (3, 3), the rotation the calibrated model's folded joint offsets
+    give its hand frame (:meth:`CalibratedRobot.fold_rotations`, last joint). The fit's R_t is
+    in the fitted model's hand frame, R'_n R_fold of the calibrated one, so the file carries
+    R_fold R_t: ``predict_rotation(q) @ probe_rotation`` is then the probe's orientation."""
     if fp is None or not fp.orientation:
         return None
     rt = np.asarray(fp.probe_rotation)
+    if fold is not None:
+        rt = np.asarray(fold, dtype=float) @ rt
     return {"probe_rotation": rt.tolist(),
             "probe_rotvec_rad": rotvec_from_er(er_from_matrix(rt)).tolist(),
             "sigma_orientation_rad": fp.sigma_orientation,
@@ -77,7 +87,7 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "withheld_rms": cal.withheld_rms,
         "gravity_side_weights": (None if cal.gravity_side_weights is None
                                  else np.asarray(cal.gravity_side_weights).tolist()),
-        "full_pose": full_pose_document(full_pose),
+        "full_pose": full_pose_document(full_pose, cal.fold_rotations()[-1]),
         "conditions": None if cal.conditions is None else cal.conditions.to_dict(),
         "domains_widened": cal.widen,
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
