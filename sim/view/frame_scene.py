@@ -81,12 +81,13 @@ def draw_scene(r: OffscreenRenderer, arm: tuple[mujoco.MjModel, mujoco.MjData],
                              (tip_px[0], float(np.linalg.norm(tip_px[1] - tip_px[0]))))
     if shown.ghost:
         r.update_scene(d_a, extra, model=m_a)
-    # added top first: where two lines meet at equal depth the one added first is seen
-    if shown.actual:
-        r.add_polyline(actual, ACTUAL_RGBA, 2.5)
-    if shown.desired:
-        r.add_polyline(desired, DESIRED_RGBA, 2.0)
+    # where two lines meet at equal depth the one added later is seen (added the other way
+    # round, coinciding paths mixed their colours)
     for prev, drawn in zip(earlier, shown.earlier, strict=True):
         if drawn:
             r.add_polyline(prev, EARLIER_RGBA, 1.5)
+    if shown.desired:
+        r.add_polyline(desired, DESIRED_RGBA, 2.0)
+    if shown.actual:
+        r.add_polyline(actual, ACTUAL_RGBA, 2.5)
     return shown, ends_px

@@ -55,6 +55,11 @@ ENTRIES = {
 }
 
 
+def _count(img: np.ndarray, name: str) -> int:
+    im = _scene_px(img)
+    return int(ENTRIES[name][1](im[..., 0], im[..., 1], im[..., 2]).sum())
+
+
 def _mismatches(frames: list[np.ndarray], legends: list[str]) -> list[str]:
     """Frames where an entry's colour is present but the legend does not name it, or named
     but absent (pixel counts)."""
@@ -173,6 +178,12 @@ def test_sweep_legend_matches_its_pixels(sweep_video):
     assert not any("white ghost" in leg or "yellow" in leg for leg in first)
     assert all("perturbed = nominal" in leg for leg in first)
     assert "magenta: actual = desired path" in first[-1] and "green" not in first[-1]
+    # traced on the desired path, the actual one is drawn over it (the other way round the
+    # green stayed whole, spotted with magenta): two thirds round, most of the circle is
+    # magenta and little green is left (pixel counts; the circle at frame 0: all green)
+    circle = _count(frames[0], "green")
+    assert _count(frames[10], "green") < 0.5 * circle < _count(frames[10], "magenta")
+    assert _count(frames[14], "magenta") >= 0.9 * circle
     assert not any("purple" in leg for leg in first)
     assert any("purple" in leg for leg in legends[15:])   # the earlier levels' paths
 
