@@ -2,9 +2,10 @@
 
 Each frame shows the perturbed ("actual") arm (orange links), the nominal arm as a translucent
 white ghost, the desired path (nominal direct kinematics, green), the actual path (magenta) and
-the current deviation vector (a yellow arrow painted over the image, named in the legend only
-on frames where it is painted), both magnified about the desired path by one stated factor for
-the whole video, a colour legend, a text block with the
+the current deviation vector (a yellow arrow painted over the image), both magnified about the
+desired path by one stated factor for the whole video, a colour legend that names each element
+only on the frames where it is visible (one rule, :func:`sim.view.overlays.visible_in_frame`;
+what is not visible is not drawn either, :mod:`sim.view.frame_scene`), a text block with the
 perturbation, delta_p, delta_R (eq 15) and theta (values below :data:`NOISE_FLOOR` print as 0,
 and the floor is stated), and a live plot of delta_p(t). In a video of several segments (a
 sweep over levels) the actual paths of the earlier segments stay drawn, dimmed.
@@ -34,17 +35,14 @@ from numpy.typing import ArrayLike
 
 from mjcf import BuiltArm, MJCFOptions, build
 from sim.robot.dynamics import check_timed_q
-from sim.view.framing import frame_on_path, projected_fractions
+from sim.view.frame_scene import HIDDEN_GROUP, draw_scene, hide_triad, tool_radius_m
+from sim.view.framing import frame_on_path
 from sim.view.gl import _check_name
 from sim.view.magnify import exaggerated_model as exaggerated_model
 from sim.view.magnify import nice_factor as nice_factor
 from sim.view.overlays import (
-    ACTUAL_RGBA,
     ARM_RGBA,
-    DESIRED_RGBA,
-    EARLIER_RGBA,
     GHOST_RGBA,
-    MIN_ARROW_PX,
     NOISE_FLOOR,
     PANEL_PX,
     delta_p_figure,
@@ -161,13 +159,6 @@ class _Segment:
     drawn: BuiltArm | None = None  # the opaque arm drawn (perturbed, maybe exaggerated)
 
 
-def _hide_triad(arm: BuiltArm) -> None:
-    """Make the end effector's RGB triad invisible: its red axis looked like the deviation."""
-    for g in range(arm.model.ngeom):
-        if "hand_" in (mujoco.mj_id2name(arm.model, mujoco.mjtObj.mjOBJ_GEOM, g) or ""):
-            arm.model.geom_rgba[g, 3] = 0.0
-
-
 def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: ArrayLike,
              frames: int, label: str, ghost_alpha: float, size: tuple[int, int]) -> _Segment:
     if not isinstance(nominal, Manipulator) or not isinstance(perturbed, Manipulator):
@@ -182,7 +173,7 @@ def _segment(nominal: Manipulator, perturbed: Manipulator, t: ArrayLike, q: Arra
     arm_n = build(nominal, MJCFOptions(alpha=ghost_alpha, floor=False, prefix="ghost_",
                                        tint=GHOST_RGBA, offscreen_size=size))
     for arm in (arm_a, arm_n):
-        _hide_triad(arm)
+        hide_triad(arm)
     des = kinematic_playback(arm_n, qf)
     act = kinematic_playback(arm_a, qf)
     dp = np.linalg.norm(act.position - des.position, axis=-1)
@@ -217,6 +208,7 @@ def _camera(r: OffscreenRenderer, segs: Sequence[_Segment], opts: VideoOptions) 
                   box=(0.01, max(0.5, 1 - (PANEL_PX + 10) / w), 0.01, max(0.7, 1 - 55 / h)),
                   margin=opts.fill)
     r.option.geomgroup[2] = 0
+    r.option.geomgroup[HIDDEN_GROUP] = 0
     r.option.frame = mujoco.mjtFrame.mjFRAME_NONE
 
 
@@ -227,9 +219,11 @@ def _magnified(seg: _Segment, magnify: float) -> F64:
 
 def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: VideoOptions,
                     unit: str, title: str, plot_top: float | None = None,
-                    earlier: Sequence[F64] = ()) -> Iterator[U8]:
+                    earlier: Sequence[F64] = (), legends: list[str] | None = None
+                    ) -> Iterator[U8]:
     """The frames of one segment; ``earlier``: magnified actual paths of the segments before
-    it (m, each shape (F, 3)), kept on screen dimmed."""
+    it (m, each shape (F, 3)), kept on screen dimmed; each frame's legend text is appended to
+    ``legends`` when given."""
     drawn = seg.drawn or seg.actual
     m_a, m_n = drawn.model, seg.nominal.model
     d_a, d_n = mujoco.MjData(m_a), mujoco.MjData(m_n)
@@ -245,22 +239,20 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
     col = max(pw, PANEL_PX)   # the right-hand column: legend, numbers, plot
     numbers = (opts.width - col - 4, ph + 8, col, max(1, opts.height - ph - 8))
     size = np.array([opts.width, opts.height], dtype=float)
+    earlier_drawn = list(earlier)
+    tool = (drawn.site_id, tool_radius_m(drawn))
     for f in range(n_frames):
         d_a.qpos[drawn.qpos_adr] = drawn.qpos(seg.q[f])
         d_n.qpos[seg.nominal.qpos_adr] = seg.nominal.qpos(seg.q[f])
         mujoco.mj_kinematics(m_a, d_a)
         mujoco.mj_kinematics(m_n, d_n)
-        r.update_scene(d_a, [(m_n, d_n)], model=m_a)
-        r.add_polyline(seg.p_des[idx_all], DESIRED_RGBA, 2.0)
-        for prev in earlier:
-            r.add_polyline(prev[idx_all[idx_all < len(prev)]], EARLIER_RGBA, 1.5)
         done = idx_all[idx_all <= f]
         if len(done) and done[-1] != f:
             done = np.r_[done, f]
-        if len(done) > 1:
-            r.add_polyline(magnified[done], ACTUAL_RGBA, 2.5)
-        ends = projected_fractions(r.scene, [seg.p_des[f], magnified[f]], size[0] / size[1])
-        ends_px = np.stack([ends[:, 0], 1.0 - ends[:, 1]], axis=1) * size  # from the top left
+        paths = ([prev[idx_all[idx_all < len(prev)]] for prev in earlier_drawn],
+                 seg.p_des[idx_all], magnified[done])
+        shown, ends_px = draw_scene(r, (m_a, d_a), (m_n, d_n), paths,
+                                     (seg.p_des[f], magnified[f]), size, tool)
         r.render()
         r.text(f"{title}\n{seg.label}",
                corner=mujoco.mjtGridPos.mjGRID_TOPLEFT)
@@ -268,19 +260,20 @@ def _segment_frames(r: OffscreenRenderer, seg: _Segment, magnify: float, opts: V
                f"{seg.t[f]:.2f} s\n{shown_value(seg.delta_p[f], '.4g')} {unit}\n"
                f"{shown_value(seg.delta_r[f], '.3e')}\n{shown_value(seg.theta[f], '.3e')} rad\n",
                corner=mujoco.mjtGridPos.mjGRID_BOTTOMLEFT, viewport=numbers)
-        arrow = bool(np.linalg.norm(ends_px[1] - ends_px[0]) >= MIN_ARROW_PX)
-        r.text(legend_text(magnify, seg.drawn is not None, arrow),
-               corner=mujoco.mjtGridPos.mjGRID_TOPRIGHT)
+        legend = legend_text(magnify, seg.drawn is not None, shown)
+        r.text(legend, corner=mujoco.mjtGridPos.mjGRID_TOPRIGHT)
         if opts.plot:
-            shown = plot_idx[plot_idx <= f]
-            fig.linepnt[0] = len(shown)
-            if len(shown):
-                fig.linedata[0][0:2 * len(shown):2] = seg.t[shown]
-                fig.linedata[0][1:2 * len(shown):2] = seg.delta_p[shown]
+            plotted = plot_idx[plot_idx <= f]
+            fig.linepnt[0] = len(plotted)
+            if len(plotted):
+                fig.linedata[0][0:2 * len(plotted):2] = seg.t[plotted]
+                fig.linedata[0][1:2 * len(plotted):2] = seg.delta_p[plotted]
             r.figure(fig, opts.width - pw - 4, 4, pw, ph)
         image = r.read()
-        if arrow:
+        if shown.arrow:
             paint_arrow(image, ends_px[0], ends_px[1])
+        if legends is not None:
+            legends.append(legend)
         yield image
 
 
@@ -332,14 +325,14 @@ def _prepare(segments: Sequence[VideoSegment | tuple[Manipulator, Manipulator, A
             except ZRPError:  # a degenerate exaggeration: draw the true arm
                 shown = seg_in.perturbed
             arm = build(shown, MJCFOptions(offscreen_size=size, link_rgba=ARM_RGBA))
-            _hide_triad(arm)
+            hide_triad(arm)
             drawn.append(replace(s, drawn=arm))
         segs = drawn
     return _Prepared(tuple(segs), magnify, top)
 
 
-def _frames(prep: _Prepared, opts: VideoOptions, title: str, r: OffscreenRenderer
-            ) -> Iterator[U8]:
+def _frames(prep: _Prepared, opts: VideoOptions, title: str, r: OffscreenRenderer,
+            legends: list[str] | None = None) -> Iterator[U8]:
     segs = prep.segments
     unit = segs[0].nominal.manipulator.length_unit
     _camera(r, segs, opts)
@@ -349,14 +342,17 @@ def _frames(prep: _Prepared, opts: VideoOptions, title: str, r: OffscreenRendere
             raise InputError("segments: every perturbed model must have the same structure "
                              "as the first")
         yield from _segment_frames(r, seg, prep.magnify, opts, unit, title, prep.top,
-                                   tuple(earlier))
+                                   tuple(earlier), legends)
         earlier.append(_magnified(seg, prep.magnify))
 
 
 def video_frames(segments: Sequence[VideoSegment], *, title: str = "nominal vs perturbed",
-                 options: VideoOptions | None = None) -> Iterator[U8]:
+                 options: VideoOptions | None = None, legends: list[str] | None = None
+                 ) -> Iterator[U8]:
     """The frames of :func:`sim.view.video.render_video` without encoding, each shape
-    (height, width, 3) uint8 (e.g. for ``mediapy.show_video`` in a notebook).
+    (height, width, 3) uint8 (e.g. for ``mediapy.show_video`` in a notebook). When
+    ``legends`` is a list, each frame's legend text is appended to it as the frame is yielded
+    (a line per element the frame shows, :func:`sim.view.overlays.visible_in_frame`).
 
     The GL context is freed when the generator finishes or is closed; use
     ``contextlib.closing(video_frames(...))`` when stopping early.
@@ -365,7 +361,7 @@ def video_frames(segments: Sequence[VideoSegment], *, title: str = "nominal vs p
     prep = _prepare(segments, opts)
     with OffscreenRenderer(prep.first_model, opts.width, opts.height,
                            backend=opts.backend) as r:
-        yield from _frames(prep, opts, title, r)
+        yield from _frames(prep, opts, title, r, legends)
 
 
 def comparison_frames(
