@@ -4,8 +4,10 @@ here describes (example-robot-data): import -> plan -> measure --poses plan.csv 
 written. It ends when the compensated program, commanded on the simulated robot, misses its
 targets by at most 1.5x the tracker's pure noise.
 
-The simulated robot's dynamics are the physics robot's defaults for the arm (sim.RealRobot);
-the hidden effects are geometric (joint offsets and a link length) on three joints.
+The simulated robot is the arm as itself: `zrp measure --arm URDF` gives it the inertias,
+damping, friction and tool of the shipped URDF, and `zrp verify` rebuilds that same robot from
+the truth file (which names the URDF and its SHA-256). The hidden effects are geometric (joint
+offsets and a link length) on three joints.
 Pinocchio and example-robot-data are optional: the test skips without them."""
 
 from __future__ import annotations
@@ -67,8 +69,11 @@ def test_plan_to_verify_on_an_unseen_urdf(tmp_path, capsys, arm):
 
     hidden = [a for spec in HIDDEN for a in ("--effect", spec)]
     meas = _run(capsys, ["measure", "--model", model_file, "--poses", str(tmp_path / "plan.csv"),
-                         *hidden, "--out", str(tmp_path / "meas.csv"), "--seed", "3"])
+                         "--arm", urdf, *hidden, "--out", str(tmp_path / "meas.csv"),
+                         "--seed", "3"])
     assert meas["poses"] == 40 and meas["trajectory"] == "plan"
+    build = json.loads((tmp_path / "meas.truth.json").read_text())["robot"]
+    assert build["inertia"] == "own" and build["arm_file"] == os.path.abspath(urdf)
     _run(capsys, ["diagnose", "--model", model_file, "--data", str(tmp_path / "meas.csv"),
                   "--out", str(tmp_path / "diag"), "--no-plots"])
     _run(capsys, ["calibrate", "--model", model_file, "--data", str(tmp_path / "meas.csv"),

@@ -188,8 +188,10 @@ def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> 
                          "--motion-effect")
     traj_name = "moves" if args.trajectory == "random" else args.trajectory
     t0 = time.perf_counter()
+    opts = _robot_options(args.arm, model)
     run = measure_stream(model, traj_name, args.motion_effect, args.stream,  # type: ignore[arg-type]
-                         args.noise, args.seed, field="--motion-effect")
+                         args.noise, args.seed, field="--motion-effect",
+                         dynamics=getattr(opts, "dynamics", None))
     wall = time.perf_counter() - t0
     write_trajectory(run.trajectory, out, deg=args.deg, model=model,  # type: ignore[arg-type]
                      overwrite=args.force)
