@@ -42,7 +42,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "; default puma)")
     p.add_argument("--arm", default=None, metavar="FILE",
                    help="the arm's shipped URDF or MJCF (joints named as the model's): the "
-                        "simulated robot takes its inertias, damping, friction and tool; "
+                        "simulated robot (at rest or with --stream) takes its inertias, "
+                        "damping, friction and tool (the truth file names it and its "
+                        "SHA-256 for zrp verify); "
                         "without it an arm with no inertias of its own borrows the PUMA "
                         "560's (6R) or rods' (announced)")
     p.add_argument("--out", required=True, metavar="D.csv", help="measurement CSV to write")
