@@ -99,7 +99,8 @@ def test_plan_to_verify_on_an_unseen_urdf(tmp_path, capsys, arm):
     res = _run(capsys, ["verify", "--calibration", comp_json, "--truth",
                         str(tmp_path / "meas.truth.json"), "--targets",
                         str(tmp_path / "program.csv"), "--commands", str(tmp_path / "cmd.csv")])
-    print(f"{arm} ({', '.join(diag['effects'])}): {res['rms_before']:.4g} -> {res['rms_after']:.4g} {model.length_unit} "
+    print(f"{arm} ({', '.join(diag['effects'])}): {res['rms_before']:.4g} -> "
+          f"{res['rms_after']:.4g} {model.length_unit} "
           f"({res['ratio_after_to_noise']:.2f}x the noise)")
     assert res["rms_before"] > 5 * res["noise_rms"]  # the hidden effects show as programmed
     assert res["ratio_after_to_noise"] <= RATIO, res
