@@ -20,6 +20,7 @@ the file (MuJoCo's URDF reader maps ``<dynamics damping= friction=>``).
 
 from __future__ import annotations
 
+import hashlib
 import os
 from dataclasses import dataclass
 from pathlib import Path
@@ -34,7 +35,7 @@ from zrp.arrays import F64
 from zrp.model.manipulator import Manipulator
 from zrp.units import metres_per_unit
 
-__all__ = ["MASSLESS_LINK", "ArmDynamics", "arm_dynamics"]
+__all__ = ["MASSLESS_LINK", "ArmDynamics", "arm_dynamics", "file_sha256"]
 
 #: (kg, kg m^2) given to a chain link the file leaves without mass (MuJoCo needs a moving body
 #: to have some); far below any real link, it changes no torque beyond 1e-5 N m.
@@ -56,6 +57,8 @@ class ArmDynamics:
         armature: rotor inertia per joint, kg m^2 (kg), shape (n,).
         massless: 1-based joints whose link the file leaves without mass (given
             :data:`MASSLESS_LINK`).
+        sha256: SHA-256 (hex) of the file's bytes as read: a later run rebuilding this robot
+            (``zrp verify`` from a truth file) checks it is the same file.
     """
 
     source: str
@@ -64,6 +67,7 @@ class ArmDynamics:
     friction: F64
     armature: F64
     massless: tuple[int, ...] = ()
+    sha256: str = ""
 
     def summary(self) -> str:
         """One line for a report: the file, the total moving mass."""
@@ -144,6 +148,7 @@ def arm_dynamics(path: str | os.PathLike[str], model: Manipulator) -> ArmDynamic
             axes are not the model's at the zero reference (a named joint).
     """
     source = str(path)
+    digest = file_sha256(path)
     m = load_shipped(path)
     jids = _chain_joint_ids(m, model, source)
     d = mujoco.MjData(m)
@@ -165,4 +170,16 @@ def arm_dynamics(path: str | os.PathLike[str], model: Manipulator) -> ArmDynamic
         inertias.append(lumped)
     return ArmDynamics(source, tuple(inertias), m.dof_damping[dofs].copy(),
                        m.dof_frictionloss[dofs].copy(), m.dof_armature[dofs].copy(),
-                       tuple(massless))
+                       tuple(massless), digest)
+
+
+def file_sha256(path: str | os.PathLike[str]) -> str:
+    """SHA-256 (hex) of a file's bytes; "" when it cannot be read (the loader names that)."""
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as fh:
+            for block in iter(lambda: fh.read(1 << 20), b""):
+                h.update(block)
+    except OSError:
+        return ""
+    return h.hexdigest()

@@ -41,6 +41,7 @@ import mujoco
 import numpy as np
 from scipy import signal
 
+from mjcf.own_dynamics import ArmDynamics
 from sim.robot.effects import HiddenEffects
 from sim.robot.instrument import Instrument
 from sim.robot.model import RealRobotOptions
@@ -136,9 +137,10 @@ class MotionRun:
     truth: dict[str, Any]
 
 
-def _robot(model: Manipulator, eff: MotionEffects) -> tuple[RealRobot, mujoco.MjModel]:
+def _robot(model: Manipulator, eff: MotionEffects, dynamics: ArmDynamics | None
+           ) -> tuple[RealRobot, mujoco.MjModel]:
     robot = RealRobot(model, HiddenEffects(joint_compliance=dict(eff.dynamic_compliance)),
-                      RealRobotOptions(timestep=1e-3))
+                      RealRobotOptions(timestep=1e-3, dynamics=dynamics))
     ff = copy.deepcopy(robot.model)
     m = robot.model
     for k, f in eff.reversal_friction.items():
@@ -190,14 +192,16 @@ def _references(command: Callable[[F64, int], F64], times: F64, lag: Mapping[int
 
 def execute_trajectory(model: Manipulator, command: Callable[[F64, int], F64], duration: float,
                        effects: MotionEffects, instrument: Instrument, rng: np.random.Generator,
-                       *, rate_hz: float = 1000.0, tool_point: F64 | None = None) -> MotionRun:
+                       *, rate_hz: float = 1000.0, tool_point: F64 | None = None,
+                       dynamics: ArmDynamics | None = None) -> MotionRun:
     """Run the real robot along ``command`` (a function of time and derivative order returning
     joint values/velocities/accelerations, shape (..., n)) for ``duration`` s and stream the
     first reflector (or ``tool_point``) at ``rate_hz`` (the simulation step must divide the
-    tracker period)."""
+    tracker period). ``dynamics``: the arm's own (:func:`mjcf.arm_dynamics`); None: the
+    physics robot's fallback, announced."""
     if not 1.0 <= rate_hz <= 1000.0:
         raise InputError(f"rate_hz: expected 1-1000 Hz, got {rate_hz!r}")
-    robot, ff = _robot(model, effects)
+    robot, ff = _robot(model, effects, dynamics)
     ids = robot._ids
     n = model.n
     dt = robot.timestep

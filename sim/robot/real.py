@@ -38,6 +38,7 @@ length unit in the API (MuJoCo works in metres inside), torques N m, masses kg, 
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass
 from typing import Any
 
@@ -198,7 +199,8 @@ class RealRobot:
         return out
 
     def describe(self) -> dict[str, Any]:
-        """The build (servo gains, time step, friction, inertias) for the truth file."""
+        """The build (servo gains, time step, friction, inertias; the arm's own file and its
+        SHA-256 when its dynamics came from one) for the truth file."""
         return {"timestep_s": self.timestep, "servo_kp_Nm_per_rad": self._ids["kp"].tolist(),
                 "servo_kv_Nms_per_rad": self._ids["kv"].tolist(),
                 "integral_trim": self._ids["trim"].tolist(),
@@ -208,7 +210,14 @@ class RealRobot:
                 "tool_points": self.tool_points.tolist(),
                 "true_axes": np.asarray(self.true_model.axes).tolist(),
                 "true_bodies": np.asarray(self.true_model.bodies).tolist(),
-                "gravity_m_s2": list(self.options.gravity)}
+                "gravity_m_s2": list(self.options.gravity), **self._arm_file()}
+
+    def _arm_file(self) -> dict[str, str]:
+        """The arm's own file the dynamics came from (absolute path, SHA-256), if any."""
+        dyn = self.options.dynamics
+        if dyn is None:
+            return {}
+        return {"arm_file": os.path.abspath(dyn.source), "arm_sha256": dyn.sha256}
 
 
 class Session:

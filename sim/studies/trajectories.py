@@ -18,6 +18,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from mjcf.own_dynamics import ArmDynamics
 from sim.robot.instrument import random_instrument
 from sim.robot.measurement import trajectory_poses
 from sim.robot.motion import MotionRun, execute_trajectory
@@ -69,11 +70,14 @@ def named_command(model: Manipulator, name: str, rng: np.random.Generator, moves
 
 
 def measure_stream(model: Manipulator, trajectory: str, specs: Sequence[str], rate_hz: float,
-                   noise_sigma: float, seed: int, field: str = "specs") -> MotionRun:
+                   noise_sigma: float, seed: int, field: str = "specs",
+                   dynamics: ArmDynamics | None = None) -> MotionRun:
     """Execute the named trajectory on the real robot with the hidden effects ``specs`` and
-    stream time-stamped tracker points at ``rate_hz`` (seeded instrument frame and noise)."""
+    stream time-stamped tracker points at ``rate_hz`` (seeded instrument frame and noise).
+    ``dynamics``: the arm's own (:func:`mjcf.arm_dynamics`; None: the announced fallback)."""
     effects = parse_motion_effects(specs, model, field)
     rng = np.random.default_rng(seed)
     command, duration = named_command(model, trajectory, rng)
     inst = random_instrument(model, rng, noise_sigma)
-    return execute_trajectory(model, command, duration, effects, inst, rng, rate_hz=rate_hz)
+    return execute_trajectory(model, command, duration, effects, inst, rng, rate_hz=rate_hz,
+                              dynamics=dynamics)

@@ -1,7 +1,8 @@
 """A compensated joint program checked on the simulated robot it was calibrated on (``zrp verify``).
 
 The robot and the tracker are rebuilt from the truth file ``zrp measure`` wrote beside its
-measurements (the hidden effects, the tracker's placement and noise, the reflectors), so the
+measurements (the hidden effects, the tracker's placement and noise, the reflectors, and the
+arm's own URDF/MJCF its dynamics came from, read again once its SHA-256 matches), so the
 check runs on the same "real" robot and in the same tracker frame as the calibration. The
 program is commanded as it is ("before"), then the compensated commands ("after"), each with
 straight moves in program order (the approach directions the compensation assumed when none
@@ -31,9 +32,11 @@ from typing import Any
 
 import numpy as np
 
+from mjcf.own_dynamics import arm_dynamics, file_sha256
 from sim.robot.effects import HiddenEffects
 from sim.robot.instrument import Instrument
 from sim.robot.measurement import TRUTH_FORMAT, Procedure, measure
+from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
 from zrp.arrays import F64
 from zrp.calibration import CalibratedRobot
@@ -41,10 +44,15 @@ from zrp.errors import InputError
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["Verification", "read_truth", "robot_from_truth", "verify_program"]
+__all__ = ["ArmFileError", "Verification", "arm_options", "read_truth", "robot_from_truth",
+           "verify_program"]
 
 #: The largest truth file read (a truth file of 100,000 poses is about 30 MB).
 MAX_TRUTH_BYTES = 256 * 2 ** 20
+
+
+class ArmFileError(InputError):
+    """The arm's own file a truth file names (its dynamics) is gone or no longer the same."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,11 +126,34 @@ def robot_from_truth(model: Manipulator, truth: dict[str, Any], field: str = "tr
         tool = np.asarray(truth["robot"]["tool_points"], dtype=float)
     except (KeyError, TypeError, ValueError) as exc:
         raise InputError(f"{field}: incomplete truth file ({exc})") from None
-    robot = RealRobot(model, effects)
+    robot = RealRobot(model, effects, arm_options(model, truth["robot"], field))
     if not np.allclose(np.asarray(robot.tool_points), tool, rtol=0, atol=1e-9):
         raise InputError(f"{field}: its reflectors differ from the simulated robot's "
                          "(written by another version)")
     return robot, inst
+
+
+def arm_options(model: Manipulator, build: dict[str, Any], field: str = "truth"
+                ) -> RealRobotOptions | None:
+    """The options of the robot a truth file's ``robot`` block describes: the arm's own
+    dynamics read again from the file it names, once its SHA-256 is checked (None: the
+    robot had no file of its own).
+
+    Raises:
+        ArmFileError: the file is gone, or its bytes are not those the measurement read.
+    """
+    path = build.get("arm_file") if isinstance(build, dict) else None
+    if not path:
+        return None
+    if not os.path.isfile(path):
+        raise ArmFileError(f"{field}: the measured robot's dynamics came from {path}, which is "
+                           "gone; restore it to rebuild the robot")
+    digest = file_sha256(path)
+    if digest != build.get("arm_sha256"):
+        raise ArmFileError(f"{field}: {path} changed since the measurement (SHA-256 "
+                           f"{digest[:16]}..., measured {str(build.get('arm_sha256'))[:16]}...);"
+                           " restore the file the robot was measured with")
+    return RealRobotOptions(dynamics=arm_dynamics(path, model))
 
 
 def _targets(cal: CalibratedRobot, q: F64, labels: tuple[str, ...]) -> F64:

@@ -4,8 +4,11 @@ here describes (example-robot-data): import -> plan -> measure --poses plan.csv 
 written. It ends when the compensated program, commanded on the simulated robot, misses its
 targets by at most 1.5x the tracker's pure noise.
 
-The simulated robot's dynamics are the physics robot's defaults for the arm (sim.RealRobot);
-the hidden effects are geometric (joint offsets and a link length) on three joints.
+The simulated robot is the arm as itself: `zrp measure --arm URDF` gives it the inertias,
+damping, friction and tool of the shipped URDF, and `zrp verify` rebuilds that same robot from
+the truth file (which names the URDF and its SHA-256); diagnose, calibrate and compensate get the
+same URDF's gravity torques (--mjcf). The hidden effects are geometric (joint offsets and a link
+length) on three joints.
 Pinocchio and example-robot-data are optional: the test skips without them."""
 
 from __future__ import annotations
@@ -67,12 +70,16 @@ def test_plan_to_verify_on_an_unseen_urdf(tmp_path, capsys, arm):
 
     hidden = [a for spec in HIDDEN for a in ("--effect", spec)]
     meas = _run(capsys, ["measure", "--model", model_file, "--poses", str(tmp_path / "plan.csv"),
-                         *hidden, "--out", str(tmp_path / "meas.csv"), "--seed", "3"])
+                         "--arm", urdf, *hidden, "--out", str(tmp_path / "meas.csv"),
+                         "--seed", "3"])
     assert meas["poses"] == 40 and meas["trajectory"] == "plan"
-    _run(capsys, ["diagnose", "--model", model_file, "--data", str(tmp_path / "meas.csv"),
-                  "--out", str(tmp_path / "diag"), "--no-plots"])
+    build = json.loads((tmp_path / "meas.truth.json").read_text())["robot"]
+    assert build["inertia"] == "own" and build["arm_file"] == os.path.abspath(urdf)
+    diag = _run(capsys, ["diagnose", "--model", model_file, "--data",
+                         str(tmp_path / "meas.csv"), "--mjcf", urdf, "--out",
+                         str(tmp_path / "diag"), "--no-plots"])
     _run(capsys, ["calibrate", "--model", model_file, "--data", str(tmp_path / "meas.csv"),
-                  "--out", str(tmp_path / "cal")])
+                  "--mjcf", urdf, "--out", str(tmp_path / "cal")])
     cal_toml = str(tmp_path / "cal" / "calibrated.toml")
     _run(capsys, ["export", "--model", cal_toml, "--to", "urdf",
                   "--out", str(tmp_path / "calibrated.urdf")])
@@ -86,12 +93,14 @@ def test_plan_to_verify_on_an_unseen_urdf(tmp_path, capsys, arm):
             fh.write(f"T{i + 1}," + ",".join(repr(float(v)) for v in row) + "\n")
     comp_json = str(tmp_path / "cal" / "compensation.json")
     comp = _run(capsys, ["compensate", "--calibration", comp_json, "--targets",
-                         str(tmp_path / "program.csv"), "--out", str(tmp_path / "cmd.csv")])
+                         str(tmp_path / "program.csv"), "--mjcf", urdf,
+                         "--out", str(tmp_path / "cmd.csv")])
     assert comp["not_converged"] == 0
     res = _run(capsys, ["verify", "--calibration", comp_json, "--truth",
                         str(tmp_path / "meas.truth.json"), "--targets",
                         str(tmp_path / "program.csv"), "--commands", str(tmp_path / "cmd.csv")])
-    print(f"{arm}: {res['rms_before']:.4g} -> {res['rms_after']:.4g} {model.length_unit} "
+    print(f"{arm} ({', '.join(diag['effects'])}): {res['rms_before']:.4g} -> "
+          f"{res['rms_after']:.4g} {model.length_unit} "
           f"({res['ratio_after_to_noise']:.2f}x the noise)")
     assert res["rms_before"] > 5 * res["noise_rms"]  # the hidden effects show as programmed
     assert res["ratio_after_to_noise"] <= RATIO, res

@@ -42,7 +42,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "; default puma)")
     p.add_argument("--arm", default=None, metavar="FILE",
                    help="the arm's shipped URDF or MJCF (joints named as the model's): the "
-                        "simulated robot takes its inertias, damping, friction and tool; "
+                        "simulated robot (at rest or with --stream) takes its inertias, "
+                        "damping, friction and tool (the truth file names it and its "
+                        "SHA-256 for zrp verify); "
                         "without it an arm with no inertias of its own borrows the PUMA "
                         "560's (6R) or rods' (announced)")
     p.add_argument("--out", required=True, metavar="D.csv", help="measurement CSV to write")
@@ -188,8 +190,10 @@ def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> 
                          "--motion-effect")
     traj_name = "moves" if args.trajectory == "random" else args.trajectory
     t0 = time.perf_counter()
+    opts = _robot_options(args.arm, model)
     run = measure_stream(model, traj_name, args.motion_effect, args.stream,  # type: ignore[arg-type]
-                         args.noise, args.seed, field="--motion-effect")
+                         args.noise, args.seed, field="--motion-effect",
+                         dynamics=getattr(opts, "dynamics", None))
     wall = time.perf_counter() - t0
     write_trajectory(run.trajectory, out, deg=args.deg, model=model,  # type: ignore[arg-type]
                      overwrite=args.force)
