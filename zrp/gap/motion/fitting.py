@@ -117,7 +117,8 @@ class Engine:
         """Fit registration + ``effects`` on ``poses`` (sample indices)."""
         vals = dict(values or {})
         reg = np.zeros(self.nreg) if reg_theta is None else np.asarray(reg_theta, float)
-        nonlinear = any(e in NONLINEAR for e in effects)
+        nonlinear = (any(e in NONLINEAR for e in effects)
+                     or any(k.endswith(".dyn_omega") for k in vals))  # eq. M8
         it = 0
         while True:
             it += 1

@@ -16,9 +16,12 @@ from zrp.gap.model.context import EFFECTS
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise, plausible, tested
 from zrp.gap.motion.fitting import Engine, ModelFit
-from zrp.gap.motion.profile import vibration_start
+from zrp.gap.motion.profile import compliance_start, vibration_start
 
 __all__ = ["Trial", "backward_check", "drop_effects", "greedy"]
+
+#: the effects whose start values (and joints) come from a profile search
+STARTS = {"residual_vibration": vibration_start, "dynamic_compliance": compliance_start}
 
 
 
@@ -56,7 +59,7 @@ def _candidate_specs(eng: Engine, effect: str, start: dict[str, float]) -> list:
     if effect in EFFECTS:
         return effect_parameters(eng.base_ctx, effect)[0]
     specs = linearise(effect_columns(eng.traj, effect, start, eng.torque, eng.terms))[1]
-    if effect == "residual_vibration":  # only the joints the profile search found a mode on
+    if effect in STARTS:  # only the joints the profile search found the effect on
         specs = [s for s in specs if s.name in start]
     return specs
 
@@ -74,7 +77,7 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                folds: Sequence[I64], alpha: float) -> Trial:
     """Fit ``effect`` on top of ``current``: identifiable parameters, Wald pruning of its
     joint groups at alpha / groups, then the scores."""
-    start = vibration_start(eng, current, poses) if effect == "residual_vibration" else {}
+    start = ({} if effect not in STARTS else STARTS[effect](eng, current, poses))
     cand = _candidate_specs(eng, effect, start)
     if not cand:
         return Trial(effect, None, note="no parameter applies to these data")
