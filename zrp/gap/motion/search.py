@@ -73,11 +73,44 @@ def _implausible_groups(eng: Engine, mf: ModelFit, first: int) -> set[str]:
             if v <= 0.0 or not plausible(s.name, float(v), rate)}
 
 
+def _one_mode_per_joint(current: ModelFit, start: dict[str, float]) -> dict[str, float]:
+    """A joint has one elastic mode: its compliance's spring-mass response (eq. M8) or a
+    residual vibration (eq. M5), not both. Start values of the other one on a joint that
+    already has one are dropped (the compliance stays, quasi-static; the mode is not offered)."""
+    have = {s.joint for s in current.specs
+            if s.name.endswith((".dyn_omega", ".vib_omega"))}
+    out = {}
+    for k, v in start.items():
+        j = int(k[1:k.index(".")]) if k.startswith("q") else 0
+        if j in have and k.endswith(("_omega", "_zeta", ".vib_gain")):
+            continue
+        out[k] = v
+    return out
+
+
+def _quasi_static_fallback(eng: Engine, mf: ModelFit, first: int,
+                           effects: dict[str, frozenset[str] | None], poses: I64) -> ModelFit:
+    """Refit quasi-statically (-c tau) the compliant joints whose spring-mass response (eq. M8)
+    left the physical range (zeta above the servo's, omega the sampling cannot see): its
+    limit for omega -> infinity. ``effects`` is updated in place."""
+    rate = eng.traj.rate_hz
+    bad = {s.joint for s, v in zip(mf.specs[first:], mf.result.theta[first:], strict=True)
+           if s.name.endswith((".dyn_omega", ".dyn_zeta")) and not plausible(s.name, v, rate)}
+    if not bad:
+        return mf
+    drop = {f"q{k}.dyn_{x}" for k in bad for x in ("omega", "zeta")}
+    keep = effects["dynamic_compliance"] or frozenset(s.name for s in mf.specs[first:])
+    effects["dynamic_compliance"] = frozenset(keep - drop)
+    values = {k: v for k, v in mf.values.items() if k not in drop}
+    return eng.fit(effects, poses, values, mf.result.theta[:eng.nreg])
+
+
 def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                folds: Sequence[I64], alpha: float) -> Trial:
     """Fit ``effect`` on top of ``current``: identifiable parameters, Wald pruning of its
     joint groups at alpha / groups, then the scores."""
-    start = ({} if effect not in STARTS else STARTS[effect](eng, current, poses))
+    start = _one_mode_per_joint(current, STARTS[effect](eng, current, poses)
+                                if effect in STARTS else {})
     cand = _candidate_specs(eng, effect, start)
     if not cand:
         return Trial(effect, None, note="no parameter applies to these data")
@@ -90,6 +123,8 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
     effects = {**current.effects, effect: frozenset(s.name for s in keep)}
     mf = eng.fit(effects, poses, {**current.values, **start},
                  current.result.theta[:eng.nreg])
+    if effect == "dynamic_compliance":
+        mf = _quasi_static_fallback(eng, mf, first, effects, poses)
     pw = wald_groups(mf.result, first, tested)
     sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
     if effect in POSITIVE:
