@@ -141,6 +141,32 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                  aliased=al)
 
 
+def refine_compliance(eng: Engine, current: ModelFit, cur_cv: float, poses: I64,
+                      folds: Sequence[I64], alpha: float) -> tuple[ModelFit, float]:
+    """Give the quasi-static compliant joints of ``current`` their spring-mass response (eq. M8)
+    when, now that other effects are modelled (e.g. friction on the same joint), the profile
+    screen passes and the refit is significant (F test, BIC, CV RMS: the rules of a step)."""
+    keep = current.effects.get("dynamic_compliance", frozenset())
+    if keep is None or not keep:
+        return current, cur_cv
+    start = _one_mode_per_joint(current, compliance_start(eng, current, poses))
+    new = {k: v for k, v in start.items()
+           if k.endswith((".dyn_omega", ".dyn_zeta")) and k.replace(
+               k[k.rindex("_"):], "_compliance") in keep and k not in keep}
+    if not new:
+        return current, cur_cv
+    effects = {**current.effects, "dynamic_compliance": frozenset(keep | set(new))}
+    mf = eng.fit(effects, poses, {**current.values, **new}, current.result.theta[:eng.nreg])
+    mf = _quasi_static_fallback(eng, mf, eng.nreg, effects, poses)
+    if effects["dynamic_compliance"] == keep:
+        return current, cur_cv
+    cv = cv_rms(mf.ctx, mf.result, folds)
+    if (f_test(current.result, mf.result) < alpha and mf.result.bic < current.result.bic
+            and cv < cur_cv):
+        return mf, cv
+    return current, cur_cv
+
+
 def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
            folds: Sequence[I64], alpha: float = 1e-3, min_gain: float = 0.01,
            max_steps: int = 3) -> tuple[ModelFit, list[tuple[Trial, list[Trial]]]]:
@@ -167,6 +193,7 @@ def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
             break
         steps.append((best, [best, *light]))
         current, cur_cv = best.fit, best.cv_rms
+        current, cur_cv = refine_compliance(eng, current, cur_cv, poses, folds, alpha)
     return current, steps
 
 
