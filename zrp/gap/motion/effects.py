@@ -15,8 +15,14 @@ effect                  parameter (per joint k)        unit  d(t; theta)
                                                              r = F / kp (eq. M2, stick-slip at
                                                              velocity reversals)
 ``dynamic_compliance``  ``q{k}.dyn_compliance``        rad/  -c tau_k(t): deflection under the full
-                                                       (N m) inverse-dynamics torque (MJCF inertias,
-                                                             ``mj_inverse``; passed in as an array)
+                        [``q{k}.dyn_omega``            (N m) inverse-dynamics torque (gravity and
+                        ``q{k}.dyn_zeta``]             rad/s inertia; MJCF inertias; passed in as
+                                                       1     an array); with omega and zeta,
+                                                             c omega^2 x, x'' + 2 zeta omega x'
+                                                             + omega^2 x = -tau_k (eq. M8: the
+                                                             spring 1/c against the joint's own
+                                                             inertia; unit static gain; the
+                                                             quasi-static limit omega -> infinity)
 ``residual_vibration``  ``q{k}.vib_gain``              1     g y(t): a lightly damped mode driven
                         ``q{k}.vib_omega``             rad/s by the joint's commanded acceleration,
                         ``q{k}.vib_zeta``              1     y'' + 2 zeta omega y' + omega^2 y =
@@ -31,6 +37,12 @@ MJCF by ``mjcf.mode_terms``) the mode is y'' + (2 zeta omega + b_k) y' + (omega^
 f (eq. M6); with a sync delay or a servo lag on the joint in the model, it is driven through
 them, f = -L_tau[u_k''(t - delta)] (eq. M7), and its derivatives in delta and tau join those
 parameters' columns (:attr:`Column.via`, merged by :func:`linearise`).
+
+Compliance and vibration are both a spring against the joint's inertia; what tells them apart
+is what the spring carries: the compliance's the joint's whole torque, gravity and the other
+joints' coupling included (eq. M8), the vibration's mode only the joint's own acceleration
+(eq. M5: the transmission behind a servo that feeds the gravity forward). A joint carries one
+of the two (``search._one_mode_per_joint``).
 
 The nonlinear ones (delay, lag, play, the mode's omega and zeta) are linearised at the current
 estimate theta0: q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the
@@ -276,8 +288,9 @@ def mode_band(rate_hz: float) -> tuple[float, float]:
 
 
 def plausible(name: str, value: float, rate_hz: float) -> bool:
-    """Whether a mode parameter's estimate is physical: 0 < zeta < 1 and omega in
-    :func:`mode_band` (other parameters: True; their sign is checked with :data:`POSITIVE`)."""
+    """Whether a mode parameter's estimate is physical: 0 < zeta < 1 (a compliance response's
+    0 < zeta <= :data:`MAX_SERVO_ZETA`) and omega in :func:`mode_band` (other parameters:
+    True; their sign is checked with :data:`POSITIVE`)."""
     if name.endswith(".vib_zeta"):
         return 0.0 < value < 1.0
     if name.endswith(".dyn_zeta"):  # a servo may be overdamped
@@ -289,9 +302,9 @@ def plausible(name: str, value: float, rate_hz: float) -> bool:
 
 
 def limit_step(name: str, old: float | None, new: float) -> float:
-    """A trust region for the Gauss-Newton steps of a mode's omega (a factor 1.5 per step)
-    and zeta (a factor 3): far from the optimum, the linearisation of a ringing response
-    overshoots. Other parameters: ``new`` unchanged."""
+    """A trust region for the Gauss-Newton steps of a mode's (or a compliance response's, eq.
+    M8) omega (a factor 1.5 per step) and zeta (a factor 3): far from the optimum, the
+    linearisation of a ringing response overshoots. Other parameters: ``new`` unchanged."""
     if old is None or old <= 0.0 or not name.endswith(MODE_NONLINEAR):
         return new
     f = 1.5 if name.endswith(("vib_omega", "dyn_omega")) else 3.0
@@ -299,8 +312,9 @@ def limit_step(name: str, old: float | None, new: float) -> float:
 
 
 def tested(spec: ParamSpec) -> bool:
-    """Whether a parameter enters the Wald test of its joint group: all but a mode's omega and
-    zeta (whose "absent" value is not zero: the gain alone says whether the mode is there)."""
+    """Whether a parameter enters the Wald test of its joint group: all but the omega and zeta
+    of a mode or of a compliance response (whose "absent" value is not zero: the gain alone
+    says whether the mode is there)."""
     return not spec.name.endswith(MODE_NONLINEAR)
 
 

@@ -18,8 +18,8 @@ from scipy.optimize import minimize
 from zrp.arrays import F64, I64
 from zrp.gap.model.problem import Problem
 from zrp.gap.motion.effects import MotionParam, joint_mode, mode_band
-from zrp.gap.motion.kernels import mode_response
 from zrp.gap.motion.fitting import Engine, ModelFit
+from zrp.gap.motion.kernels import mode_response
 
 __all__ = ["SERVO_ZETA_GRID", "ZETA_GRID", "compliance_start", "vibration_start"]
 
@@ -164,7 +164,7 @@ def compliance_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.
     out: dict[str, float] = {}
     for j, k in enumerate(joints):
         ex0, g0, _ = _explained(C[:, j] * np.repeat(-tau[poses, k], rows), r, Q)
-        best = max((_explained(C[:, j] * np.repeat(y, rows), r, Q)[:2] + (w, z)
+        best = max(((*_explained(C[:, j] * np.repeat(y, rows), r, Q)[:2], w, z)
                     for (w, z), y in grid[k].items()), key=lambda b: b[0])
         p = f"q{k + 1}.dyn_"
         if best[0] - ex0 > screen * var and best[1] > 0.0:

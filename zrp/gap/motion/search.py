@@ -88,6 +88,13 @@ def _one_mode_per_joint(current: ModelFit, start: dict[str, float]) -> dict[str,
     return out
 
 
+def _start(eng: Engine, current: ModelFit, effect: str, poses: I64) -> dict[str, float]:
+    """Start values (and joints) of a profiled effect (:data:`STARTS`); {} for the others."""
+    if effect not in STARTS:
+        return {}
+    return _one_mode_per_joint(current, STARTS[effect](eng, current, poses))
+
+
 def _quasi_static_fallback(eng: Engine, mf: ModelFit, first: int,
                            effects: dict[str, frozenset[str] | None], poses: I64) -> ModelFit:
     """Refit quasi-statically (-c tau) the compliant joints whose spring-mass response (eq. M8)
@@ -109,8 +116,7 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                folds: Sequence[I64], alpha: float) -> Trial:
     """Fit ``effect`` on top of ``current``: identifiable parameters, Wald pruning of its
     joint groups at alpha / groups, then the scores."""
-    start = _one_mode_per_joint(current, STARTS[effect](eng, current, poses)
-                                if effect in STARTS else {})
+    start = _start(eng, current, effect, poses)
     cand = _candidate_specs(eng, effect, start)
     if not cand:
         return Trial(effect, None, note="no parameter applies to these data")
