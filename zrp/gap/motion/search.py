@@ -18,7 +18,7 @@ from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise, plausibl
 from zrp.gap.motion.fitting import Engine, ModelFit
 from zrp.gap.motion.profile import compliance_start, vibration_start
 
-__all__ = ["Trial", "backward_check", "drop_effects", "greedy"]
+__all__ = ["Trial", "backward_check", "drop_effects", "greedy", "settle_compliance"]
 
 #: the effects whose start values (and joints) come from a profile search
 STARTS = {"residual_vibration": vibration_start, "dynamic_compliance": compliance_start}
@@ -88,6 +88,14 @@ def _one_mode_per_joint(current: ModelFit, start: dict[str, float]) -> dict[str,
     return out
 
 
+def settle_compliance(eng: Engine, mf: ModelFit, poses: I64) -> ModelFit:
+    """A fitted model whose compliance responses (eq. M8) are all physical: those that left
+    the range (a refit on other samples can drift there) become quasi-static."""
+    if "dynamic_compliance" not in mf.effects:
+        return mf
+    return _quasi_static_fallback(eng, mf, eng.nreg, dict(mf.effects), poses)
+
+
 def _start(eng: Engine, current: ModelFit, effect: str, poses: I64) -> dict[str, float]:
     """Start values (and joints) of a profiled effect (:data:`STARTS`); {} for the others."""
     if effect not in STARTS:
@@ -106,7 +114,8 @@ def _quasi_static_fallback(eng: Engine, mf: ModelFit, first: int,
     if not bad:
         return mf
     drop = {f"q{k}.dyn_{x}" for k in bad for x in ("omega", "zeta")}
-    keep = effects["dynamic_compliance"] or frozenset(s.name for s in mf.specs[first:])
+    keep = effects["dynamic_compliance"] or frozenset(
+        s.name for s in mf.specs[first:] if s.effect == "dynamic_compliance")
     effects["dynamic_compliance"] = frozenset(keep - drop)
     values = {k: v for k, v in mf.values.items() if k not in drop}
     return eng.fit(effects, poses, values, mf.result.theta[:eng.nreg])
