@@ -15,8 +15,14 @@ effect                  parameter (per joint k)        unit  d(t; theta)
                                                              r = F / kp (eq. M2, stick-slip at
                                                              velocity reversals)
 ``dynamic_compliance``  ``q{k}.dyn_compliance``        rad/  -c tau_k(t): deflection under the full
-                                                       (N m) inverse-dynamics torque (MJCF inertias,
-                                                             ``mj_inverse``; passed in as an array)
+                        [``q{k}.dyn_omega``            (N m) inverse-dynamics torque (gravity and
+                        ``q{k}.dyn_zeta``]             rad/s inertia; MJCF inertias; passed in as
+                                                       1     an array); with omega and zeta,
+                                                             c omega^2 x, x'' + 2 zeta omega x'
+                                                             + omega^2 x = -tau_k (eq. M8: the
+                                                             spring 1/c against the joint's own
+                                                             inertia; unit static gain; the
+                                                             quasi-static limit omega -> infinity)
 ``residual_vibration``  ``q{k}.vib_gain``              1     g y(t): a lightly damped mode driven
                         ``q{k}.vib_omega``             rad/s by the joint's commanded acceleration,
                         ``q{k}.vib_zeta``              1     y'' + 2 zeta omega y' + omega^2 y =
@@ -31,6 +37,12 @@ MJCF by ``mjcf.mode_terms``) the mode is y'' + (2 zeta omega + b_k) y' + (omega^
 f (eq. M6); with a sync delay or a servo lag on the joint in the model, it is driven through
 them, f = -L_tau[u_k''(t - delta)] (eq. M7), and its derivatives in delta and tau join those
 parameters' columns (:attr:`Column.via`, merged by :func:`linearise`).
+
+Compliance and vibration are both a spring against the joint's inertia; what tells them apart
+is what the spring carries: the compliance's the joint's whole torque, gravity and the other
+joints' coupling included (eq. M8), the vibration's mode only the joint's own acceleration
+(eq. M5: the transmission behind a servo that feeds the gravity forward). A joint carries one
+of the two (``search._one_mode_per_joint``).
 
 The nonlinear ones (delay, lag, play, the mode's omega and zeta) are linearised at the current
 estimate theta0: q' = u + [d(theta0) - D(theta0) theta0] + D(theta0) theta; the bracket (the
@@ -65,6 +77,10 @@ __all__ = ["MOTION_EFFECTS", "POSITIVE", "Column", "JointColumn", "MotionContext
 POSITIVE = ("servo_lag", "reversal_friction", "dynamic_compliance", "residual_vibration")
 #: where the mode's linearisation starts when no value is given (rad/s, 1)
 VIB_START = (2.0 * np.pi * 10.0, 0.1)
+#: the nonlinear parameters of a mode (residual vibration, eq. M5; compliance's response, M8)
+MODE_NONLINEAR = (".vib_omega", ".vib_zeta", ".dyn_omega", ".dyn_zeta")
+#: the largest damping ratio of a compliant joint's servo response taken as physical
+MAX_SERVO_ZETA = 3.0
 #: a joint must move at least this far (rad or length unit) to carry a per-joint effect.
 MIN_TRAVEL = 1e-4
 
@@ -163,6 +179,11 @@ def _friction(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
 
 def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | None
                 ) -> list[Column]:
+    """Per joint carrying a torque: c (d = c y, D = y) with y = -tau_k quasi-statically, or,
+    when ``q{k}.dyn_omega`` is in ``values``, y = omega^2 x with x'' + 2 zeta omega x' +
+    omega^2 x = -tau_k (eq. M8: the joint's spring 1/c against its own inertia, unit static
+    gain) and the columns of omega and zeta (d = 0, D = c dy/dparameter), as
+    :func:`_vibration` does for the mode."""
     if torque is None:
         return []
     s, n = traj.q.shape
@@ -170,11 +191,25 @@ def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | Non
     for k in range(n):
         if not np.any(torque[:, k] != 0.0):
             continue
-        name = f"q{k + 1}.dyn_compliance"
-        c = float(values.get(name, 0.0))
-        D = _one_joint(s, n, k, -torque[:, k])  # the joint yields to the torque it carries
-        out.append(Column(name, "rad/(N m)", "dynamic_compliance", k + 1, c,
-                          JointColumn(n, k, c * D.col), D))
+        p = f"q{k + 1}.dyn_"
+        c = float(values.get(p + "compliance", 0.0))
+        if p + "omega" not in values:  # the joint yields to the torque it carries
+            D = _one_joint(s, n, k, -torque[:, k])
+            out.append(Column(p + "compliance", "rad/(N m)", "dynamic_compliance", k + 1, c,
+                              JointColumn(n, k, c * D.col), D))
+            continue
+        lo, hi = mode_band(traj.rate_hz)
+        w = float(np.clip(values[p + "omega"], 0.5 * lo, 2.0 * hi))
+        z = float(np.clip(values.get(p + "zeta", 1.0), 1e-3, 4.0))
+        x, dw, dz = mode_response(traj.t, -torque[:, k], w, z)
+        y = w * w * x
+        zero = JointColumn(n, k, np.zeros(s))
+        out += [Column(p + "compliance", "rad/(N m)", "dynamic_compliance", k + 1, c,
+                       _one_joint(s, n, k, c * y), _one_joint(s, n, k, y)),
+                Column(p + "omega", "rad/s", "dynamic_compliance", k + 1, w, zero,
+                       _one_joint(s, n, k, c * (2.0 * w * x + w * w * dw))),
+                Column(p + "zeta", "1", "dynamic_compliance", k + 1, z, zero,
+                       _one_joint(s, n, k, c * w * w * dz))]
     return out
 
 
@@ -253,30 +288,34 @@ def mode_band(rate_hz: float) -> tuple[float, float]:
 
 
 def plausible(name: str, value: float, rate_hz: float) -> bool:
-    """Whether a mode parameter's estimate is physical: 0 < zeta < 1 and omega in
-    :func:`mode_band` (other parameters: True; their sign is checked with :data:`POSITIVE`)."""
+    """Whether a mode parameter's estimate is physical: 0 < zeta < 1 (a compliance response's
+    0 < zeta <= :data:`MAX_SERVO_ZETA`) and omega in :func:`mode_band` (other parameters:
+    True; their sign is checked with :data:`POSITIVE`)."""
     if name.endswith(".vib_zeta"):
         return 0.0 < value < 1.0
-    if name.endswith(".vib_omega"):
+    if name.endswith(".dyn_zeta"):  # a servo may be overdamped
+        return 0.0 < value <= MAX_SERVO_ZETA
+    if name.endswith((".vib_omega", ".dyn_omega")):
         lo, hi = mode_band(rate_hz)
         return lo <= value <= hi
     return True
 
 
 def limit_step(name: str, old: float | None, new: float) -> float:
-    """A trust region for the Gauss-Newton steps of a mode's omega (a factor 1.5 per step)
-    and zeta (a factor 3): far from the optimum, the linearisation of a ringing response
-    overshoots. Other parameters: ``new`` unchanged."""
-    if old is None or old <= 0.0 or not name.endswith((".vib_omega", ".vib_zeta")):
+    """A trust region for the Gauss-Newton steps of a mode's (or a compliance response's, eq.
+    M8) omega (a factor 1.5 per step) and zeta (a factor 3): far from the optimum, the
+    linearisation of a ringing response overshoots. Other parameters: ``new`` unchanged."""
+    if old is None or old <= 0.0 or not name.endswith(MODE_NONLINEAR):
         return new
-    f = 1.5 if name.endswith(".vib_omega") else 3.0
+    f = 1.5 if name.endswith(("vib_omega", "dyn_omega")) else 3.0
     return float(np.clip(new, old / f, old * f))
 
 
 def tested(spec: ParamSpec) -> bool:
-    """Whether a parameter enters the Wald test of its joint group: all but a mode's omega and
-    zeta (whose "absent" value is not zero: the gain alone says whether the mode is there)."""
-    return not spec.name.endswith((".vib_omega", ".vib_zeta"))
+    """Whether a parameter enters the Wald test of its joint group: all but the omega and zeta
+    of a mode or of a compliance response (whose "absent" value is not zero: the gain alone
+    says whether the mode is there)."""
+    return not spec.name.endswith(MODE_NONLINEAR)
 
 
 def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],

@@ -63,6 +63,22 @@ def _couplings(traj: Trajectory, effects: Mapping[str, frozenset[str] | None],
     return out
 
 
+def _kept(values: Mapping[str, float], keep: frozenset[str] | None) -> Mapping[str, float]:
+    """``values`` without the compliance response's omega and zeta (eq. M8) that the model does
+    not keep: the joint is then quasi-static (its column is chosen by the presence of omega)."""
+    if keep is None:
+        return values
+    return {k: v for k, v in values.items()
+            if k in keep or not k.endswith((".dyn_omega", ".dyn_zeta"))}
+
+
+def _dynamic(effects: Mapping[str, frozenset[str] | None], values: Mapping[str, float]) -> bool:
+    """Whether the model's compliance has a spring-mass response (eq. M8: nonlinear)."""
+    if "dynamic_compliance" not in effects:
+        return False
+    return any(k.endswith(".dyn_omega") for k in _kept(values, effects["dynamic_compliance"]))
+
+
 class Engine:
     """The data and registration shared by all fits of one diagnosis.
 
@@ -104,7 +120,8 @@ class Engine:
                 sp, _ = effect_parameters(self.base_ctx, e)
                 static += [s for s in sp if keep is None or s.name in keep]
                 continue
-            cols += [c for c in effect_columns(self.traj, e, values, self.torque,
+            vals = values if e != "dynamic_compliance" else _kept(values, keep)
+            cols += [c for c in effect_columns(self.traj, e, vals, self.torque,
                                                self.terms, couple)
                      if keep is None or (c.via or c.name) in keep]
         shift, mspecs = linearise(cols)
@@ -117,7 +134,7 @@ class Engine:
         """Fit registration + ``effects`` on ``poses`` (sample indices)."""
         vals = dict(values or {})
         reg = np.zeros(self.nreg) if reg_theta is None else np.asarray(reg_theta, float)
-        nonlinear = any(e in NONLINEAR for e in effects)
+        nonlinear = any(e in NONLINEAR for e in effects) or _dynamic(effects, vals)
         it = 0
         while True:
             it += 1

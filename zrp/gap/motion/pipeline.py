@@ -27,7 +27,7 @@ from zrp.gap.motion.data import Trajectory, check_rate
 from zrp.gap.motion.effects import MOTION_EFFECTS
 from zrp.gap.motion.fitting import Engine, ModelFit
 from zrp.gap.motion.results import MotionDiagnosis, MotionEstimate, MotionStep, PhaseError
-from zrp.gap.motion.search import backward_check, drop_effects, greedy
+from zrp.gap.motion.search import backward_check, drop_effects, greedy, settle_compliance
 from zrp.gap.motion.segments import PHASES, phases, split_segments, stream_noise_sigma
 from zrp.model.manipulator import Manipulator
 
@@ -172,11 +172,12 @@ def diagnose_motion(model: Manipulator, trajectory: Trajectory, *,
     clock["register"] = time.perf_counter()
     final, trace = greedy(eng, start, list(effects), search, sfolds, alpha, 0.01, max_steps)
     final = drop_effects(eng, backward_check(eng, final, search, alpha), search, alpha)
+    final = settle_compliance(eng, final, search)
     clock["search"] = time.perf_counter()
     fitting = _decimate(split.fitting, max_fit_samples)
     nominal = eng.fit({}, fitting, reg_theta=start.result.theta)
-    final_all = eng.fit(final.effects, fitting, final.values,
-                        final.result.theta[:eng.nreg])
+    final_all = settle_compliance(eng, eng.fit(final.effects, fitting, final.values,
+                                               final.result.theta[:eng.nreg]), fitting)
     clock["final_fit"] = time.perf_counter()
     steps = []
     for tr, ranked in trace:

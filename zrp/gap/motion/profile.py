@@ -19,11 +19,15 @@ from zrp.arrays import F64, I64
 from zrp.gap.model.problem import Problem
 from zrp.gap.motion.effects import MotionParam, joint_mode, mode_band
 from zrp.gap.motion.fitting import Engine, ModelFit
+from zrp.gap.motion.kernels import mode_response
 
-__all__ = ["ZETA_GRID", "vibration_start"]
+__all__ = ["SERVO_ZETA_GRID", "ZETA_GRID", "compliance_start", "vibration_start"]
 
 #: damping ratios tried (a lightly damped mode: well below 1)
 ZETA_GRID = (0.01, 0.03, 0.1, 0.3)
+#: damping ratios tried for a compliant joint's servo response (eq. M8; servos are tuned near
+#: critical damping)
+SERVO_ZETA_GRID = (0.3, 0.7, 1.0, 2.0)
 
 
 def _explained(col: F64, r: F64, Q: F64) -> tuple[float, float, F64]:
@@ -128,4 +132,43 @@ def vibration_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0
         Q = np.column_stack([Q, u])
         dof -= 3
         left.remove(j)
+    return out
+
+
+def compliance_start(eng: Engine, cur: ModelFit, poses: I64, screen: float = 30.0,
+                     n_omega: int = 24) -> dict[str, float]:
+    """Start values of ``dynamic_compliance`` per joint carrying a torque: ``q{k}.dyn_compliance``
+    from the quasi-static column (-tau_k), and ``q{k}.dyn_omega``, ``q{k}.dyn_zeta`` too when
+    the joint's spring-mass response (eq. M8, gridded over omega in :func:`mode_band` and
+    :data:`SERVO_ZETA_GRID`) explains more than the quasi-static column by ``screen`` times
+    the residual variance per degree of freedom (the rule of :func:`vibration_start`).
+    Joints whose compliance would be negative are left out."""
+    tau = eng.torque
+    traj = eng.traj
+    if tau is None:
+        return {}
+    joints = [k for k in range(traj.n_joints) if np.any(tau[:, k] != 0.0)]
+    if not joints:
+        return {}
+    r, C, Q = _joint_columns(eng, cur, poses, joints)
+    rows = r.size // poses.size
+    var = float(r @ r) / max(r.size - Q.shape[1], 1)
+    key = ("compliance_grid", n_omega, poses.tobytes())
+    if key not in eng.cache:
+        lo, hi = mode_band(traj.rate_hz)
+        omegas = np.geomspace(lo, min(hi, 2.0 * np.pi * 100.0), n_omega)
+        eng.cache[key] = {k: {(float(w), z): w * w * mode_response(
+            traj.t, -tau[:, k], float(w), z, derivatives=False)[0][poses]
+            for w in omegas for z in SERVO_ZETA_GRID} for k in joints}
+    grid = eng.cache[key]
+    out: dict[str, float] = {}
+    for j, k in enumerate(joints):
+        ex0, g0, _ = _explained(C[:, j] * np.repeat(-tau[poses, k], rows), r, Q)
+        best = max(((*_explained(C[:, j] * np.repeat(y, rows), r, Q)[:2], w, z)
+                    for (w, z), y in grid[k].items()), key=lambda b: b[0])
+        p = f"q{k + 1}.dyn_"
+        if best[0] - ex0 > screen * var and best[1] > 0.0:
+            out.update({p + "compliance": best[1], p + "omega": best[2], p + "zeta": best[3]})
+        elif g0 > 0.0:
+            out[p + "compliance"] = g0
     return out

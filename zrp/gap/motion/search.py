@@ -16,9 +16,12 @@ from zrp.gap.model.context import EFFECTS
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise, plausible, tested
 from zrp.gap.motion.fitting import Engine, ModelFit
-from zrp.gap.motion.profile import vibration_start
+from zrp.gap.motion.profile import compliance_start, vibration_start
 
-__all__ = ["Trial", "backward_check", "drop_effects", "greedy"]
+__all__ = ["Trial", "backward_check", "drop_effects", "greedy", "settle_compliance"]
+
+#: the effects whose start values (and joints) come from a profile search
+STARTS = {"residual_vibration": vibration_start, "dynamic_compliance": compliance_start}
 
 
 
@@ -56,7 +59,7 @@ def _candidate_specs(eng: Engine, effect: str, start: dict[str, float]) -> list:
     if effect in EFFECTS:
         return effect_parameters(eng.base_ctx, effect)[0]
     specs = linearise(effect_columns(eng.traj, effect, start, eng.torque, eng.terms))[1]
-    if effect == "residual_vibration":  # only the joints the profile search found a mode on
+    if effect in STARTS:  # only the joints the profile search found the effect on
         specs = [s for s in specs if s.name in start]
     return specs
 
@@ -70,11 +73,59 @@ def _implausible_groups(eng: Engine, mf: ModelFit, first: int) -> set[str]:
             if v <= 0.0 or not plausible(s.name, float(v), rate)}
 
 
+def _one_mode_per_joint(current: ModelFit, start: dict[str, float]) -> dict[str, float]:
+    """A joint has one elastic mode: its compliance's spring-mass response (eq. M8) or a
+    residual vibration (eq. M5), not both. Start values of the other one on a joint that
+    already has one are dropped (the compliance stays, quasi-static; the mode is not offered)."""
+    have = {s.joint for s in current.specs
+            if s.name.endswith((".dyn_omega", ".vib_omega"))}
+    out = {}
+    for k, v in start.items():
+        j = int(k[1:k.index(".")]) if k.startswith("q") else 0
+        if j in have and k.endswith(("_omega", "_zeta", ".vib_gain")):
+            continue
+        out[k] = v
+    return out
+
+
+def settle_compliance(eng: Engine, mf: ModelFit, poses: I64) -> ModelFit:
+    """A fitted model whose compliance responses (eq. M8) are all physical: those that left
+    the range (a refit on other samples can drift there) become quasi-static."""
+    if "dynamic_compliance" not in mf.effects:
+        return mf
+    return _quasi_static_fallback(eng, mf, eng.nreg, dict(mf.effects), poses)
+
+
+def _start(eng: Engine, current: ModelFit, effect: str, poses: I64) -> dict[str, float]:
+    """Start values (and joints) of a profiled effect (:data:`STARTS`); {} for the others."""
+    if effect not in STARTS:
+        return {}
+    return _one_mode_per_joint(current, STARTS[effect](eng, current, poses))
+
+
+def _quasi_static_fallback(eng: Engine, mf: ModelFit, first: int,
+                           effects: dict[str, frozenset[str] | None], poses: I64) -> ModelFit:
+    """Refit quasi-statically (-c tau) the compliant joints whose spring-mass response (eq. M8)
+    left the physical range (zeta above the servo's, omega the sampling cannot see): its
+    limit for omega -> infinity. ``effects`` is updated in place."""
+    rate = eng.traj.rate_hz
+    bad = {s.joint for s, v in zip(mf.specs[first:], mf.result.theta[first:], strict=True)
+           if s.name.endswith((".dyn_omega", ".dyn_zeta")) and not plausible(s.name, v, rate)}
+    if not bad:
+        return mf
+    drop = {f"q{k}.dyn_{x}" for k in bad for x in ("omega", "zeta")}
+    keep = effects["dynamic_compliance"] or frozenset(
+        s.name for s in mf.specs[first:] if s.effect == "dynamic_compliance")
+    effects["dynamic_compliance"] = frozenset(keep - drop)
+    values = {k: v for k, v in mf.values.items() if k not in drop}
+    return eng.fit(effects, poses, values, mf.result.theta[:eng.nreg])
+
+
 def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
                folds: Sequence[I64], alpha: float) -> Trial:
     """Fit ``effect`` on top of ``current``: identifiable parameters, Wald pruning of its
     joint groups at alpha / groups, then the scores."""
-    start = vibration_start(eng, current, poses) if effect == "residual_vibration" else {}
+    start = _start(eng, current, effect, poses)
     cand = _candidate_specs(eng, effect, start)
     if not cand:
         return Trial(effect, None, note="no parameter applies to these data")
@@ -87,6 +138,8 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
     effects = {**current.effects, effect: frozenset(s.name for s in keep)}
     mf = eng.fit(effects, poses, {**current.values, **start},
                  current.result.theta[:eng.nreg])
+    if effect == "dynamic_compliance":
+        mf = _quasi_static_fallback(eng, mf, first, effects, poses)
     pw = wald_groups(mf.result, first, tested)
     sig = {g for g, p in pw.items() if p < alpha / max(len(pw), 1)}
     if effect in POSITIVE:
@@ -101,6 +154,32 @@ def try_effect(eng: Engine, current: ModelFit, effect: str, poses: I64,
     return Trial(effect, mf, joints, cv_rms(mf.ctx, mf.result, folds),
                  f_test(current.result, mf.result), mf.result.bic - current.result.bic,
                  aliased=al)
+
+
+def refine_compliance(eng: Engine, current: ModelFit, cur_cv: float, poses: I64,
+                      folds: Sequence[I64], alpha: float) -> tuple[ModelFit, float]:
+    """Give the quasi-static compliant joints of ``current`` their spring-mass response (eq. M8)
+    when, now that other effects are modelled (e.g. friction on the same joint), the profile
+    screen passes and the refit is significant (F test, BIC, CV RMS: the rules of a step)."""
+    keep = current.effects.get("dynamic_compliance", frozenset())
+    if keep is None or not keep:
+        return current, cur_cv
+    start = _one_mode_per_joint(current, compliance_start(eng, current, poses))
+    new = {k: v for k, v in start.items()
+           if k.endswith((".dyn_omega", ".dyn_zeta")) and k.replace(
+               k[k.rindex("_"):], "_compliance") in keep and k not in keep}
+    if not new:
+        return current, cur_cv
+    effects = {**current.effects, "dynamic_compliance": frozenset(keep | set(new))}
+    mf = eng.fit(effects, poses, {**current.values, **new}, current.result.theta[:eng.nreg])
+    mf = _quasi_static_fallback(eng, mf, eng.nreg, effects, poses)
+    if effects["dynamic_compliance"] == keep:
+        return current, cur_cv
+    cv = cv_rms(mf.ctx, mf.result, folds)
+    if (f_test(current.result, mf.result) < alpha and mf.result.bic < current.result.bic
+            and cv < cur_cv):
+        return mf, cv
+    return current, cur_cv
 
 
 def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
@@ -129,6 +208,7 @@ def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
             break
         steps.append((best, [best, *light]))
         current, cur_cv = best.fit, best.cv_rms
+        current, cur_cv = refine_compliance(eng, current, cur_cv, poses, folds, alpha)
     return current, steps
 
 
