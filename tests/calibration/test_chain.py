@@ -21,6 +21,7 @@ import numpy as np
 import pytest
 
 import zrp
+from tests.arms import erd_root
 from zrp.cli import main
 
 ARMS = {  # folder, file in example-robot-data's robots/, and the import's options
@@ -30,18 +31,6 @@ ARMS = {  # folder, file in example-robot-data's robots/, and the import's optio
 }
 HIDDEN = ["joint_offset:2=0.5mrad", "joint_offset:3=-0.4mrad", "link_length:3=0.1,0.2,-0.1mm"]
 RATIO = 1.5
-
-
-def _erd_root() -> str:
-    pin = pytest.importorskip("pinocchio", reason="optional: pip install pin")
-    base = os.path.dirname(pin.__file__)
-    for up in ("../../../../share/example-robot-data/robots",
-               "../../../share/example-robot-data/robots"):
-        root = os.path.normpath(os.path.join(base, up))
-        if os.path.isdir(root):
-            return root
-    pytest.skip("optional: pip install example-robot-data")
-    return ""
 
 
 def _run(capsys, argv):
@@ -55,7 +44,7 @@ def _run(capsys, argv):
 @pytest.mark.parametrize("arm", sorted(ARMS))
 def test_plan_to_verify_on_an_unseen_urdf(tmp_path, capsys, arm):
     folder, name, options = ARMS[arm]
-    urdf = os.path.join(_erd_root(), folder, "urdf", name)
+    urdf = os.path.join(erd_root(), folder, "urdf", name)
     model_file = str(tmp_path / f"{arm}.toml")
     _run(capsys, ["import", urdf, *options, "--out", model_file])
     model = zrp.load_model(model_file)

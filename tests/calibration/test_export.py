@@ -18,6 +18,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
+from tests.arms import erd_root
 from zrp.calibration import CalibratedRobot, Term
 from zrp.calibration.calibrated import chain
 from zrp.calibration.export import export_urdf
@@ -36,18 +37,6 @@ ROBOTS = [("ur_description/urdf/ur5_robot.urdf", "tool0"),
           ("z1_description/urdf/z1.urdf", "gripperStator"),
           # continuous joints; the end link is the last moving joint's child
           ("double_pendulum_description/urdf/double_pendulum_continuous.urdf", None)]
-
-
-def _erd_root() -> str:
-    pin = pytest.importorskip("pinocchio", reason="optional: pip install pin")
-    base = os.path.dirname(pin.__file__)
-    for up in ("../../../../share/example-robot-data/robots",
-               "../../../share/example-robot-data/robots"):
-        root = os.path.normpath(os.path.join(base, up))
-        if os.path.isdir(root):
-            return root
-    pytest.skip("optional: pip install example-robot-data")
-    return ""
 
 
 def _simulated(nominal, seed: int) -> CalibratedRobot:
@@ -94,7 +83,7 @@ def _structure(path) -> tuple:
 @pytest.mark.parametrize(("rel", "end"), ROBOTS, ids=[r[0].split("/")[-1] for r in ROBOTS])
 def test_exported_urdf_is_the_original_patched(rel, end, tmp_path):
     pin = pytest.importorskip("pinocchio")
-    src = os.path.join(_erd_root(), rel)
+    src = os.path.join(erd_root(), rel)
     imp = import_urdf(src, end_link=end)
     cal = _simulated(imp.model, seed=len(rel))
     urdf, side = export_urdf(cal, src, tmp_path / "cal.urdf", tmp_path / "cal.calibration.json",
@@ -135,7 +124,7 @@ def test_mujoco_puts_the_joints_where_the_calibration_does(tmp_path):
     """MuJoCo, another URDF parser: joint anchors and axes at random q equal the calibrated
     model's joint points and axes (meshes stripped: MuJoCo cannot resolve package:// URIs)."""
     mujoco = pytest.importorskip("mujoco")
-    src = os.path.join(_erd_root(), "ur_description/urdf/ur10_joint_limited_robot.urdf")
+    src = os.path.join(erd_root(), "ur_description/urdf/ur10_joint_limited_robot.urdf")
     imp = import_urdf(src, end_link="tool0")
     cal = _simulated(imp.model, seed=3)
     urdf, _ = export_urdf(cal, src, tmp_path / "c.urdf", tmp_path / "c.json", end_link="tool0")
@@ -165,7 +154,7 @@ def test_figaroh_loads_the_export(tmp_path):
         warnings.simplefilter("ignore")
         robot_mod = pytest.importorskip("figaroh.tools.robot",
                                         reason="optional: pip install figaroh")
-    root = _erd_root()
+    root = erd_root()
     share = os.path.dirname(os.path.dirname(root))    # package://example-robot-data/...
     src = os.path.join(root, "ur_description/urdf/ur10_joint_limited_robot.urdf")
     imp = import_urdf(src, end_link="tool0")
@@ -180,7 +169,7 @@ def test_figaroh_loads_the_export(tmp_path):
 
 
 def test_export_refuses_implausible_values(tmp_path):
-    src = os.path.join(_erd_root(), "ur_description/urdf/ur5_robot.urdf")
+    src = os.path.join(erd_root(), "ur_description/urdf/ur5_robot.urdf")
     cal = _simulated(import_urdf(src, end_link="tool0").model, 5)
     import dataclasses
 
@@ -191,7 +180,7 @@ def test_export_refuses_implausible_values(tmp_path):
 
 
 def test_end_link_on_a_moving_joint_needs_the_end_on_its_axis(tmp_path):
-    src = os.path.join(_erd_root(), "ur_description/urdf/ur5_robot.urdf")
+    src = os.path.join(erd_root(), "ur_description/urdf/ur5_robot.urdf")
     imp = import_urdf(src)      # ends at wrist_3_link: the child of the last moving joint
     bodies = np.array(imp.model.bodies)
     bodies[-1] += [0.3, 0.0, 0.0]     # a calibrated end point off the last axis
@@ -212,7 +201,7 @@ def test_cli_measurements_to_a_patched_urdf(tmp_path, capsys):
     from zrp.gap import Injection, synthesize
     from zrp.kinematics import uniform_joint_values
 
-    src = os.path.join(_erd_root(), "ur_description/urdf/ur10_joint_limited_robot.urdf")
+    src = os.path.join(erd_root(), "ur_description/urdf/ur10_joint_limited_robot.urdf")
     assert main(["import", src, "--end", "tool0", "--out", str(tmp_path / "ur10.toml")]) == 0
     model = import_urdf(src, end_link="tool0").model
     rng = np.random.default_rng(8)

@@ -5,26 +5,17 @@ the model's own results rescaled by hand on a model with a slide."""
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
 
 import zrp
+from tests.arms import erd_root
 from zrp.errors import InputError
 from zrp.model.urdf import import_urdf
 
 
 def _ur10() -> str:
-    pin = pytest.importorskip("pinocchio", reason="optional: pip install pin")
-    base = os.path.dirname(pin.__file__)
-    for up in ("../../../../share/example-robot-data/robots",
-               "../../../share/example-robot-data/robots"):
-        f = os.path.normpath(os.path.join(base, up, "ur_description/urdf/ur10_robot.urdf"))
-        if os.path.isfile(f):
-            return f
-    pytest.skip("optional: pip install example-robot-data")
-    return ""
+    return str(erd_root() / "ur_description/urdf/ur10_robot.urdf")
 
 
 def test_vw_rows_in_metres_equal_pinocchio_local_world_aligned():

@@ -13,20 +13,9 @@ import numpy as np
 import pytest
 
 import zrp
+from tests.arms import erd_root
 from zrp.errors import ModelFileError
 from zrp.model.urdf import import_urdf, read_urdf
-
-
-def _erd_root() -> str:
-    pin = pytest.importorskip("pinocchio", reason="optional: pip install pin")
-    base = os.path.dirname(pin.__file__)
-    for up in ("../../../../share/example-robot-data/robots",
-               "../../../share/example-robot-data/robots"):
-        root = os.path.normpath(os.path.join(base, up))
-        if os.path.isdir(root):
-            return root
-    pytest.skip("optional: pip install example-robot-data")
-    return ""
 
 
 def _chains(tree):
@@ -55,7 +44,7 @@ def _pin_q(pm, imp, qz):
 @pytest.mark.slow
 def test_every_example_robot_data_urdf_matches_pinocchio():
     pin = pytest.importorskip("pinocchio")
-    root = _erd_root()
+    root = erd_root()
     files = sorted(glob.glob(os.path.join(root, "*", "*", "*.urdf")))
     assert len(files) > 50
     rng = np.random.default_rng(0)
@@ -101,7 +90,7 @@ def test_every_example_robot_data_urdf_matches_pinocchio():
 
 
 def test_panda_as_shipped_fixed_tool_frame_limits():
-    root = _erd_root()
+    root = erd_root()
     f = os.path.join(root, "panda_description", "urdf", "panda.urdf")
     imp = import_urdf(f, end_link="panda_hand")  # behind the fixed joint panda_hand_joint
     m = imp.model
