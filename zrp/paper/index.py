@@ -25,7 +25,7 @@ from zrp.escape import file_href, html_text
 from zrp.output import LOCK_NAME, OutputDir, write_text
 
 __all__ = ["CATALOGUE", "INDEX_NAME", "START_HERE", "index_entries", "index_html",
-           "start_here_html", "write_index"]
+           "start_here_html", "write_described_index", "write_index"]
 
 INDEX_NAME = "index.html"
 DESCRIPTIONS = "descriptions.json"
@@ -192,6 +192,21 @@ def index_html(root: str | os.PathLike[str], title: str = "zrp outputs") -> str:
         *start_here_html(entries), '<section id="all-files">', "<h2>All files</h2>",
         f"<p>{len(items)} files, each with one sentence on what it shows.</p>",
         "<ul>", *items, "</ul>", "</section>", "</body>", "</html>", ""])
+
+
+def write_described_index(folder: OutputDir, sentences: dict[str, str]) -> Path:
+    """Write ``sentences`` (file name -> what it shows) to the entered ``folder``'s
+    descriptions, keeping the earlier sentences of files still there that this run did not
+    make (lessons or notebooks not run now), then its ``index.html``."""
+    from zrp.jsonio import dumps  # on use: keeps the command line's help quick
+
+    old_path = folder.root / DESCRIPTIONS
+    if old_path.is_file():
+        old = json.loads(old_path.read_text(encoding="utf-8"))
+        sentences = {**{k: v for k, v in old.items() if (folder.root / k).is_file()},
+                     **sentences}
+    folder.write_text(DESCRIPTIONS, dumps(sentences))
+    return write_index(folder)
 
 
 def write_index(out: str | os.PathLike[str] | OutputDir, *, overwrite: bool = False) -> Path:

@@ -4,12 +4,11 @@ with the renders/ index page refreshed."""
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.output import OutputDir
-from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_index
+from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_described_index, write_index
 
 DEFAULT_OUT = "renders/lessons"
 
@@ -37,7 +36,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo, the lessons Matplotlib and the diagnosis: only when this command runs
     from sim.lessons import lesson_file_names, run_lessons
-    from zrp.jsonio import dumps  # on use: keeps --help quick
 
     out = Path(args.out)
     names = args.names or None
@@ -46,11 +44,7 @@ def _run(args: argparse.Namespace) -> int:
     with OutputDir(out, overwrite=overwrite, names=files) as folder:
         lessons = run_lessons(folder, names, small=args.small)
         sentences = {k: v for les in lessons for k, v in les.sentences.items()}
-        if (out / DESCRIPTIONS).is_file():   # keep the sentences of lessons not run now
-            old = json.loads((out / DESCRIPTIONS).read_text(encoding="utf-8"))
-            sentences = {**{k: v for k, v in old.items() if (out / k).is_file()}, **sentences}
-        folder.write_text(DESCRIPTIONS, dumps(sentences))
-        index = write_index(folder)
+        index = write_described_index(folder, sentences)
     if out == Path(DEFAULT_OUT):   # the renders/ page links the lessons too
         with OutputDir(out.parent, overwrite=True, names=[INDEX_NAME]) as parent:
             index = write_index(parent)

@@ -5,13 +5,12 @@ refreshed."""
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.options import real
 from zrp.output import OutputDir
-from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_index
+from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_described_index, write_index
 
 DEFAULT_OUT = "renders/notebooks"
 
@@ -56,7 +55,6 @@ def _list(args: argparse.Namespace) -> int:
 
 
 def _run(args: argparse.Namespace) -> int:
-    from zrp.jsonio import dumps  # on use: keeps --help quick
 
     if args.list:
         return _list(args)
@@ -82,11 +80,7 @@ def _run(args: argparse.Namespace) -> int:
             sentences[r.html.name] = f"Notebook {i}, {r.title} (executed): {what}"
             sentences[r.ipynb.name] = (f"Notebook {i}, {r.title}, executed, to open in "
                                        "Jupyter.")
-        if (out / DESCRIPTIONS).is_file():   # keep the sentences of notebooks not run now
-            old = json.loads((out / DESCRIPTIONS).read_text(encoding="utf-8"))
-            sentences = {**{k: v for k, v in old.items() if (out / k).is_file()}, **sentences}
-        folder.write_text(DESCRIPTIONS, dumps(sentences))
-        index = write_index(folder)
+        index = write_described_index(folder, sentences)
     if out == Path(DEFAULT_OUT):   # the renders/ page links the notebooks too
         with OutputDir(out.parent, overwrite=True, names=[INDEX_NAME]) as parent:
             index = write_index(parent)
