@@ -23,6 +23,7 @@ from zrp.gap import (
     synthesize,
     write_outputs,
 )
+from zrp.gap.data.synthetic import _gravity_torque
 from zrp.gap.fit.leastsq import fit, initial_registration
 from zrp.gap.fit.uncertainty import robust_covariance
 from zrp.gap.model.context import Context
@@ -152,15 +153,26 @@ def test_backlash_is_the_full_play_and_negative_play_is_refused():
     p = d.parameter("q2.backlash")
     assert p.ci95[0] <= 8e-4 <= p.ci95[1]  # the full play, as `zrp measure` defines it
     assert not d.assessment.implausible
-    # a negative play is what no gear train does: backlash is not accepted, and the verdict
-    # says why (issue 22: plausibility as a constraint, not a footnote)
+    # the joint ahead of its approach by b/2 in every pose: the load's inertia carried it onto
+    # the leading flank (eq. B1); that is a positive play on the other flank, not a negative one
     d = _quiet(PUMA, _meas(Injection(backlash={2: -8e-4}), n=200), seed=0)
-    assert "backlash" not in d.final_joints
+    p = d.parameter("q2.backlash")
+    assert p.ci95[0] <= 8e-4 <= p.ci95[1]
+    assert d.where["backlash_lead"][1] is True and d.where["backlash_switch"][1] is None
+    assert not d.outside_domain
+    # resting against gravity is what no play does (a negative play on the loaded flank): with
+    # the gravity torques known (as an MJCF gives them), backlash is not accepted, and the
+    # verdict says why (issue 22: plausibility as a constraint, not a footnote)
+    inj = Injection(backlash_gravity={2: -8e-4})
+    m = _meas(inj, n=200)
+    tau = _gravity_torque(PUMA, m.q_pose, inj.masses, np.array([0.0, 0.0, -1.0]))
+    d = _quiet(PUMA, m, gravity_torque=tau, seed=0)
     assert all(s.effect != "backlash" or d.final_fit.theta[i] >= 0
                for i, s in enumerate(d.final_fit.specs))
     assert any(e == "backlash" and "q2.backlash" in n for e, n in d.outside_domain)
     assert "backlash was not accepted: fitted to these data it needs values outside" in (
         verdict_text(d))
+    assert d.unexplained  # nothing physical explains it, and the verdict says so
 
 
 def test_no_effect_on_a_joint_the_data_do_not_excite():

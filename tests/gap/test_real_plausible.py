@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from zrp.gap.fit.constrained import outside_domains
 from zrp.gap.report import diagnosis_document
+from zrp.gap.report.backlash import backlash_flank_text
 
 
 def test_final_model_is_inside_every_physical_domain(irb120_real):
@@ -13,9 +14,14 @@ def test_final_model_is_inside_every_physical_domain(irb120_real):
     assert outside_domains(d.context, d.final_fit) == []
     assert all(p.value >= 0 for p in d.final_parameters if p.effect == "backlash")
     assert not d.assessment.implausible
-    # the negative plays these data ask for are named in the verdict, not used
+    # the plays these data ask for are negative when every joint is taken to lag behind its
+    # approach (0.3.0 refused them); with the flank profiled (eq. B1) they are positive plays
+    # on the leading flank, and the report says where each joint rests
     doc = diagnosis_document(d)
-    assert any(o["effect"] == "backlash" for o in doc["identification"]["outside_domain"])
+    assert not any(o["effect"] == "backlash" for o in doc["identification"]["outside_domain"])
+    lead = d.where["backlash_lead"]
+    assert all(lead[k - 1] for k in d.final_joints["backlash"])
+    assert "on the leading flank after the approach" in backlash_flank_text(d)
 
 
 def test_no_fit_stopped_early_and_final_beats_the_geometric_calibration(irb120_real):

@@ -132,6 +132,8 @@ class CalibratedRobot:
             None (unknown: nothing can be enforced).
         widen: physical domains widened by the user (domain key -> upper bound,
             :mod:`zrp.gap.model.domains`), or None.
+        backlash_lead: per joint, whether the approach leaves the load on the leading flank
+            of its play (the diagnosis's profiled flank, eq. B1), or None (lagging everywhere).
     """
 
     model: Manipulator
@@ -154,6 +156,7 @@ class CalibratedRobot:
     gravity_side_weights: F64 | None = None
     conditions: Conditions | None = None
     widen: dict[str, float] | None = None
+    backlash_lead: tuple[bool, ...] | None = None
 
     def __post_init__(self) -> None:
         n = self.model.n
@@ -174,6 +177,8 @@ class CalibratedRobot:
         if self.conditions is not None and len(self.conditions.joint_limits) != n:
             raise InputError(f"conditions.joint_limits: {len(self.conditions.joint_limits)} "
                              f"entries for {n} joints")
+        if self.backlash_lead is not None and len(self.backlash_lead) != n:
+            raise InputError(f"backlash_lead: {len(self.backlash_lead)} flags for {n} joints")
         bad = [t.name for t in self.terms if not 1 <= t.joint <= n]
         if bad:
             raise InputError(f"terms {bad}: joint outside 1..{n}")
@@ -220,7 +225,8 @@ class CalibratedRobot:
                    tuple(ctx.harmonics), ctx.meas.frame,
                    "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
                    float(diag.nominal.rms if registration_only else diag.final.rms),
-                   _side_weights(ctx), Conditions.from_measurements(ctx.meas, ctx.model))
+                   _side_weights(ctx), Conditions.from_measurements(ctx.meas, ctx.model),
+                   None, None if bl is None or not bl.lead else tuple(bl.lead))
 
     @classmethod
     def from_corrections(cls, nominal: Manipulator, joint_offsets: ArrayLike,
@@ -271,7 +277,8 @@ class CalibratedRobot:
         tau = None if cond.gravity_torque is None else np.asarray(cond.gravity_torque,
                                                                   dtype=float)
         ctx = Context(self.nominal, meas, tau, self.gravity_dir, self.harmonics, self.t_ref,
-                      backlash_switch=sw, payload_kg=self.payload_kg)
+                      backlash_switch=sw, payload_kg=self.payload_kg,
+                      backlash_lead=self.backlash_lead)
         if tau is None and self.gravity_side_weights is not None:
             _, h = ctx.moment_arms()
             side = np.einsum("pkj,kj->pk", h, np.asarray(self.gravity_side_weights))

@@ -80,7 +80,8 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "joint_map": [t.to_dict() for t in cal.terms],
         "thermal": {"kappa": cal.kappa, "t_ref_degC": cal.t_ref},
         "backlash": {"switch": None if cal.backlash_switch is None else list(
-            cal.backlash_switch), "payload_kg": cal.payload_kg},
+            cal.backlash_switch), "payload_kg": cal.payload_kg,
+                     "lead": None if cal.backlash_lead is None else list(cal.backlash_lead)},
         "gravity_dir": list(cal.gravity_dir),
         "harmonics": list(cal.harmonics),
         "compliance_model": cal.compliance_model,
@@ -239,4 +240,16 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
         None if doc.get("gravity_side_weights") is None
         else np.array(doc["gravity_side_weights"], dtype=float),
         None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
-        None if widen is None else {str(k): float(v) for k, v in dict(widen).items()})
+        None if widen is None else {str(k): float(v) for k, v in dict(widen).items()},
+        _lead(bl.get("lead"), src))
+
+
+def _lead(value: Any, src: str) -> tuple[bool, ...] | None:
+    """backlash.lead: null (lagging everywhere; files before 0.3.1) or one true/false per
+    joint."""
+    if value is None:
+        return None
+    if not isinstance(value, list) or not all(isinstance(v, bool) for v in value):
+        raise InputError(f"{src}: backlash.lead: expected null or a list of true/false, one "
+                         f"per joint, got {str(value)[:80]}")
+    return tuple(value)

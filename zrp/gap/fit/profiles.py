@@ -1,19 +1,25 @@
 """Profiled choices of the ``backlash`` effect: which flank of its play a joint rests on.
 
-A joint with play lags against its approach direction unless gravity (beating the load's
-Coulomb friction) holds it on the loaded flank. Which side that is, and above which gravity
-torque it happens, is chosen on the fitting poses by profiling on top of the current model:
+A joint with play rests on the flank gravity loads when gravity beats the load's Coulomb
+friction; below that the approach decides (eq. B1): the load lags behind the motor when its
+friction stops it first, or rests on the leading flank when its inertia carries it over as the
+motor decelerates (friction torque below inertia x deceleration: a light, lightly loaded wrist
+joint). Which side that is, above which gravity torque gravity takes over, and which flank the
+approach leaves the load on, are chosen on the fitting poses by profiling on top of the current
+model, for a play b >= 0 only (a negative play is no play: eq. B2):
 
 * :func:`with_gravity_side`: without MJCF inertias, the sign of the gravity torque comes from a
   lumped-mass compliance fit;
-* :func:`with_backlash_switch`: per joint the switching torque (and, with MJCF torques, an
-  unknown payload at the tool), with profile-likelihood weights of the plausible switches;
+* :func:`with_backlash_switch`: per joint the switching torque and the approach flank (and,
+  with MJCF torques, an unknown payload at the tool), with profile-likelihood weights of the
+  plausible switches;
 * :func:`switch_bands`: the range of plausible switching torques, for the report.
 """
 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -74,8 +80,9 @@ def with_gravity_side(ctx: Context, reg: FitResult, fitting: NDArray[np.int64], 
 class _Gains:
     """Residual removed by one play parameter of joint k for switching torques F, with the
     columns projected off span(Q): gain(F) = (c.r)^2 / (|c|^2 - |Q^T c|^2) where the column
-    c = sum over rows of G_k B_F(pose). Everything is reduced per pose first, so a candidate
-    costs O(S q) instead of O(R q)."""
+    c = sum over rows of G_k B_F(pose), if the play it fits, b = -(c.r) / (|c|^2 - |Q^T c|^2)
+    (r = predicted - measured), is positive, else 0 (eq. B2). Everything is reduced per pose
+    first, so a candidate costs O(S q) instead of O(R q)."""
 
     M: F64  # (S, q): Q^T G_k summed per pose
     u: F64  # (S,): r . G_k summed per pose
@@ -98,13 +105,26 @@ class _Gains:
         nv = np.bincount(pose, weights=np.einsum("rc,rc->r", Gk, Gk), minlength=S)
         return cls(M, u, nv, tau_k, d_k)
 
-    def __call__(self, grid: F64) -> F64:
-        B = np.where(np.abs(self.tau_k)[:, None] > grid[None, :], np.sign(self.tau_k)[:, None],
-                     -self.d_k[:, None])  # (S, m)
+    def __call__(self, grid: F64, lead: bool = False) -> F64:
+        """Gains for thresholds ``grid`` (m,), the approach leaving the load on the leading
+        (``lead``) or the lagging flank, 0 where the play would be negative (eq. B2)."""
+        gain, positive = self.signed(grid, lead)
+        return np.where(positive, gain, 0.0)
+
+    def signed(self, grid: F64, lead: bool = False) -> tuple[F64, NDArray[np.bool_]]:
+        """Gains whatever the sign of the play, and where the play is positive."""
+        B = _basis(self.tau_k, self.d_k, grid, lead)  # (S, m)
         den = self.nv @ B**2 - np.sum((self.M.T @ B) ** 2, axis=0)
-        num = (self.u @ B) ** 2
-        return np.where(den > 1e-12 * max(float(self.nv.sum()), 1e-300), num / np.where(
-            den > 0, den, 1.0), 0.0)
+        ub = self.u @ B
+        ok = den > 1e-12 * max(float(self.nv.sum()), 1e-300)
+        return np.where(ok, ub**2 / np.where(den > 0, den, 1.0), 0.0), ub < 0.0
+
+
+def _basis(tau_k: F64, d_k: F64, grid: F64, lead: bool) -> F64:
+    """Flank per pose (S,) and threshold (m,), shape (S, m) (eq. B1): sign(tau) above the
+    threshold, +d (leading) or -d (lagging) at or below it."""
+    return np.where(np.abs(tau_k)[:, None] > grid[None, :], np.sign(tau_k)[:, None],
+                    (1.0 if lead else -1.0) * d_k[:, None])
 
 
 def switch_bands(dists: Weights | None, mass: float = 0.99) -> list[list[float] | None]:
@@ -162,16 +182,17 @@ class _PlayFit:
                    prob.row_pose, ctx.meas.approach_direction()[fitting], base.rss / base.dof,
                    base)
 
-    def columns(self, tau: F64, k: int, grid: F64) -> F64:
+    def columns(self, tau: F64, k: int, grid: F64, lead: bool = False) -> F64:
         """Basis columns of joint k's play for thresholds ``grid`` (m,): shape (3R, m)."""
-        B = np.where(np.abs(tau[:, k])[:, None] > grid[None, :],
-                     np.sign(tau[:, k])[:, None], -self.d[:, k][:, None])  # (S, m)
+        B = _basis(tau[:, k], self.d[:, k], grid, lead)  # (S, m)
         return (self.G[:, :, k][:, :, None] * B[self.pose][:, None, :]).reshape(-1, grid.size)
 
-    def gains(self, tau: F64, grids: dict[int, F64], switch: F64, k: int) -> _Gains:
-        """The gain function of joint k with the other joints' play (at ``switch``) in the
-        model."""
-        others = [self.columns(tau, j, switch[j:j + 1])[:, 0] for j in grids if j != k]
+    def gains(self, tau: F64, grids: dict[int, F64], switch: F64, lead: NDArray[np.bool_],
+              k: int) -> _Gains:
+        """The gain function of joint k with the other joints' play (at ``switch`` and
+        ``lead``) in the model."""
+        others = [self.columns(tau, j, switch[j:j + 1], bool(lead[j]))[:, 0] for j in grids
+                  if j != k]
         A = np.column_stack([self.Abase, *[c / max(np.linalg.norm(c), 1e-300)
                                            for c in others]])
         Q = orthonormal_basis(A)
@@ -195,7 +216,8 @@ def _grids(pf: _PlayFit, tau: F64, max_candidates: int) -> dict[int, F64]:
     return grids
 
 
-def _refine(gains_of: _Gains, grid: F64, gains: F64, i: int, tau_k: F64) -> float:
+def _refine(gains_of: Callable[[F64], F64], grid: F64, gains: F64, i: int, tau_k: F64
+            ) -> float:
     """A finite threshold grid[i] > 0 refined between its neighbouring grid values with every
     data value, then put half-way to the next larger |torque| of the data (|torque| <= the
     threshold keeps the approach side)."""
@@ -213,33 +235,58 @@ def _refine(gains_of: _Gains, grid: F64, gains: F64, i: int, tau_k: F64) -> floa
     return 0.5 * (best + above.min()) if above.size else best
 
 
-def _sweep(pf: _PlayFit, tau: F64, grids: dict[int, F64], sweeps: int) -> F64:
-    """Thresholds per joint by coordinate sweeps: for each joint in turn (the others' play
-    in the model) the threshold that removes the most residual; infinity unless another
-    removes clearly more."""
+def _best_of_joint(pf: _PlayFit, tau: F64, grid: F64, k: int, gains_of: _Gains
+                   ) -> tuple[float, bool]:
+    """Joint k's threshold and approach flank (eq. B2): by default the approach alone
+    (infinity), on the flank that makes the play positive; another pair whose play is
+    positive when it removes clearly more residual; a pair whose play is negative when it
+    removes clearly more than every physical one (the fit then needs a negative play, which
+    the domain gate refuses and the verdict names: the residual has a shape no play makes)."""
+    lag, lag_pos = gains_of.signed(grid)
+    lead, lead_pos = gains_of.signed(grid, lead=True)
+    every = np.concatenate([lag, lead])
+    physical = np.where(np.concatenate([lag_pos, lead_pos]), every, 0.0)
+    default = (np.inf, not bool(lag_pos[0]))
+    if every.max() > physical.max() + CLEARLY_MORE * pf.s2:
+        chosen, i = every, int(np.argmax(every))
+    elif physical.max() > lag[0] + CLEARLY_MORE * pf.s2:
+        chosen, i = physical, int(np.argmax(physical))
+    else:
+        return default
+    is_lead, best = bool(i >= grid.size), float(grid[i % grid.size])
+    if np.isfinite(best) and best > 0:
+        def gains(g: F64) -> F64:
+            return (gains_of(g, lead=is_lead) if chosen is physical
+                    else gains_of.signed(g, lead=is_lead)[0])
+        best = _refine(gains, grid, chosen[grid.size:] if is_lead else chosen[:grid.size],
+                       i % grid.size, tau[:, k])
+    return best, is_lead
+
+
+def _sweep(pf: _PlayFit, tau: F64, grids: dict[int, F64], sweeps: int
+           ) -> tuple[F64, NDArray[np.bool_]]:
+    """Thresholds and approach flanks per joint by coordinate sweeps: for each joint in turn
+    (the others' play in the model) the pair that removes the most residual."""
     switch = np.full(tau.shape[1], np.inf)
+    lead = np.zeros(tau.shape[1], dtype=bool)
     for _ in range(sweeps):
         changed = False
         for k, grid in grids.items():
-            if grid.size == 1:
-                continue
-            gains_of = pf.gains(tau, grids, switch, k)
-            gains = gains_of(grid)
-            i = int(np.argmax(gains))
-            best = float(grid[i]) if gains[i] > gains[0] + CLEARLY_MORE * pf.s2 else np.inf
-            if np.isfinite(best) and best > 0:
-                best = _refine(gains_of, grid, gains, i, tau[:, k])
-            if best != switch[k]:
-                switch[k] = best
+            best, is_lead = _best_of_joint(pf, tau, grid, k, pf.gains(tau, grids, switch,
+                                                                       lead, k))
+            if best != switch[k] or is_lead != lead[k]:
+                switch[k], lead[k] = best, is_lead
                 changed = True
         if not changed:
             break
-    return switch
+    return switch, lead
 
 
-def _removed(pf: _PlayFit, tau: F64, grids: dict[int, F64], switch: F64) -> float:
+def _removed(pf: _PlayFit, tau: F64, grids: dict[int, F64], switch: F64,
+             lead: NDArray[np.bool_]) -> float:
     """Residual the play of all joints at ``switch`` removes together (length unit^2)."""
-    C = np.column_stack([pf.columns(tau, k, switch[k:k + 1])[:, 0] for k in grids])
+    C = np.column_stack([pf.columns(tau, k, switch[k:k + 1], bool(lead[k]))[:, 0]
+                         for k in grids])
     C = C - pf.Qbase @ (pf.Qbase.T @ C)
     cn = np.linalg.norm(C, axis=0)
     Qc = orthonormal_basis(C / np.where(cn > 0, cn, 1.0))
@@ -247,10 +294,10 @@ def _removed(pf: _PlayFit, tau: F64, grids: dict[int, F64], switch: F64) -> floa
     return float(np.sum((Qc.T @ rp) ** 2))
 
 
-def _weights(pf: _PlayFit, tau: F64, grids: dict[int, F64], switch: F64, total: float
-             ) -> Weights:
+def _weights(pf: _PlayFit, tau: F64, grids: dict[int, F64], switch: F64,
+             lead: NDArray[np.bool_], total: float) -> Weights:
     """How sure is each threshold? Profile-likelihood weights exp(-d(RSS) / 2 sigma^2), with
-    sigma^2 from the residual left after the play is modelled."""
+    sigma^2 from the residual left after the play is modelled (the approach flank as chosen)."""
     s2a = max((pf.base.rss - total) / max(pf.base.dof - len(grids), 1), 1e-30)
     dists: list[tuple[tuple[float, ...], tuple[float, ...]]] = []
     for k in range(tau.shape[1]):
@@ -260,47 +307,57 @@ def _weights(pf: _PlayFit, tau: F64, grids: dict[int, F64], switch: F64, total: 
         a = np.unique(np.abs(tau[:, k]))
         a = a[a > 0]
         cand = np.array([*a.tolist(), 0.0, float(switch[k])])
-        g = pf.gains(tau, grids, switch, k)(cand)
+        g = pf.gains(tau, grids, switch, lead, k)(cand, lead=bool(lead[k]))
         w = np.exp(-(g.max() - g) / (2.0 * s2a))
         keep = w > 1e-6 * w.max()
         dists.append((tuple(cand[keep].tolist()), tuple((w[keep] / w[keep].sum()).tolist())))
     return tuple(dists)
 
 
-def _select(pf: _PlayFit, tau: F64, sweeps: int, max_candidates: int
-            ) -> tuple[F64, float, Weights]:
-    """Thresholds per joint, the residual they remove together (length unit^2) and per
-    joint the plausible thresholds with their weights."""
+@dataclass(frozen=True)
+class _Selection:
+    """Per joint the switching torque and approach flank, the residual the play removes
+    with them (length unit^2) and the plausible thresholds with their weights."""
+
+    switch: F64
+    lead: NDArray[np.bool_]
+    gain: float
+    dists: Weights
+
+
+def _select(pf: _PlayFit, tau: F64, sweeps: int, max_candidates: int) -> _Selection:
     grids = _grids(pf, tau, max_candidates)
-    switch = _sweep(pf, tau, grids, sweeps)
+    switch, lead = _sweep(pf, tau, grids, sweeps)
     if not grids:
-        return switch, 0.0, ()
-    total = _removed(pf, tau, grids, switch)
-    return switch, total, _weights(pf, tau, grids, switch, total)
+        return _Selection(switch, lead, 0.0, ())
+    total = _removed(pf, tau, grids, switch, lead)
+    return _Selection(switch, lead, total, _weights(pf, tau, grids, switch, lead, total))
 
 
 def with_backlash_switch(ctx: Context, base: FitResult, fitting: NDArray[np.int64],
                          sweeps: int = 2, max_candidates: int = 40) -> Context:
     """Per joint, the gravity torque above which a joint with play rests on the loaded flank
-    instead of lagging against its approach direction (Coulomb friction of the load holds it
-    below). Chosen on the fitting poses by profiling on top of the current model ``base``,
-    joint by joint with the other joints' play in the model (a few coordinate sweeps): for
-    thresholds at 0, the data's |torque| values (at most ``max_candidates`` quantiles) and
-    infinity, the play fit that removes the most residual wins; infinity (the plain
-    approach-direction model) unless another threshold removes clearly more (by 25 sigma^2).
+    (Coulomb friction of the load holds it below), and which flank the approach leaves it on
+    below that (lagging or leading, eq. B1). Chosen on the fitting poses by profiling on top of
+    the current model ``base``, joint by joint with the other joints' play in the model (a few
+    coordinate sweeps): for thresholds at 0, the data's |torque| values (at most
+    ``max_candidates`` quantiles) and infinity, each with either approach flank, the play fit
+    (b >= 0, eq. B2) that removes the most residual wins; infinity and lagging (the plain
+    approach-direction model) unless another choice removes clearly more (by 25 sigma^2).
     With MJCF torques, an unknown payload at the tool (which shifts the torques) is profiled
     too, over :data:`PAYLOAD_GRID_KG`, kept when it removes clearly more (25 sigma^2)."""
     pf = _PlayFit.of(ctx, base, fitting)
     tau0 = ctx.gravity_side_torque()[fitting]
-    switch, gain, dists = _select(pf, tau0, sweeps, max_candidates)
+    sel = _select(pf, tau0, sweeps, max_candidates)
     payload = 0.0
     if ctx.gravity_torque is not None:
         h_ee = ctx.end_effector_arms()[fitting]
         to_m = metres_per_unit(ctx.model.length_unit, "model.length_unit")
         for m in PAYLOAD_GRID_KG[1:]:
-            sw_m, g_m, d_m = _select(pf, tau0 + G_STANDARD * m * h_ee * to_m, sweeps,
-                                     max_candidates)
-            if g_m > gain + CLEARLY_MORE * pf.s2:
-                switch, gain, dists, payload = sw_m, g_m, d_m, m
-    return dataclasses.replace(ctx, backlash_switch=tuple(float(v) for v in switch),
-                               backlash_switch_weights=dists or None, payload_kg=payload)
+            sel_m = _select(pf, tau0 + G_STANDARD * m * h_ee * to_m, sweeps, max_candidates)
+            if sel_m.gain > sel.gain + CLEARLY_MORE * pf.s2:
+                sel, payload = sel_m, m
+    return dataclasses.replace(ctx, backlash_switch=tuple(float(v) for v in sel.switch),
+                               backlash_switch_weights=sel.dists or None,
+                               backlash_lead=tuple(bool(v) for v in sel.lead),
+                               payload_kg=payload)

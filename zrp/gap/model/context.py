@@ -129,6 +129,10 @@ class Context:
         backlash_switch_weights: per joint, plausible switching torques and their weights
             (profile likelihood); poses whose torque lies among them get the weighted mean of
             the two flanks instead of a hard choice. None: use ``backlash_switch`` alone.
+        backlash_lead: per joint, whether a joint the approach decides rests on the leading
+            flank of its play (True: the load's inertia carries it onto the front flank as the
+            motor stops, eq. B1) instead of lagging behind the motor (False, the default:
+            the load's friction holds it back). None: lagging everywhere.
         payload_kg: a payload at the tool that the MJCF torques lack, kg (added to them for
             the backlash flank; the diagnosis profiles it).
         max_tilt_rad: the largest axis tilt a fit may accept (the domain of
@@ -146,6 +150,7 @@ class Context:
     gravity_side: F64 | None = None
     backlash_switch: tuple[float, ...] | None = None
     backlash_switch_weights: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None = None
+    backlash_lead: tuple[bool, ...] | None = None
     payload_kg: float = 0.0
     max_tilt_rad: float = DEFAULT_MAX_TILT_RAD
     orientation: OrientationWeights | None = None
@@ -163,6 +168,9 @@ class Context:
                              f"{self.model.n}), got {np.shape(self.gravity_torque)}")
         if not self.harmonics or any(int(h) < 1 for h in self.harmonics):
             raise InputError(f"harmonics: expected positive integers, got {self.harmonics}")
+        if self.backlash_lead is not None and len(self.backlash_lead) != self.model.n:
+            raise InputError(f"backlash_lead: expected {self.model.n} flags (one per joint), "
+                             f"got {len(self.backlash_lead)}")
 
     @property
     def n(self) -> int:
@@ -208,20 +216,28 @@ class Context:
 
     def backlash_basis(self) -> F64:
         """Which side of its play each joint sits on in each pose, shape (P, n), in [-1, 1] per
-        unit play: -approach direction where |gravity torque| <= the joint's
-        :attr:`backlash_switch`, else the sign of the gravity torque; with
+        unit play (eq. B1): where |gravity torque| <= the joint's :attr:`backlash_switch`, the
+        approach decides, -d (lagging) or +d (leading, :attr:`backlash_lead`) for approach
+        direction d; above it the sign of the gravity torque; with
         :attr:`backlash_switch_weights`, the weighted mean over the plausible switches."""
-        d = self.meas.approach_direction()
+        d = self.meas.approach_direction() * self.approach_flank()[None, :]
         tau = self.gravity_side_torque()
         sw = (np.full(self.n, np.inf) if self.backlash_switch is None
               else np.asarray(self.backlash_switch, dtype=float))
-        out = np.where(np.abs(tau) > sw, np.sign(tau), -d)
+        out = np.where(np.abs(tau) > sw, np.sign(tau), d)
         if self.backlash_switch_weights is not None:
             for k, (thr, w) in enumerate(self.backlash_switch_weights):
                 t = np.asarray(thr, dtype=float)
                 p_g = (np.abs(tau[:, k])[:, None] > t[None, :]) @ np.asarray(w, dtype=float)
-                out[:, k] = p_g * np.sign(tau[:, k]) - (1.0 - p_g) * d[:, k]
+                out[:, k] = p_g * np.sign(tau[:, k]) + (1.0 - p_g) * d[:, k]
         return out
+
+    def approach_flank(self) -> F64:
+        """Per joint, the side of its play a joint the approach decides rests on, per unit
+        approach direction, shape (n,): -1 lagging, +1 leading (:attr:`backlash_lead`)."""
+        if self.backlash_lead is None:
+            return -np.ones(self.n)
+        return np.where(np.asarray(self.backlash_lead, dtype=bool), 1.0, -1.0)
 
     def gravity_side_torque(self) -> F64:
         """A gravity torque per pose and joint whose sign is trusted, shape (P, n): the MJCF

@@ -14,6 +14,7 @@ from scipy.spatial.transform import Rotation
 
 from zrp.escape import md_text as _t
 from zrp.gap.analysis.where import Region, WhereAnalysis
+from zrp.gap.report.backlash import backlash_flank_text
 from zrp.gap.report.identification import identification_markdown
 from zrp.gap.report.verdict import (
     baseline_text,
@@ -172,6 +173,8 @@ def _parameters(diag: Diagnosis) -> list[str]:
         L.append(f"### {eff} (joints {_joints(diag.final_joints.get(eff, ()))})\n")
         L += _parameter_table(params, flags=flags)
         L.append("")
+        if eff == "backlash" and backlash_flank_text(diag):
+            L.append(backlash_flank_text(diag) + "\n")
     for i, st in enumerate(diag.steps, 1):
         if not math.isnan(st.geometric_overlap):
             L.append(f"Step {i} ({st.effect}): geometric overlap "

@@ -181,13 +181,17 @@ class BacklashSwitch:
         band: per joint, the range of plausible switching torques (None where modelled by the
             approach direction only).
         payload_kg: the unknown payload at the tool profiled with MJCF torques, kg.
+        lead: per joint, whether the approach leaves the load on the leading flank of its play
+            (its inertia carries it over as the motor stops) rather than lagging behind.
     """
 
     switch: tuple[float | None, ...]
     band: tuple[list[float] | None, ...]
     payload_kg: float
+    lead: tuple[bool, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         return dict_from_dataclass(self, rename={"switch": "backlash_switch",
                                                  "band": "backlash_switch_band",
-                                                 "payload_kg": "backlash_payload_kg"})
+                                                 "payload_kg": "backlash_payload_kg",
+                                                 "lead": "backlash_lead"})
