@@ -32,6 +32,8 @@ GEOMETRIC = Injection(joint_offset={2: 1e-3, 3: -8e-4}, link={3: (0.3, 0.0, -0.2
 NON_GEOMETRIC = Injection(joint_offset={2: 1e-3}, backlash={2: 5e-4},
                           compliance={2: 2e-5, 3: 3e-5}, cyclic_error={3: (1, 5e-4, 3e-4)},
                           encoder_scale={5: 4e-4})
+#: the load ahead of its approach by b/2 (its inertia carried it onto the leading flank, eq. B1)
+LEADING = Injection(joint_offset={2: 1e-3}, backlash={3: -8e-4})
 
 
 def _diagnosed(inj, seed=1):
@@ -53,7 +55,12 @@ def non_geometric():
     return _diagnosed(NON_GEOMETRIC)
 
 
-@pytest.mark.parametrize("which", ["geometric", "non_geometric"])
+@pytest.fixture(scope="module")
+def leading():
+    return _diagnosed(LEADING)
+
+
+@pytest.mark.parametrize("which", ["geometric", "non_geometric", "leading"])
 def test_round_trip_reproduces_withheld_error(which, request, withheld_residual, tmp_path):
     diag = request.getfixturevalue(which)
     cal = CalibratedRobot.from_diagnosis(diag)
@@ -68,6 +75,24 @@ def test_round_trip_reproduces_withheld_error(which, request, withheld_residual,
     # both files record the toolkit version that wrote them
     assert m.read_text().splitlines()[0] == f"# written by zrp-accuracy {zrp.__version__}"
     assert json.loads(c.read_text())["zrp_version"] == zrp.__version__
+
+
+def test_a_leading_flank_is_written_read_and_checked(leading, tmp_path):
+    assert "backlash" in leading.final_joints
+    cal = CalibratedRobot.from_diagnosis(leading)
+    assert cal.backlash_lead is not None and cal.backlash_lead[2] is True
+    _, c = write_calibration(cal, tmp_path / "cal.toml", tmp_path / "comp.json")
+    doc = json.loads(c.read_text())
+    assert doc["backlash"]["lead"][2] is True
+    assert read_calibration(c).backlash_lead == cal.backlash_lead
+    doc["backlash"]["lead"] = ["yes"] * 6
+    c.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match=r"backlash\.lead"):
+        read_calibration(c)
+    doc["backlash"]["lead"] = [True] * 5
+    c.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match="backlash_lead: 5 flags for 6 joints"):
+        read_calibration(c)
 
 
 def test_offsets_are_folded_into_the_model(geometric):

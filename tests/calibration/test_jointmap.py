@@ -5,6 +5,8 @@ compliance, backlash with and without a switching torque."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
@@ -50,6 +52,11 @@ def test_backlash_is_half_the_side_and_unknown_terms_are_refused():
     ctx = _context(True, None)
     b = term_basis(Term("q2.backlash", "backlash", 2, "rad", 8e-4), ctx)
     np.testing.assert_array_equal(b, -0.5 * ctx.meas.approach_direction()[:, 1])
+    lead = dataclasses.replace(ctx, backlash_lead=(False, True, False, False, False, False))
+    b = term_basis(Term("q2.backlash", "backlash", 2, "rad", 8e-4), lead)
+    np.testing.assert_array_equal(b, 0.5 * ctx.meas.approach_direction()[:, 1])  # eq. B1
+    with pytest.raises(InputError, match="backlash_lead: expected 6 flags"):
+        dataclasses.replace(ctx, backlash_lead=(True,))
     with pytest.raises(InputError, match=r"q2\.sin9"):
         term_basis(Term("q2.sin9", "cyclic_error", 2, "rad", 1e-4), ctx)
     with pytest.raises(InputError, match="gravity torque"):
