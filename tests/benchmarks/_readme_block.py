@@ -27,13 +27,23 @@ def _cells(cells: Sequence[str]) -> str:
 
 
 def block_text(heading: str, columns: Sequence[str], rows: Sequence[Sequence[Any]],
-               meta: dict[str, Any]) -> str:
-    """The block's text (without its markers)."""
+               meta: dict[str, Any], more: Sequence[dict[str, Any]] = ()) -> str:
+    """The block's text (without its markers); ``more``: further report sections (heading,
+    columns, rows) printed after the table, each under its heading in bold."""
     commit = meta.get("versions", {}).get("zrp", "")
     lines = [f"{heading}; generated {meta.get('date', '')} by `{meta.get('command', '')}` "
              f"(zrp {commit}):", "", _cells(columns), _cells(["---"] * len(columns)),
              *(_cells(r) for r in rows)]
+    for sec in more:
+        lines += ["", f"**{sec['heading']}**", ""]
+        lines += ([_cells(sec["columns"]), _cells(["---"] * len(sec["columns"])),
+                   *(_cells(r) for r in sec["rows"])] if sec["rows"] else ["(none)"])
     return "\n".join(lines)
+
+
+def readme_sections(meta: dict[str, Any]) -> list[dict[str, Any]]:
+    """The report's sections after the first that go into the README block too."""
+    return [sec for sec in meta.get("sections", [])[1:] if sec.get("readme")]
 
 
 def digest(text: str) -> str:
@@ -58,9 +68,10 @@ def read_block(path: Path, name: str) -> tuple[str, str] | None:
 
 def replace_block(path: Path, name: str, heading: str, columns: Sequence[str],
                   rows: Sequence[Sequence[Any]], meta: dict[str, Any]) -> None:
-    """Write block ``name`` of ``path`` (it must be there once, markers included)."""
+    """Write block ``name`` of ``path`` (it must be there once, markers included): the
+    table, then the report's sections marked ``readme`` (``meta["sections"]``)."""
     text = path.read_text(encoding="utf-8")
-    body = block_text(heading, columns, rows, meta)
+    body = block_text(heading, columns, rows, meta, readme_sections(meta))
     new = (f"<!-- generated: {name} by tests/benchmarks/{name}.py; do not edit (run it "
            f"again); sha256={digest(body)} -->\n{body}\n<!-- end generated: {name} -->")
     found = list(_pattern(name).finditer(text))

@@ -165,10 +165,12 @@ class Report:
         self.sections: list[dict[str, Any]] = []
 
     def table(self, heading: str, columns: Sequence[str], rows: Sequence[Sequence[Any]],
-              note: str = "") -> None:
-        """A table (cells printed with ``str``) under ``heading``, with an optional note."""
+              note: str = "", readme: bool = False) -> None:
+        """A table (cells printed with ``str``) under ``heading``, with an optional note;
+        ``readme``: it follows the first table in the README's generated block too."""
         self.sections.append({"heading": heading, "columns": [str(c) for c in columns],
-                              "rows": [[str(c) for c in r] for r in rows], "note": note})
+                              "rows": [[str(c) for c in r] for r in rows], "note": note,
+                              **({"readme": True} if readme else {})})
 
     def note(self, heading: str, text: str) -> None:
         """A paragraph of text under ``heading``."""

@@ -54,7 +54,8 @@ def test_the_block_is_the_reports_table(name, readme):
         pytest.skip(f"the last {name} run did not write the README (quick or elsewhere)")
     mod = _block_module()
     sec = data["sections"][0]
-    expected = mod.block_text(sec["heading"], sec["columns"], sec["rows"], data)
+    expected = mod.block_text(sec["heading"], sec["columns"], sec["rows"], data,
+                              mod.readme_sections(data))
     assert mod.read_block(readme, name)[1] == expected
 
 
