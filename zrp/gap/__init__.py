@@ -33,7 +33,7 @@ _LAZY = {
     "split_poses": "zrp.gap.data.split",
     "Injection": "zrp.gap.data.synthetic",
     "synthesize": "zrp.gap.data.synthetic",
-    "Aliased": "zrp.gap.fit.leastsq",
+    "Aliased": "zrp.gap.fit.aliasing",
     "FitResult": "zrp.gap.fit.leastsq",
     "FitWarning": "zrp.gap.fit.leastsq",
     "Metrics": "zrp.gap.fit.metrics",
@@ -72,7 +72,7 @@ if TYPE_CHECKING:  # type checkers and IDEs see the same names, imported eagerly
     from zrp.gap.data.split import split_poses as split_poses
     from zrp.gap.data.synthetic import Injection as Injection
     from zrp.gap.data.synthetic import synthesize as synthesize
-    from zrp.gap.fit.leastsq import Aliased as Aliased
+    from zrp.gap.fit.aliasing import Aliased as Aliased
     from zrp.gap.fit.leastsq import FitResult as FitResult
     from zrp.gap.fit.leastsq import FitWarning as FitWarning
     from zrp.gap.fit.metrics import Metrics as Metrics

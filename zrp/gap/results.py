@@ -28,7 +28,8 @@ from zrp.gap.analysis.checks import GapWarning as GapWarning
 from zrp.gap.analysis.identifiability import EffectIdentifiability as EffectIdentifiability
 from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.data.noise import NoiseFloor
-from zrp.gap.fit.leastsq import Aliased, FitResult
+from zrp.gap.fit.aliasing import Aliased
+from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.fit.wellposed import HeldDirection
 from zrp.gap.model.context import Context

@@ -21,7 +21,8 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.analysis.checks import GapWarning
 from zrp.gap.data.measurements import Measurements
-from zrp.gap.fit.leastsq import ALIAS_TOL, Aliased, FitResult, check_identifiable, orthonormal_basis
+from zrp.gap.fit.aliasing import ALIAS_TOL, Aliased
+from zrp.gap.fit.leastsq import FitResult, check_identifiable, orthonormal_basis
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.model.problem import Problem

@@ -7,7 +7,6 @@ from __future__ import annotations
 import warnings
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -17,18 +16,17 @@ from scipy import (
 
 from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
+from zrp.gap.fit.aliasing import Acceptance, Aliased
 from zrp.gap.fit.orientation import alias_jacobian, solve_with_orientation
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.problem import Evaluation, Problem
-from zrp.jsonio import dict_from_dataclass
 
 #: Two-sided 95 % quantile of the standard normal (the one home of the constant in zrp.gap).
 Z95 = 1.959963984540054
 
 __all__ = [
     "Z95",
-    "Aliased",
     "FitResult",
     "FitWarning",
     "check_identifiable",
@@ -44,11 +42,6 @@ __all__ = [
 ]
 
 
-#: A parameter whose Jacobian column keeps less than this fraction of its norm after
-#: projection on the other columns cannot be told apart from them (structural aliasing).
-ALIAS_TOL = 1e-6
-#: Below this fraction it is identifiable only weakly (reported, kept).
-WEAK_TOL = 1e-2
 
 
 class FitWarning(ZRPWarning):
@@ -254,28 +247,6 @@ def _fit_with_orientation(ctx: Context, prob: Problem, theta0: F64, scales: F64)
                      prob.poses, sol.converged, sol.held, sol.reason, sol.iterations, rt)
 
 
-@dataclass(frozen=True)
-class Aliased:
-    """A parameter that the data cannot tell apart from others.
-
-    Attributes:
-        name: the parameter.
-        effect: its effect.
-        partners: the parameters it trades against (largest share first).
-        fraction: share of its Jacobian column outside the span of the others (0: identical).
-        dropped: True when it was left out of the fit (structural), False when only weak.
-    """
-
-    name: str
-    effect: str
-    partners: tuple[str, ...]
-    fraction: float
-    dropped: bool
-
-    def to_dict(self) -> dict[str, Any]:
-        return dict_from_dataclass(self)
-
-
 def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[ParamSpec],
                        poses: ArrayLike | None = None) -> tuple[list[ParamSpec], list[Aliased]]:
     """Which candidate parameters the data can identify on top of ``base``.
@@ -310,43 +281,23 @@ def identifiable_start(ctx: Context, base: FitResult, candidates: Sequence[Param
     Q = orthonormal_basis(np.hstack([A, probe / np.linalg.norm(probe, axis=0)])
                           if probe.shape[1] else A)
     names = [s.name for s in specs]
-    accepted_cols = list(range(nb))
-    keep: list[ParamSpec] = []
-    report: list[Aliased] = []
     # every candidate projected off the base span at once (two passes, one matrix product each
     # instead of one matrix-vector product per candidate), then, in order, off the candidates
     # accepted before it: the same projection onto span(base, accepted)
     C = Jt[:, nb:] / np.where(norms[nb:] > 0, norms[nb:], 1.0)
     P = C - Q @ (Q.T @ C)
     P = P - Q @ (Q.T @ P)
-    Qa = np.empty((Jt.shape[0], len(candidates)))  # the accepted candidates' directions
-    na = 0
-    for i, spec in enumerate(candidates):
-        nrm = norms[nb + i]
-        if nrm <= 1e-12 * max(norms.max(), 1.0):
-            report.append(Aliased(spec.name, spec.effect, (), 0.0, True))
-            continue
-        c = C[:, i]
-        rr = P[:, i]
-        if na:
-            qa = Qa[:, :na]
-            rr = rr - qa @ (qa.T @ rr)
-            rr = rr - qa @ (qa.T @ rr)
-        frac = float(np.linalg.norm(rr))
-        if frac < WEAK_TOL:
-            acc = Jt[:, accepted_cols] / np.where(norms[accepted_cols] > 0,
-                                                 norms[accepted_cols], 1.0)
-            corr = np.abs(acc.T @ c)  # cosines between normalised columns
-            order = np.argsort(-corr)
-            partners = tuple(names[accepted_cols[o]] for o in order[:3]
-                             if corr[o] >= 0.5 * corr.max())
-            report.append(Aliased(spec.name, spec.effect, partners, frac, frac < ALIAS_TOL))
-            if frac < ALIAS_TOL:
-                continue
-        keep.append(spec)
-        accepted_cols.append(nb + i)
-        Qa[:, na] = rr / frac
-        na += 1
+    acc = Acceptance(Jt, norms, nb, names, P)
+    deferred = []
+    for i, spec in enumerate(candidates):  # pass 1: the clearly identifiable ones, in order
+        if not acc.consider(i, spec, defer_weak=True):
+            deferred.append(i)
+    for i in deferred:  # pass 2: the weak ones against all of them (near gauges drop here)
+        acc.consider(i, candidates[i], defer_weak=False)
+    order = sorted(range(len(acc.keep)), key=lambda j: acc.keep_index[j])
+    keep = [acc.keep[j] for j in order]
+    report = sorted(acc.report, key=lambda a: acc.index_of[a.name])
+    accepted_cols = list(range(nb)) + sorted(nb + acc.keep_index[j] for j in order)
     return keep, report, Evaluation(prob.poses, theta[accepted_cols], r, J[:, accepted_cols])
 
 

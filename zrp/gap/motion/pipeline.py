@@ -18,7 +18,8 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.arrays import F64, I64
 from zrp.blas import blas_threads
 from zrp.errors import InputError
-from zrp.gap.fit.leastsq import ALIAS_TOL, initial_registration, point_errors
+from zrp.gap.fit.aliasing import ALIAS_TOL
+from zrp.gap.fit.leastsq import initial_registration, point_errors
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.model.context import EFFECTS, Context
 from zrp.gap.model.effects import registration_parameters

@@ -20,9 +20,9 @@ from zrp.arrays import F64
 from zrp.gap.analysis.checks import GapWarning
 from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.identifiability import GEOMETRIC, geometric_overlap
+from zrp.gap.fit.aliasing import Aliased
 from zrp.gap.fit.constrained import n_registration, within_domains
 from zrp.gap.fit.leastsq import (
-    Aliased,
     FitResult,
     cv_rms,
     f_test,

@@ -13,8 +13,9 @@ from typing import Any
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.fit.aliasing import Aliased
 from zrp.gap.fit.leastsq import Z95 as Z95
-from zrp.gap.fit.leastsq import Aliased, FitResult
+from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.fit.uncertainty import simultaneous_z
 from zrp.gap.model.context import EFFECTS
