@@ -93,6 +93,19 @@ def test_a_leading_flank_is_written_read_and_checked(leading, tmp_path):
     c.write_text(json.dumps(doc))
     with pytest.raises(InputError, match="backlash_lead: 5 flags for 6 joints"):
         read_calibration(c)
+    # a version-1 file (0.3.0) has no leading flanks: read as lagging, and a lead in it refused
+    doc["schema_version"] = 1
+    del doc["backlash"]["lead"]
+    c.write_text(json.dumps(doc))
+    assert read_calibration(c).backlash_lead is None
+    doc["backlash"]["lead"] = list(cal.backlash_lead)
+    c.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match="backlash.lead in a schema_version 1 file"):
+        read_calibration(c)
+    doc["schema_version"] = 3
+    c.write_text(json.dumps(doc))
+    with pytest.raises(InputError, match="schema_version 3, expected one of 1, 2"):
+        read_calibration(c)
 
 
 def test_offsets_are_folded_into_the_model(geometric):

@@ -81,6 +81,21 @@ def chain(model: Manipulator, x: F64, scale: F64 | None = None) -> tuple[F64, F6
     return pos, np.array(r), pts, axes
 
 
+def _joint_terms(fit: FitResult, model: Manipulator) -> tuple[F64, list[Term], float]:
+    """The revolute offsets to fold (n,), the joint-map terms and kappa of a fit."""
+    delta = np.zeros(model.n)
+    terms: list[Term] = []
+    kappa = 0.0
+    for s, v, se in zip(fit.specs, fit.theta, fit.stderr, strict=True):
+        if s.kind == "thermal":
+            kappa = float(v)
+        elif s.kind == "dq" and s.effect == "joint_offset" and not model.prismatic[s.joint - 1]:
+            delta[s.joint - 1] = float(v)
+        elif s.kind == "dq" and s.effect in NON_GEOMETRIC:
+            terms.append(Term(s.name, s.effect, s.joint, s.unit, float(v), float(se)))
+    return delta, terms, kappa
+
+
 @dataclass(frozen=True)
 class PoseConditions:
     """What the joint map needs besides the commanded joint values (P poses, n joints).
@@ -204,18 +219,7 @@ class CalibratedRobot:
         u, _, bodies = prob.geometry(theta)
         tools = prob.tool_offsets(theta)
         rb, tb = prob.base(theta)
-        n = ctx.n
-        delta = np.zeros(n)
-        terms: list[Term] = []
-        kappa = 0.0
-        for s, v, se in zip(fit.specs, theta, fit.stderr, strict=True):
-            if s.kind == "thermal":
-                kappa = float(v)
-            elif s.kind == "dq" and s.effect == "joint_offset" and not ctx.model.prismatic[
-                    s.joint - 1]:
-                delta[s.joint - 1] = float(v)
-            elif s.kind == "dq" and s.effect in NON_GEOMETRIC:
-                terms.append(Term(s.name, s.effect, s.joint, s.unit, float(v), float(se)))
+        delta, terms, kappa = _joint_terms(fit, ctx.model)
         folded, tools_f = _fold(ctx.model, u, bodies, delta, tools)
         bl = None if registration_only else diag.where.backlash
         return cls(folded, ctx.model, rb, tb, tuple(ctx.meas.point_labels), tools_f, delta,

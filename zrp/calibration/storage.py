@@ -1,7 +1,8 @@
 """Write and read a calibrated robot: a model TOML (geometry) and a compensation JSON.
 
-The compensation file (``schema_version`` 1, lengths in the model's ``length_unit``, angles
-in rad) holds everything the model file cannot: the nominal model, the instrument-from-base
+The compensation file (``schema_version`` 2, lengths in the model's ``length_unit``, angles
+in rad; version 1, written by 0.3.0 and earlier, is read too: it has no ``backlash.lead``, so
+every joint lags behind its approach) holds everything the model file cannot: the nominal model, the instrument-from-base
 transform, the tool points in full, the folded offsets, the joint map, thermal expansion,
 the backlash flank model and, after a full-pose fit, the probe rotation and noise weights;
 its keys are documented in zrp/calibration/README.md.
@@ -33,7 +34,9 @@ from zrp.version import __version__
 __all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "model_file_path",
            "read_calibration", "write_calibration"]
 
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
+#: the versions this reader understands (1: no ``backlash.lead``)
+READABLE_VERSIONS = (1, 2)
 
 
 def full_pose_document(fp: FullPoseFit | None,
@@ -197,9 +200,14 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
         raise InputError(f"{src}: cannot read the compensation file: {exc}") from exc
     if not isinstance(doc, dict):
         raise InputError(f"{src}: expected a JSON object")
-    if doc.get("schema_version") != SCHEMA_VERSION:
-        raise InputError(f"{src}: schema_version {doc.get('schema_version')!r}, expected "
-                         f"{SCHEMA_VERSION}")
+    if doc.get("schema_version") not in READABLE_VERSIONS:
+        raise InputError(f"{src}: schema_version {doc.get('schema_version')!r}, expected one "
+                         f"of {', '.join(map(str, READABLE_VERSIONS))} (a file from a newer "
+                         f"zrp-accuracy? zrp_version {doc.get('zrp_version')!r})")
+    bl = doc.get("backlash")
+    if doc.get("schema_version") == 1 and isinstance(bl, dict) and "lead" in bl:
+        raise InputError(f"{src}: backlash.lead in a schema_version 1 file (version 1 has "
+                         f"no leading flanks)")
     mpath = (model_file_path(comp_path, _get(doc, "model_file", src),
                              allow_outside=allow_outside)
              if model_path is None else Path(model_path))
