@@ -17,7 +17,7 @@ from zrp.gap.fit.uncertainty import simultaneous_z
 from zrp.gap.fit.wellposed import solve
 from zrp.gap.model.domains import domain_violations, parameter_domain
 from zrp.gap.model.problem import Problem
-from zrp.gap.report import diagnosis_document, verdict_text
+from zrp.gap.report import diagnosis_document, report_markdown, verdict_text
 from zrp.kinematics.identification import axis_tangents
 
 TILT = (3, 0, 1.5e-3)           # joint 3's axis tilted 1.5 mrad towards its first tangent
@@ -84,6 +84,21 @@ def test_positions_only_holds_the_unpinned_directions_and_names_them(ur_position
     assert doc["identification"]["held_directions"][0]["parameters"] == list(h.parameters)
     assert doc["identification"]["solver"]["converged"] is True
     assert "stayed at their nominal values" in verdict_text(d)
+
+
+def test_positions_only_names_the_held_tilt_by_the_distal_axis(ur_positions):
+    """The held direction is a common tilt of axes 1-5 in the fit's parameters (which carry
+    no tilt of axis 6); the name a reader sees says which axis turns against which, then the
+    solver's loadings, unchanged."""
+    _m, d = ur_positions
+    h = d.held_directions[0]
+    assert {f"u{k}.t2" for k in range(1, 6)} <= set(h.parameters)
+    assert not any(n.startswith("u6.") for n in h.parameters)
+    assert h.reading.startswith("axis 6 tilted against axes 1-5")
+    assert h.label == f"{h.reading}: {h.combination}"
+    assert h.label in verdict_text(d)
+    assert diagnosis_document(d)["identification"]["held_directions"][0]["reading"] == h.reading
+    assert f"| {h.label} |" in report_markdown(d)
 
 
 def test_positions_only_orientation_no_worse_than_nominal(ur_positions):

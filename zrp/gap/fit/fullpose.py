@@ -37,6 +37,7 @@ from scipy.spatial.transform import Rotation
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.constrained import n_registration
+from zrp.gap.fit.heldname import tilt_reading
 from zrp.gap.fit.leastsq import FitResult, FitWarning, fit, initial_registration
 from zrp.gap.fit.orientation import (
     orientation_residual,
@@ -183,7 +184,7 @@ def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
             so = float(np.sqrt(np.sum(e ** 2) / max(e.size - 3, 1))) or 1e-9
     r, J = both(x, so)
     sol = solve(lambda v, s=so: both(v, s), lambda v, s=so: both(v, s)[0], x, prior, scales,
-                names, start=(r, J))
+                names, start=(r, J), reading=tilt_reading(ctx, specs, scales))
     x, cov = sol.theta, sol.cov
     if not sol.converged:
         warnings.warn(f"least squares with {len(names)} parameters (full pose): {sol.reason}",

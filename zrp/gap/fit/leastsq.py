@@ -17,6 +17,7 @@ from scipy import (
 from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
 from zrp.gap.fit.aliasing import Acceptance, Aliased
+from zrp.gap.fit.heldname import tilt_reading
 from zrp.gap.fit.orientation import alias_jacobian, solve_with_orientation
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
@@ -225,7 +226,8 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
     if orientation and ctx.orientation is not None:
         return _fit_with_orientation(ctx, prob, theta0, scales)
     sol = solve(prob.residual_and_jacobian, prob.residual, theta0, prior_values(specs, theta0),
-                scales, [s.name for s in specs], start=at0)
+                scales, [s.name for s in specs], start=at0,
+                reading=tilt_reading(ctx, specs, scales))
     if not sol.converged:
         warnings.warn(f"least squares with {len(specs)} parameters: {sol.reason}", FitWarning,
                       stacklevel=2)

@@ -12,6 +12,7 @@ from scipy.spatial.transform import Rotation
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.fit.heldname import tilt_reading
 from zrp.gap.fit.wellposed import Solution, prior_values, solve
 from zrp.gap.model.context import Context, OrientationWeights
 from zrp.gap.model.problem import Problem
@@ -135,7 +136,8 @@ def solve_with_orientation(ctx: Context, prob: Problem, theta0: F64, scales: F64
     names = [s.name for s in prob.specs] + ["probe.rx", "probe.ry", "probe.rz"]
     sol = solve(both, lambda v: both(v)[0], np.concatenate([theta0, np.zeros(3)]),
                 np.concatenate([prior_values(prob.specs, theta0), np.zeros(3)]),
-                np.concatenate([scales, np.ones(3)]), names)
+                np.concatenate([scales, np.ones(3)]), names,
+                reading=tilt_reading(ctx, prob.specs, scales))
     return sol, Rotation.from_rotvec(sol.theta[prob.size:]).as_matrix() @ rt0
 
 

@@ -81,6 +81,9 @@ class HeldDirection:
             that one tolerance along the direction changes).
         threshold: the noise it fell below (sigma per coordinate, length unit).
         exact: True when it is (numerically) not seen at all (a gauge or structural alias).
+        reading: the same direction in the arm's terms, e.g. "axis 6 tilted against axes
+            1-5" for a common tilt of axes 1-5 (:mod:`zrp.gap.fit.heldname`); "" when the
+            loadings are its only name.
     """
 
     parameters: tuple[str, ...]
@@ -88,6 +91,7 @@ class HeldDirection:
     singular_value: float
     threshold: float
     exact: bool
+    reading: str = ""
 
     @property
     def combination(self) -> str:
@@ -98,12 +102,17 @@ class HeldDirection:
             out += f"{' ' if i else ''}{sign}{' ' if i else ''}{abs(w):.2f} {n}"
         return out
 
+    @property
+    def label(self) -> str:
+        """The name a reader sees: the reading (when there is one), then the combination."""
+        return f"{self.reading}: {self.combination}" if self.reading else self.combination
+
     def describe(self, unit: str) -> str:
-        """One line: the combination and why it was held."""
+        """One line: the direction (:attr:`label`) and why it was held."""
         why = ("not seen by these data at all" if self.exact else
                f"singular value {self.singular_value:.3g} {unit} per tolerance <= the noise "
                f"{self.threshold:.3g} {unit}: the data pin it less well than the tolerance")
-        return f"{self.combination} ({why})"
+        return f"{self.label} ({why})"
 
     def to_dict(self) -> dict[str, Any]:
         return {**dict_from_dataclass(self), "combination": self.combination}
@@ -161,14 +170,15 @@ def prior_values(specs: Sequence[ParamSpec], theta0: F64) -> F64:
 
 
 def _held(vt: F64, s: F64, keep: NDArray[np.bool_], names: Sequence[str], tau: float,
-          exact_tol: float) -> tuple[HeldDirection, ...]:
+          exact_tol: float, reading: Callable[[F64], str] | None = None
+          ) -> tuple[HeldDirection, ...]:
     out = []
     for i in np.flatnonzero(~keep):
         v = vt[i] * (1.0 if vt[i][np.argmax(np.abs(vt[i]))] > 0 else -1.0)
         order = [j for j in np.argsort(-np.abs(v)) if abs(v[j]) >= 0.1][:6]
         out.append(HeldDirection(tuple(names[j] for j in order),
                                  tuple(float(v[j]) for j in order), float(s[i]), float(tau),
-                                 bool(s[i] <= exact_tol)))
+                                 bool(s[i] <= exact_tol), reading(v) if reading else ""))
     return tuple(out)
 
 
@@ -228,7 +238,8 @@ def _line_search(evaluate: Callable[[F64], tuple[F64, F64]],
 def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], F64],
           theta0: F64, prior: F64, scales: F64, names: Sequence[str], *,
           start: tuple[F64, F64] | None = None,
-          max_iterations: int = MAX_ITERATIONS) -> Solution:
+          max_iterations: int = MAX_ITERATIONS,
+          reading: Callable[[F64], str] | None = None) -> Solution:
     """Minimise |r(theta)|^2 + sigma^2 |x|^2 by the Gauss-Newton steps of eq. W4, the
     directions at or below the noise held at the prior (eq. W2).
 
@@ -239,6 +250,8 @@ def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], 
         scales: d_j (p,), > 0.
         names: the parameters' names (for the held directions).
         start: (r, J) at theta0 when already known.
+        reading: a held direction (tolerance units) -> its name in the arm's terms
+            (:func:`zrp.gap.fit.heldname.tilt_reading`); only the description, no number.
     """
     theta = np.array(theta0, dtype=float)
     r, J = start if start is not None else evaluate(theta)
@@ -272,6 +285,7 @@ def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], 
     if reason != "converged":  # the decomposition at theta is not at hand
         _, _, s, Vt, _, tau = _decompose(r, J, scales, tau_fixed)
         keep = s > tau
-    held = _held(Vt, s, keep, names, tau, RANK_RTOL * float(s[0]) if s.size else 0.0)
+    held = _held(Vt, s, keep, names, tau, RANK_RTOL * float(s[0]) if s.size else 0.0,
+                 reading)
     return Solution(theta, r, J, _covariance(r, s, Vt, keep, scales), held, converged, it,
                     reason)

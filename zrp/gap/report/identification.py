@@ -31,7 +31,7 @@ def identification_markdown(diag: Diagnosis) -> list[str]:
         L.append("| held combination (tolerance units) | singular value | noise | seen at "
                  "all |")
         L.append("|---|---|---|---|")
-        L += [f"| {h.combination} | {h.singular_value:.3g} {u} | {h.threshold:.3g} {u} | "
+        L += [f"| {h.label} | {h.singular_value:.3g} {u} | {h.threshold:.3g} {u} | "
               f"{'no' if h.exact else 'weakly'} |" for h in held]
         L.append("")
     else:

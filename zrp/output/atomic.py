@@ -1,0 +1,104 @@
+"""Atomic writes (part of :mod:`zrp.output`): each file appears whole or not at all. It is
+written under a temporary name in the same folder and moved into place with
+:func:`os.replace` (atomic on POSIX and Windows), so an interrupted run never leaves half a
+CSV behind; and :func:`claim_generated`, which marks a command's default folder as generated
+output."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+from zrp.errors import InputError, OutputExistsError
+from zrp.output.paths import as_path, check_regular, check_writable, make_folder
+
+__all__ = ["GENERATED_MARK", "atomic_path", "claim_generated", "write_bytes", "write_json",
+           "write_text"]
+
+#: Mark of a folder created for generated output (the commands' default folders, such as
+#: ``renders/``): see :func:`claim_generated`.
+GENERATED_MARK = ".zrp-generated"
+#: Longest suffix the temporary file keeps (so writers that infer the format from it can).
+_SUFFIX_MAX = 16
+
+
+@contextlib.contextmanager
+def atomic_path(path: str | os.PathLike[str], *, overwrite: bool = False) -> Iterator[Path]:
+    """A temporary file name beside ``path`` (same suffix, so writers can infer the format);
+    on a clean exit it is moved onto ``path`` in one step, on an error it is removed.
+
+    Raises:
+        OutputExistsError: ``path`` exists and ``overwrite`` is False.
+        InputError: the folder cannot be created or written.
+    """
+    (p,) = check_writable([path], overwrite)
+    make_folder(p.parent)
+    suffix = p.suffix if len(p.suffix) <= _SUFFIX_MAX else ""
+    tmp = p.with_name(f".zrp-{os.getpid()}-{time.monotonic_ns()}.tmp{suffix}")
+    try:
+        yield tmp
+        if not tmp.exists():
+            raise InputError(f"{p}: the writer produced no file")
+        # checked again: a link or a device may have appeared while we were writing
+        if check_regular(p) and not overwrite:
+            raise OutputExistsError([p])
+        os.replace(tmp, p)
+    except OSError as exc:
+        if isinstance(exc, OutputExistsError):
+            raise
+        raise InputError(f"{p}: cannot write ({exc.strerror or exc})") from exc
+    finally:
+        with contextlib.suppress(OSError):
+            tmp.unlink()
+
+
+def write_text(path: str | os.PathLike[str], text: str, *, overwrite: bool = False) -> Path:
+    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically; returns the path."""
+    with atomic_path(path, overwrite=overwrite) as tmp:
+        tmp.write_text(text, encoding="utf-8", newline="\n")
+    return Path(path)
+
+
+def write_bytes(path: str | os.PathLike[str], data: bytes, *, overwrite: bool = False) -> Path:
+    """Write ``data`` to ``path`` atomically; returns the path."""
+    with atomic_path(path, overwrite=overwrite) as tmp:
+        tmp.write_bytes(data)
+    return Path(path)
+
+
+def write_json(path: str | os.PathLike[str], obj: Any, *, overwrite: bool = False,
+               indent: int | None = 2) -> Path:
+    """Write ``obj`` as strict JSON (:func:`zrp.jsonio.dumps`: no NaN) atomically."""
+    from zrp.jsonio import dumps  # NumPy: on use, so that `zrp --help` does not load it
+
+    return write_text(path, dumps(obj, indent), overwrite=overwrite)
+
+
+def claim_generated(folder: str | os.PathLike[str]) -> bool:
+    """May files in ``folder`` be replaced as generated output, without ``overwrite``?
+
+    True when the folder is missing or empty (it is created and marked now with
+    :data:`GENERATED_MARK`) or carries the mark; False for a folder that holds files but not
+    the mark, such as a ``renders/`` the user made in the working directory: its files are
+    then replaced only with ``overwrite=True``. Commands call this for their default folders
+    only.
+    """
+    root = as_path(folder, "folder")
+    if root.is_dir():
+        if (root / GENERATED_MARK).is_file():
+            return True
+        try:  # an empty folder (dot files aside) has nothing to lose: claimed
+            if any(not p.name.startswith(".") for p in root.iterdir()):
+                return False
+        except OSError:
+            return False
+    elif root.exists():
+        return False  # a file: OutputDir/check_writable say why it cannot be written
+    make_folder(root)
+    write_text(root / GENERATED_MARK, "Generated output of zrp: files here are replaced by "
+               "the next run of the command that wrote them.\n", overwrite=True)
+    return True
