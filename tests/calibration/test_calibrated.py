@@ -100,7 +100,7 @@ def test_a_leading_flank_is_written_read_and_checked(leading, tmp_path):
     assert read_calibration(c).backlash_lead is None
     doc["backlash"]["lead"] = list(cal.backlash_lead)
     c.write_text(json.dumps(doc))
-    with pytest.raises(InputError, match="backlash.lead in a schema_version 1 file"):
+    with pytest.raises(InputError, match=r"backlash\.lead in a schema_version 1 file"):
         read_calibration(c)
     doc["schema_version"] = 3
     c.write_text(json.dumps(doc))

@@ -2,10 +2,10 @@
 
 The compensation file (``schema_version`` 2, lengths in the model's ``length_unit``, angles
 in rad; version 1, written by 0.3.0 and earlier, is read too: it has no ``backlash.lead``, so
-every joint lags behind its approach) holds everything the model file cannot: the nominal model, the instrument-from-base
-transform, the tool points in full, the folded offsets, the joint map, thermal expansion,
-the backlash flank model and, after a full-pose fit, the probe rotation and noise weights;
-its keys are documented in zrp/calibration/README.md.
+every joint lags behind its approach) holds everything the model file cannot: the nominal
+model, the instrument-from-base transform, the tool points in full, the folded offsets, the
+joint map, thermal expansion, the backlash flank model and, after a full-pose fit, the probe
+rotation and noise weights; its keys are documented in zrp/calibration/README.md.
 """
 
 from __future__ import annotations
