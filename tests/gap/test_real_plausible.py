@@ -21,7 +21,7 @@ def test_final_model_is_inside_every_physical_domain(irb120_real):
     assert not any(o["effect"] == "backlash" for o in doc["identification"]["outside_domain"])
     lead = d.where["backlash_lead"]
     assert all(lead[k - 1] for k in d.final_joints["backlash"])
-    assert "on the leading flank after the approach" in backlash_flank_text(d)
+    assert "ahead of the approach, on the leading flank" in backlash_flank_text(d)
 
 
 def test_no_fit_stopped_early_and_final_beats_the_geometric_calibration(irb120_real):

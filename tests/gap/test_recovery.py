@@ -20,6 +20,7 @@ from mjcf.gravity import gravity_torques as gravity_torques_mjcf
 from zrp.gap import Injection, Measurements, diagnose, synthesize
 from zrp.gap.data.synthetic import _gravity_torque
 from zrp.gap.report import verdict_text
+from zrp.gap.report.backlash import backlash_flank_text
 from zrp.kinematics import uniform_joint_values
 
 SIGMA = 0.02  # mm, per coordinate
@@ -320,3 +321,26 @@ def test_gravity_torques_from_mjcf(tmp_path):
     np.testing.assert_allclose(tau[:, 0], 2 * 9.81 * 0.5 * np.cos(q[:, 0]), atol=1e-9)
     with pytest.raises(zrp.InputError, match="2 joints"):
         gravity_torques_mjcf(str(p), np.zeros((3, 2)))
+
+
+def test_a_leading_flank_below_the_switch_is_recovered_and_reported():
+    """The load rests ahead of its approach where friction holds it (its inertia carried it
+    over), on the loaded flank above the switching torque (eq. B1): the flank, the switch and
+    the play are profiled together, and the report says where the joint rests."""
+    rng = np.random.default_rng(14)
+    q = uniform_joint_values(PUMA, 300, rng)
+    tau = _gravity_torque(PUMA, q, MASSES, np.array([0.0, 0.0, -1.0]))
+    friction = float(np.quantile(np.abs(tau[:, 2]), 0.5))
+    inj = Injection(backlash={3: 8e-4}, backlash_friction={3: friction},
+                    backlash_lead=frozenset({3}), masses=MASSES)
+    meas = synthesize(PUMA, q, inj, rng=rng, noise_sigma=SIGMA)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = diagnose(PUMA, meas, gravity_torque=tau, seed=0)
+    assert d.top_effect == "backlash" and d.steps[0].joints == (3,)
+    _check_values(d, {"q3.backlash": 8e-4})
+    assert d.where["backlash_lead"][2] is True
+    assert 0.9 * friction < d.where["backlash_switch"][2] < 1.1 * friction
+    text = backlash_flank_text(d)
+    assert "joint 3: on the flank gravity loads where |gravity torque| >" in text
+    assert "N m, below that ahead of the approach, on the leading flank" in text

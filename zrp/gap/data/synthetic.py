@@ -41,6 +41,8 @@ class Injection:
         backlash_friction: N m per joint (with ``backlash``): where the gravity torque of
             ``masses`` exceeds it, the joint rests on the loaded flank instead of lagging
             against its approach direction.
+        backlash_lead: joints (with ``backlash``) that the approach leaves b/2 ahead, on the
+            leading flank, instead of lagging (eq. B1 of :mod:`zrp.gap.fit.profiles`).
         cyclic_error: per joint, (harmonic h, sin amplitude rad, cos amplitude rad).
         compliance: rad per (N m) per joint; deflection = c tau with tau the gravity torque of
             the point masses ``masses``.
@@ -56,6 +58,7 @@ class Injection:
     backlash: Mapping[int, float] = field(default_factory=dict)
     backlash_gravity: Mapping[int, float] = field(default_factory=dict)
     backlash_friction: Mapping[int, float] = field(default_factory=dict)
+    backlash_lead: frozenset[int] = frozenset()
     cyclic_error: Mapping[int, tuple[int, float, float]] = field(default_factory=dict)
     compliance: Mapping[int, float] = field(default_factory=dict)
     masses: Mapping[str, float] = field(default_factory=lambda: {"p3": 8.0, "p5": 4.0,
@@ -109,7 +112,8 @@ def _actual_joint_values(model: Manipulator, q: F64, inj: Injection) -> F64:
         for k, v in inj.backlash.items():
             f = inj.backlash_friction.get(k, np.inf)
             t = tau_b[:, k - 1]
-            qa[:, k - 1] += 0.5 * v * np.where(np.abs(t) > f, np.sign(t), -d[:, k - 1])
+            side = 1.0 if k in inj.backlash_lead else -1.0
+            qa[:, k - 1] += 0.5 * v * np.where(np.abs(t) > f, np.sign(t), side * d[:, k - 1])
     for k, (h, a, b) in inj.cyclic_error.items():
         qa[:, k - 1] += a * np.sin(h * q[:, k - 1]) + b * np.cos(h * q[:, k - 1])
     if inj.compliance or inj.backlash_gravity:

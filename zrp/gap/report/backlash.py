@@ -12,9 +12,10 @@ __all__ = ["backlash_flank_text"]
 
 
 def _side(switch: float | None, lead: bool, unit: str) -> str:
-    side = ("on the leading flank after the approach (the load's inertia carried it over as "
-            "the motor stopped)" if lead else
-            "lagging behind the approach (the load's friction held it back)")
+    side = ("ahead of the approach, on the leading flank (as when the load's inertia carries "
+            "it over while the motor stops)" if lead else
+            "behind the approach, on the lagging flank (as when the load's friction holds it "
+            "back)")
     if switch is None or not math.isfinite(switch):
         return side
     if switch == 0.0:
