@@ -16,8 +16,9 @@ Steps:
 4. candidate effects (:mod:`sim.dynamics.effects`) chosen by forward selection on the
    out-of-segment chi^2 (:mod:`sim.dynamics.select`, eq. S1);
 5. the chosen effects refitted on the whole log with physical bounds and 95 % intervals
-   (:mod:`sim.dynamics.fit`, eq. F2); link inertial parameters made physically consistent
-   (eq. R5) through the directions the log cannot see (:mod:`sim.dynamics.feasible`);
+   (:mod:`sim.dynamics.fit`, eq. F2); link inertial parameters, when chosen, fitted
+   physically consistent by construction (log-Cholesky, :mod:`sim.dynamics.physical`,
+   eq. P1) jointly with the other effects, and the withheld error is that of this fit;
 6. "cannot tell": a joint effect whose regressor column is (almost) a multiple of another's
    on the same joint along this log (e.g. Coulomb friction and a torque offset when the joint
    never reverses), or (almost) zero (the joint never moves or accelerates).
@@ -32,9 +33,9 @@ from scipy.signal import savgol_coeffs, savgol_filter
 
 from sim.dynamics.arm import Arm
 from sim.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, payload_columns
-from sim.dynamics.feasible import feasible_inertias
 from sim.dynamics.fit import design, solve
 from sim.dynamics.inertial import gravity_torques, inverse_dynamics
+from sim.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
 from sim.dynamics.regimes import regime_masks, regime_rms
 from sim.dynamics.select import Step, forward_select
 from zrp.arrays import F64
@@ -115,8 +116,10 @@ class DynamicDiagnosis:
         effects: the chosen effects, in order of choice.
         cannot_tell: what this log cannot separate, in words.
         regimes: {"before"|"after": {regime: [rms or None per joint]}}.
-        inertial_feasible: None (no inertial fit), True, or False before shrinking.
-        inertial_shrink: the factor the inertial correction was shrunk by (1: none).
+        inertial_fit: the physically consistent link inertia fit (None: no inertial effect
+            chosen), with how far it is from the unconstrained one
+            (:class:`sim.dynamics.physical.InertialFit`).
+        inertial_phi: phi_b (eq. R1) of each moving body after it.
         notes: what else the user should know.
     """
 
@@ -129,8 +132,7 @@ class DynamicDiagnosis:
     effects: list[FoundEffect]
     cannot_tell: list[str]
     regimes: dict[str, dict[str, list[float | None]]]
-    inertial_feasible: bool | None = None
-    inertial_shrink: float = 1.0
+    inertial_fit: InertialFit | None = None
     inertial_phi: dict[int, F64] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
     samples: Samples | None = None
@@ -227,28 +229,29 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
                                          max_effects=opt.max_effects)
     d = design(chosen, *b.shape)
     fit = solve(d, b, sigma)
-    found, feasible, shrink, phi = [], None, 1.0, {}
-    for i, (e, sl) in enumerate(zip(chosen, d.slices, strict=True)):
-        theta = fit.theta[sl]
-        if e.name == "inertial":
-            feasible, shrink, phi = feasible_inertias(arm, theta, e.basis)
-        found.append(FoundEffect(e.key, e.name, e.joint, e.detail,
-                                 _params(e, theta, fit.cov[sl, sl], fit.at_bound[sl]),
-                                 steps[i].chi2 - steps[i + 1].chi2))
+    values, inert = fit.theta, None
+    if any(e.name == "inertial" for e in chosen):
+        # physical by construction (eq. P1); the withheld error is that of the physical fit
+        inert = physical_fit(arm, chosen, b, sigma)
+        values = inert.theta
+        pred, _ = physical_cross_validate(arm, chosen, b, sigma, opt.folds, guard)
+    at_bound = np.isclose(values, d.lower) | np.isclose(values, d.upper)
+    found = [FoundEffect(e.key, e.name, e.joint, e.detail,
+                         _params(e, values[sl], fit.cov[sl, sl], at_bound[sl]),
+                         steps[i].chi2 - steps[i + 1].chi2)
+             for i, (e, sl) in enumerate(zip(chosen, d.slices, strict=True))]
     masks = regime_masks(s.qd, gravity_torques(arm.model, s.q), guard)
     notes = [f"accelerations by Savitzky-Golay, window {s.window_s:.3g} s; fit at "
              f"{1.0 / (stride * log.dt):.4g} Hz"]
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
             "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
-    if feasible is False:
-        notes.append("the minimum-norm link inertias were not physical; made so through the "
-                     "parameter directions the log cannot see" + (
-                         "" if shrink == 1.0 else f", then shrunk to {shrink:.0%} of the "
-                         "correction (no physical set found otherwise)"))
+    if inert is not None:
+        notes.append(inert.describe())
     return DynamicDiagnosis(
         arm.name, arm.joint_names, sigma, np.sqrt(np.mean(b_raw**2, 0)),
         np.sqrt(np.mean((b_raw - pred) ** 2, 0)), steps, found,
         ties + _cannot_tell([e for e in effects if e.name in JOINT_EFFECTS], sigma,
                             opt.collinear),
         {"before": regime_rms(b_raw, masks), "after": regime_rms(b_raw - pred, masks)},
-        feasible, shrink, phi, notes, Samples(s.t, s.q, s.qd, b_raw, b_raw - pred))
+        inert, {} if inert is None else inert.phi, notes,
+        Samples(s.t, s.q, s.qd, b_raw, b_raw - pred))

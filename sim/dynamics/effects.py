@@ -65,6 +65,7 @@ class Effect:
     upper: F64
     detail: str = ""
     basis: tuple[F64, F64] | None = None  # "inertial": (V, scale) of eq. R4
+    full: F64 | None = None  # "inertial": the full regressor Y (S, n, 10 B) of eq. R2
 
     @property
     def key(self) -> str:
@@ -150,7 +151,7 @@ def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,
         r = v.shape[1]
         out.append(Effect("inertial", None, yb, tuple(f"beta{i + 1}" for i in range(r)),
                           ("(scaled)",) * r, np.full(r, -inf), np.full(r, inf),
-                          basis=(v, scale)))
+                          basis=(v, scale), full=y))
     return out
 
 

@@ -21,7 +21,7 @@ from scipy.optimize import lsq_linear
 from sim.dynamics.effects import Effect
 from zrp.arrays import F64
 
-__all__ = ["Design", "Fit", "cross_validate", "design", "solve"]
+__all__ = ["Design", "Fit", "cross_validate", "design", "lag_one", "solve"]
 
 
 @dataclass(frozen=True)
@@ -90,14 +90,14 @@ def solve(d: Design, b: F64, sigma: F64, rows: np.ndarray | None = None,
     if not with_cov or p == 0:
         return Fit(theta, np.zeros((p, p)), 0.0, at_bound)
     r = (bw - aw @ x).reshape(-1, b.shape[1])
-    rho = _lag_one(r)
+    rho = lag_one(r)
     dof = max(bw.size - p, 1)
     s2 = float(r.ravel() @ r.ravel()) / dof
     cov_x = s2 * np.linalg.pinv(aw.T @ aw, rcond=1e-12) * (1 + rho) / (1 - rho)
     return Fit(theta, cov_x / np.outer(scale, scale), rho, at_bound)
 
 
-def _lag_one(r: F64) -> float:
+def lag_one(r: F64) -> float:
     """The residual's lag-one autocorrelation (over time, pooled over joints), in [0, 0.99]."""
     if r.shape[0] < 3:
         return 0.0

@@ -28,8 +28,8 @@ from sim.dynamics.arm import Arm
 from zrp.arrays import F64
 
 __all__ = ["PARAM_NAMES", "V_EPS", "base_directions", "body_params", "gravity_torques",
-           "inverse_dynamics", "pseudo_inertia_min", "pseudo_inertia_ok", "regressor",
-           "set_body_params"]
+           "inverse_dynamics", "pseudo_inertia", "pseudo_inertia_min", "pseudo_inertia_ok",
+           "regressor", "set_body_params"]
 
 #: Velocity scale of the smoothed sign function tanh(qd / V_EPS) of Coulomb friction, rad/s.
 V_EPS = 0.01
@@ -76,14 +76,19 @@ def set_body_params(m: mujoco.MjModel, b: int, phi: F64) -> None:
     m.body_inertia[b] = w
 
 
-def pseudo_inertia_min(phi: F64) -> float:
-    """The smallest eigenvalue of phi_b's pseudo-inertia J (eq. R5)."""
+def pseudo_inertia(phi: F64) -> F64:
+    """phi_b's pseudo-inertia J = [[tr(I)/2 1 - I, h], [h^T, m]] (eq. R5), shape (4, 4)."""
     i = _inertia_matrix(phi)
     j = np.zeros((4, 4))
     j[:3, :3] = 0.5 * np.trace(i) * np.eye(3) - i
     j[:3, 3] = j[3, :3] = phi[1:4]
     j[3, 3] = phi[0]
-    return float(np.linalg.eigvalsh(j).min())
+    return j
+
+
+def pseudo_inertia_min(phi: F64) -> float:
+    """The smallest eigenvalue of phi_b's pseudo-inertia J (eq. R5)."""
+    return float(np.linalg.eigvalsh(pseudo_inertia(phi)).min())
 
 
 def pseudo_inertia_ok(phi: F64) -> bool:

@@ -123,13 +123,22 @@ def _figure(d: DynamicDiagnosis, which: str, xlabel: str) -> Any:
     return fig, plt
 
 
+def _inertial_fit(d: DynamicDiagnosis) -> dict[str, Any] | None:
+    """The physical link inertia fit's figures (its values are under effects and
+    inertial_phi)."""
+    f = d.inertial_fit
+    if f is None:
+        return None
+    return {**{k: v for k, v in asdict(f).items() if k not in ("theta", "phi")},
+            "matched": f.matched, "summary": f.describe()}
+
+
 def diagnosis_json(d: DynamicDiagnosis, extra: dict[str, Any] | None = None) -> dict:
     out = {"arm": d.arm, "joints": d.joints, "noise_nm": d.noise_nm,
            "rms_before_nm": d.rms_before, "rms_after_withheld_nm": d.rms_after,
            "steps": [asdict(s) for s in d.steps],
            "effects": [asdict(e) for e in d.effects], "cannot_tell": d.cannot_tell,
-           "regimes": d.regimes, "inertial_feasible": d.inertial_feasible,
-           "inertial_shrink": d.inertial_shrink,
+           "regimes": d.regimes, "inertial_fit": _inertial_fit(d),
            "inertial_phi": {str(b): v for b, v in d.inertial_phi.items()}, "notes": d.notes}
     return to_jsonable({**out, **(extra or {})})
 

@@ -1,9 +1,11 @@
-"""Physically consistent link inertias with the identified base combinations kept.
+"""The post-hoc repair the physical fit replaced (sim/dynamics/feasible.py before the
+log-Cholesky fit), kept here only as the reference it is compared against: physically
+consistent link inertias with the identified base combinations kept.
 
 The fit fixes only the identifiable combinations V^T dphi_s = beta (eq. R4, dphi_s: the change
 of the scaled parameters); the rest of dphi_s (the null space N of V^T) the log cannot see and
 is free. The minimum-norm choice (N z = 0) can leave a link with a non-physical pseudo-inertia
-(eq. R5); then z is chosen to make every link physical (eq. P1)::
+(eq. R5); then z is chosen to make every link physical (eq. H1)::
 
     min_z |z|^2  subject to  lambda_min(J_b(phi(z))) >= eps_b  for every link b
 
