@@ -253,7 +253,7 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
 
 
 def _lead(value: Any, src: str) -> tuple[bool, ...] | None:
-    """backlash.lead: null (lagging everywhere; files before 0.3.1) or one true/false per
+    """backlash.lead: null (lagging everywhere; files before 0.4.0) or one true/false per
     joint."""
     if value is None:
         return None
