@@ -331,3 +331,22 @@ def test_measure_and_diagnose_share_the_backlash_definition(tmp_path):
     assert d.top_effect == "backlash"
     p = d.parameter("q1.backlash")
     assert p.value == pytest.approx(8e-4, rel=0.05)
+
+
+def test_a_joint_gravity_loads_one_way_is_named_as_hiding_a_play():
+    """Where the MJCF gravity torque keeps one sign in every pose, a play held on the loaded
+    flank is a constant shift of the joint: the verdict says these data cannot tell it from
+    the joint's offset (and which poses would)."""
+    inj = Injection(joint_offset={2: 5e-4})
+    m = _meas(inj, n=120)
+    tau = _gravity_torque(PUMA, m.q_pose, inj.masses, np.array([0.0, 0.0, -1.0]))
+    tau[:, 1] = -np.abs(tau[:, 1]) - 1.0  # joint 2 loaded one way throughout
+    tau[:, 2] = np.abs(tau[:, 2]) + 1.0  # and joint 3 the other way
+    d = _quiet(PUMA, m, gravity_torque=tau, seed=0)
+    assert d.assessment.one_sided == (2, 3)
+    assert diagnosis_document(d)["one_sided_gravity_joints"] == [2, 3]
+    assert "Gravity loads joint(s) 2-3 one way in every pose" in verdict_text(d)
+    free = _quiet(PUMA, m, gravity_torque=_gravity_torque(
+        PUMA, m.q_pose, inj.masses, np.array([0.0, 0.0, -1.0])), seed=0)
+    assert 2 not in free.assessment.one_sided and 3 not in free.assessment.one_sided
+    assert _quiet(PUMA, m, seed=0).assessment.one_sided == ()  # no MJCF: nothing claimed

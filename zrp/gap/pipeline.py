@@ -339,4 +339,13 @@ def _assess(ctx: Context, baseline: GeometricBaseline, choice: FinalChoice, fina
     frame = registration_of(final, se, cov, ctx.meas.point_labels, ctx.model.length_unit)
     return Assessment(baseline, frame, correlations(names, cov), se, implausible, unexcited,
                       remainder_evidence(ctx, final, where_final), resolution, choice,
-                      compliance_units(ctx))
+                      compliance_units(ctx), _one_sided(ctx))
+
+
+def _one_sided(ctx: Context) -> tuple[int, ...]:
+    """Joints whose MJCF gravity torque keeps one sign (never 0) in every pose."""
+    if ctx.gravity_torque is None:
+        return ()
+    tau = ctx.gravity_side_torque()
+    return tuple(k + 1 for k in range(ctx.n)
+                 if np.all(tau[:, k] > 0.0) or np.all(tau[:, k] < 0.0))

@@ -195,6 +195,9 @@ class Assessment:
         compliance: the unit of ``joint_compliance`` and why (:func:`compliance_units`).
         choice: which model is final - the search's, or the geometric calibration when the
             search's is worse on the withheld poses (:mod:`zrp.gap.analysis.fallback`).
+        one_sided: joints whose MJCF gravity torque keeps one sign in every pose: a play that
+            gravity holds on its loaded flank there shifts the joint by a constant, which these
+            data cannot tell from its offset (empty without MJCF torques).
     """
 
     baseline: GeometricBaseline
@@ -207,9 +210,11 @@ class Assessment:
     resolution: float
     choice: FinalChoice | None = None
     compliance: dict[str, Any] | None = None
+    one_sided: tuple[int, ...] = ()
 
     def to_dict(self) -> dict[str, Any]:
         return dict_from_dataclass(self, exclude=("stderr",), rename={
             "baseline": "geometric_baseline", "frame": "registration_full",
             "correlations": "correlation", "unexcited": "unexcited_joints",
-            "choice": "final_model", "compliance": "compliance_units"})
+            "choice": "final_model", "compliance": "compliance_units",
+            "one_sided": "one_sided_gravity_joints"})

@@ -138,6 +138,11 @@ def _trust(diag: Diagnosis) -> list[str]:
     if a.unexcited:
         parts.append(f"These data leave joint(s) {_ranges(a.unexcited)} unidentifiable for "
                      "scale, cyclic error and backlash (they barely move).")
+    if a.one_sided:
+        parts.append(f"Gravity loads joint(s) {_ranges(a.one_sided)} one way in every pose: a "
+                     "play that gravity holds on its loaded flank there shifts the joint by a "
+                     "constant, which these data cannot tell from its offset (poses where that "
+                     "torque reverses would).")
     return parts
 
 
