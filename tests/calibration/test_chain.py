@@ -33,15 +33,18 @@ ARMS = {  # folder, file in example-robot-data's robots/, and the import's optio
 #: 10 urad/(N m) is a stiffness of 1e5 N m/rad, in the range of harmonic-drive and cycloid
 #: joints of arms this size; under the shoulder's gravity torque (URDF inertias: up to 121 N m on
 #: the UR10, 32 on the xArm7, 57 on the Panda) it sags up to 1.2, 0.3 and 0.6 mrad, 1.6, 0.24
-#: and 0.52 mm at the tool: well above the 0.02 mm noise, and 6x (xArm7) to 50x (UR10) the
-#: compliance's predicted std in a 40-pose plan.
+#: and 0.52 mm at the tool: well above the 0.02 mm noise, and 3.6x (xArm7) to 33x (UR10) the
+#: compliance's predicted std in the 20-pose plan.
 HIDDEN = ["joint_offset:2=0.5mrad", "joint_offset:3=-0.4mrad", "link_length:3=0.1,0.2,-0.1mm",
           "joint_compliance:2=10urad/Nm"]
-#: Poses planned. 40, the fewest measured to hold on every arm: with 30 the xArm7 and the
-#: Panda end 2-6x the noise (four measurement seeds), because the diagnosis fits 3/4 of the
-#: poses with 30-40 parameters (registration, offsets, link vectors, axis tilts, compliance)
-#: and its backward pass then drops correlated groups together (see the report).
-POSES = 40
+#: Poses planned: 20, the fewest that held on every arm for four measurement seeds (1.12-1.28x
+#: the noise, the compliance named every time; 24, 30, 35 and 40 held too). With 16 the xArm7
+#: ended 1.5-2.8x the noise: the diagnosis fits 3/4 of the poses and meets 30-40 parameters
+#: (registration, offsets, link vectors, axis tilts, the compliance and its payload term) that
+#: stand in for one another on a 7-joint arm. Planned without --mjcf (for geometry only, or on
+#: lumped masses), 20 and 24 poses left the Panda 5x the noise on one seed of four and the
+#: xArm7 up to 1.54x.
+POSES = 20
 RATIO = 1.5
 
 
@@ -70,9 +73,9 @@ def test_plan_to_verify_on_an_unseen_urdf(tmp_path, capsys, arm):
     assert np.all(q_plan >= model.lower) and np.all(q_plan <= model.upper)  # within limits
     assert all(p["std"] < 1.0 for p in plan["parameters"])  # none unidentifiable left in
     # the compliance planned on the URDF's gravity torques (the diagnosis's basis), and the
-    # plan pins it: its predicted std is well below the hidden value
+    # plan pins it: the hidden value is more than 3 predicted standard deviations
     std = {p["name"]: p["std"] for p in plan["parameters"]}
-    assert 0.0 < std["q2.compliance"] < 10e-6 / 5
+    assert 0.0 < std["q2.compliance"] < 10e-6 / 3
 
     hidden = [a for spec in HIDDEN for a in ("--effect", spec)]
     meas = _run(capsys, ["measure", "--model", model_file, "--poses", str(tmp_path / "plan.csv"),
