@@ -8,6 +8,8 @@ import warnings
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
+
     import numpy as np
 
     from zrp.model.manipulator import Manipulator
@@ -40,6 +42,13 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "+-2.5 rad)")
     p.add_argument("--floor", type=FINITE, metavar="Z", help="keep every joint and tool point "
                    "above z = Z (base frame, length unit)")
+    p.add_argument("--mjcf", metavar="FILE",
+                   help="MJCF, or the arm's shipped URDF, with the robot's inertias: "
+                        "joint_compliance (and backlash's gravity side) is planned on its "
+                        "gravity torques, the basis zrp diagnose --mjcf fits (without it: "
+                        "lumped unit masses on the joints, the basis of a diagnosis without "
+                        "--mjcf); its joints named as the model's, or one hinge/slide joint "
+                        "per model joint, same order and zero")
     p.add_argument("--tool", nargs=3, type=FINITE, action="append", metavar=("X", "Y", "Z"),
                    help="a tool point offset (repeat per reflector; default the end point)")
     p.add_argument("--noise", type=LENGTH, default=None, metavar="SIGMA",
@@ -51,7 +60,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print the prediction as JSON")
     p.set_defaults(func=_run, api_names={"n_poses": "--poses", "floor_z": "--floor",
                                          "limits": "--limits", "effects": "--effects",
-                                         "noise_sigma": "--noise"})
+                                         "noise_sigma": "--noise",
+                                         "gravity_torque_fn": "--mjcf"})
 
 
 def _limits(text: str | None, model: Manipulator, deg: bool) -> np.ndarray | None:
@@ -85,6 +95,19 @@ def _check_limits(lim: np.ndarray, pairs: list[str]) -> None:
                          "planned pose would be the same; give at least one joint a range")
 
 
+def _gravity(path: str | None, model: Manipulator) -> Callable[[np.ndarray], np.ndarray] | None:
+    """q (C, n) -> the gravity torques (C, n) of the file ``path`` (N m), as zrp diagnose
+    --mjcf computes them (the file's joints read through the model's joint names), or None.
+    A file that does not load or whose joints do not match is a named error (InputError)."""
+    if path is None:
+        return None
+    # mjcf loads MuJoCo (+0.25 s): only when --mjcf is given, never for `zrp --help`
+    from mjcf.gravity import gravity_torques
+
+    names = [j.name for j in model.joints]
+    return lambda q: gravity_torques(path, q, field="--mjcf", joint_names=names)
+
+
 def _run(args: argparse.Namespace) -> int:
     import numpy as np  # on use: keeps --help quick
 
@@ -94,13 +117,14 @@ def _run(args: argparse.Namespace) -> int:
 
     check_writable([args.out], args.force)
     model = load_model(args.model)
+    tau_fn = _gravity(args.mjcf, model)
     with warnings.catch_warnings(record=True) as wl:
         warnings.simplefilter("always")
         plan = plan_poses(model, args.poses, args.effects, rng=np.random.default_rng(args.seed),
                           limits=_limits(args.limits, model, args.deg),
                           tool_points=args.tool or ((0.0, 0.0, 0.0),), floor_z=args.floor,
                           noise_sigma=args.noise,  # None: a tracker's 20 um in the model's unit
-                          candidates=args.candidates)
+                          candidates=args.candidates, gravity_torque_fn=tau_fn)
     path = write_plan(plan, model, args.out, deg=args.deg, overwrite=args.force)
     lines = [f"{p}: predicted std {s:.3g} {u}"
              for p, s, u in zip(plan.names, plan.std, plan.units, strict=True)]
@@ -108,11 +132,14 @@ def _run(args: argparse.Namespace) -> int:
               "others, in every pose); not planned"
               for p in plan.unidentifiable]
     lines += [f"warning: {w.message}" for w in wl]
+    if args.mjcf is not None and {"joint_compliance", "backlash"} & set(args.effects):
+        lines.append(f"gravity torques from {args.mjcf} (the basis of zrp diagnose --mjcf)")
     lines += [f"log det per pose: {plan.log_det:.4g} (random start {plan.log_det_random:.4g})",
               f"wrote {path}"]
     payload = {"parameters": [{"name": p, "std": s, "unit": u} for p, s, u in
                               zip(plan.names, plan.std, plan.units, strict=True)],
                "unidentifiable": list(plan.unidentifiable), "log_det": plan.log_det,
-               "log_det_random": plan.log_det_random, "warnings": [str(w.message) for w in wl]}
+               "log_det_random": plan.log_det_random, "gravity_torques": args.mjcf,
+               "warnings": [str(w.message) for w in wl]}
     emit(args, payload, "\n".join(lines))
     return 0
