@@ -4,7 +4,8 @@ Every module in ``zrp/cli/commands/`` defines ``register(subparsers)``, which ad
 sets ``func`` (called with the parsed namespace, returning an exit code). Errors derived from
 :class:`zrp.ZRPError` are printed as one clear line (exit code 2) instead of a traceback, and
 every warning as one line ``zrp CMD: warning: ...`` (:func:`one_line_warnings`), the same in
-every command.
+every command; output closed early (``zrp fk --json | head -c 10``) ends quietly with status
+141 (:mod:`zrp.cli.pipes`).
 
 Registration stays light: a command module imports its numerical code (SciPy, numba, MuJoCo,
 Matplotlib, Dask) inside the function that runs it, so ``zrp --help`` and ``zrp CMD --help``
@@ -27,6 +28,7 @@ from typing import Any, TextIO
 
 from zrp import __version__
 from zrp.cli import commands
+from zrp.cli.pipes import CLOSED_EXIT, closed_output
 from zrp.cli.signals import handling
 from zrp.errors import OutputExistsError, ZRPError
 from zrp.packages import PackageShadowedError, check_own_packages
@@ -117,6 +119,23 @@ def _interrupt(signum: int, frame: object) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command ``argv`` (default ``sys.argv[1:]``); returns its exit code: 0, 2 for an
+    error (one line on stderr), 130 when interrupted, 141 when its output was closed early
+    (``zrp measure ... | head -1``: no traceback, :mod:`zrp.cli.pipes`)."""
+    try:
+        code = _run(argv)
+        # a pipe closed early fails on this flush, inside the try, not in the interpreter's
+        # final flush (the recipe of the signal module's documentation)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        return code
+    except BrokenPipeError:
+        if not closed_output():
+            raise
+        return CLOSED_EXIT
+
+
+def _run(argv: Sequence[str] | None) -> int:
     try:  # the commands import mjcf and sim: another package of either name must not shadow them
         check_own_packages()
     except PackageShadowedError as exc:
