@@ -67,6 +67,13 @@ def test_an_error_into_a_closed_pipe_2_and_1(tmp_path):
     assert res.returncode == CLOSED_EXIT
 
 
+def test_a_command_started_with_stdout_closed(tmp_path):
+    # `zrp fk >&-`: Python sets sys.stdout to None and print writes nothing; not an error
+    res = subprocess.run(["sh", "-c", f"exec {sys.executable} -m zrp fk --q 0 0 0 0 0 0 >&-"],
+                         stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=ENV, timeout=300)
+    assert res.returncode == 0 and res.stderr == "", res.stderr
+
+
 def test_a_broken_pipe_elsewhere_is_not_hidden(tmp_path):
     # stdout open and read: a BrokenPipeError from inside the command (a subprocess, a
     # connection) is not the reader going away and still shows as the failure it is

@@ -126,8 +126,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         code = _run(argv)
         # a pipe closed early fails on this flush, inside the try, not in the interpreter's
         # final flush (the recipe of the signal module's documentation)
-        sys.stdout.flush()
-        sys.stderr.flush()
+        for stream in (sys.stdout, sys.stderr):
+            if stream is not None:  # None: started with the descriptor closed (`>&-`)
+                stream.flush()
         return code
     except BrokenPipeError:
         if not closed_output():
