@@ -1,6 +1,7 @@
 """A command whose output is closed early (``zrp fk --json | head -c 10``) ends without a
-traceback and with status 141 (128 + SIGPIPE), in every command: ``zrp.cli.app.main``
-handles it once (``zrp.cli.pipes``). Each command runs in a fresh interpreter whose stdout
+traceback and with status 141 (128 + SIGPIPE), in every command, and one whose output is on a
+full device (``> /dev/full``) says so in one line: ``zrp.cli.app.main`` handles both once
+(``zrp.cli.streams``). Each command runs in a fresh interpreter whose stdout
 is a pipe whose reader has already gone: the same as ``| head`` having exited, without a race."""
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from zrp.cli.pipes import CLOSED_EXIT
+from zrp.cli.streams import CLOSED_EXIT
 
 pytestmark = pytest.mark.skipif(sys.platform == "win32", reason="POSIX pipes")
 
@@ -88,14 +89,39 @@ def test_a_broken_pipe_elsewhere_is_not_hidden(tmp_path):
 
 def test_the_closed_stream_is_pointed_at_devnull(tmp_path):
     # the recipe: after the handler, fd 1 is os.devnull, so the final flush cannot fail
-    code = ("import os, sys\nfrom zrp.cli.pipes import closed_output\n"
+    code = ("import os, sys\nfrom zrp.cli.streams import closed_output\n"
             "ok = closed_output()\nnull = os.stat(os.devnull)\nst = os.fstat(1)\n"
             "sys.exit(0 if ok and (st.st_rdev, st.st_ino) == (null.st_rdev, null.st_ino) "
             "else 3)")
     res = _closed_pipe_run([sys.executable, "-c", code], tmp_path)
     assert res.returncode == 0, res.stderr
     with open(tmp_path / "out.txt", "w") as fh:  # an open file: nothing was closed
-        res = subprocess.run([sys.executable, "-c", "from zrp.cli.pipes import closed_output\n"
+        res = subprocess.run([sys.executable, "-c", "from zrp.cli.streams import closed_output\n"
                               "import sys\nsys.exit(5 if closed_output() else 0)"],
                              stdout=fh, stderr=subprocess.PIPE, text=True, env=ENV, timeout=300)
     assert res.returncode == 0, res.stderr
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/full"), reason="Linux's /dev/full")
+@pytest.mark.parametrize("argv", [["fk", "--q", "0", "0", "0", "0", "0", "0", "--json"],
+                                  ["models"]])
+def test_output_on_a_full_device_is_one_line(argv, tmp_path):
+    with open("/dev/full", "w") as full:
+        res = subprocess.run([sys.executable, "-m", "zrp", *argv], stdout=full,
+                             stderr=subprocess.PIPE, text=True, cwd=tmp_path, env=ENV,
+                             timeout=300)
+    assert res.returncode == 2
+    assert res.stderr == (f"zrp {argv[0]}: error: cannot write the output (No space left on "
+                          "device)\n")
+
+
+def test_another_os_error_is_not_hidden(tmp_path):
+    # only a device's errors (no space, quota, I/O) are the environment's; any other OSError
+    # escaping a command is unexpected and keeps its traceback
+    code = ("import sys\nfrom zrp.cli.commands import kin\n"
+            "def boom(args):\n    raise PermissionError(13, 'Permission denied')\n"
+            "kin._fk = boom\nfrom zrp.cli.app import main\n"
+            "sys.exit(main(['fk', '--q', '0', '0', '0', '0', '0', '0']))")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=tmp_path, env=ENV, timeout=300)
+    assert res.returncode == 1 and "PermissionError" in res.stderr
