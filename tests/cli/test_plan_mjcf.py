@@ -7,6 +7,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 import zrp
 from mjcf.gravity import gravity_torques
@@ -95,3 +96,39 @@ def test_a_file_that_is_not_the_arm_is_named_and_nothing_written(tmp_path, capsy
                          "joint_compliance", "--mjcf", str(tmp_path / "none.urdf"),
                          "--out", str(out)], code=2)
     assert "--mjcf" in err and not out.exists()
+
+
+
+@pytest.mark.parametrize("effects", [["joint_offset"], ["joint_offset", "link_length"],
+                                     ["backlash"], ["joint_offset", "backlash"]])
+def test_mjcf_without_joint_compliance_is_refused_by_name(tmp_path, capsys, effects):
+    # no effect planned on gravity torques: the file would be read and change nothing (as
+    # zrp import --base for an MJCF or zrp diagnose --workers on one file, it is refused)
+    xml = tmp_path / "puma.xml"
+    assert main(["mjcf", "--model", "puma", "--inertia", "rods", "--out", str(xml)]) == 0
+    capsys.readouterr()
+    out = tmp_path / "plan.csv"
+    argv = ["plan", "--model", "puma", "--poses", "12", "--candidates", "100", "--out",
+            str(out), "--mjcf", str(xml), "--effects", *effects]
+    err = _plan(capsys, argv, code=2)
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.startswith("zrp plan: error: --mjcf: only with joint_compliance in --effects")
+    assert f"--effects {' '.join(effects)} uses no torques" in err
+    assert not out.exists()
+    # with joint_compliance the same file is used: its basis, not the lumped masses'
+    res = _plan(capsys, [*argv, "joint_compliance"])
+    names = [p["name"] for p in res["parameters"]] + res["unidentifiable"]
+    assert "q2.compliance" in names and not any(".w_" in n for n in names)
+
+
+def test_backlash_is_planned_without_the_torques():
+    # why backlash alone does not take --mjcf: its predicted std is the same with any torques
+    model = zrp.load_model("puma")
+    rng = np.random.default_rng(3)
+    q = uniform_joint_values(model, 40, rng, default_limits(model))
+    d = rng.choice([-1.0, 1.0], size=q.shape)
+    tau = 100.0 * rng.standard_normal(q.shape)  # N m: large enough to set any gravity side
+    names, s0 = design_std(model, q, d, ["backlash"])
+    names_t, s1 = design_std(model, q, d, ["backlash"], gravity_torque=tau)
+    assert names == names_t and any(".backlash" in n for n in names)
+    np.testing.assert_array_equal(s0, s1)

@@ -4,7 +4,8 @@ Every module in ``zrp/cli/commands/`` defines ``register(subparsers)``, which ad
 sets ``func`` (called with the parsed namespace, returning an exit code). Errors derived from
 :class:`zrp.ZRPError` are printed as one clear line (exit code 2) instead of a traceback, and
 every warning as one line ``zrp CMD: warning: ...`` (:func:`one_line_warnings`), the same in
-every command.
+every command; output closed early (``zrp fk --json | head -c 10``) ends quietly with status
+141, and a full device is one line too (:mod:`zrp.cli.streams`).
 
 Registration stays light: a command module imports its numerical code (SciPy, numba, MuJoCo,
 Matplotlib, Dask) inside the function that runs it, so ``zrp --help`` and ``zrp CMD --help``
@@ -28,6 +29,7 @@ from typing import Any, TextIO
 from zrp import __version__
 from zrp.cli import commands
 from zrp.cli.signals import handling
+from zrp.cli.streams import CLOSED_EXIT, closed_output, device_error
 from zrp.errors import OutputExistsError, ZRPError
 from zrp.packages import PackageShadowedError, check_own_packages
 
@@ -117,6 +119,29 @@ def _interrupt(signum: int, frame: object) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command ``argv`` (default ``sys.argv[1:]``); returns its exit code: 0, 2 for an
+    error (one line on stderr), 130 when interrupted, 141 when its output was closed early
+    (``zrp measure ... | head -1``: no traceback, :mod:`zrp.cli.streams`)."""
+    try:
+        code = _run(argv)
+        _flush_output()
+        return code
+    except BrokenPipeError:
+        if not closed_output():
+            raise
+        return CLOSED_EXIT
+
+
+def _flush_output() -> None:
+    """Flush stdout and stderr: a pipe closed early or a full device fails here, inside
+    ``main``'s handlers, not in the interpreter's final flush (the recipe of the signal
+    module's documentation)."""
+    for stream in (sys.stdout, sys.stderr):
+        if stream is not None:  # None: started with the descriptor closed (`>&-`)
+            stream.flush()
+
+
+def _run(argv: Sequence[str] | None) -> int:
     try:  # the commands import mjcf and sim: another package of either name must not shadow them
         check_own_packages()
     except PackageShadowedError as exc:
@@ -131,9 +156,17 @@ def main(argv: Sequence[str] | None = None) -> int:
         # SIGTERM (a batch scheduler's time limit, `kill`) stops a command like Ctrl-C: it
         # closes its cluster and keeps what it saves when stopped (a Monte Carlo checkpoint)
         with handling(signal.SIGTERM, _interrupt), one_line_warnings(f"zrp {args.command}"):
-            return int(args.func(args) or 0)
+            code = int(args.func(args) or 0)
+            _flush_output()
+            return code
     except ZRPError as exc:
         msg = cli_message(exc, getattr(args, "api_names", None))
+        print(f"zrp {args.command}: error: {msg}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # a full disk under stdout (`> /dev/full`): one line, not a traceback
+        msg = device_error(exc)
+        if msg is None:
+            raise
         print(f"zrp {args.command}: error: {msg}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:  # pragma: no cover

@@ -44,11 +44,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "above z = Z (base frame, length unit)")
     p.add_argument("--mjcf", metavar="FILE",
                    help="MJCF, or the arm's shipped URDF, with the robot's inertias: "
-                        "joint_compliance (and backlash's gravity side) is planned on its "
-                        "gravity torques, the basis zrp diagnose --mjcf fits (without it: "
-                        "lumped unit masses on the joints, the basis of a diagnosis without "
-                        "--mjcf); its joints named as the model's, or one hinge/slide joint "
-                        "per model joint, same order and zero")
+                        "joint_compliance is planned on its gravity torques, the basis zrp "
+                        "diagnose --mjcf fits (without it: lumped unit masses on the joints, "
+                        "the basis of a diagnosis without --mjcf); its joints named as the "
+                        "model's, or one hinge/slide joint per model joint, same order and "
+                        "zero. Only with joint_compliance in "
+                        "--effects (refused otherwise: it would change nothing)")
     p.add_argument("--tool", nargs=3, type=FINITE, action="append", metavar=("X", "Y", "Z"),
                    help="a tool point offset (repeat per reflector; default the end point)")
     p.add_argument("--noise", type=LENGTH, default=None, metavar="SIGMA",
@@ -95,6 +96,19 @@ def _check_limits(lim: np.ndarray, pairs: list[str]) -> None:
                          "planned pose would be the same; give at least one joint a range")
 
 
+def _refuse_unused_mjcf(args: argparse.Namespace) -> None:
+    """``--mjcf`` without ``joint_compliance``, the one effect planned on its gravity torques
+    (backlash is planned on the approach directions alone: no switching torque is known before
+    the diagnosis, so its plan is the same with or without them): the file would be read and
+    change nothing, so it is refused by name, as other commands refuse an option that does
+    nothing (``zrp diagnose --workers`` on one file, ``zrp import --base`` for an MJCF)."""
+    if args.mjcf is not None and "joint_compliance" not in args.effects:
+        raise InputError("--mjcf: only with joint_compliance in --effects (planned on the "
+                         "file's gravity torques; backlash is planned on the approach "
+                         f"directions alone); --effects {' '.join(args.effects)} uses no "
+                         "torques: drop --mjcf, or add joint_compliance")
+
+
 def _gravity(path: str | None, model: Manipulator) -> Callable[[np.ndarray], np.ndarray] | None:
     """q (C, n) -> the gravity torques (C, n) of the file ``path`` (N m), as zrp diagnose
     --mjcf computes them (the file's joints read through the model's joint names), or None.
@@ -115,6 +129,7 @@ def _run(args: argparse.Namespace) -> int:
     from zrp.calibration.planfile import write_plan  # on use: keeps --help quick
     from zrp.model.files import load_model  # on use: keeps --help quick
 
+    _refuse_unused_mjcf(args)
     check_writable([args.out], args.force)
     model = load_model(args.model)
     tau_fn = _gravity(args.mjcf, model)
@@ -132,7 +147,7 @@ def _run(args: argparse.Namespace) -> int:
               "others, in every pose); not planned"
               for p in plan.unidentifiable]
     lines += [f"warning: {w.message}" for w in wl]
-    if args.mjcf is not None and {"joint_compliance", "backlash"} & set(args.effects):
+    if args.mjcf is not None:
         lines.append(f"gravity torques from {args.mjcf} (the basis of zrp diagnose --mjcf)")
     lines += [f"log det per pose: {plan.log_det:.4g} (random start {plan.log_det_random:.4g})",
               f"wrote {path}"]
