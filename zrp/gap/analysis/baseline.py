@@ -51,6 +51,8 @@ class GeometricBaseline:
         fit: the geometric calibration's fit (registration + base set; the final model when
             the search's model does not beat it on the withheld poses, see
             :mod:`zrp.gap.analysis.fallback`).
+        combined_fit: the fit of geometric + non-geometric (None with ``combined``; the final
+            model when it clearly beats both others on the withheld poses, same module).
     """
 
     n_parameters: int
@@ -61,6 +63,7 @@ class GeometricBaseline:
     n_non_geometric: int
     combined: Metrics | None
     fit: FitResult | None = field(default=None, compare=False, repr=False)
+    combined_fit: FitResult | None = field(default=None, compare=False, repr=False)
 
     @property
     def increment(self) -> float | None:
@@ -116,9 +119,9 @@ def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
     nreg = len(reg.specs)
     non_geo = [s for s in final.specs[nreg:] if s.effect not in KINEMATIC]
     effects = tuple(dict.fromkeys(s.effect for s in non_geo))
-    combined, n_ng = None, 0
+    combined, n_ng, both = None, 0, None
     if non_geo:
         both, n_ng, _ = _on_top(ctx, base, non_geo, fitting, rb0)
         combined = _withheld(ctx, both, withheld)
     return GeometricBaseline(n_geo, n_drop, _withheld(ctx, base, withheld),
-                             cv_rms(ctx, base, folds), effects, n_ng, combined, base)
+                             cv_rms(ctx, base, folds), effects, n_ng, combined, base, both)

@@ -118,9 +118,12 @@ def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
                  f"{w.max:.4g} | {st.cv_rms:.4g} | {st.p_value:.2g} | {st.bic_delta:.1f} |")
     fin = diag.final
     a = diag.assessment
-    fell_back = a is not None and a.choice is not None and a.choice.fell_back
-    what = ("the geometric calibration (the search's model was worse on withheld poses)"
-            if fell_back else "final model after pruning")
+    source = "search" if a is None or a.choice is None else a.choice.source
+    what = {"geometric_baseline": "the geometric calibration (the search's model was worse "
+                                  "on withheld poses)",
+            "search": "final model after pruning"}.get(
+        source, "the geometric calibration + the search's non-geometric effects (clearly "
+                "better than both on withheld poses)")
     L.append(f"| final | {what}: {final_effects_text(diag) or 'none'} | | "
              f"{fin.rms:.4g} | {fin.p95:.4g} | {fin.max:.4g} | | | |")
     if a is not None:
