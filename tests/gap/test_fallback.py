@@ -82,12 +82,11 @@ def test_search_model_kept_when_it_beats_the_baseline():
     _not_worse_than_baseline(d)
 
 
-def test_the_combination_is_final_when_the_search_stops_early(tmp_path):
+def stopped_early_panda() -> tuple[zrp.gap.Diagnosis, list[warnings.WarningMessage]]:
     """A 7-axis Panda with geometric errors on five joints (offsets, two body vectors, two axis
-    tilts) and a cyclic error of joint 2, 60 poses, and a search allowed two steps: it finds
-    the cyclic error and one geometric effect, so its model misses the other geometric errors
-    and the geometric calibration misses the cyclic error; the geometric calibration plus the
-    search's cyclic error explains all and is final (seeds 1-8 of these data all end so)."""
+    tilts) and a cyclic error of joint 2, 60 poses, and a search allowed two steps: the
+    diagnosis and the warnings it raised (the combination is final on seeds 1-8 of these data;
+    tests/calibration/test_calibrated.py uses it too)."""
     panda = panda_mdh()
     rng = np.random.default_rng(1)
     lo, hi = np.array(PANDA_LIMITS).T
@@ -99,6 +98,15 @@ def test_the_combination_is_final_when_the_search_stops_early(tmp_path):
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         d = diagnose(panda, m, seed=0, max_steps=2)
+    return d, caught
+
+
+def test_the_combination_is_final_when_the_search_stops_early(tmp_path):
+    """The search (two steps, :func:`stopped_early_panda`) finds the cyclic error and one
+    geometric effect, so its model misses the other geometric errors and the geometric
+    calibration misses the cyclic error; the geometric calibration plus the search's cyclic
+    error explains all and is final."""
+    d, caught = stopped_early_panda()
     assert any("so the final model is that combination" in str(w.message) for w in caught)
     a, ch = d.assessment, d.assessment.choice
     assert ch.source == COMBINED and not ch.fell_back and ch.n_candidates == 3

@@ -205,8 +205,9 @@ class FinalChoice:
                 f"complete geometric calibration ({self.baseline_rms:.4g} {unit}) is as good on "
                 f"the withheld poses as {self._combined_words(unit)}: a clear difference, "
                 f"{two} is {self.combined_ratio:.3g}x worse (paired z = {self.combined_z:.2g}); "
-                "the search stopped before it had added every geometric error, while the "
-                "non-geometric effects it found are real; so the final model is that "
+                "the search stopped before it had added every geometric error (or took a "
+                "step these data do not support), and the non-geometric effects it found hold "
+                "on top of a complete geometric calibration; so the final model is that "
                 f"combination {self._optimistic()}.")
 
     def to_dict(self) -> dict[str, Any]:

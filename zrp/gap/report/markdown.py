@@ -144,7 +144,8 @@ def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
     if a is not None:
         L.append(baseline_text(diag) + "\n")
     L.append(f"Steps 1..{len(diag.steps)} show each effect as it was added; the final row is the "
-             "jointly refitted model after the backward pass (the one the verdict, the "
+             "jointly refitted model after the backward pass, or the baseline row that beat it "
+             "on the withheld poses (diagnosis.json's `final_model`; the one the verdict, the "
              "parameter tables and diagnosis.json's `final` describe). Final withheld RMS / "
              f"nominal: {diag.shrink:.3f}. ")
     if nf.sigma is not None:
