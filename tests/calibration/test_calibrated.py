@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import zrp
+from tests.gap.test_fallback import stopped_early_panda
 from zrp.calibration import (
     CalibratedRobot,
     compensate,
@@ -60,7 +61,17 @@ def leading():
     return _diagnosed(LEADING)
 
 
-@pytest.mark.parametrize("which", ["geometric", "non_geometric", "leading"])
+@pytest.fixture(scope="module")
+def combined():
+    """The final model is the geometric calibration plus the search's non-geometric effects
+    (zrp/gap/analysis/fallback.py): the registration, the complete geometric base set and the
+    cyclic error."""
+    diag = stopped_early_panda()[0]
+    assert diag.assessment.choice.source == "geometric_plus_non_geometric"
+    return diag
+
+
+@pytest.mark.parametrize("which", ["geometric", "non_geometric", "leading", "combined"])
 def test_round_trip_reproduces_withheld_error(which, request, withheld_residual, tmp_path):
     diag = request.getfixturevalue(which)
     cal = CalibratedRobot.from_diagnosis(diag)

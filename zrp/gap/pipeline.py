@@ -290,12 +290,12 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
     baseline = geometric_baseline(ctx, reg, found.final_fit, prep.fitting, prep.withheld,
                                   prep.folds, regd.rb0)
     final_fit, after, choice = choose_final(ctx, found.final_fit, baseline, prep.withheld)
-    if choice.fell_back:
+    if choice.source != "search":
         warnings.warn(choice.note(model.length_unit), GapWarning, stacklevel=2)
     final = Metrics.of(after)
     unexplained = (None if floor.rms is None
                    else bool(final.rms > UNEXPLAINED_RATIO * max(floor.rms, resolution)))
-    changed = bool(found.steps) or choice.fell_back
+    changed = bool(found.steps) or choice.source != "search"
     where = Where(where_nominal, identifiability, found.backlash, found.last_candidates,
                   found.pruned, where_analysis(ctx, final_fit) if changed else None)
     assessment = _assess(ctx, baseline, choice, final_fit, len(reg.specs),

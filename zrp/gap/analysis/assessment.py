@@ -193,8 +193,9 @@ class Assessment:
         resolution: numerical resolution of the fits (length unit): below it nothing is
             resolved.
         compliance: the unit of ``joint_compliance`` and why (:func:`compliance_units`).
-        choice: which model is final - the search's, or the geometric calibration when the
-            search's is worse on the withheld poses (:mod:`zrp.gap.analysis.fallback`).
+        choice: which model is final - the search's, the geometric calibration when the
+            search's is worse on the withheld poses, or that calibration plus the search's
+            non-geometric effects when it clearly beats both (:mod:`zrp.gap.analysis.fallback`).
         one_sided: joints whose MJCF gravity torque keeps one sign in every pose: a play that
             gravity holds on its loaded flank there shifts the joint by a constant, which these
             data cannot tell from its offset (empty without MJCF torques).

@@ -4,12 +4,14 @@ A calibration engineer's reference: all kinematic parameters (joint offsets, bod
 axis tilts: :data:`KINEMATIC`) on top of the registration, reduced to a base set that these
 poses identify (column-pivoted Gram-Schmidt on the normalised Jacobian, :func:`~zrp.gap.fit.leastsq.
 check_identifiable`: a QR reduction), fitted on the fitting poses and judged on the withheld
-ones. Then the non-geometric effects of the final model are added on top of it, which answers
-the question "what do the non-geometric effects add beyond a full geometric calibration, on
-withheld poses?". When the measurements carry orientations (and they are used), every fit here
-identifies the parameters from positions and orientations together, each weighted by its noise
-(``Context.orientation``, :func:`zrp.gap.fit.leastsq.fit`): a direction that positions alone
-cannot pin (a common tilt of parallel axes) is then estimated, not held at its nominal.
+ones. Then the non-geometric effects of the search's model are added on top of it, which
+answers the question "what do the non-geometric effects add beyond a full geometric
+calibration, on withheld poses?" (and gives the third candidate for the final model,
+:mod:`zrp.gap.analysis.fallback`). When the measurements carry orientations (and they are
+used), every fit here identifies the parameters from positions and orientations together,
+each weighted by its noise (``Context.orientation``, :func:`zrp.gap.fit.leastsq.fit`): a
+direction that positions alone cannot pin (a common tilt of parallel axes) is then
+estimated, not held at its nominal.
 """
 
 from __future__ import annotations
@@ -44,13 +46,16 @@ class GeometricBaseline:
         n_dropped: geometric parameters the reduction dropped (aliased).
         withheld: withheld errors of the geometric calibration.
         cv_rms: its cross-validated RMS on the fitting poses.
-        non_geometric: the non-geometric effects of the final model added on top ("" none).
+        non_geometric: the non-geometric effects of the search's model added on top (empty:
+            none).
         n_non_geometric: their parameters identifiable on top of the base set.
-        combined: withheld errors of geometric + non-geometric, or None when the final model
-            has no non-geometric effect.
+        combined: withheld errors of geometric + non-geometric, or None when the search's
+            model has no non-geometric effect.
         fit: the geometric calibration's fit (registration + base set; the final model when
             the search's model does not beat it on the withheld poses, see
             :mod:`zrp.gap.analysis.fallback`).
+        combined_fit: the fit of geometric + non-geometric (None with ``combined``; the final
+            model when it clearly beats both others on the withheld poses, same module).
     """
 
     n_parameters: int
@@ -61,6 +66,7 @@ class GeometricBaseline:
     n_non_geometric: int
     combined: Metrics | None
     fit: FitResult | None = field(default=None, compare=False, repr=False)
+    combined_fit: FitResult | None = field(default=None, compare=False, repr=False)
 
     @property
     def increment(self) -> float | None:
@@ -106,8 +112,8 @@ def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
                        folds: list[NDArray[np.int64]], rb0: F64
                        ) -> GeometricBaseline:
     """Fit the complete geometric calibration on top of the registration ``reg`` and then the
-    final model's non-geometric parameters on top of it (see the module docstring). With
-    ``ctx.orientation`` the fits use the measured orientations too
+    non-geometric parameters of ``final`` (the search's model) on top of it (see the module
+    docstring). With ``ctx.orientation`` the fits use the measured orientations too
     (:func:`zrp.gap.fit.leastsq.fit`); the withheld errors are the positions'."""
     geo: list[ParamSpec] = []
     for e in KINEMATIC:
@@ -116,9 +122,9 @@ def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
     nreg = len(reg.specs)
     non_geo = [s for s in final.specs[nreg:] if s.effect not in KINEMATIC]
     effects = tuple(dict.fromkeys(s.effect for s in non_geo))
-    combined, n_ng = None, 0
+    combined, n_ng, both = None, 0, None
     if non_geo:
         both, n_ng, _ = _on_top(ctx, base, non_geo, fitting, rb0)
         combined = _withheld(ctx, both, withheld)
     return GeometricBaseline(n_geo, n_drop, _withheld(ctx, base, withheld),
-                             cv_rms(ctx, base, folds), effects, n_ng, combined, base)
+                             cv_rms(ctx, base, folds), effects, n_ng, combined, base, both)

@@ -102,6 +102,10 @@ def _header(diag: Diagnosis) -> list[str]:
 FIGURES = (("shrink.png", "shrink"), ("residuals_before_after.png", "residuals"),
            ("residual_vs_joint.png", "residual vs joint"), ("residual_map.png", "workspace"),
            ("correlation.png", "correlation"))
+_FINAL_ROW = {"search": "final model after pruning",  # per source (analysis/fallback.py)
+              "geometric_baseline": "the geometric calibration (the search's model was worse "
+              "on withheld poses)", "geometric_plus_non_geometric": "the geometric calibration "
+              "+ the search's non-geometric effects (clearly better than both on withheld poses)"}
 
 
 def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
@@ -118,9 +122,7 @@ def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
                  f"{w.max:.4g} | {st.cv_rms:.4g} | {st.p_value:.2g} | {st.bic_delta:.1f} |")
     fin = diag.final
     a = diag.assessment
-    fell_back = a is not None and a.choice is not None and a.choice.fell_back
-    what = ("the geometric calibration (the search's model was worse on withheld poses)"
-            if fell_back else "final model after pruning")
+    what = _FINAL_ROW["search" if a is None or a.choice is None else a.choice.source]
     L.append(f"| final | {what}: {final_effects_text(diag) or 'none'} | | "
              f"{fin.rms:.4g} | {fin.p95:.4g} | {fin.max:.4g} | | | |")
     if a is not None:
@@ -141,7 +143,8 @@ def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
     if a is not None:
         L.append(baseline_text(diag) + "\n")
     L.append(f"Steps 1..{len(diag.steps)} show each effect as it was added; the final row is the "
-             "jointly refitted model after the backward pass (the one the verdict, the "
+             "jointly refitted model after the backward pass, or the baseline row that beat it "
+             "on the withheld poses (diagnosis.json's `final_model`; the one the verdict, the "
              "parameter tables and diagnosis.json's `final` describe). Final withheld RMS / "
              f"nominal: {diag.shrink:.3f}. ")
     if nf.sigma is not None:

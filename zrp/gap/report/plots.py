@@ -100,10 +100,13 @@ def _against_joint(plt: Any, diag: Diagnosis) -> Any:
 
 def _shrink(plt: Any, diag: Diagnosis) -> Any:
     unit, floor = diag.length_unit, diag.noise_floor.rms
-    labels = ["registration"] + [f"+ {s.effect}" for s in diag.steps] + ["final (pruned)"]
+    a = diag.assessment
+    source = "search" if a is None or a.choice is None else a.choice.source
+    last = {"search": "final (pruned)", "geometric_baseline": "final (geometric)"}.get(
+        source, "final (geometric + non-geometric)")
+    labels = ["registration"] + [f"+ {s.effect}" for s in diag.steps] + [last]
     rms = [diag.nominal.rms] + [s.withheld.rms for s in diag.steps] + [diag.final.rms]
     p95 = [diag.nominal.p95] + [s.withheld.p95 for s in diag.steps] + [diag.final.p95]
-    a = diag.assessment
     if a is not None:
         labels.append("geometric calibration")
         rms.append(a.baseline.withheld.rms)

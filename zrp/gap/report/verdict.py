@@ -89,7 +89,7 @@ def final_effects_text(diag: Diagnosis) -> str:
 def _effects_found(diag: Diagnosis) -> list[str]:
     steps = diag.steps
     choice = None if diag.assessment is None else diag.assessment.choice
-    if choice is not None and choice.fell_back:
+    if choice is not None and choice.source != "search":
         found = (f"The search found {', '.join(s.effect for s in steps)}." if steps else
                  "No effect in the library improves the model significantly (none).")
         return [found, choice.note(diag.length_unit),
@@ -97,6 +97,8 @@ def _effects_found(diag: Diagnosis) -> list[str]:
     if not steps:
         return ["No effect in the library improves the model significantly (none)."]
     parts = [f"Final model (after pruning): {final_effects_text(diag)}."]
+    if choice is not None and choice.note(diag.length_unit):  # an equally good combination
+        parts.append(choice.note(diag.length_unit))
     for i, s in enumerate(steps, 1):
         if s.ties:
             parts.append(f"At step {i} {', '.join(s.ties)} explain(s) the data equally well; "
