@@ -131,6 +131,15 @@ def test_the_combination_is_final_when_the_search_stops_early(tmp_path):
     cal = CalibratedRobot.from_diagnosis(d)
     assert cal.withheld_rms == d.final.rms
     assert {t.effect for t in cal.terms} == {"cyclic_error"}
+    # the shrink plot shows all three candidates, the combination as the last bar
+    from zrp.gap.report.plots import figures
+
+    ax = next(fig for name, fig in figures(d) if "shrink" in name).axes[0]
+    labels = [t.get_text() for t in ax.get_xticklabels()]
+    assert labels[-3:] == ["final (geometric + non-geometric)", "geometric calibration",
+                           "geometric + non-geometric"]
+    heights = [p.get_height() for p in ax.patches[:len(labels)]]  # the RMS bars
+    assert heights[-1] == heights[-3] == ch.combined_rms
 
 
 def test_the_rule_and_its_order():

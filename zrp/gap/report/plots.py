@@ -111,6 +111,10 @@ def _shrink(plt: Any, diag: Diagnosis) -> Any:
         labels.append("geometric calibration")
         rms.append(a.baseline.withheld.rms)
         p95.append(a.baseline.withheld.p95)
+        if a.baseline.combined is not None:  # the third candidate of the final choice
+            labels.append("geometric + non-geometric")
+            rms.append(a.baseline.combined.rms)
+            p95.append(a.baseline.combined.p95)
     fig, ax = plt.subplots(figsize=(max(6, 1.5 * len(labels)), 4))
     xs = np.arange(len(labels))
     ax.bar(xs - 0.2, rms, 0.4, label="RMS")
