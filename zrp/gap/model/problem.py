@@ -106,15 +106,18 @@ class Problem:
         self.B = (np.stack([self.specs[i].basis[self.poses] for i in self.idx["dq"]], -1)
                   if self.idx["dq"].size else np.zeros((self.poses.size, ctx.n, 0)))
         self.dT = (None if ctx.dtemp is None else ctx.dtemp[self.poses])
+        self.scale_basis = self._scale_basis()
+        self.q = ctx.q[self.poses]
+
+    def _scale_basis(self) -> F64:
+        """Body scale per pose and unit parameter of each ``thermal`` spec, shape (S, k):
+        dT_i for kappa (comp 0), 1 for a common scale of the links (comp 1)."""
         comps = [self.specs[i].comp for i in self.idx["thermal"]]
         if 0 in comps and self.dT is None:
             raise InputError("thermal_expansion needs a temp column")
-        #: body scale per pose and unit parameter of each ``thermal`` spec, shape (S, k):
-        #: dT_i for kappa (comp 0), 1 for a common scale (comp 1)
-        self.scale_basis = np.stack(
-            [self.dT if c == 0 else np.ones(self.poses.size) for c in comps], -1
-        ) if comps else np.zeros((self.poses.size, 0))
-        self.q = ctx.q[self.poses]
+        cols = [self.dT if c == 0 and self.dT is not None else np.ones(self.poses.size)
+                for c in comps]
+        return np.stack(cols, -1) if cols else np.zeros((self.poses.size, 0))
 
     @property
     def size(self) -> int:
