@@ -10,6 +10,7 @@ from zrp.gap.data.measurements import Measurements
 from zrp.gap.model.context import EFFECTS, Context
 from zrp.gap.model.effects import effect_parameters, registration_parameters
 from zrp.gap.model.problem import Problem
+from zrp.gap.search.lookalike import SCALE
 from zrp.kinematics.identification import parameter_jacobian
 from zrp.rotations import matrix_from_rotvec
 
@@ -57,6 +58,31 @@ def test_effect_jacobian_matches_finite_differences(name, effect):
     scale = np.abs(Jfd).max(axis=0) + 1e-9
     err = np.abs(J - Jfd).max(axis=0) / scale
     assert err.max() < 1e-5, [s.name for s, e in zip(specs, err, strict=False) if e >= 1e-5]
+
+
+@pytest.mark.parametrize("name", ["puma", "stanford"])
+def test_thermal_with_its_lookalike_scale_matches_finite_differences(name):
+    """kappa and a common scale of the links in one model (the look-alike test of
+    zrp.gap.search.lookalike): two ``thermal`` parameters whose scales add per pose."""
+    rng = np.random.default_rng(12)
+    model = zrp.load_model(name)
+    meas = _data(model, rng)
+    ctx = Context(model, meas)
+    kappa, _ = effect_parameters(ctx, "thermal_expansion")
+    specs = registration_parameters(ctx) + kappa + [SCALE]
+    prob = Problem(ctx, specs, np.arange(len(meas.pose_ids)),
+                   base_rotation=matrix_from_rotvec([0.3, -0.2, 1.0]))
+    theta = rng.normal(size=len(specs)) * 1e-2
+    _, J = prob.residual_and_jacobian(theta)
+    Jfd = _fd(prob, theta)
+    err = np.abs(J - Jfd).max(axis=0) / (np.abs(Jfd).max(axis=0) + 1e-9)
+    assert err.max() < 1e-5
+    # the scale is kappa's column with 1 in place of dT (up to the other's scale factor)
+    i_k, i_s = len(specs) - 2, len(specs) - 1
+    theta[[i_k, i_s]] = 0.0
+    _, J0 = prob.residual_and_jacobian(theta)
+    dT = np.repeat(ctx.dtemp, 2)[:, None] * np.ones((1, 3))
+    assert np.allclose(J0[:, i_k].reshape(-1, 3), dT * J0[:, i_s].reshape(-1, 3))
 
 
 def test_geometric_columns_agree_with_identification_module():

@@ -12,7 +12,9 @@ tests:
 
 * rot: -[R_b x]_x J_l(phi) (J_l: left Jacobian of SO(3));  trans: I;  tool t_j: R_b R_n;
 * dq (joint k): R_b (u_k x (x - p_k)) B[i, k] (revolute), R_b u_k B[i, k] (prismatic);
-* link db_k: R_b s_i R_{k-1};  thermal: R_b dT_i sum_k R_{k-1} b_{k,0};
+* link db_k: R_b s_i R_{k-1};  thermal: R_b dT_i sum_k R_{k-1} b_{k,0} (kappa, comp 0; a
+  common scale of all body vectors, comp 1, has the column with 1 in place of dT_i: the
+  look-alike that :mod:`zrp.gap.search.greedy` tests kappa against);
 * tilt of axis k along dv: omega = R_{k-1}(sin q_k du + (1 - cos q_k) u x du) with
   du = (I - u u^T) dv / |v|; column R_b (omega x (x - p_k)) (revolute) or R_b q_k R_{k-1} du.
 """
@@ -104,9 +106,18 @@ class Problem:
         self.B = (np.stack([self.specs[i].basis[self.poses] for i in self.idx["dq"]], -1)
                   if self.idx["dq"].size else np.zeros((self.poses.size, ctx.n, 0)))
         self.dT = (None if ctx.dtemp is None else ctx.dtemp[self.poses])
-        if self.idx["thermal"].size and self.dT is None:
-            raise InputError("thermal_expansion needs a temp column")
+        self.scale_basis = self._scale_basis()
         self.q = ctx.q[self.poses]
+
+    def _scale_basis(self) -> F64:
+        """Body scale per pose and unit parameter of each ``thermal`` spec, shape (S, k):
+        dT_i for kappa (comp 0), 1 for a common scale of the links (comp 1)."""
+        comps = [self.specs[i].comp for i in self.idx["thermal"]]
+        if 0 in comps and self.dT is None:
+            raise InputError("thermal_expansion needs a temp column")
+        cols = [self.dT if c == 0 and self.dT is not None else np.ones(self.poses.size)
+                for c in comps]
+        return np.stack(cols, -1) if cols else np.zeros((self.poses.size, 0))
 
     @property
     def size(self) -> int:
@@ -160,9 +171,7 @@ class Problem:
         S = self.poses.size
         q = self.joint_values(theta)
         u, v, bodies = self.geometry(theta)
-        scale = np.ones(S)
-        if self.idx["thermal"].size:
-            scale = 1.0 + theta[self.idx["thermal"][0]] * self.dT
+        scale = 1.0 + self.scale_basis @ theta[self.idx["thermal"]]
         rprev = np.empty((S, n + 1, 3, 3))
         pts = np.empty((S, n, 3))
         ucur = np.empty((S, n, 3))
@@ -205,8 +214,8 @@ class Problem:
         self._dq_columns(J, ch, x)
         self._link_columns(J, ch)
         self._tilt_columns(J, ch, x)
-        if self.idx["thermal"].size:
-            J[:, :, self.idx["thermal"][0]] = self.dT[rp, None] * ch.bsum[rp]
+        for j, i in enumerate(self.idx["thermal"]):
+            J[:, :, i] = self.scale_basis[rp, j, None] * ch.bsum[rp]
         J = np.matmul(rb, J)  # R_b J per row; 2.8x faster than the einsum it replaces
         if self.instrument:
             y = x @ rb.T

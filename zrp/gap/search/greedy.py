@@ -3,7 +3,9 @@
 At each step every effect not yet in the model is fitted on top of it (the parameters the data
 can identify; joints whose parameters fail a Wald test are pruned), the candidates are ranked
 by cross-validated RMS, and the best is added when its F test is significant, its BIC falls and
-its CV RMS improves by at least ``min_gain``. The withheld poses only judge each step.
+its CV RMS improves by at least ``min_gain`` (``thermal_expansion`` also when the temperature
+explains what a common scale of the links cannot, :mod:`zrp.gap.search.lookalike`). The
+withheld poses only judge each step.
 """
 
 from __future__ import annotations
@@ -36,6 +38,7 @@ from zrp.gap.fit.profiles import switch_bands, with_backlash_switch
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.model.problem import Problem
+from zrp.gap.search.lookalike import temperature_needed
 from zrp.gap.search.progress import progress_bar
 from zrp.gap.search.steps import BacklashSwitch, Candidate, Step, parameter_estimates
 
@@ -157,6 +160,9 @@ def _try_effect(ctx: Context, current: FitResult, current_cv: float, effect: str
     joints = tuple(sorted({p.joint for p in kept if p.joint > 0}))
     ok, note = _judged(pval, dbic, cv / current_cv if current_cv > 0 else math.inf, s, own,
                        others)
+    if ok and effect == "thermal_expansion":  # not a common scale of the links in disguise
+        ok, _, why = temperature_needed(ctx, current, f1, s.fitting, s.rb0, s.alpha)
+        note = "; ".join(filter(None, [why, note]))
     return _Trial(Candidate(effect, joints, len(kept), cv, dbic, pval, ok, note), f1, aliased)
 
 
