@@ -182,6 +182,26 @@ def refine_compliance(eng: Engine, current: ModelFit, cur_cv: float, poses: I64,
     return current, cur_cv
 
 
+def _trials(eng: Engine, current: ModelFit, left: Sequence[str], poses: I64,
+            folds: Sequence[I64], alpha: float) -> list[Trial]:
+    """``try_effect`` of each candidate, keeping the fit of the best so far only (the lowest
+    CV RMS; the first of equals, as the stable sort ranks them): each fit holds arrays of the
+    whole trajectory (bases, shifts), so holding every candidate's fit until the ranking made
+    the search the diagnosis' memory peak (memory linear in the samples per fit kept)."""
+    out: list[Trial] = []
+    best = -1
+    for e in left:
+        tr = try_effect(eng, current, e, poses, folds, alpha)
+        if best < 0 or tr.cv_rms < out[best].cv_rms:
+            if best >= 0:
+                out[best] = replace(out[best], fit=None)
+            best = len(out)
+        else:
+            tr = replace(tr, fit=None)
+        out.append(tr)
+    return out
+
+
 def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
            folds: Sequence[I64], alpha: float = 1e-3, min_gain: float = 0.01,
            max_steps: int = 3) -> tuple[ModelFit, list[tuple[Trial, list[Trial]]]]:
@@ -195,12 +215,10 @@ def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
         left = [e for e in effects if e not in current.effects]
         if not left:
             break
-        trials = [try_effect(eng, current, e, poses, folds, alpha) for e in left]
-        ranked = sorted(trials, key=lambda tr: tr.cv_rms)
+        ranked = sorted(_trials(eng, current, left, poses, folds, alpha),
+                        key=lambda tr: tr.cv_rms)
         best = ranked[0]
-        # the ranking keeps its scores, not the losers' fits: each fit holds arrays of the
-        # whole trajectory (bases, shifts: memory linear in the samples per fit kept)
-        light = [replace(tr, fit=None) for tr in ranked[1:]]
+        light = ranked[1:]
         if (best.fit is None or best.p_value >= alpha or best.bic_delta >= 0
                 or best.cv_rms > (1.0 - min_gain) * cur_cv):
             steps.append((Trial(best.effect, None, note="stop"),
