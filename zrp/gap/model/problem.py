@@ -106,7 +106,7 @@ class Problem:
         self.dT = (None if ctx.dtemp is None else ctx.dtemp[self.poses])
         if self.idx["thermal"].size and self.dT is None:
             raise InputError("thermal_expansion needs a temp column")
-        self.q = ctx.q[self.poses]
+        self.q = ctx.q_of(self.poses)
 
     @property
     def size(self) -> int:

@@ -15,7 +15,7 @@ from zrp.gap.fit.leastsq import check_identifiable, cv_rms, f_test, group_key, w
 from zrp.gap.model.context import EFFECTS
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise, plausible, tested
-from zrp.gap.motion.fitting import Engine, ModelFit
+from zrp.gap.motion.fitting import Engine, ModelFit, named_joints
 from zrp.gap.motion.profile import compliance_start, vibration_start
 
 __all__ = ["Trial", "backward_check", "drop_effects", "greedy", "settle_compliance"]
@@ -58,7 +58,9 @@ class Trial:
 def _candidate_specs(eng: Engine, effect: str, start: dict[str, float]) -> list:
     if effect in EFFECTS:
         return effect_parameters(eng.base_ctx, effect)[0]
-    specs = linearise(effect_columns(eng.traj, effect, start, eng.torque, eng.terms))[1]
+    joints = named_joints(start) if effect in STARTS else None  # the joints profiled
+    specs = linearise(effect_columns(eng.traj, effect, start, eng.torque, eng.terms,
+                                     joints=joints))[1]
     if effect in STARTS:  # only the joints the profile search found the effect on
         specs = [s for s in specs if s.name in start]
     return specs
