@@ -1,7 +1,8 @@
 """The memory-saving paths of the motion diagnosis give the values of the direct ones: the
 residual evaluated block by block (a tiny block forced) against one evaluation of all samples,
-and the initial registration from the kinematics of the fitted poses only against the one
-from the cached kinematics of every pose."""
+the initial registration from the kinematics of the fitted poses only against the one from the
+cached kinematics of every pose, and an effect's columns of the kept joints only against
+those of all joints."""
 
 from __future__ import annotations
 
@@ -14,7 +15,8 @@ from zrp.gap.model.context import Context
 from zrp.gap.model.effects import registration_parameters
 from zrp.gap.model.problem import Problem
 from zrp.gap.motion import Trajectory, fitting
-from zrp.gap.motion.fitting import Engine
+from zrp.gap.motion.effects import effect_columns
+from zrp.gap.motion.fitting import Engine, named_joints
 from zrp.gap.motion.paths import exercise_moves
 from zrp.gap.motion.pipeline import _registration
 
@@ -56,3 +58,28 @@ def test_registration_from_the_fitted_poses_kinematics_equals_the_cached_one(pum
     theta_all, rb_all = initial_registration(cached, specs, poses)
     np.testing.assert_allclose(theta_sub, theta_all, rtol=1e-9, atol=1e-12)
     np.testing.assert_allclose(rb_sub, rb_all, rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.parametrize("effect", ["servo_lag", "reversal_friction", "dynamic_compliance",
+                                    "residual_vibration"])
+def test_columns_of_the_kept_joints_equal_those_of_all_joints(traj, effect) -> None:
+    tau = np.random.default_rng(9).normal(0.0, 20.0, traj.q.shape)
+    vals = {"q2.lag": 0.004, "q3.friction": 2e-4, "q2.dyn_compliance": 1e-5,
+            "q2.dyn_omega": 60.0, "q2.dyn_zeta": 0.7, "q2.vib_gain": 0.5, "q2.vib_omega": 80.0}
+    couple = {"sync.delay": 0.002, "q2.lag": 0.004}
+    every = effect_columns(traj, effect, vals, tau, couple=couple)
+    some = effect_columns(traj, effect, vals, tau, couple=couple,
+                          joints=named_joints(["q2.x", "q3.y"]))
+    want = [c for c in every if c.joint in (2, 3) or c.via.startswith(("q2.", "q3."))]
+    assert len(some) == len(want) < len(every)
+    for a, b in zip(some, want, strict=True):
+        assert (a.name, a.via) == (b.name, b.via)
+        np.testing.assert_array_equal(np.asarray(a.d), np.asarray(b.d))
+        np.testing.assert_array_equal(np.asarray(a.D), np.asarray(b.D))
+
+
+def test_named_joints() -> None:
+    assert named_joints(["q2.lag", "q12.vib_gain"]) == {2, 12}
+    assert named_joints(["q2.lag", "sync.delay"]) is None
+    assert named_joints(None) is None
+    assert named_joints([]) == frozenset()
