@@ -10,18 +10,26 @@ prints figures and ratios measured in the same run.
   about 4 is linear: it was quadratic, 109 s for 20,000 joints) and of a 20 MB file that is
   mostly comments (it took 46 s).
 
+* With ``--baseline REF``: each trajectory file also runs through the code of git commit REF
+  (extracted by ``git archive`` into a temporary folder) in the same run, and the table gives
+  the ratios of peak memory and wall time of this checkout to that baseline (e.g. the memory
+  work on ``diagnose-motion`` against the commit before it). ``--rows`` picks the sizes (e.g.
+  ``--rows 200000 --baseline main --skip-urdf``: 2e5 rows show the peak; it grows linearly).
+
 Run from the repository root: PYTHONPATH=. python3 tests/benchmarks/bench_input_scaling.py
-[--quick] [--out FILE.md] [--force] (--quick: 1e5 rows at most). Writes the tables to
-renders/benchmarks/bench_input_scaling.md and .json.
+[--quick] [--rows N ...] [--baseline REF] [--skip-urdf] [--out FILE.md] [--force] (--quick:
+1e5 rows at most). Writes the tables to renders/benchmarks/bench_input_scaling.md and .json.
 """
 
 from __future__ import annotations
 
 import argparse
+import io
 import os
 import resource
 import subprocess
 import sys
+import tarfile
 import tempfile
 import time
 from pathlib import Path
@@ -58,16 +66,29 @@ def _cpu_children() -> float:
     return r.ru_utime + r.ru_stime
 
 
-def _diagnose_motion(path: Path, out: Path) -> tuple[float, float, float, str]:
+def _checkout(ref: str, folder: Path) -> Path:
+    """The code of git commit ``ref`` extracted into ``folder`` (``git archive``)."""
+    tar = subprocess.run(["git", "archive", "--format=tar", ref], cwd=ROOT,
+                         capture_output=True, check=False)
+    if tar.returncode != 0:
+        raise SystemExit(f"--baseline {ref}: {tar.stderr.decode().strip()}")
+    folder.mkdir()
+    with tarfile.open(fileobj=io.BytesIO(tar.stdout)) as tf:
+        tf.extractall(folder)  # this repository's own commit
+    return folder
+
+
+def _diagnose_motion(path: Path, out: Path, src: Path = ROOT) -> tuple[float, float, float, str]:
     """Wall time (s), CPU time (s), peak resident memory (MB) and the verdict's first line of
-    `zrp diagnose-motion` in a fresh process."""
+    `zrp diagnose-motion` in a fresh process running the code in ``src``."""
     code = ("import resource, sys; from zrp.cli import main; rc = main(sys.argv[1:]); "
             "print('PEAK_MB', resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024); "
             "sys.exit(rc)")
     t0, c0 = time.perf_counter(), _cpu_children()
     proc = subprocess.run([sys.executable, "-c", code, "diagnose-motion", "--model", "puma",
                            "--data", str(path), "--frame", "base", "--out", str(out)],
-                          cwd=ROOT, capture_output=True, text=True, check=False)
+                          cwd=src, capture_output=True, text=True, check=False,
+                          env={**os.environ, "PYTHONPATH": str(src)})
     wall, cpu = time.perf_counter() - t0, _cpu_children() - c0
     if proc.returncode != 0:
         raise SystemExit(proc.stderr)
@@ -115,34 +136,68 @@ def _urdf_rows(folder: Path) -> list[tuple[str, ...]]:
     return rows
 
 
+def _motion_rows(sizes: list[int], folder: Path, base_src: Path | None
+                 ) -> list[tuple[str, ...]]:
+    """One row per size: this checkout's figures, then (with a baseline) the baseline's and
+    the ratios, both measured on the same file in the same run."""
+    rows: list[tuple[str, ...]] = []
+    base = None
+    warm = _trajectory_csv(2000, folder)  # numba compiles into each checkout's cache first
+    for i, src in enumerate((ROOT,) if base_src is None else (ROOT, base_src)):
+        _diagnose_motion(warm, folder / f"warm{i}", src)
+    for n in sizes:
+        path = _trajectory_csv(n, folder)
+        wall, cpu, peak, verdict = _diagnose_motion(path, folder / f"out{n}")
+        per_row = cpu / n
+        base = base or per_row
+        print(f"{n:>10,} rows: wall {wall:.1f} s, CPU {cpu:.1f} s, peak {peak:.0f} MB, "
+              f"CPU per row x {per_row / base:.2f} of {sizes[0]:,} rows; {verdict}")
+        row = (f"{n:,}", f"{wall:.1f}", f"{cpu:.1f}", f"{peak:.0f}", f"{peak * 1024 / n:.1f}",
+               f"{per_row / base:.2f}")
+        if base_src is not None:
+            bwall, _, bpeak, bverdict = _diagnose_motion(path, folder / f"base{n}", base_src)
+            same = "same" if bverdict == verdict else f"baseline: {bverdict}"
+            print(f"{n:>10,} rows, baseline: wall {bwall:.1f} s, peak {bpeak:.0f} MB; "
+                  f"peak x {peak / bpeak:.2f}, wall x {wall / bwall:.2f}; verdict {same}")
+            row += (f"{bpeak:.0f}", f"{peak / bpeak:.2f}", f"{bwall:.1f}", f"{wall / bwall:.2f}",
+                    same)
+        rows.append((*row, verdict))
+        os.remove(path)
+    return rows
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="1e5 rows at most")
+    ap.add_argument("--rows", type=int, nargs="+", metavar="N",
+                    help="trajectory sizes, rows (default 25,000 100,000 400,000 1,000,000; "
+                         "--quick: the first two)")
+    ap.add_argument("--baseline", metavar="REF",
+                    help="also run each trajectory with the code of git commit REF in the same "
+                         "run: ratios of peak memory and wall time to it")
+    ap.add_argument("--skip-urdf", action="store_true", help="skip the URDF import rows")
     add_output_arguments(ap, "bench_input_scaling")
     args = ap.parse_args()
     out = output_path(args)
     report = Report("bench_input_scaling", "the cost of large trajectory and URDF inputs")
-    sizes = [25_000, 100_000] + ([] if args.quick else [400_000, 1_000_000])
-    rows = []
+    sizes = args.rows or [25_000, 100_000] + ([] if args.quick else [400_000, 1_000_000])
+    if any(n < 100 for n in sizes):
+        ap.error(f"--rows: expected at least 100 rows each, got {sizes}")
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        report.table("URDF import (CPU time, best of 2)",
-                     ["file", "MB", "CPU s", "ratio to 5,000 joints"], _urdf_rows(folder))
-        base = None
-        for n in sizes:
-            path = _trajectory_csv(n, folder)
-            wall, cpu, peak, verdict = _diagnose_motion(path, folder / f"out{n}")
-            per_row = cpu / n
-            base = base or per_row
-            print(f"{n:>10,} rows: wall {wall:.1f} s, CPU {cpu:.1f} s, peak {peak:.0f} MB, "
-                  f"CPU per row x {per_row / base:.2f} of {sizes[0]:,} rows; {verdict}")
-            rows.append((f"{n:,}", f"{wall:.1f}", f"{cpu:.1f}", f"{peak:.0f}",
-                         f"{peak * 1024 / n:.1f}", f"{per_row / base:.2f}", verdict))
-            os.remove(path)
+        if not args.skip_urdf:
+            report.table("URDF import (CPU time, best of 2)",
+                         ["file", "MB", "CPU s", "ratio to 5,000 joints"], _urdf_rows(folder))
+        base_src = None if args.baseline is None else _checkout(args.baseline, folder / "base")
+        rows = _motion_rows(sizes, folder, base_src)
+    cols = ["rows", "wall s", "CPU s", "peak MB", "peak KB per row",
+            f"CPU per row / {sizes[0]:,} rows'"]
+    if args.baseline is not None:
+        cols += [f"peak MB at {args.baseline}", "peak ratio", f"wall s at {args.baseline}",
+                 "wall ratio", "verdict at baseline"]
     report.table("`zrp diagnose-motion` in a fresh process on N rows (PUMA, 1 kHz, hidden "
                  "4 ms sync delay, 0.02 mm noise; before issue 26: 1e6 rows 434 s, 5.3 GB)",
-                 ["rows", "wall s", "CPU s", "peak MB", "peak KB per row",
-                  f"CPU per row / {sizes[0]:,} rows'", "verdict"], rows)
+                 [*cols, "verdict"], rows)
     report.write(out, args)
 
 

@@ -22,6 +22,7 @@ from zrp.gap.fit.orientation import alias_jacobian, solve_with_orientation
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.problem import Evaluation, Problem
+from zrp.kinematics.forward import forward_kinematics
 
 #: Two-sided 95 % quantile of the standard normal (the one home of the constant in zrp.gap).
 Z95 = 1.959963984540054
@@ -154,9 +155,15 @@ def initial_registration(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayL
     """
     poses = np.asarray(poses, dtype=np.int64)
     prob = Problem(ctx, specs, poses)
-    fk = ctx.nominal_fk
-    p = fk.position[poses][prob.row_pose]
-    rn = fk.rotation[poses][prob.row_pose]
+    if poses.size < len(ctx.meas.pose_ids) and "nominal_fk" not in vars(ctx):
+        # a subset (the motion search's 2,500 of 1e6 samples): the kinematics of those poses
+        # only; caching it for every pose held ~0.5 KB a pose for the whole diagnosis
+        fk = forward_kinematics(ctx.model, ctx.q[poses])
+        p, rn = fk.position[prob.row_pose], fk.rotation[prob.row_pose]
+    else:
+        fk = ctx.nominal_fk
+        p = fk.position[poses][prob.row_pose]
+        rn = fk.rotation[poses][prob.row_pose]
     m = prob.measured
     M = len(ctx.meas.point_labels)
     t = np.zeros((M, 3))

@@ -181,6 +181,11 @@ class Context:
         """Joint values per pose, shape (P, n)."""
         return self.meas.q_pose
 
+    def q_of(self, poses: NDArray[np.int64]) -> F64:
+        """Joint values of the given poses, shape (len(poses), n) (``q[poses]``; a subclass
+        may compute them for those poses only, without holding q of every pose)."""
+        return self.q[poses]
+
     @cached_property
     def excited(self) -> NDArray[np.bool_]:
         """Joints that move enough for a per-joint function of their angle (scale, cyclic

@@ -107,7 +107,7 @@ class Problem:
                   if self.idx["dq"].size else np.zeros((self.poses.size, ctx.n, 0)))
         self.dT = (None if ctx.dtemp is None else ctx.dtemp[self.poses])
         self.scale_basis = self._scale_basis()
-        self.q = ctx.q[self.poses]
+        self.q = ctx.q_of(self.poses)
 
     def _scale_basis(self) -> F64:
         """Body scale per pose and unit parameter of each ``thermal`` spec, shape (S, k):

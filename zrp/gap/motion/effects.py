@@ -55,11 +55,11 @@ zeta start from the profile search of :mod:`zrp.gap.motion.profile`, within a tr
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass
-from functools import cached_property
 
 import numpy as np
+from numpy.typing import NDArray
 
 from zrp.arrays import F64
 from zrp.errors import InputError
@@ -101,14 +101,22 @@ class MotionParam(ParamSpec):
 @dataclass(frozen=True, eq=False)
 class MotionContext(Context):
     """A :class:`~zrp.gap.model.context.Context` whose joint values carry the linearisation shift of
-    the nonlinear motion effects: q = commanded + shift, shape (S, n)."""
+    the nonlinear motion effects: q = commanded + shift, shape (S, n).
+
+    q is computed when asked, not cached: a search holds several fits, and a cached q of every
+    sample beside the shift was 48 bytes a sample per fit; a
+    :class:`~zrp.gap.model.problem.Problem` takes the rows of its poses only (:meth:`q_of`)."""
 
     shift: F64 | None = None
 
-    @cached_property
+    @property
     def q(self) -> F64:  # type: ignore[override]
         q = self.meas.q_pose
         return q if self.shift is None else q + self.shift
+
+    def q_of(self, poses: NDArray[np.int64]) -> F64:
+        q = self.meas.q_pose[poses]
+        return q if self.shift is None else q + self.shift[poses]
 
 
 @dataclass(frozen=True, eq=False)
@@ -140,8 +148,10 @@ def _one_joint(s: int, n: int, k: int, col: F64) -> JointColumn:
     return JointColumn(n, k, np.array(col, dtype=float).reshape(s))
 
 
-def _moving(traj: Trajectory) -> list[int]:
-    return [k for k in range(traj.n_joints) if np.ptp(traj.q[:, k]) > MIN_TRAVEL]
+def _moving(traj: Trajectory, joints: Collection[int] | None = None) -> list[int]:
+    """0-based moving joints, of ``joints`` (1-based; None: all) only."""
+    return [k for k in range(traj.n_joints) if (joints is None or k + 1 in joints)
+            and np.ptp(traj.q[:, k]) > MIN_TRAVEL]
 
 
 def _sync(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
@@ -153,13 +163,14 @@ def _sync(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
 
 
 def _per_joint(traj: Trajectory, values: Mapping[str, float], suffix: str, unit: str,
-               effect: str, response: Callable[[F64, float], tuple[F64, F64]]) -> list[Column]:
+               effect: str, response: Callable[[F64, float], tuple[F64, F64]],
+               joints: Collection[int] | None = None) -> list[Column]:
     """One column ``q{k}.{suffix}`` per moving joint k of an effect that passes the joint's
     commanded path u (S,) through ``response(u, value) -> (y, dy/dvalue)``, shapes (S,):
     d = y - u and D = dy/dvalue on joint k, zero on the others."""
     s, n = traj.q.shape
     out = []
-    for k in _moving(traj):
+    for k in _moving(traj, joints):
         name = f"q{k + 1}.{suffix}"
         v = float(values.get(name, 0.0))
         y, dy = response(traj.q[:, k], v)
@@ -168,17 +179,19 @@ def _per_joint(traj: Trajectory, values: Mapping[str, float], suffix: str, unit:
     return out
 
 
-def _lag(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
+def _lag(traj: Trajectory, values: Mapping[str, float], joints: Collection[int] | None = None
+         ) -> list[Column]:
     return _per_joint(traj, values, "lag", "s", "servo_lag",
-                      lambda u, tau: first_order_lag(traj.t, u, tau))
+                      lambda u, tau: first_order_lag(traj.t, u, tau), joints)
 
 
-def _friction(traj: Trajectory, values: Mapping[str, float]) -> list[Column]:
-    return _per_joint(traj, values, "friction", "rad", "reversal_friction", play)
+def _friction(traj: Trajectory, values: Mapping[str, float],
+              joints: Collection[int] | None = None) -> list[Column]:
+    return _per_joint(traj, values, "friction", "rad", "reversal_friction", play, joints)
 
 
-def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | None
-                ) -> list[Column]:
+def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | None,
+                joints: Collection[int] | None = None) -> list[Column]:
     """Per joint carrying a torque: c (d = c y, D = y) with y = -tau_k quasi-statically, or,
     when ``q{k}.dyn_omega`` is in ``values``, y = omega^2 x with x'' + 2 zeta omega x' +
     omega^2 x = -tau_k (eq. M8: the joint's spring 1/c against its own inertia, unit static
@@ -189,7 +202,7 @@ def _compliance(traj: Trajectory, values: Mapping[str, float], torque: F64 | Non
     s, n = traj.q.shape
     out = []
     for k in range(n):
-        if not np.any(torque[:, k] != 0.0):
+        if (joints is not None and k + 1 not in joints) or not np.any(torque[:, k] != 0.0):
             continue
         p = f"q{k + 1}.dyn_"
         c = float(values.get(p + "compliance", 0.0))
@@ -244,7 +257,8 @@ def joint_mode(traj: Trajectory, k: int, omega: float, zeta: float, terms: F64 |
 
 
 def _vibration(traj: Trajectory, values: Mapping[str, float], terms: F64 | None = None,
-               couple: Mapping[str, float] | None = None) -> list[Column]:
+               couple: Mapping[str, float] | None = None,
+               joints: Collection[int] | None = None) -> list[Column]:
     """Per moving joint: gain (d = g y, D = y), omega and zeta (d = 0, D = g dy/dparameter),
     so that :func:`linearise` gives the Gauss-Newton step of the exact model (eq. M5, M6).
     With ``couple`` (``sync.delay``, ``q{k}.lag`` of the effects in the model) the mode is
@@ -254,7 +268,7 @@ def _vibration(traj: Trajectory, values: Mapping[str, float], terms: F64 | None 
     lo, hi = mode_band(traj.rate_hz)
     couple = dict(couple or {})
     out = []
-    for k in _moving(traj):
+    for k in _moving(traj, joints):
         p = f"q{k + 1}.vib_"
         g = float(values.get(p + "gain", 0.0))
         # a Gauss-Newton step may leave the physical range: linearise at the nearest point of
@@ -320,8 +334,11 @@ def tested(spec: ParamSpec) -> bool:
 
 def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
                    torque: F64 | None = None, terms: F64 | None = None,
-                   couple: Mapping[str, float] | None = None) -> list[Column]:
-    """All parameters of one motion effect evaluated at ``values`` (missing names: 0).
+                   couple: Mapping[str, float] | None = None,
+                   joints: Collection[int] | None = None) -> list[Column]:
+    """All parameters of one motion effect evaluated at ``values`` (missing names: 0), of the
+    1-based ``joints`` only for a per-joint effect (None: all; the others are not evaluated:
+    a fit keeping one joint's mode does not hold every joint's columns of the whole stream).
 
     Args:
         torque: inverse-dynamics torque per sample and joint, N m, shape (S, n), or None
@@ -334,13 +351,13 @@ def effect_columns(traj: Trajectory, effect: str, values: Mapping[str, float],
     if effect == "sync_delay":
         return _sync(traj, values)
     if effect == "servo_lag":
-        return _lag(traj, values)
+        return _lag(traj, values, joints)
     if effect == "reversal_friction":
-        return _friction(traj, values)
+        return _friction(traj, values, joints)
     if effect == "dynamic_compliance":
-        return _compliance(traj, values, torque)
+        return _compliance(traj, values, torque, joints)
     if effect == "residual_vibration":
-        return _vibration(traj, values, terms, couple)
+        return _vibration(traj, values, terms, couple, joints)
     raise InputError(f"effect: {effect!r} is not a motion effect; valid: "
                      f"{', '.join(MOTION_EFFECTS)}")
 

@@ -5,7 +5,7 @@ each linear step."""
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,7 +19,7 @@ from zrp.gap.motion.data import Trajectory
 from zrp.gap.motion.effects import MotionContext, effect_columns, limit_step, linearise
 from zrp.model.manipulator import Manipulator
 
-__all__ = ["Engine", "ModelFit"]
+__all__ = ["Engine", "ModelFit", "named_joints"]
 
 #: samples per block of :meth:`Engine.residual`.
 RESIDUAL_BLOCK = 20_000
@@ -61,6 +61,21 @@ def _couplings(traj: Trajectory, effects: Mapping[str, frozenset[str] | None],
         if e in effects and (keep is None or name in keep):
             out[name] = float(values.get(name, 0.0))
     return out
+
+
+def named_joints(names: Iterable[str] | None) -> frozenset[int] | None:
+    """The 1-based joints of per-joint parameter names ``q{k}.<name>`` (None when ``names`` is
+    None or holds a parameter of all joints, e.g. ``sync.delay``): the joints whose columns
+    an effect needs to evaluate."""
+    if names is None:
+        return None
+    out = set()
+    for name in names:
+        head = name.split(".", 1)[0]
+        if not (head[:1] == "q" and head[1:].isdigit()):
+            return None
+        out.add(int(head[1:]))
+    return frozenset(out)
 
 
 def _kept(values: Mapping[str, float], keep: frozenset[str] | None) -> Mapping[str, float]:
@@ -122,7 +137,7 @@ class Engine:
                 continue
             vals = values if e != "dynamic_compliance" else _kept(values, keep)
             cols += [c for c in effect_columns(self.traj, e, vals, self.torque,
-                                               self.terms, couple)
+                                               self.terms, couple, named_joints(keep))
                      if keep is None or (c.via or c.name) in keep]
         shift, mspecs = linearise(cols)
         ctx = MotionContext(self.model, self.meas, shift=shift)

@@ -15,7 +15,7 @@ from zrp.gap.fit.leastsq import check_identifiable, cv_rms, f_test, group_key, w
 from zrp.gap.model.context import EFFECTS
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.motion.effects import POSITIVE, effect_columns, linearise, plausible, tested
-from zrp.gap.motion.fitting import Engine, ModelFit
+from zrp.gap.motion.fitting import Engine, ModelFit, named_joints
 from zrp.gap.motion.profile import compliance_start, vibration_start
 
 __all__ = ["Trial", "backward_check", "drop_effects", "greedy", "settle_compliance"]
@@ -58,7 +58,9 @@ class Trial:
 def _candidate_specs(eng: Engine, effect: str, start: dict[str, float]) -> list:
     if effect in EFFECTS:
         return effect_parameters(eng.base_ctx, effect)[0]
-    specs = linearise(effect_columns(eng.traj, effect, start, eng.torque, eng.terms))[1]
+    joints = named_joints(start) if effect in STARTS else None  # the joints profiled
+    specs = linearise(effect_columns(eng.traj, effect, start, eng.torque, eng.terms,
+                                     joints=joints))[1]
     if effect in STARTS:  # only the joints the profile search found the effect on
         specs = [s for s in specs if s.name in start]
     return specs
@@ -182,6 +184,26 @@ def refine_compliance(eng: Engine, current: ModelFit, cur_cv: float, poses: I64,
     return current, cur_cv
 
 
+def _trials(eng: Engine, current: ModelFit, left: Sequence[str], poses: I64,
+            folds: Sequence[I64], alpha: float) -> list[Trial]:
+    """``try_effect`` of each candidate, keeping the fit of the best so far only (the lowest
+    CV RMS; the first of equals, as the stable sort ranks them): each fit holds arrays of the
+    whole trajectory (bases, shifts), so holding every candidate's fit until the ranking made
+    the search the diagnosis' memory peak (memory linear in the samples per fit kept)."""
+    out: list[Trial] = []
+    best = -1
+    for e in left:
+        tr = try_effect(eng, current, e, poses, folds, alpha)
+        if best < 0 or tr.cv_rms < out[best].cv_rms:
+            if best >= 0:
+                out[best] = replace(out[best], fit=None)
+            best = len(out)
+        else:
+            tr = replace(tr, fit=None)
+        out.append(tr)
+    return out
+
+
 def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
            folds: Sequence[I64], alpha: float = 1e-3, min_gain: float = 0.01,
            max_steps: int = 3) -> tuple[ModelFit, list[tuple[Trial, list[Trial]]]]:
@@ -195,12 +217,10 @@ def greedy(eng: Engine, start: ModelFit, effects: Sequence[str], poses: I64,
         left = [e for e in effects if e not in current.effects]
         if not left:
             break
-        trials = [try_effect(eng, current, e, poses, folds, alpha) for e in left]
-        ranked = sorted(trials, key=lambda tr: tr.cv_rms)
+        ranked = sorted(_trials(eng, current, left, poses, folds, alpha),
+                        key=lambda tr: tr.cv_rms)
         best = ranked[0]
-        # the ranking keeps its scores, not the losers' fits: each fit holds arrays of the
-        # whole trajectory (bases, shifts: memory linear in the samples per fit kept)
-        light = [replace(tr, fit=None) for tr in ranked[1:]]
+        light = ranked[1:]
         if (best.fit is None or best.p_value >= alpha or best.bic_delta >= 0
                 or best.cv_rms > (1.0 - min_gain) * cur_cv):
             steps.append((Trial(best.effect, None, note="stop"),
