@@ -25,13 +25,28 @@ import mujoco
 from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
 
-__all__ = ["MESH_SUFFIXES", "load_shipped", "load_shipped_spec", "resolve_mesh",
-           "shipped_urdf_xml"]
+__all__ = ["MESH_SUFFIXES", "example_robot_data_root", "load_shipped", "load_shipped_spec",
+           "resolve_mesh", "shipped_urdf_xml"]
 
 #: Mesh file types MuJoCo reads; others (Collada .dae, ...) are dropped from a URDF.
 MESH_SUFFIXES = (".stl", ".obj", ".msh")
 _COMPILER = {"fusestatic": "false", "discardvisual": "false", "inertiafromgeom": "false",
              "balanceinertia": "false"}
+
+
+def example_robot_data_root() -> Path | None:
+    """example-robot-data's ``robots`` folder (its wheel installs it in Pinocchio's prefix,
+    ``share/example-robot-data/robots``), or None without Pinocchio or the package."""
+    try:
+        import pinocchio
+    except ImportError:
+        return None
+    base = Path(pinocchio.__file__).parent
+    for up in (4, 3):
+        root = base.parents[up - 1] / "share" / "example-robot-data" / "robots"
+        if root.is_dir():
+            return root
+    return None
 
 
 def resolve_mesh(uri: str, urdf_dir: Path) -> Path | None:

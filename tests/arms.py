@@ -52,19 +52,15 @@ SHIPPED_URDFS = {
 
 def erd_root():
     """example-robot-data's robots folder (installed beside Pinocchio), or skip the test."""
-    import os
-    from pathlib import Path
-
     import pytest
 
-    pin = pytest.importorskip("pinocchio", reason="optional: pip install pin")
-    base = Path(os.path.dirname(pin.__file__))
-    for up in (4, 3):
-        root = base.parents[up - 1] / "share" / "example-robot-data" / "robots"
-        if root.is_dir():
-            return root
-    pytest.skip("optional: pip install example-robot-data")
-    return None
+    from mjcf.shipped import example_robot_data_root
+
+    pytest.importorskip("pinocchio", reason="optional: pip install pin")
+    root = example_robot_data_root()
+    if root is None:
+        pytest.skip("optional: pip install example-robot-data")
+    return root
 
 
 def shipped_arm(name: str):

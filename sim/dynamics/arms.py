@@ -11,6 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
+from mjcf.shipped import example_robot_data_root
 from sim.dynamics.arm import Arm, arm_from_manipulator, load_arm
 from zrp.arrays import F64
 from zrp.errors import InputError
@@ -30,11 +31,12 @@ def _puma() -> Arm:
 
 
 def panda_urdf() -> Path:
-    """example-robot-data's Panda URDF (its package is found through Pinocchio's prefix)."""
-    import pinocchio
-
-    return (Path(pinocchio.__file__).parents[4] / "share" / "example-robot-data" / "robots"
-            / "panda_description" / "urdf" / "panda.urdf")
+    """example-robot-data's Panda URDF (:func:`mjcf.shipped.example_robot_data_root`)."""
+    root = example_robot_data_root()
+    if root is None:
+        raise InputError("panda: example-robot-data not found (pip install pin "
+                         "example-robot-data)")
+    return root / "panda_description" / "urdf" / "panda.urdf"
 
 
 def _panda() -> Arm:

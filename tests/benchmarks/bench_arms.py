@@ -36,19 +36,12 @@ from _report import ROOT, Report, add_output_arguments, check_outputs, output_pa
 
 import zrp
 
+sys.path.insert(0, str(ROOT))  # tests.arms: the shipped arms' table, one copy
+from tests.arms import SHIPPED_URDFS
+
 SHARED = ROOT.parent / "shared" / "data" / "irb120-lasertracker" / "irb120.toml"
 QUICK_ARMS = ("ur5", "scara")
 TARGET_SHARE = 0.9  # visible singles named right and corrected (issue 23)
-
-#: example-robot-data arms: name -> (file under its robots folder, end link or None)
-ERD = {
-    "ur5": ("ur_description/urdf/ur5_robot.urdf", "tool0"),
-    "ur10": ("ur_description/urdf/ur10_robot.urdf", "tool0"),
-    "panda": ("panda_description/urdf/panda.urdf", "panda_hand"),
-    "xarm7": ("xarm_description/urdf/xarm7.urdf", None),
-    "kinova": ("kinova_description/robots/kinova.urdf", None),
-    "z1": ("z1_description/urdf/z1.urdf", "link06"),
-}
 
 Arm = tuple[zrp.Manipulator, "Path | None"]
 
@@ -64,16 +57,13 @@ def _in_metres(model: zrp.Manipulator) -> zrp.Manipulator:
 
 def _erd(name: str) -> Callable[[], Arm | None]:
     def load() -> Arm | None:
-        try:
-            import pinocchio as pin
-        except ImportError:
+        from mjcf.shipped import example_robot_data_root
+
+        root = example_robot_data_root()
+        rel, end = SHIPPED_URDFS[name]
+        if root is None or not (root / rel).is_file():
             return None
-        rel, end = ERD[name]
-        path = (Path(pin.__file__).parents[4] / "share" / "example-robot-data" / "robots"
-                / rel)
-        if not path.is_file():
-            return None
-        return zrp.import_urdf(path, end_link=end).model, path
+        return zrp.import_urdf(root / rel, end_link=end).model, root / rel
     return load
 
 

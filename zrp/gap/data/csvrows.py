@@ -18,7 +18,7 @@ from zrp.gap.data.measurements import OPTIONAL_SCALARS, QUAT_COLUMNS
 from zrp.model.manipulator import Manipulator
 from zrp.units import split_unit
 
-__all__ = ["Accumulator", "Columns", "Header", "check_header", "parse_row"]
+__all__ = ["Accumulator", "Columns", "Header", "check_header", "number_cell", "parse_row"]
 
 
 
@@ -54,7 +54,8 @@ class Columns:
     lines: NDArray[np.int64]
 
 
-def _number(text: str, src: str, line: int, col: str) -> float:
+def number_cell(text: str, src: str, line: int, col: str) -> float:
+    """The finite number in a CSV cell, or an error naming the file, line and column."""
     s = text.strip()
     if s == "":
         raise InputError(f"{src} line {line}: column {col} is empty; expected a number")
@@ -126,7 +127,7 @@ def _label(rec: list[str], i: int, name: str, what: str, src: str, lineno: int) 
 
 
 def _quaternion(rec: list[str], h: Header, src: str, lineno: int) -> list[float]:
-    quat = [_number(rec[h.col[c]], src, lineno, c) for c in QUAT_COLUMNS]
+    quat = [number_cell(rec[h.col[c]], src, lineno, c) for c in QUAT_COLUMNS]
     nq = float(np.linalg.norm(quat))
     if abs(nq - 1.0) > 1e-3:
         raise InputError(f"{src} line {lineno}: orientation (qw, qx, qy, qz) has norm "
@@ -137,7 +138,7 @@ def _quaternion(rec: list[str], h: Header, src: str, lineno: int) -> list[float]
 def _direction(rec: list[str], h: Header, src: str, lineno: int) -> list[float]:
     out = []
     for c in h.dcols:
-        v = _number(rec[h.col[c]], src, lineno, c)
+        v = number_cell(rec[h.col[c]], src, lineno, c)
         if v not in (-1.0, 0.0, 1.0):
             raise InputError(f"{src} line {lineno}: column {c} is {v:g}; expected -1, 0 or +1")
         out.append(v)
@@ -155,10 +156,10 @@ def parse_row(c: Accumulator, lineno: int, rec: list[str], h: Header, header: li
     if "point" in h.col:
         label = _label(rec, h.col["point"], "point", "a label", src, lineno)
         c.point.append(c.labels.setdefault(label, label))  # one string object per label
-    c.q.extend([_number(rec[h.col[q]], src, lineno, q) for q in h.qcols])
-    c.xyz.extend([_number(rec[h.col[x]], src, lineno, x) for x in "xyz"])
+    c.q.extend([number_cell(rec[h.col[q]], src, lineno, q) for q in h.qcols])
+    c.xyz.extend([number_cell(rec[h.col[x]], src, lineno, x) for x in "xyz"])
     for name in h.scalars:
-        c.scalars[name].append(_number(rec[h.col[name]], src, lineno, name))
+        c.scalars[name].append(number_cell(rec[h.col[name]], src, lineno, name))
     if h.quat:
         c.quat.extend(_quaternion(rec, h, src, lineno))
     if h.dirs:

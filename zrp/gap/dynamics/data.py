@@ -39,6 +39,7 @@ import numpy as np
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.data.csvrows import number_cell
 from zrp.gap.data.measurements import DataWarning
 from zrp.output import atomic_path
 from zrp.units import SI_UNITS, si_factor, split_unit
@@ -170,19 +171,6 @@ def _layout(header: list[str], src: str) -> _Layout:
     return _Layout(n, {c: i for i, c in enumerate(names)}, factor, groups, defaulted)
 
 
-def _number(text: str, src: str, line: int, col: str) -> float:
-    s = text.strip()
-    if not s:
-        raise InputError(f"{src} line {line}: column {col} is empty; expected a number")
-    try:
-        v = float(s)
-    except ValueError:
-        raise InputError(f"{src} line {line}: column {col} is {s!r}; expected a number") from None
-    if not np.isfinite(v):
-        raise InputError(f"{src} line {line}: column {col} is {s!r}; expected a finite number")
-    return v
-
-
 def _locate_error(path: Path, src: str, names: list[str]) -> InputError:
     """Read the file again row by row and return the error of its first bad row."""
     with open(path, newline="", encoding="utf-8-sig") as fh:
@@ -196,7 +184,7 @@ def _locate_error(path: Path, src: str, names: list[str]) -> InputError:
                 return InputError(f"{src} line {line}: {len(rec)} fields, but the header has "
                                   f"{len(names)} ({', '.join(names)})")
             for text, col in zip(rec, names, strict=True):
-                _number(text, src, line, col)
+                number_cell(text, src, line, col)
     return InputError(f"{src}: not a numeric CSV after its header")
 
 
