@@ -78,13 +78,18 @@ def test_a_command_started_with_stdout_closed(tmp_path):
 def test_a_broken_pipe_elsewhere_is_not_hidden(tmp_path):
     # stdout open and read: a BrokenPipeError from inside the command (a subprocess, a
     # connection) is not the reader going away and still shows as the failure it is
+    res = _fk_raising("BrokenPipeError(32, 'Broken pipe')", tmp_path)
+    assert res.returncode == 1 and "BrokenPipeError" in res.stderr
+
+
+def _fk_raising(exc: str, tmp_path):
+    """`zrp fk` in a subprocess whose command raises ``exc`` (Python source)."""
     code = ("import sys\nfrom zrp.cli.commands import kin\n"
-            "def boom(args):\n    raise BrokenPipeError(32, 'Broken pipe')\n"
+            f"def boom(args):\n    raise {exc}\n"
             "kin._fk = boom\nfrom zrp.cli.app import main\n"
             "sys.exit(main(['fk', '--q', '0', '0', '0', '0', '0', '0']))")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         cwd=tmp_path, env=ENV, timeout=300)
-    assert res.returncode == 1 and "BrokenPipeError" in res.stderr
+    return subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          cwd=tmp_path, env=ENV, timeout=300)
 
 
 def test_the_closed_stream_is_pointed_at_devnull(tmp_path):
@@ -118,10 +123,5 @@ def test_output_on_a_full_device_is_one_line(argv, tmp_path):
 def test_another_os_error_is_not_hidden(tmp_path):
     # only a device's errors (no space, quota, I/O) are the environment's; any other OSError
     # escaping a command is unexpected and keeps its traceback
-    code = ("import sys\nfrom zrp.cli.commands import kin\n"
-            "def boom(args):\n    raise PermissionError(13, 'Permission denied')\n"
-            "kin._fk = boom\nfrom zrp.cli.app import main\n"
-            "sys.exit(main(['fk', '--q', '0', '0', '0', '0', '0', '0']))")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         cwd=tmp_path, env=ENV, timeout=300)
+    res = _fk_raising("PermissionError(13, 'Permission denied')", tmp_path)
     assert res.returncode == 1 and "PermissionError" in res.stderr
