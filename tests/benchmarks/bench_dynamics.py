@@ -4,14 +4,14 @@ each with its own inertias (the Menagerie UR5e, the PUMA 560, the Franka Panda U
 Per scenario the physics robot with one hidden effect (or none) is driven along a random
 exciting Fourier command (20 s at 1 kHz, torque noise 1 % of each joint's torque range); the
 log CSV is diagnosed blind (CSV + nominal arm only) and scored against the truth written
-apart (:mod:`sim.dynamics.benchmark`). Target: in >= 90 % of the visible single effects the
+apart (:mod:`sim.studies.dynamics.benchmark`). Target: in >= 90 % of the visible single effects the
 first effect named is the hidden one, on the right joint, and the withheld torque RMS is
 <= 1.5x the true noise on every joint.
 
 Run: python3 tests/benchmarks/bench_dynamics.py [--reps 2] [--seed 1] [--seconds 20]
 [--arms ur5e puma panda] [--quick] [--out FILE.md] [--force] [--no-readme]   (writes
 renders/benchmarks/bench_dynamics.md and .json; its first table, per arm, also replaces the
-generated block of sim/dynamics/README.md, its heading saying the size of the run (arms,
+generated block of zrp/gap/dynamics/README.md, its heading saying the size of the run (arms,
 effects, repetitions, log length, seed), reduced or --quick runs included; not with --out or
 --no-readme)
 """
@@ -27,9 +27,9 @@ import numpy as np
 from _readme_block import replace_block
 from _report import ROOT, Report, add_output_arguments, output_path
 
-from sim.dynamics import benchmark as bm
-from sim.dynamics.arms import available_arms
-from sim.dynamics.scenarios import KINDS
+from sim.studies.dynamics import benchmark as bm
+from sim.studies.dynamics.arms import available_arms
+from sim.studies.dynamics.scenarios import KINDS
 
 
 def main() -> None:
@@ -41,7 +41,7 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true",
                     help="PUMA only, coulomb/payload/none, one 10 s log each (a smoke run)")
     ap.add_argument("--no-readme", action="store_true",
-                    help="leave sim/dynamics/README.md's generated table as it is")
+                    help="leave zrp/gap/dynamics/README.md's generated table as it is")
     add_output_arguments(ap, "bench_dynamics")
     args = ap.parse_args()
     out = output_path(args)
@@ -94,7 +94,7 @@ def main() -> None:
         print(f"replaced the generated bench_dynamics table of {README.relative_to(ROOT)}")
 
 
-README = ROOT / "sim" / "dynamics" / "README.md"
+README = ROOT / "zrp" / "gap" / "dynamics" / "README.md"
 BLOCK_COLUMNS = ["arm", "visible singles", "right", "named first (not tied)",
                  "effect-free logs, nothing named", "withheld ratio, median (max)",
                  "visibility", "diagnosis s"]

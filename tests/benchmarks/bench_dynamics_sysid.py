@@ -4,7 +4,7 @@ Problem: the Menagerie UR5e with hidden Coulomb friction on joint 2 (2 N m), vis
 on joint 4 (0.5 N m s/rad) and a 1 kg payload, driven by a servo along an exciting Fourier
 command; 20 s logged at 1 kHz (positions, velocities, motor torques with 1 % noise).
 
-* ``zrp`` (:func:`sim.dynamics.diagnosis.diagnose_dynamics`): inverse dynamics along the log,
+* ``zrp`` (:func:`zrp.gap.dynamics.diagnosis.diagnose_dynamics`): inverse dynamics along the log,
   which effects among all candidates, their sizes with intervals; linear least squares.
 * ``mujoco.sysid``: simulation error. The measured torques drive the model open loop
   (``motor`` actuators); the parameters are fitted so that the simulated joint positions and
@@ -26,10 +26,10 @@ import mujoco
 import numpy as np
 from _report import Report, add_output_arguments, output_path
 
-from sim.dynamics.arms import BENCH_ARMS
-from sim.dynamics.diagnosis import diagnose_dynamics
-from sim.dynamics.scenarios import scenario_command
-from sim.dynamics.truth import HiddenDynamics, simulate
+from sim.studies.dynamics.arms import BENCH_ARMS
+from sim.studies.dynamics.scenarios import scenario_command
+from sim.studies.dynamics.truth import HiddenDynamics, simulate
+from zrp.gap.dynamics.diagnosis import diagnose_dynamics
 
 TRUE = {"frictionloss_j2": 2.0, "damping_j4": 0.5, "payload_kg": 1.0}
 

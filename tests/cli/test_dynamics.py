@@ -13,9 +13,9 @@ from zrp.cli import main
 
 @pytest.fixture(scope="module")
 def puma_log(tmp_path_factory):
-    from sim.dynamics.arms import BENCH_ARMS
-    from sim.dynamics.scenarios import scenario_command
-    from sim.dynamics.truth import HiddenDynamics, simulate
+    from sim.studies.dynamics.arms import BENCH_ARMS
+    from sim.studies.dynamics.scenarios import scenario_command
+    from sim.studies.dynamics.truth import HiddenDynamics, simulate
     from zrp.gap.dynamics import write_torque_log
 
     b = BENCH_ARMS["puma"]

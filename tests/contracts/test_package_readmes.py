@@ -13,7 +13,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("zrp/model", "zrp/kinematics", "zrp/manufacturing", "zrp/paper", "zrp/calibration",
-            "zrp/cli", "mjcf", "sim/dynamics")
+            "zrp/cli", "mjcf", "zrp/gap/dynamics")
 
 
 def python_blocks(readme: Path) -> list[str]:

@@ -12,17 +12,17 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from sim.dynamics import benchmark as bm
-from sim.dynamics.arm import Arm, resolve_arm
-from sim.dynamics.arms import available_arms
-from sim.dynamics.corrected import corrected_spec, corrections, tracking_gap
-from sim.dynamics.diagnosis import DynamicDiagnosis, DynamicsOptions, diagnose_dynamics
-from sim.dynamics.excitation import design_excitation
-from sim.dynamics.report import diagnosis_json, write_report
-from sim.dynamics.scenarios import KINDS
-from sim.dynamics.truth import Servo
+from mjcf.arm import Arm, resolve_arm
+from mjcf.corrected import corrected_spec, corrections
+from mjcf.tracking import Servo, tracking_gap
+from sim.studies.dynamics import benchmark as bm
+from sim.studies.dynamics.arms import available_arms
+from sim.studies.dynamics.scenarios import KINDS
 from zrp.errors import InputError
 from zrp.gap.dynamics.data import TorqueLog, load_torque_log
+from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, DynamicsOptions, diagnose_dynamics
+from zrp.gap.dynamics.excitation import design_excitation
+from zrp.gap.dynamics.report import diagnosis_json, write_report
 from zrp.jsonio import to_jsonable
 from zrp.output import OutputDir, atomic_path, write_text
 

@@ -19,13 +19,14 @@ import mediapy
 import mujoco
 import numpy as np
 
-from sim.dynamics.arms import BENCH_ARMS
-from sim.dynamics.corrected import SampledCommand, tracking_gap, write_corrected_mjcf
-from sim.dynamics.diagnosis import diagnose_dynamics
-from sim.dynamics.inertial import inverse_dynamics
-from sim.dynamics.scenarios import scenario_command
-from sim.dynamics.truth import HiddenDynamics, Servo, run_servo, simulate
+from mjcf.corrected import write_corrected_mjcf
+from mjcf.tracking import SampledCommand, tracking_gap
+from mjcf.inverse import inverse_dynamics
+from sim.studies.dynamics.arms import BENCH_ARMS
+from sim.studies.dynamics.scenarios import scenario_command
+from sim.studies.dynamics.truth import HiddenDynamics, Servo, run_servo, simulate
 from zrp.gap.dynamics import derive_states, load_torque_log, write_torque_log
+from zrp.gap.dynamics.diagnosis import diagnose_dynamics
 
 
 def show(fig: plt.Figure) -> None:
@@ -74,7 +75,7 @@ print(f"{log.n_samples} samples at {1 / log.dt:.0f} Hz, {log.n_joints} joints")
 # ## Where the model's torques miss
 #
 # The model's torques along the log are MuJoCo's inverse dynamics, tau = M(q) qdd +
-# c(q, qd) + g(q) (`mj_inverse`; eq. R2 of `sim.dynamics.inertial` writes it linear in the
+# c(q, qd) + g(q) (`mj_inverse`; eq. R2 of `zrp.gap.dynamics.inertia` writes it linear in the
 # link inertias), at the logged positions with velocities and
 # accelerations from a zero-phase Savitzky-Golay filter (differentiating raw encoder
 # readings twice would multiply their noise by 1/dt^2, a million at 1 kHz). The residual,

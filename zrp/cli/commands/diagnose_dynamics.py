@@ -15,7 +15,7 @@ GAIN = real(0.0, 1e9, open_lo=True)
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "diagnose-dynamics", help="where a MuJoCo model's joint torques miss a torque log, and why",
-        description="Diagnose the dynamic gap (sim/dynamics/README.md): inverse dynamics "
+        description="Diagnose the dynamic gap (zrp/gap/dynamics/README.md): inverse dynamics "
         "(mj_inverse) along the logged states against the logged torques; which effect "
         "(friction, armature, payload, link inertias, torque sensor offset/gain) on which "
         "joint, its size with an interval, the withheld torque error before and after. "

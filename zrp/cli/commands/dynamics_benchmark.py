@@ -18,7 +18,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "dynamics-benchmark", help="blind benchmark of the dynamic gap diagnosis",
         description="Hide one dynamic effect (friction laws, armature, torque offset, payload, "
         "link inertias, or none) in the physics robot of each arm, log it along an exciting "
-        "command, diagnose the log blind and score against the truth (sim/dynamics/README.md)."
+        "command, diagnose the log blind and score against the truth (zrp/gap/dynamics/README.md)."
         " Writes summary.json and summary.md.")
     p.add_argument("--arms", nargs="+", choices=ARMS, help="default: every installed arm")
     p.add_argument("--effects", nargs="+", choices=EFFECTS, help="default: all")

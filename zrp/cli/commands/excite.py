@@ -16,7 +16,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "excite", help="design an exciting trajectory (Fourier series) for the dynamic gap",
         description="A finite Fourier series about --q0 within position, velocity, "
         "acceleration and torque limits that minimises the identification regressor's "
-        "condition number (sim/dynamics/README.md). Writes the command as a CSV "
+        "condition number (zrp/gap/dynamics/README.md). Writes the command as a CSV "
         "(t [s], qc1..qcn [rad]) for the robot's controller; log the run as a torque log.")
     p.add_argument("--model", required=True, metavar="M.xml|M.urdf|NAME")
     p.add_argument("--end-link", metavar="LINK", help="URDF: the arm's last link")

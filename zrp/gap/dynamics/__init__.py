@@ -1,8 +1,17 @@
-"""The dynamic gap's data: the joint torque log (a time series of joint positions, velocities
-and measured torques) and its zero-phase derivatives. NumPy/SciPy only; the diagnosis against a
-MuJoCo model lives in :mod:`sim.dynamics`."""
+"""The dynamic gap: where a model's joint torques miss what the real arm needs, which
+unmodelled effect causes it, and how far the withheld torque error shrinks with it in the
+model ([README](README.md)). NumPy/SciPy only: the arm model is behind
+:class:`~zrp.gap.dynamics.arm.DynamicArm` (MuJoCo's implementation: :mod:`mjcf.arm`).
 
+Modules: ``data`` (the torque log), ``states`` (zero-phase derivatives), ``arm`` (the
+interface), ``inertia`` (link inertial parameters), ``effects``, ``fit``, ``cvgram``,
+``select``, ``regimes``, ``logchol``, ``physical``, ``diagnosis``, ``fourier``,
+``excitation``, ``report``.
+"""
+
+from zrp.gap.dynamics.arm import DynamicArm
 from zrp.gap.dynamics.data import TorqueLog, load_torque_log, write_torque_log
 from zrp.gap.dynamics.states import States, derive_states
 
-__all__ = ["States", "TorqueLog", "derive_states", "load_torque_log", "write_torque_log"]
+__all__ = ["DynamicArm", "States", "TorqueLog", "derive_states", "load_torque_log",
+           "write_torque_log"]

@@ -11,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from sim.dynamics.diagnosis import DynamicDiagnosis
+from zrp.gap.dynamics.diagnosis import DynamicDiagnosis
 from zrp.gap.report.html import report_html
 from zrp.jsonio import to_jsonable
 from zrp.output import OutputDir

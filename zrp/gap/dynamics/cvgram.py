@@ -2,7 +2,7 @@
 equations of every candidate column are accumulated once per training set (all segments but
 one, less a guard), so that scoring a set of effects solves only a small P x P system per
 segment (eq. F3: G_f = A_-f^T A_-f, c_f = A_-f^T b_-f; the same least squares as
-:func:`sim.dynamics.fit.cross_validate`, bounds included).
+:func:`zrp.gap.dynamics.fit.cross_validate`, bounds included).
 """
 
 from __future__ import annotations
@@ -10,9 +10,9 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from sim.dynamics.effects import Effect
-from sim.dynamics.fit import design, folds
 from zrp.arrays import F64
+from zrp.gap.dynamics.effects import Effect
+from zrp.gap.dynamics.fit import design, folds
 
 __all__ = ["CVGram"]
 

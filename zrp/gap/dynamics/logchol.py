@@ -1,7 +1,7 @@
 """The log-Cholesky parametrisation of a rigid body's inertial parameters (Rucker & Wensing
 2022, "Smooth parameterization of rigid-body inertia", IEEE RA-L 7(2)): every real vector
 theta in R^10 is a physically consistent body, and every physically consistent body (positive
-definite pseudo-inertia, eq. R5 of :mod:`sim.dynamics.inertial`) is exactly one theta.
+definite pseudo-inertia, eq. R5 of :mod:`zrp.gap.dynamics.inertia`) is exactly one theta.
 
 With theta = [alpha, d1, d2, d3, s12, s23, s13, t1, t2, t3] (eq. L1)::
 
@@ -26,9 +26,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.dynamics.inertial import pseudo_inertia
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.dynamics.inertia import pseudo_inertia
 
 __all__ = ["phi_from_pseudo", "phi_from_theta", "phi_jacobian", "theta_from_phi", "upper"]
 

@@ -18,8 +18,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import lsq_linear
 
-from sim.dynamics.effects import Effect
 from zrp.arrays import F64
+from zrp.gap.dynamics.effects import Effect
 
 __all__ = ["Design", "Fit", "cross_validate", "design", "lag_one", "solve"]
 

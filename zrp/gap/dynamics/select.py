@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.dynamics.cvgram import CVGram
-from sim.dynamics.effects import Effect
 from zrp.arrays import F64
+from zrp.gap.dynamics.cvgram import CVGram
+from zrp.gap.dynamics.effects import Effect
 
 __all__ = ["Step", "chi2_of", "forward_select"]
 

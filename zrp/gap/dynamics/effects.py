@@ -27,9 +27,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.inertial import V_EPS, base_directions, body_params, regressor
 from zrp.arrays import F64
+from zrp.gap.dynamics.arm import DynamicArm as Arm
+from zrp.gap.dynamics.inertia import V_EPS, base_directions
 
 __all__ = ["JOINT_EFFECTS", "STRIBECK_SPEEDS", "Effect", "candidate_effects"]
 
@@ -85,15 +85,16 @@ def _on_joint(col: F64, k: int, n: int) -> F64:
 
 
 def _joint_effects(arm: Arm, qd: F64, qdd: F64, tau0: F64) -> list[Effect]:
-    m, n = arm.model, arm.n
+    n = arm.n
+    coulomb, damping, armature = arm.joint_terms()
     out: list[Effect] = []
     inf = np.inf
     for k in range(n):
         w = qd[:, k]
         sgn = np.tanh(w / V_EPS)
-        spec = [("coulomb", sgn, "N m", -float(m.dof_frictionloss[k]), inf, ""),
-                ("viscous", w, "N m s/rad", -float(m.dof_damping[k]), inf, ""),
-                ("armature", qdd[:, k], "kg m^2", -float(m.dof_armature[k]), inf, ""),
+        spec = [("coulomb", sgn, "N m", -float(coulomb[k]), inf, ""),
+                ("viscous", w, "N m s/rad", -float(damping[k]), inf, ""),
+                ("armature", qdd[:, k], "kg m^2", -float(armature[k]), inf, ""),
                 ("offset", np.ones_like(w), "N m", -inf, inf, ""),
                 ("gain", tau0[:, k], "1", -1.0 + 1e-6, inf, "")]
         spec += [("stribeck", sgn * np.exp(-(w / vs) ** 2), "N m", 0.0, inf, f"v_s={vs:g} rad/s")
@@ -106,7 +107,7 @@ def _joint_effects(arm: Arm, qd: F64, qdd: F64, tau0: F64) -> list[Effect]:
 
 def payload_columns(arm: Arm, q: F64, qd: F64, qdd: F64) -> F64:
     """The payload block (eq. E2), shape (S, n, 4)."""
-    y, labels = regressor(arm, q, qd, qdd, [arm.tool_body])
+    y, labels = arm.regressor(q, qd, qdd, [arm.tool_body])
     p = arm.tool_point
     ym, yh = y[..., 0], y[..., 1:4]
     yi = y[..., 4:10]
@@ -140,7 +141,7 @@ def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,
                       np.array([0.0, -inf, -inf, -inf]), np.full(4, inf)))
     if inertial:
         v, scale = base_directions(arm)
-        y, _ = regressor(arm, q, qd, qdd)
+        y, _ = arm.regressor(q, qd, qdd)
         # only the combinations this log excites (eq. R6): directions of the base whose
         # singular value along the log is below EXCITED of the largest would be fitted to
         # noise (and make the links unphysical); they keep the model's values
@@ -163,5 +164,5 @@ def inertial_correction(arm: Arm, beta: F64, basis: tuple[F64, F64]) -> dict[int
     dphi = scale * (v @ beta)
     out = {}
     for i, b in enumerate(arm.moving_bodies()):
-        out[b] = body_params(arm.model, b) + dphi[10 * i:10 * i + 10]
+        out[b] = arm.body_params(b) + dphi[10 * i:10 * i + 10]
     return out

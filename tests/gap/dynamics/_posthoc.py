@@ -20,9 +20,10 @@ import numpy as np
 from scipy.linalg import null_space
 from scipy.optimize import minimize
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.inertial import body_params, pseudo_inertia_min
+from mjcf.arm import Arm
+from mjcf.inverse import body_params
 from zrp.arrays import F64
+from zrp.gap.dynamics.inertia import pseudo_inertia_min
 
 __all__ = ["feasible_inertias"]
 

@@ -1,4 +1,4 @@
-"""The physically consistent link inertia fit (sim.dynamics.physical, eq. P1-P5): physical by
+"""The physically consistent link inertia fit (zrp.gap.dynamics.physical, eq. P1-P5): physical by
 construction, equal to the unconstrained fit when that is already physical, the right torques
 on a known link change, and, where the minimum-norm set is not physical, no worse on withheld
 data than the post-hoc repair it replaced (tests/sim/dynamics/_posthoc.py)."""
@@ -8,13 +8,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.dynamics.arms import BENCH_ARMS
-from sim.dynamics.effects import candidate_effects, inertial_correction
-from sim.dynamics.fit import design, folds, solve
-from sim.dynamics.inertial import body_params, inverse_dynamics, pseudo_inertia_min, regressor
-from sim.dynamics.physical import physical_cross_validate, physical_fit
-from sim.dynamics.scenarios import scenario_command
-from tests.sim.dynamics._posthoc import feasible_inertias
+from mjcf.inverse import body_params, inverse_dynamics
+from sim.studies.dynamics.arms import BENCH_ARMS
+from sim.studies.dynamics.scenarios import scenario_command
+from tests.gap.dynamics._posthoc import feasible_inertias
+from zrp.gap.dynamics.effects import candidate_effects, inertial_correction
+from zrp.gap.dynamics.fit import design, folds, solve
+from zrp.gap.dynamics.inertia import pseudo_inertia_min
+from zrp.gap.dynamics.physical import physical_cross_validate, physical_fit
 
 
 @pytest.fixture(scope="module")
@@ -30,7 +31,7 @@ def puma_states():
 
 def _link_torques(arm, states, dphi):
     """The torques of a change dphi of every link's parameters, from MuJoCo's regressor."""
-    y, _ = regressor(arm, *states)
+    y, _ = arm.regressor(*states)
     return y @ dphi
 
 
@@ -97,10 +98,11 @@ def test_non_physical_torques_give_a_physical_set_that_says_how_far(puma_states)
 def ur5e_inertial_case(ur5e):
     """The UR5e benchmark case "inertial", seed 1: the minimum-norm link inertias are not
     physical and the post-hoc repair shrank the correction to about a quarter."""
-    from sim.dynamics import diagnosis as dg
-    from sim.dynamics.scenarios import draw_hidden
-    from sim.dynamics.select import forward_select
-    from sim.dynamics.truth import simulate
+    from zrp.gap.dynamics import diagnosis as dg
+
+    from sim.studies.dynamics.scenarios import draw_hidden
+    from sim.studies.dynamics.truth import simulate
+    from zrp.gap.dynamics.select import forward_select
 
     bench = BENCH_ARMS["ur5e"]
     command = scenario_command(bench.q0_array, bench.amplitude_rad, 1)
@@ -161,8 +163,8 @@ def test_ur5e_case_physical_and_no_worse_than_the_shrunk_repair(ur5e, ur5e_inert
 
 @pytest.mark.slow
 def test_ur5e_case_diagnosis_says_how_far(ur5e, ur5e_inertial_case):
-    from sim.dynamics.diagnosis import diagnose_dynamics
-    from sim.dynamics.report import diagnosis_json
+    from zrp.gap.dynamics.diagnosis import diagnose_dynamics
+    from zrp.gap.dynamics.report import diagnosis_json
 
     log, sigma_true = ur5e_inertial_case[:2]
     diag = diagnose_dynamics(ur5e, log)

@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.dynamics.diagnosis import diagnose_dynamics
-from sim.dynamics.fourier import random_fourier
-from sim.dynamics.truth import HiddenDynamics, simulate
-from tests.sim.dynamics.conftest import UR5E_NOISE
+from sim.studies.dynamics.truth import HiddenDynamics, simulate
+from tests.gap.dynamics.conftest import UR5E_NOISE
+from zrp.gap.dynamics.diagnosis import diagnose_dynamics
+from zrp.gap.dynamics.fourier import random_fourier
 
 
 def _run(arm, command, hidden, seconds=20.0, seed=2):

@@ -7,11 +7,12 @@ import mujoco
 import numpy as np
 import pytest
 
-from sim.dynamics.corrected import tracking_gap, write_corrected_mjcf
-from sim.dynamics.diagnosis import diagnose_dynamics
-from sim.dynamics.inertial import inverse_dynamics
-from sim.dynamics.truth import HiddenDynamics, Servo, simulate, true_model
-from tests.sim.dynamics.conftest import UR5E_NOISE
+from mjcf.corrected import write_corrected_mjcf
+from mjcf.inverse import inverse_dynamics
+from mjcf.tracking import tracking_gap
+from sim.studies.dynamics.truth import HiddenDynamics, Servo, simulate, true_model
+from tests.gap.dynamics.conftest import UR5E_NOISE
+from zrp.gap.dynamics.diagnosis import diagnose_dynamics
 
 
 @pytest.mark.slow
@@ -43,8 +44,9 @@ def test_corrected_model_tracks_like_the_real_arm(ur5e, ur5e_command, tmp_path):
 
 @pytest.mark.slow
 def test_corrected_link_inertias_load_and_are_physical(ur5e, tmp_path):
-    from sim.dynamics.inertial import body_params, pseudo_inertia_ok
-    from sim.dynamics.scenarios import draw_hidden, scenario_command
+    from mjcf.inverse import body_params
+    from sim.studies.dynamics.scenarios import draw_hidden, scenario_command
+    from zrp.gap.dynamics.inertia import pseudo_inertia_ok
 
     command = scenario_command(np.array([0.0, -1.2, 1.2, -1.5, -1.5, 0.0]), 0.6, 1)
     hidden, sigma, _ = draw_hidden(ur5e, command, "inertial", 1)

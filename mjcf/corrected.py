@@ -1,5 +1,5 @@
-"""The corrected model: the arm's MJCF with the identified effects written in, and the
-re-simulation of the logged command through it (the same servo) to show the tracking gap.
+"""The corrected model: the arm's MJCF with the identified effects written in (the
+re-simulation of the logged command through it is :mod:`mjcf.tracking`).
 
 Written into the MJCF: Coulomb friction (``frictionloss``), viscous friction (``damping``),
 armature (``armature``), each added to the model's own value; a payload (a child body of the
@@ -11,25 +11,20 @@ Stribeck bump, a torque sensor's offset and gain (they are listed in
 
 from __future__ import annotations
 
-import copy
 import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import mujoco
 import numpy as np
-from scipy.interpolate import CubicSpline
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.diagnosis import DynamicDiagnosis
-from sim.dynamics.truth import Servo, run_servo
+from mjcf.arm import Arm
 from zrp.arrays import F64
 from zrp.errors import InputError
-from zrp.gap.dynamics.data import TorqueLog
+from zrp.gap.dynamics.diagnosis import DynamicDiagnosis
 from zrp.output import write_text
 
-__all__ = ["Corrections", "SampledCommand", "corrected_spec", "corrections", "tracking_gap",
-           "write_corrected_mjcf"]
+__all__ = ["Corrections", "corrected_spec", "corrections", "write_corrected_mjcf"]
 
 _JOINT_FIELDS = {"coulomb": "frictionloss", "viscous": "damping", "armature": "armature"}
 
@@ -122,32 +117,3 @@ def write_corrected_mjcf(arm: Arm, diag: DynamicDiagnosis, path: str | os.PathLi
     return write_text(path, spec.to_xml(), overwrite=overwrite)
 
 
-@dataclass(frozen=True)
-class SampledCommand:
-    """A logged command (t, qc) as a cubic spline, with its derivatives."""
-
-    t: F64
-    qc: F64
-
-    @property
-    def q0(self) -> F64:
-        return self.qc[0]
-
-    def evaluate(self, t: F64) -> tuple[F64, F64, F64]:
-        sp = CubicSpline(self.t - self.t[0], self.qc, axis=0)
-        return sp(t), sp(t, 1), sp(t, 2)
-
-
-def tracking_gap(model: mujoco.MjModel, nominal: mujoco.MjModel, log: TorqueLog, servo: Servo,
-                 command: object | None = None) -> F64:
-    """RMS of (re-simulated minus logged) joint positions per joint (n,), ``model`` driven by
-    ``servo`` (feed-forward from ``nominal``, as the real controller) along the log's
-    commanded positions (or ``command``, an object with ``evaluate(t)``)."""
-    if command is None:
-        if log.qc is None:
-            raise InputError(f"{log.source}: no commanded positions qc1..qcn; the "
-                             "re-simulation drives them")
-        command = SampledCommand(log.t, log.qc)
-    run = run_servo(copy.deepcopy(model), nominal, servo, command,
-                    log.n_samples / (1.0 / log.dt), 1.0 / log.dt)
-    return np.sqrt(np.mean((run.q - log.q) ** 2, axis=0))

@@ -1,7 +1,7 @@
 """The blind benchmark of the dynamic gap diagnosis.
 
-For each scenario (:mod:`sim.dynamics.scenarios`) the physics robot with one hidden effect
-(:mod:`sim.dynamics.truth`) is driven along an exciting command and its log is written as a
+For each scenario (:mod:`sim.studies.dynamics.scenarios`) the physics robot with one hidden effect
+(:mod:`sim.studies.dynamics.truth`) is driven along an exciting command and its log is written as a
 torque log CSV, with a SEPARATE truth file (the hidden effect, the true noise, how visible the
 effect is). :func:`diagnose_blind` then runs on the CSV alone: it receives the CSV path and
 the arm's key (it loads the nominal model itself), never the scenario, the truth file or
@@ -25,15 +25,16 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.arms import BENCH_ARMS
-from sim.dynamics.diagnosis import DynamicDiagnosis, diagnose_dynamics
-from sim.dynamics.fourier import Fourier
-from sim.dynamics.inertial import inverse_dynamics
-from sim.dynamics.scenarios import Scenario, draw_hidden, scenario_command
-from sim.dynamics.truth import TRUTH_V_EPS, HiddenDynamics, simulate, true_model
+from mjcf.arm import Arm
+from mjcf.inverse import inverse_dynamics
+from mjcf.tracking import TRUTH_V_EPS
+from sim.studies.dynamics.arms import BENCH_ARMS
+from sim.studies.dynamics.scenarios import Scenario, draw_hidden, scenario_command
+from sim.studies.dynamics.truth import HiddenDynamics, simulate, true_model
 from zrp.arrays import F64
 from zrp.gap.dynamics.data import TorqueLog, load_torque_log, write_torque_log
+from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, diagnose_dynamics
+from zrp.gap.dynamics.fourier import Fourier
 from zrp.jsonio import to_jsonable
 from zrp.output import write_json
 

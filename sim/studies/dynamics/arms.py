@@ -11,8 +11,8 @@ from pathlib import Path
 
 import numpy as np
 
+from mjcf.arm import Arm, arm_from_manipulator, load_arm
 from mjcf.shipped import example_robot_data_root
-from sim.dynamics.arm import Arm, arm_from_manipulator, load_arm
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.files import load_model

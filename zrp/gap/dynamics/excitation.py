@@ -1,4 +1,4 @@
-"""Exciting trajectory design: a finite Fourier series (:mod:`sim.dynamics.fourier`, eq. X1)
+"""Exciting trajectory design: a finite Fourier series (:mod:`zrp.gap.dynamics.fourier`, eq. X1)
 within position, velocity, acceleration and torque limits that minimises the condition number
 of the identification regressor (eq. X2)::
 
@@ -22,11 +22,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.fourier import Fourier, _rest_projector, random_fourier, scale_into
-from sim.dynamics.inertial import V_EPS, base_directions, inverse_dynamics, regressor
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.dynamics.arm import DynamicArm as Arm
+from zrp.gap.dynamics.fourier import Fourier, _rest_projector, random_fourier, scale_into
+from zrp.gap.dynamics.inertia import V_EPS, base_directions
 
 __all__ = ["Excitation", "condition_number", "design_excitation", "structural_rank"]
 
@@ -47,7 +47,7 @@ def _identification_matrix(arm: Arm, f: Fourier, basis: tuple[F64, F64], samples
 
 
 def _matrix_at(arm: Arm, q: F64, qd: F64, qdd: F64, basis: tuple[F64, F64]) -> F64:
-    y, _ = regressor(arm, q, qd, qdd)
+    y, _ = arm.regressor(q, qd, qdd)
     v, scale = basis
     blocks = [(y * scale) @ v]
     n = arm.n
@@ -88,18 +88,13 @@ def condition_number(arm: Arm, f: Fourier, samples: int = 200,
 def _torque_limits(arm: Arm, torque_limit: F64 | None) -> F64:
     if torque_limit is not None:
         return np.broadcast_to(np.asarray(torque_limit, dtype=float), (arm.n,))
-    m = arm.model
-    lim = np.full(arm.n, np.inf)
-    for k in range(arm.n):
-        if m.jnt_actfrclimited[k]:
-            lim[k] = float(np.abs(m.jnt_actfrcrange[k]).max())
-    return lim
+    return arm.torque_limits()
 
 
 def _within_torque(arm: Arm, f: Fourier, limit: F64) -> tuple[Fourier, F64]:
     t = np.linspace(0.0, 1.0 / f.f0_hz, 400, endpoint=False)
     for _ in range(40):
-        peak = np.abs(inverse_dynamics(arm.model, *f.evaluate(t))).max(0)
+        peak = np.abs(arm.inverse_dynamics(*f.evaluate(t))).max(0)
         if np.all(peak <= limit):
             return f, peak
         f = Fourier(f.q0, 0.9 * f.a, 0.9 * f.b, f.f0_hz)

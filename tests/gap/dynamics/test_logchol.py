@@ -1,4 +1,4 @@
-"""The log-Cholesky map (eq. L1-L5 of sim.dynamics.logchol): every parameter vector is a
+"""The log-Cholesky map (eq. L1-L5 of zrp.gap.dynamics.logchol): every parameter vector is a
 physical body, a known body (a solid box) round-trips to its closed-form parameters, and the
 Jacobian matches central finite differences."""
 
@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from sim.dynamics.inertial import pseudo_inertia, pseudo_inertia_min
-from sim.dynamics.logchol import phi_from_theta, phi_jacobian, theta_from_phi, upper
 from zrp.errors import InputError
+from zrp.gap.dynamics.inertia import pseudo_inertia, pseudo_inertia_min
+from zrp.gap.dynamics.logchol import phi_from_theta, phi_jacobian, theta_from_phi, upper
 
 
 def _box(mass, sides, centre, rot):

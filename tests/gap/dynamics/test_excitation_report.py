@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.dynamics.diagnosis import diagnose_dynamics
-from sim.dynamics.excitation import condition_number, design_excitation
-from sim.dynamics.fourier import random_fourier
-from sim.dynamics.report import write_report
-from sim.dynamics.truth import HiddenDynamics, simulate
-from tests.sim.dynamics.conftest import UR5E_NOISE
+from sim.studies.dynamics.truth import HiddenDynamics, simulate
+from tests.gap.dynamics.conftest import UR5E_NOISE
+from zrp.gap.dynamics.diagnosis import diagnose_dynamics
+from zrp.gap.dynamics.excitation import condition_number, design_excitation
+from zrp.gap.dynamics.fourier import random_fourier
+from zrp.gap.dynamics.report import write_report
 
 
 @pytest.mark.slow

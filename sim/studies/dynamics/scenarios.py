@@ -19,11 +19,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.fourier import Fourier, random_fourier
-from sim.dynamics.inertial import body_params, inverse_dynamics
-from sim.dynamics.truth import HiddenDynamics, add_point_mass
+from mjcf.arm import Arm
+from mjcf.inverse import body_params, inverse_dynamics
+from sim.studies.dynamics.truth import HiddenDynamics, add_point_mass
 from zrp.arrays import F64
+from zrp.gap.dynamics.fourier import Fourier, random_fourier
 
 __all__ = ["KINDS", "Scenario", "draw_hidden", "scenario_command"]
 

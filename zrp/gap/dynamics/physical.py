@@ -1,5 +1,5 @@
 """Link inertial parameters identified physically consistent by construction: each moving
-body's phi_b is the image of a free log-Cholesky vector theta_b (:mod:`sim.dynamics.logchol`,
+body's phi_b is the image of a free log-Cholesky vector theta_b (:mod:`zrp.gap.dynamics.logchol`,
 eq. L1-L3), so every set the fit can return has positive definite pseudo-inertias (eq. R5)
 and nothing is repaired afterwards.
 
@@ -8,7 +8,7 @@ their physical bounds) and of the link changes dphi = phi(theta) - phi0::
 
     min  |W (A x + Y dphi - b)|^2  +  lam^2 |w * dphi|^2                         (eq. P1)
 
-* the first term is the weighted least squares of :mod:`sim.dynamics.fit` (eq. F1: rows
+* the first term is the weighted least squares of :mod:`zrp.gap.dynamics.fit` (eq. F1: rows
   weighted by 1 / sigma_k, so it is a chi^2 in noise units), with the *exact* torque change
   of the links, Y dphi (Y the full inertial regressor, eq. R2), not only its excited base
   combinations;
@@ -45,13 +45,13 @@ from scipy.linalg import block_diag
 from scipy.optimize import least_squares, lsq_linear
 from scipy.stats import chi2
 
-from sim.dynamics.arm import Arm
-from sim.dynamics.effects import EXCITED, Effect
-from sim.dynamics.fit import design, folds, lag_one
-from sim.dynamics.inertial import body_params, pseudo_inertia, pseudo_inertia_min
-from sim.dynamics.logchol import phi_from_pseudo, phi_from_theta, phi_jacobian, theta_from_phi
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.dynamics.arm import DynamicArm as Arm
+from zrp.gap.dynamics.effects import EXCITED, Effect
+from zrp.gap.dynamics.fit import design, folds, lag_one
+from zrp.gap.dynamics.inertia import pseudo_inertia, pseudo_inertia_min
+from zrp.gap.dynamics.logchol import phi_from_pseudo, phi_from_theta, phi_jacobian, theta_from_phi
 
 __all__ = ["InertialFit", "physical_cross_validate", "physical_fit"]
 
@@ -178,7 +178,7 @@ def _problem(arm: Arm, a: F64, lo: F64, hi: F64, scale: F64, b: F64, sigma: F64,
     lam = EXCITED * s_max
     prior = np.zeros((w.size, a.shape[-1]))
     prior[:, po:] = lam * np.diag(w)
-    phi0 = [body_params(arm.model, bb) for bb in arm.moving_bodies()]
+    phi0 = [arm.body_params(bb) for bb in arm.moving_bodies()]
     return _Problem(np.vstack([r, prior]), np.concatenate([c, np.zeros(w.size)]),
                     max(float(bw @ bw - c @ c), 0.0), aw, bw, b.shape[1], po, lo, hi, phi0,
                     [phi_from_pseudo(_floor(ph)) for ph in phi0])
@@ -325,7 +325,7 @@ def predict(arm: Arm, effects: list[Effect], fit: InertialFit, rows: np.ndarray)
     start = sum(e.columns.shape[-1] for e in effects[:i])
     r = effects[i].columns.shape[-1]
     others = np.concatenate([fit.theta[:start], fit.theta[start + r:]])
-    dphi = np.concatenate([fit.phi[bb] - body_params(arm.model, bb)
+    dphi = np.concatenate([fit.phi[bb] - arm.body_params(bb)
                            for bb in arm.moving_bodies()])
     return a[rows] @ np.concatenate([others, dphi])
 
@@ -333,7 +333,7 @@ def predict(arm: Arm, effects: list[Effect], fit: InertialFit, rows: np.ndarray)
 def physical_cross_validate(arm: Arm, effects: list[Effect], b: F64, sigma: F64, k: int,
                             guard: int = 0) -> tuple[F64, list[InertialFit]]:
     """Out-of-segment predictions (S, n) with eq. P1 fitted on the other segments (as
-    :func:`sim.dynamics.fit.cross_validate`, a guard each side), and each segment's fit."""
+    :func:`zrp.gap.dynamics.fit.cross_validate`, a guard each side), and each segment's fit."""
     s = b.shape[0]
     pred = np.zeros_like(b)
     fits = []

@@ -11,13 +11,17 @@ inertias (:func:`arm_from_manipulator`).
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
-from mjcf import MJCFImportError, MJCFOptions, build, load_shipped_spec
+from mjcf.builder import MJCFOptions, build
+from mjcf.errors import MJCFImportError
+from mjcf.inverse import body_params, gravity_torques, inverse_dynamics, regressor
+from mjcf.shipped import load_shipped_spec
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.model.files import load_model
@@ -30,7 +34,8 @@ _DOF = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
 
 @dataclass(frozen=True, eq=False)
 class Arm:
-    """An arm model for the dynamic gap.
+    """An arm model for the dynamic gap (MuJoCo's implementation of
+    :class:`zrp.gap.dynamics.arm.DynamicArm`).
 
     Attributes:
         name: for reports.
@@ -60,6 +65,42 @@ class Arm:
         """Ids of the bodies that move with some joint (their inertias enter the torques)."""
         m = self.model
         return [b for b in range(1, m.nbody) if m.body_weldid[b] != 0 and m.body_mass[b] >= 0]
+
+    def body_name(self, b: int) -> str:
+        return mujoco.mj_id2name(self.model, mujoco.mjtObj.mjOBJ_BODY, b) or f"body {b}"
+
+    def body_params(self, b: int) -> F64:
+        return body_params(self.model, b)
+
+    def joint_terms(self) -> tuple[F64, F64, F64]:
+        m = self.model
+        return (np.array(m.dof_frictionloss, dtype=float), np.array(m.dof_damping, dtype=float),
+                np.array(m.dof_armature, dtype=float))
+
+    def position_limits(self) -> tuple[F64, F64]:
+        m = self.model
+        lim = np.array(m.jnt_range, dtype=float)
+        limited = np.array(m.jnt_limited, dtype=bool) & (lim[:, 1] > lim[:, 0])
+        return (np.where(limited, lim[:, 0], -np.inf), np.where(limited, lim[:, 1], np.inf))
+
+    def torque_limits(self) -> F64:
+        m = self.model
+        out = np.full(self.n, np.inf)
+        for k in range(self.n):
+            if m.jnt_actfrclimited[k]:
+                out[k] = float(np.abs(m.jnt_actfrcrange[k]).max())
+        return out
+
+    def inverse_dynamics(self, q: F64, qd: F64, qdd: F64) -> F64:
+        return inverse_dynamics(self.model, q, qd, qdd)
+
+    def gravity_torques(self, q: F64) -> F64:
+        return gravity_torques(self.model, q)
+
+    def regressor(self, q: F64, qd: F64, qdd: F64, bodies: Iterable[int] | None = None
+                  ) -> tuple[F64, list[tuple[int, str]]]:
+        chosen = self.moving_bodies() if bodies is None else list(bodies)
+        return regressor(self.model, chosen, q, qd, qdd)
 
 
 def _check(m: mujoco.MjModel, field: str) -> None:

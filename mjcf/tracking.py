@@ -1,0 +1,143 @@
+"""Re-simulation of a commanded trajectory through a MuJoCo model with a joint servo
+(``mj_step``): the controller every model shares (the nominal model's inverse dynamics as
+feed-forward plus PD feedback), and the tracking gap of a model along a logged command.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass
+from typing import Protocol
+
+import mujoco
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from mjcf.arm import Arm
+from zrp.arrays import F64
+from zrp.errors import InputError
+from zrp.gap.dynamics.data import TorqueLog
+from zrp.gap.dynamics.inertia import V_EPS
+
+__all__ = ["TRUTH_V_EPS", "Command", "Run", "SampledCommand", "Servo", "run_servo",
+           "tracking_gap"]
+
+#: Velocity scale of an applied Stribeck bump's sign, rad/s (not the diagnosis's V_EPS).
+TRUTH_V_EPS = 0.02
+
+
+class Command(Protocol):
+    """A commanded trajectory: positions, velocities, accelerations at times ``t``."""
+
+    def evaluate(self, t: F64) -> tuple[F64, F64, F64]: ...
+
+
+@dataclass(frozen=True)
+class Servo:
+    """tau = ID_nominal(qc, qcd, qcdd) + kp (qc - q) + kv (qcd - qd); kp, kv (n,)."""
+
+    kp: F64
+    kv: F64
+
+    @classmethod
+    def tuned(cls, arm: Arm, q0: F64, hz: float = 4.0, zeta: float = 1.0) -> Servo:
+        """Gains for a ``hz`` bandwidth from the nominal joint inertias at q0."""
+        m = arm.model
+        d = mujoco.MjData(m)
+        d.qpos[:] = q0
+        mujoco.mj_forward(m, d)
+        full = np.zeros((m.nv, m.nv))
+        mujoco.mj_fullM(m, d, full)
+        w = 2.0 * np.pi * hz
+        inertia = np.diag(full)
+        return cls(inertia * w * w, 2.0 * zeta * inertia * w)
+
+
+def _plant(m: mujoco.MjModel, dt: float) -> mujoco.MjModel:
+    m = copy.deepcopy(m)
+    m.opt.timestep = dt
+    m.opt.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_CONTACT
+                              | mujoco.mjtDisableBit.mjDSBL_LIMIT
+                              | mujoco.mjtDisableBit.mjDSBL_ACTUATION)
+    m.opt.integrator = int(mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
+    return m
+
+
+@dataclass(frozen=True)
+class Run:
+    """A simulated run: time, positions, velocities and the servo's torques (S, n)."""
+
+    t: F64
+    q: F64
+    qd: F64
+    tau: F64
+    qc: F64
+
+
+def run_servo(plant: mujoco.MjModel, nominal: mujoco.MjModel, servo: Servo, command: Command,
+              duration_s: float, rate_hz: float = 1000.0, substeps: int = 4,
+              stribeck: tuple[F64, float] | None = None) -> Run:
+    """Drive ``plant`` along ``command`` with ``servo`` (feed-forward from ``nominal``)."""
+    dt = 1.0 / (rate_hz * substeps)
+    p = _plant(plant, dt)
+    d = mujoco.MjData(p)
+    dn = mujoco.MjData(nominal)
+    steps = round(duration_s * rate_hz)
+    t = np.arange(steps) / rate_hz
+    tf = np.arange(steps * substeps) * dt
+    qc, qcd, qcdd = command.evaluate(tf)
+    d.qpos[:] = qc[0]
+    fl = np.asarray(nominal.dof_frictionloss)
+    n = p.nv
+    out_q, out_qd, out_tau = (np.empty((steps, n)) for _ in range(3))
+    saved = nominal.opt.disableflags
+    nominal.opt.disableflags = saved | int(mujoco.mjtDisableBit.mjDSBL_CONSTRAINT)
+    try:
+        for i in range(steps * substeps):
+            dn.qpos[:], dn.qvel[:], dn.qacc[:] = qc[i], qcd[i], qcdd[i]
+            mujoco.mj_inverse(nominal, dn)
+            tau = (dn.qfrc_inverse + fl * np.tanh(qcd[i] / V_EPS)
+                   + servo.kp * (qc[i] - d.qpos) + servo.kv * (qcd[i] - d.qvel))
+            if i % substeps == 0:
+                j = i // substeps
+                out_q[j], out_qd[j], out_tau[j] = d.qpos, d.qvel, tau
+            d.qfrc_applied[:] = tau
+            if stribeck is not None:
+                fs, vs = stribeck
+                w = d.qvel
+                d.qfrc_applied[:] -= fs * np.tanh(w / TRUTH_V_EPS) * np.exp(-(w / vs) ** 2)
+            mujoco.mj_step(p, d)
+    finally:
+        nominal.opt.disableflags = saved
+    return Run(t, out_q, out_qd, out_tau, qc[::substeps])
+
+
+@dataclass(frozen=True)
+class SampledCommand:
+    """A logged command (t, qc) as a cubic spline, with its derivatives."""
+
+    t: F64
+    qc: F64
+
+    @property
+    def q0(self) -> F64:
+        return self.qc[0]
+
+    def evaluate(self, t: F64) -> tuple[F64, F64, F64]:
+        sp = CubicSpline(self.t - self.t[0], self.qc, axis=0)
+        return sp(t), sp(t, 1), sp(t, 2)
+
+
+def tracking_gap(model: mujoco.MjModel, nominal: mujoco.MjModel, log: TorqueLog, servo: Servo,
+                 command: Command | None = None) -> F64:
+    """RMS of (re-simulated minus logged) joint positions per joint (n,), ``model`` driven by
+    ``servo`` (feed-forward from ``nominal``, as the real controller) along the log's
+    commanded positions (or ``command``, an object with ``evaluate(t)``)."""
+    if command is None:
+        if log.qc is None:
+            raise InputError(f"{log.source}: no commanded positions qc1..qcn; the "
+                             "re-simulation drives them")
+        command = SampledCommand(log.t, log.qc)
+    run = run_servo(copy.deepcopy(model), nominal, servo, command,
+                    log.n_samples / (1.0 / log.dt), 1.0 / log.dt)
+    return np.sqrt(np.mean((run.q - log.q) ** 2, axis=0))
