@@ -10,6 +10,7 @@ inertias (:func:`arm_from_manipulator`).
 
 from __future__ import annotations
 
+import itertools
 import os
 from collections.abc import Iterable
 from dataclasses import dataclass
@@ -18,12 +19,14 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from mjcf.attachments import find_attachments
 from mjcf.builder import MJCFOptions, build
 from mjcf.errors import MJCFImportError
 from mjcf.inverse import body_params, gravity_torques, inverse_dynamics, regressor
 from mjcf.shipped import load_shipped_spec
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.dynamics.arm import Attachment
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
 
@@ -43,6 +46,8 @@ class Arm:
         model: the compiled model; dof k is logged joint k.
         tool_body: id of the body carrying the tool (the last moving body).
         tool_point: the payload point in the tool body's frame, m, shape (3,).
+        attachments: the parts carried rigidly on the tool body (:mod:`mjcf.attachments`).
+        notes: what loading did to the file's model, in words (joints made fixed).
     """
 
     name: str
@@ -50,6 +55,8 @@ class Arm:
     model: mujoco.MjModel
     tool_body: int
     tool_point: F64
+    attachments: tuple[Attachment, ...] = ()
+    notes: tuple[str, ...] = ()
 
     @property
     def n(self) -> int:
@@ -120,14 +127,36 @@ def _tool(m: mujoco.MjModel, tool_site: str | None, field: str) -> tuple[int, F6
     return int(m.jnt_bodyid[m.njnt - 1]), np.zeros(3)
 
 
-def _from_spec(spec: mujoco.MjSpec, name: str, tool_site: str | None, field: str) -> Arm:
+def _from_spec(spec: mujoco.MjSpec, name: str, tool_site: str | None, field: str,
+               notes: tuple[str, ...] = ()) -> Arm:
+    parts = find_attachments(spec, tool_site)  # before static bodies are fused
     try:
         m = spec.compile()
     except ValueError as exc:
         raise InputError(f"{field}: MuJoCo could not compile it: {exc}") from exc
     _check(m, field)
     body, point = _tool(m, tool_site, field)
-    return Arm(name, spec, m, body, point)
+    return Arm(name, spec, m, body, point, parts, notes)
+
+
+def _chain_end(spec: mujoco.MjSpec, n_joints: int, field: str) -> str | None:
+    """The body of the model's ``n_joints``-th joint when the model has more joints than the
+    log and its first ``n_joints`` form one chain (the rest, e.g. a gripper's fingers, hang
+    off its end); None otherwise."""
+    try:
+        m = spec.compile()
+    except ValueError as exc:
+        raise InputError(f"{field}: MuJoCo could not compile it: {exc}") from exc
+    if m.njnt <= n_joints or n_joints < 1:
+        return None
+    bodies = [int(m.jnt_bodyid[k]) for k in range(n_joints)]
+    for a, b in itertools.pairwise(bodies):
+        up = b
+        while up not in (a, 0):
+            up = int(m.body_parentid[up])
+        if up != a:
+            return None
+    return mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, bodies[-1])
 
 
 def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> None:
@@ -151,7 +180,8 @@ def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> None:
 
 
 def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | None = None,
-             tool_site: str | None = None, name: str | None = None) -> Arm:
+             tool_site: str | None = None, name: str | None = None,
+             n_joints: int | None = None) -> Arm:
     """The arm of an MJCF or URDF file (or a spec); see the module docstring.
 
     Args:
@@ -159,6 +189,9 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
         end_link: the last link (body) of the arm: joints off its chain are fixed.
         tool_site: the site where a payload sits; None: the last joint's body origin.
         name: for reports (default: the file's stem).
+        n_joints: the joints the log has: a model with more, whose first ``n_joints`` form a
+            chain (a gripper's fingers beyond it), has the others made fixed (said in
+            :attr:`Arm.notes`) when no ``end_link`` is given.
     """
     if isinstance(source, mujoco.MjSpec):
         return _from_spec(source, name or "arm", tool_site, "spec")
@@ -170,6 +203,12 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
         spec = load_shipped_spec(path)
     except MJCFImportError as exc:
         raise InputError(f"{field}: cannot load: {exc}") from exc
+    notes: tuple[str, ...] = ()
+    if end_link is None and n_joints is not None:
+        end_link = _chain_end(spec, n_joints, field)
+        if end_link is not None:
+            notes = (f"the model has more joints than the log's {n_joints}: joints after "
+                     f"link {end_link!r} (e.g. a gripper's fingers) are made fixed",)
     if end_link is not None:
         _fix_off_chain(spec, end_link)
     if path.suffix.lower() == ".urdf":
@@ -177,7 +216,7 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
         # a hand, fingers made fixed) fuse into their parent, as the inertial regressor has
         # one set of 10 parameters per body
         spec.compiler.fusestatic = True
-    return _from_spec(spec, name or path.stem, tool_site, field)
+    return _from_spec(spec, name or path.stem, tool_site, field, notes)
 
 
 def arm_from_manipulator(model: Manipulator, inertia: str = "puma560") -> Arm:
@@ -190,12 +229,12 @@ def arm_from_manipulator(model: Manipulator, inertia: str = "puma560") -> Arm:
     return _from_spec(spec, model.name, built.site_name, f"manipulator {model.name}")
 
 
-def resolve_arm(model: str, *, end_link: str | None = None, tool_site: str | None = None
-                ) -> Arm:
+def resolve_arm(model: str, *, end_link: str | None = None, tool_site: str | None = None,
+                n_joints: int | None = None) -> Arm:
     """The arm of a command line's ``--model``: an MJCF (.xml) or URDF (.urdf) file, else a
     ZRP model (builtin name or .toml) built with PUMA 560 inertias (6R) or rods."""
     if Path(model).suffix.lower() in (".xml", ".urdf", ".mjcf"):
-        return load_arm(model, end_link=end_link, tool_site=tool_site)
+        return load_arm(model, end_link=end_link, tool_site=tool_site, n_joints=n_joints)
     m = load_model(model)
     six_r = m.n == 6 and not np.asarray(m.prismatic).any()
     return arm_from_manipulator(m, "puma560" if six_r else "rods")

@@ -11,11 +11,33 @@ double, another physics engine).
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 from zrp.arrays import F64
 
-__all__ = ["DynamicArm"]
+__all__ = ["Attachment", "DynamicArm"]
+
+
+@dataclass(frozen=True)
+class Attachment:
+    """A part the model carries rigidly on its last link (a hand, a gripper, a tool, a
+    flange with mass): something that may not be mounted on the real arm.
+
+    Attributes:
+        name: the part's first link with mass (e.g. ``panda_hand``).
+        phi: its inertial parameters (eq. R1) in the tool body's frame, with every link
+            attached to it (e.g. the fingers), shape (10,).
+        members: the names of the links it lumps.
+    """
+
+    name: str
+    phi: F64
+    members: tuple[str, ...] = ()
+
+    @property
+    def mass(self) -> float:
+        return float(self.phi[0])
 
 
 @runtime_checkable
@@ -26,11 +48,14 @@ class DynamicArm(Protocol):
         name: for reports.
         tool_body: id of the body carrying the tool (where a payload sits).
         tool_point: the payload point in the tool body's frame, m, shape (3,).
+        attachments: the parts the model carries rigidly on the tool body (may be empty),
+            each with its inertial parameters in the tool body's frame.
     """
 
     name: str
     tool_body: int
     tool_point: F64
+    attachments: tuple[Attachment, ...]
 
     @property
     def n(self) -> int:

@@ -15,23 +15,27 @@ Arm-wide:
 * ``payload``: a mass m at the tool point p plus its first moment m d about p (eq. E2: the
   inertial regressor of the tool body at phi = [m, m (p + d), m |p|^2 ...], by linearity of
   eq. R2 in the point mass): columns [m, m d_x, m d_y, m d_z]; [kg, kg m x3].
+  A negative mass is a tool lighter than the model's (bounded by the tool body's own mass).
+* ``absent_part``, ``link_mass``: a modelled part (a hand) not on the arm, a link's mass or
+  centre off (:mod:`zrp.gap.dynamics.bodies`).
 * ``inertial``: the identifiable combinations of all link inertial parameters (eq. R4).
 
 Bounds keep the corrected model physical: the model's own friction, damping and armature plus
-the correction stay >= 0, a Stribeck bump and a payload mass are >= 0, a gain is > -1.
+the correction stay >= 0, a Stribeck bump is >= 0, the tool body's mass with a payload >= 0,
+a gain is > -1.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass
 
 import numpy as np
 
 from zrp.arrays import F64
 from zrp.gap.dynamics.arm import DynamicArm as Arm
+from zrp.gap.dynamics.bodies import body_effects
+from zrp.gap.dynamics.effect import Effect
 from zrp.gap.dynamics.inertia import V_EPS, base_directions
 
-__all__ = ["JOINT_EFFECTS", "STRIBECK_SPEEDS", "Effect", "candidate_effects"]
+__all__ = ["JOINT_EFFECTS", "STRIBECK_SPEEDS", "Effect", "candidate_effects", "payload_columns"]
 
 #: Stribeck speeds tried, rad/s (each a separate candidate; the diagnosis picks by data).
 STRIBECK_SPEEDS = (0.03, 0.1, 0.3)
@@ -40,42 +44,6 @@ STRIBECK_SPEEDS = (0.03, 0.1, 0.3)
 EXCITED = 1e-2
 
 JOINT_EFFECTS = ("coulomb", "viscous", "stribeck", "armature", "offset", "gain")
-
-
-@dataclass(frozen=True)
-class Effect:
-    """One candidate effect: its regressor block and parameter bounds.
-
-    Attributes:
-        name: one of :data:`JOINT_EFFECTS`, "payload" or "inertial".
-        joint: 0-based joint for a joint effect, None for an arm-wide one.
-        columns: shape (S, n, p).
-        params: the parameter names (p).
-        units: their units.
-        lower, upper: bounds, shape (p,).
-        detail: a fixed setting (the Stribeck speed) or "".
-    """
-
-    name: str
-    joint: int | None
-    columns: F64
-    params: tuple[str, ...]
-    units: tuple[str, ...]
-    lower: F64
-    upper: F64
-    detail: str = ""
-    basis: tuple[F64, F64] | None = None  # "inertial": (V, scale) of eq. R4
-    full: F64 | None = None  # "inertial": the full regressor Y (S, n, 10 B) of eq. R2
-
-    @property
-    def key(self) -> str:
-        j = "" if self.joint is None else f"_j{self.joint + 1}"
-        return f"{self.name}{j}{'@' + self.detail if self.detail else ''}"
-
-    @property
-    def label(self) -> str:
-        where = "arm" if self.joint is None else f"joint {self.joint + 1}"
-        return f"{self.name} ({where}{', ' + self.detail if self.detail else ''})"
 
 
 def _on_joint(col: F64, k: int, n: int) -> F64:
@@ -136,12 +104,15 @@ def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,
     """Every candidate effect along the states (module docstring)."""
     out = _joint_effects(arm, qd, qdd, tau0)
     inf = np.inf
+    # a negative payload is a tool lighter than modelled: the tool body's mass stays >= 0
+    tool_mass = float(arm.body_params(arm.tool_body)[0])
     out.append(Effect("payload", None, payload_columns(arm, q, qd, qdd),
                       ("mass", "m*dx", "m*dy", "m*dz"), ("kg", "kg m", "kg m", "kg m"),
-                      np.array([0.0, -inf, -inf, -inf]), np.full(4, inf)))
+                      np.array([-tool_mass, -inf, -inf, -inf]), np.full(4, inf)))
+    y, _ = arm.regressor(q, qd, qdd)
+    out += body_effects(arm, y)
     if inertial:
         v, scale = base_directions(arm)
-        y, _ = arm.regressor(q, qd, qdd)
         # only the combinations this log excites (eq. R6): directions of the base whose
         # singular value along the log is below EXCITED of the largest would be fitted to
         # noise (and make the links unphysical); they keep the model's values

@@ -11,8 +11,12 @@ current chi2 and ``min_abs`` (noise variances): smaller drops are what a wrong f
 the acceleration filter leave, not evidence of an effect. Parsimony: among the candidates whose
 drop is within ``occam`` (10 %) of the largest, the one with the fewest parameters is taken (a
 payload is also a change of the tool link's inertias; the four payload parameters are
-preferred to the forty link combinations when both explain the torques). One Stribeck speed a
-joint.
+preferred to the forty link combinations when both explain the torques), and a torque gain
+gives way to an effect of the arm's masses in the same window (a hand the arm does not carry
+looks like gains on every joint it loads). The link inertias' forty combinations yield to one
+part or link (payload, absent part, one link's mass) that explains at least half of their
+drop: a hand that is not mounted is named as such, the rest of what the links explain comes at
+a later step. One Stribeck speed a joint; one change a part or link.
 """
 
 from __future__ import annotations
@@ -42,8 +46,26 @@ def chi2_of(b_raw: F64, pred: F64, sigma: F64) -> float:
     return float(np.mean(((b_raw - pred) / sigma) ** 2))
 
 
-def _family(e: Effect) -> tuple[str, int | None]:
-    return e.name, e.joint
+#: Effects of the arm's masses: a torque gain is named only when none of them explains the
+#: same torques (a common gain is the symptom of a wrong mass, not a sensor finding).
+PHYSICAL = ("payload", "absent_part", "link_mass", "inertial")
+
+#: The share of the link inertias' withheld drop that one part or link of the model
+#: (a payload, an absent part, one link's mass) must explain to be named before them.
+LUMPED = 0.5
+
+
+def _family(e: Effect) -> tuple[str, int | None, str]:
+    """One effect a family: per joint, or per part or link for the body effects."""
+    return e.name, e.joint, e.detail if e.name in ("absent_part", "link_mass") else ""
+
+
+def _tag(e: Effect) -> str:
+    return e.key if e.name in ("absent_part", "link_mass") else e.key.split("@")[0]
+
+
+def _rank(e: Effect, physical_near: bool) -> int:
+    return int(e.name == "gain" and physical_near)
 
 
 def _parsimonious(scored: list[tuple[float, Effect, F64]], chi2: float, occam: float
@@ -54,8 +76,15 @@ def _parsimonious(scored: list[tuple[float, Effect, F64]], chi2: float, occam: f
         return None, ()
     top = min(c for c, _, _ in scored)
     near = [s for s in scored if chi2 - s[0] >= (1.0 - occam) * (chi2 - top)]
-    best = min(near, key=lambda s: (s[1].columns.shape[-1], s[0]))
-    others = {s[1].key.split("@")[0] for s in near if _family(s[1]) != _family(best[1])}
+    if all(s[1].name == "inertial" for s in near):
+        # every link's forty combinations yield to one part or link of the model that
+        # explains at least LUMPED of their drop (the rest is left for the next steps)
+        lumped = [s for s in scored if s[1].name in ("payload", "absent_part", "link_mass")
+                  and chi2 - s[0] >= LUMPED * (chi2 - top)]
+        near += lumped
+    physical = any(s[1].name in PHYSICAL for s in near)
+    best = min(near, key=lambda s: (_rank(s[1], physical), s[1].columns.shape[-1], s[0]))
+    others = {_tag(s[1]) for s in near if _family(s[1]) != _family(best[1])}
     return best, tuple(sorted(others))
 
 
