@@ -27,7 +27,7 @@ Steps:
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
@@ -42,6 +42,7 @@ from zrp.gap.dynamics.fit import cross_validate, design, solve
 from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
 from zrp.gap.dynamics.resulting import BodyChange, resulting_bodies
+from zrp.gap.dynamics.results import DynamicDiagnosis, FoundEffect, Param, Samples
 from zrp.gap.dynamics.select import Step, forward_select
 from zrp.gap.dynamics.states import States, derive_states
 
@@ -65,95 +66,6 @@ class DynamicsOptions:
     inertial: bool = True
     collinear: float = 0.1
     effects: tuple[str, ...] | None = None  # the effect names tried (None: all)
-
-
-@dataclass(frozen=True)
-class Param:
-    """A fitted parameter: value, 95 % interval, unit, and whether it sits on its bound."""
-
-    value: float
-    low: float
-    high: float
-    unit: str
-    at_bound: bool = False
-
-
-@dataclass(frozen=True)
-class FoundEffect:
-    """A chosen effect: its key, name, joint (0-based or None), detail, parameters and the
-    withheld chi2 drop it brought."""
-
-    key: str
-    name: str
-    joint: int | None
-    detail: str
-    params: dict[str, Param]
-    chi2_drop: float
-    rms_nm: F64 | None = None  # the RMS torque it adds on each joint along the log (n,)
-
-    @property
-    def label(self) -> str:
-        where = "arm" if self.joint is None else f"joint {self.joint + 1}"
-        return f"{self.name} ({where}{', ' + self.detail if self.detail else ''})"
-
-
-@dataclass(frozen=True)
-class Samples:
-    """The states and residuals at the fit rate, for plots: q, qd, and measured (raw) minus
-    model torques before and after (withheld), each (S, n)."""
-
-    t: F64
-    q: F64
-    qd: F64
-    before: F64
-    after: F64
-
-
-@dataclass(frozen=True)
-class DynamicDiagnosis:
-    """The result (all torques in N m, per joint arrays of shape (n,)).
-
-    Attributes:
-        arm, joints: names.
-        noise_nm: the torque noise floor sigma_k (eq. N1).
-        rms_before: RMS of measured minus model torques (raw torques).
-        rms_after: RMS of measured minus corrected torques, each time segment predicted by
-            the fit on the others (withheld).
-        steps: the forward selection (nominal first) with the withheld chi2 after each.
-        effects: the chosen effects, in order of choice.
-        cannot_tell: what this log cannot separate, in words.
-        regimes: {"before"|"after": {regime: [rms or None per joint]}}.
-        inertial_fit: the physically consistent link inertia fit (None: no inertial effect
-            chosen), with how far it is from the unconstrained one
-            (:class:`zrp.gap.dynamics.physical.InertialFit`).
-        inertial_phi: phi_b (eq. R1) of each moving body after it.
-        notes: what else the user should know.
-        samples: the states and residuals at the fit rate (plots).
-        bodies: every body the effects of the masses change (payload, absent part, link
-            mass, link inertias), with its resulting phi, all physical
-            (:mod:`zrp.gap.dynamics.resulting`).
-    """
-
-    arm: str
-    joints: list[str]
-    noise_nm: F64
-    rms_before: F64
-    rms_after: F64
-    steps: list[Step]
-    effects: list[FoundEffect]
-    cannot_tell: list[str]
-    regimes: dict[str, dict[str, list[float | None]]]
-    inertial_fit: InertialFit | None = None
-    inertial_phi: dict[int, F64] = field(default_factory=dict)
-    notes: list[str] = field(default_factory=list)
-    samples: Samples | None = None
-    bodies: dict[int, BodyChange] = field(default_factory=dict)
-
-    def effect(self, name: str, joint: int | None = None) -> FoundEffect | None:
-        for e in self.effects:
-            if e.name == name and e.joint == joint:
-                return e
-        return None
 
 
 def torque_noise(log: TorqueLog, window_s: float, polyorder: int = 3) -> F64:
@@ -329,6 +241,21 @@ def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, si
     return chosen, fitted, notes
 
 
+def _common_gain(found: list[FoundEffect]) -> list[str]:
+    """Gains of one sign on several joints: a symptom to explain, not a sensor finding."""
+    gains = [e for e in found if e.name == "gain"]
+    signs = {np.sign(e.params["gain"].value) for e in gains}
+    if len(gains) < 2 or len(signs) != 1:
+        return []
+    vals = [e.params["gain"].value for e in gains]
+    joints = ", ".join(str(e.joint + 1) for e in gains if e.joint is not None)
+    return [f"torque gains of {min(vals):+.0%} .. {max(vals):+.0%} on joints {joints}: a gain "
+            "common to several joints is a symptom, not a sensor finding: a mass the model has "
+            "and the arm lacks (a hand, a tool), or the reverse, or one torque constant wrong "
+            "on every motor. Check the model's masses and the torque constants before "
+            "calibrating the sensors"]
+
+
 def _unphysical_links(arm: Arm, inert: InertialFit) -> list[str]:
     """Where the physical link fit cannot follow the data: each link whose unconstrained fit
     is not a body, and what it would need."""
@@ -365,6 +292,7 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
             "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
     inert, pred = fitted.inert, fitted.pred
+    notes += _common_gain(fitted.found)
     if inert is not None:
         notes += [inert.describe(), *_unphysical_links(arm, inert)]
     bodies = {b: replace(c, torque_rms=np.sqrt(np.mean(
