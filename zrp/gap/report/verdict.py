@@ -183,7 +183,8 @@ def _against_floor(diag: Diagnosis) -> list[str]:
     floor, final, unit = diag.noise_floor, diag.final, diag.length_unit
     if floor.rms is None:
         return ["No noise floor can be estimated from these data (one point per pose and no "
-                "repeated poses), so whether a gap remains cannot be judged."]
+                "repeated poses), so whether a gap remains cannot be judged.",
+                *_structure_words(diag, always=True)]
     if floor.rms <= (diag.assessment.resolution if diag.assessment else 0.0):
         parts = [f"The noise floor is {floor.rms:.3g} {unit} (noise-free data)."]
         if diag.unexplained:
@@ -198,10 +199,21 @@ def _against_floor(diag: Diagnosis) -> list[str]:
         parts.append(f"A gap of {final.rms:.4g} {unit} RMS remains that no effect in the "
                      "library explains.")
         parts.append(remains_text(diag.where_final, unit))
+        parts += _structure_words(diag, always=True)
         parts += _weighed(diag)
     else:
         parts.append("What remains is at the noise floor.")
+        parts += _structure_words(diag, always=False)
     return parts
+
+
+def _structure_words(diag: Diagnosis, *, always: bool) -> list[str]:
+    """The multivariate test of what remains in one sentence (``always``: also when it finds
+    no structure)."""
+    s = None if diag.assessment is None else diag.assessment.remainder.structure
+    if s is None or not (always or s.structured):
+        return []
+    return [s.words(diag.length_unit)]
 
 
 def _weighed(diag: Diagnosis) -> list[str]:
