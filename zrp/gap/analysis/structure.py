@@ -11,7 +11,7 @@ kernel (scikit-learn's kernel; one target vector per pose, all its points' x, y,
   by a model that never saw it; the kernel width and the ridge are chosen inside each training
   fold by exact leave-one-out (eigendecomposition of the kernel matrix, so every ridge value
   costs O(n^2)), on the inputs scaled by per-input length scales (ARD) that a Gaussian
-  process (scikit-learn) sets once on a subsample of at most :data:`ARD_POSES` poses (a few
+  process (scikit-learn) sets once on a subsample of the poses (:mod:`.kernel`; a few
   hyperparameters against hundreds of poses: a negligible optimism). It is the share a smooth
   function of the inputs predicts on unseen poses: a lower bound of the structured share, below
   it by the regression's estimation error (on the simulated sag of the tests, 0.37 found for a
@@ -31,7 +31,6 @@ kernel width.
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,8 +38,9 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.arrays import F64
+from zrp.gap.analysis.kernel import fit_kernel_ridge, length_scales, pose_inputs, pose_targets
 from zrp.gap.fit.leastsq import FitResult
-from zrp.gap.model.context import MIN_EXCITATION_RAD, Context
+from zrp.gap.model.context import Context
 from zrp.jsonio import dict_from_dataclass
 
 __all__ = ["MAX_POSES", "MIN_SHARE", "Structure", "remainder_structure"]
@@ -53,16 +53,6 @@ MIN_POSES = 30
 MIN_SHARE = 0.05
 #: relevance, as a fraction of the largest, above which an input is named.
 NAMED_FRACTION = 0.3
-#: kernel widths tried on the inputs scaled by their ARD length scales: RBF
-#: exp(-gamma |x - x'|^2) (0.5: the Gaussian process's own).
-GAMMAS = (0.125, 0.5, 2.0)
-#: most poses the Gaussian process that sets the length scales sees.
-ARD_POSES = 200
-#: leading principal components of the residual the Gaussian process fits (its cost grows
-#: with the number of targets).
-ARD_COMPONENTS = 3
-#: ridge values tried, relative to the mean eigenvalue of the kernel matrix.
-RIDGES = tuple(10.0 ** np.arange(-5.0, 1.5, 0.5))
 N_BOOT = 400
 SEED = 20260
 
@@ -149,116 +139,6 @@ def _and(items: list[str]) -> str:
     return items[0] if len(items) == 1 else ", ".join(items[:-1]) + " and " + items[-1]
 
 
-def _inputs(ctx: Context, rows_of_pose: NDArray[np.int64]) -> tuple[F64, list[str],
-                                                                     list[list[int]]]:
-    """Per pose the inputs, each joint's (or log column's) group of columns scaled to unit
-    spread; joints that move less than the excitation threshold are left out."""
-    meas = ctx.meas
-    cols, names, groups = [], [], []
-    q = ctx.q[meas.pose_index[rows_of_pose]]
-    for k in range(ctx.n):
-        qk = q[:, k]
-        if not ctx.excited[k] or np.ptp(qk) < MIN_EXCITATION_RAD:
-            continue
-        f = (qk[:, None] if ctx.model.prismatic[k] else
-             np.column_stack([np.sin(qk), np.cos(qk)]))
-        names.append(f"q{k + 1}")
-        cols.append(f)
-    for name, arr in (("time", meas.t), ("temperature", meas.temp), ("load", meas.load)):
-        if arr is not None and np.ptp(arr[rows_of_pose]) > 0:
-            names.append(name)
-            cols.append(arr[rows_of_pose][:, None])
-    out = []
-    for f in cols:
-        f = f - f.mean(0)
-        s = math.sqrt(float(np.sum(f.var(0))))
-        out.append(f / s if s > 0 else f)
-    i = 0
-    for f in out:
-        groups.append(list(range(i, i + f.shape[1])))
-        i += f.shape[1]
-    X = np.column_stack(out) if out else np.zeros((len(rows_of_pose), 0))
-    return X, names, groups
-
-
-def _targets(ctx: Context, fit: FitResult) -> tuple[F64, NDArray[np.int64]]:
-    """Per complete fitting pose the residual of all its points (P, 3M), and one row of each
-    pose (for its inputs)."""
-    meas = ctx.meas
-    rows = np.flatnonzero(np.isin(meas.pose_index, fit.poses))
-    r = fit.residual[: 3 * rows.size].reshape(-1, 3)
-    M = len(meas.point_labels)
-    poses, inv = np.unique(meas.pose_index[rows], return_inverse=True)
-    Y = np.full((poses.size, M, 3), np.nan)
-    Y[inv, meas.point_index[rows]] = r
-    first = np.full(poses.size, -1, dtype=np.int64)
-    first[inv[::-1]] = rows[::-1]
-    full = np.all(np.isfinite(Y.reshape(poses.size, -1)), axis=1)
-    return Y[full].reshape(int(full.sum()), -1), first[full]
-
-
-def _length_scales(X: F64, Y: F64, rng: np.random.Generator) -> F64:
-    """Per-input length scales (ARD) of a Gaussian process fitted by scikit-learn on at most
-    :data:`ARD_POSES` poses: an input the remainder does not depend on gets a long one."""
-    from sklearn.gaussian_process import GaussianProcessRegressor  # lazy: `import zrp` fast
-    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
-
-    sub = rng.choice(len(X), min(len(X), ARD_POSES), replace=False)
-    Ys = Y[sub] - Y[sub].mean(0)
-    u, sv, _ = np.linalg.svd(Ys, full_matrices=False)  # its leading principal components
-    Ys = u[:, :ARD_COMPONENTS] * sv[:ARD_COMPONENTS]
-    Ys = Ys / max(float(Ys.std()), 1e-300)
-    kernel = (ConstantKernel(0.1, (1e-4, 1e2)) * RBF(np.ones(X.shape[1]), (1e-1, 1e3))
-              + WhiteKernel(1.0, (1e-4, 1e1)))
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # bounds reached: an irrelevant input, as it should
-        gp = GaussianProcessRegressor(kernel, random_state=0).fit(X[sub], Ys)
-    return np.asarray(gp.kernel_.k1.k2.length_scale, dtype=float).reshape(-1)
-
-
-def _kernel(A: F64, B: F64, gamma: float) -> F64:
-    from sklearn.metrics.pairwise import rbf_kernel  # lazy: keeps `import zrp` fast
-    return rbf_kernel(A, B, gamma=gamma)
-
-
-@dataclass
-class _Fold:
-    Xtr: F64
-    coef: F64
-    mean: F64
-    gamma: float
-    scale: F64
-
-
-def _fit_loo(X: F64, Y: F64, scale: F64) -> _Fold:
-    """Kernel ridge on the inputs scaled by ``scale`` (1 / ARD length scales), with the width
-    and ridge of least exact leave-one-out error."""
-    Xs = X * scale
-    mean = Y.mean(0)
-    Yc = Y - mean
-    best: tuple[float, float, float, F64, F64] | None = None
-    for gamma in GAMMAS:
-        w, V = np.linalg.eigh(_kernel(Xs, Xs, gamma))
-        w = np.clip(w, 0.0, None)
-        VtY = V.T @ Yc
-        V2 = V**2
-        for lam in RIDGES:
-            lam_abs = lam * max(float(w.mean()), 1e-12)
-            h = w / (w + lam_abs)
-            loo = (Yc - V @ (h[:, None] * VtY)) / (1.0 - V2 @ h)[:, None]
-            sse = float(np.sum(loo**2))
-            if best is None or sse < best[0]:
-                best = (sse, gamma, lam_abs, w, V)
-    assert best is not None
-    _, gamma, lam_abs, w, V = best
-    coef = V @ ((1.0 / (w + lam_abs))[:, None] * (V.T @ Yc))
-    return _Fold(Xs, coef, mean, gamma, scale)
-
-
-def _predict(f: _Fold, X: F64) -> F64:
-    return f.mean + _kernel(X * f.scale, f.Xtr, f.gamma) @ f.coef
-
-
 def _region(ctx: Context, first: NDArray[np.int64], P: F64
             ) -> tuple[float, float, str, float] | None:
     pe = ctx.nominal_fk.position[ctx.meas.pose_index[first]]
@@ -290,27 +170,28 @@ def remainder_structure(ctx: Context, fit: FitResult, *, folds: int = 5,
                         max_poses: int = MAX_POSES) -> Structure | None:
     """The multivariate test of what ``fit`` leaves on its fitting poses (module docstring);
     None with fewer than :data:`MIN_POSES` complete poses or no input that varies."""
-    Y, first = _targets(ctx, fit)
+    Y, first = pose_targets(ctx, fit.poses, fit.residual)
     rng = np.random.default_rng(SEED)
     if Y.shape[0] > max_poses:
         keep = np.sort(rng.choice(Y.shape[0], max_poses, replace=False))
         Y, first = Y[keep], first[keep]
-    X, names, groups = _inputs(ctx, first)
+    inputs = pose_inputs(ctx, first)
+    X, names, groups = inputs(ctx, first), inputs.names, inputs.groups
     n = Y.shape[0]
     if n < MIN_POSES or X.shape[1] == 0 or not np.any(Y):
         return None
-    scale = 1.0 / _length_scales(X, Y, rng)
+    scale = 1.0 / length_scales(X, Y, rng)
     fold_of = rng.permutation(n) % folds
     P = np.empty_like(Y)
     perm_sse = np.zeros(len(names))
     for k in range(folds):
         te, tr = fold_of == k, fold_of != k
-        f = _fit_loo(X[tr], Y[tr], scale)
-        P[te] = _predict(f, X[te])
+        f = fit_kernel_ridge(X[tr], Y[tr], scale)
+        P[te] = f.predict(X[te])
         for j, g in enumerate(groups):
             Xp = X[te].copy()
             Xp[:, g] = Xp[rng.permutation(int(te.sum()))][:, g]
-            perm_sse[j] += float(np.sum((Y[te] - _predict(f, Xp)) ** 2))
+            perm_sse[j] += float(np.sum((Y[te] - f.predict(Xp)) ** 2))
     share = _share(Y, P)
     boot = [_share(Y, P, rng.integers(0, n, n)) for _ in range(N_BOOT)]
     lo, hi = (float(v) for v in np.percentile(boot, [2.5, 97.5]))
