@@ -30,6 +30,7 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.gap.analysis.baseline import GeometricBaseline
 from zrp.gap.analysis.fallback import FinalChoice
+from zrp.gap.analysis.residual import ResidualModel
 from zrp.gap.analysis.structure import Structure, remainder_structure
 from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.fit.leastsq import FitResult
@@ -216,6 +217,8 @@ class Assessment:
         one_sided: joints whose MJCF gravity torque keeps one sign in every pose: a play that
             gravity holds on its loaded flank there shifts the joint by a constant, which these
             data cannot tell from its offset (empty without MJCF torques).
+        residual_model: the learned residual term and its withheld test, when asked for
+            (:mod:`zrp.gap.analysis.residual`).
     """
 
     baseline: GeometricBaseline
@@ -229,6 +232,7 @@ class Assessment:
     choice: FinalChoice | None = None
     compliance: dict[str, Any] | None = None
     one_sided: tuple[int, ...] = ()
+    residual_model: ResidualModel | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return dict_from_dataclass(self, exclude=("stderr",), rename={

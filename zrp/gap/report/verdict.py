@@ -210,10 +210,12 @@ def _against_floor(diag: Diagnosis) -> list[str]:
 def _structure_words(diag: Diagnosis, *, always: bool) -> list[str]:
     """The multivariate test of what remains in one sentence (``always``: also when it finds
     no structure)."""
-    s = None if diag.assessment is None else diag.assessment.remainder.structure
-    if s is None or not (always or s.structured):
-        return []
-    return [s.words(diag.length_unit)]
+    a = diag.assessment
+    s = None if a is None else a.remainder.structure
+    out = [] if s is None or not (always or s.structured) else [s.words(diag.length_unit)]
+    if a is not None and a.residual_model is not None:
+        out.append(a.residual_model.words(diag.length_unit))
+    return out
 
 
 def _weighed(diag: Diagnosis) -> list[str]:
