@@ -63,8 +63,8 @@ class ResidualModel:
         return {"kept": self.kept, "withheld_rms_physical": self.withheld_rms_physical,
                 "withheld_rms_hybrid": self.withheld_rms_hybrid, "paired_z": self.paired_z,
                 "n_poses": self.n_poses,
-                "training_ranges": {n: list(r) for n, r in zip(self.inputs,
-                                                               self.training_ranges)},
+                "training_ranges": {n: list(r) for n, r in zip(
+                    self.inputs, self.training_ranges, strict=True)},
                 "method": "kernel ridge (RBF, ARD length scales) on (sin q, cos q) and logged "
                           "time/temperature/load, trained on the fitting poses"}
 

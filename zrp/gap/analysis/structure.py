@@ -166,6 +166,24 @@ def _share(Y: F64, P: F64, idx: NDArray[np.int64] | None = None) -> float:
     return 1.0 - float(np.sum((Y - P) ** 2)) / sst if sst > 0 else 0.0
 
 
+def _out_of_fold(X: F64, Y: F64, scale: F64, groups: list[list[int]], folds: int,
+                 rng: np.random.Generator) -> tuple[F64, F64]:
+    """Out-of-fold predictions (P, 3M) and, per input, the squared error with that input
+    permuted among the poses of each held-out fold."""
+    fold_of = rng.permutation(len(Y)) % folds
+    P = np.empty_like(Y)
+    perm_sse = np.zeros(len(groups))
+    for k in range(folds):
+        te, tr = fold_of == k, fold_of != k
+        f = fit_kernel_ridge(X[tr], Y[tr], scale)
+        P[te] = f.predict(X[te])
+        for j, g in enumerate(groups):
+            Xp = X[te].copy()
+            Xp[:, g] = Xp[rng.permutation(int(te.sum()))][:, g]
+            perm_sse[j] += float(np.sum((Y[te] - f.predict(Xp)) ** 2))
+    return P, perm_sse
+
+
 def remainder_structure(ctx: Context, fit: FitResult, *, folds: int = 5,
                         max_poses: int = MAX_POSES) -> Structure | None:
     """The multivariate test of what ``fit`` leaves on its fitting poses (module docstring);
@@ -176,22 +194,12 @@ def remainder_structure(ctx: Context, fit: FitResult, *, folds: int = 5,
         keep = np.sort(rng.choice(Y.shape[0], max_poses, replace=False))
         Y, first = Y[keep], first[keep]
     inputs = pose_inputs(ctx, first)
-    X, names, groups = inputs(ctx, first), inputs.names, inputs.groups
+    X, names = inputs(ctx, first), inputs.names
     n = Y.shape[0]
     if n < MIN_POSES or X.shape[1] == 0 or not np.any(Y):
         return None
     scale = 1.0 / length_scales(X, Y, rng)
-    fold_of = rng.permutation(n) % folds
-    P = np.empty_like(Y)
-    perm_sse = np.zeros(len(names))
-    for k in range(folds):
-        te, tr = fold_of == k, fold_of != k
-        f = fit_kernel_ridge(X[tr], Y[tr], scale)
-        P[te] = f.predict(X[te])
-        for j, g in enumerate(groups):
-            Xp = X[te].copy()
-            Xp[:, g] = Xp[rng.permutation(int(te.sum()))][:, g]
-            perm_sse[j] += float(np.sum((Y[te] - f.predict(Xp)) ** 2))
+    P, perm_sse = _out_of_fold(X, Y, scale, inputs.groups, folds, rng)
     share = _share(Y, P)
     boot = [_share(Y, P, rng.integers(0, n, n)) for _ in range(N_BOOT)]
     lo, hi = (float(v) for v in np.percentile(boot, [2.5, 97.5]))
