@@ -346,8 +346,8 @@ def _assess(ctx: Context, baseline: GeometricBaseline, choice: FinalChoice, fina
     names = tuple(sp.name for sp in final.specs)
     frame = registration_of(final, se, cov, ctx.meas.point_labels, ctx.model.length_unit)
     return Assessment(baseline, frame, correlations(names, cov), se, implausible, unexcited,
-                      remainder_evidence(ctx, final, where_final), resolution, choice,
-                      compliance_units(ctx), _one_sided(ctx))
+                      remainder_evidence(ctx, final, where_final, resolution), resolution,
+                      choice, compliance_units(ctx), _one_sided(ctx))
 
 
 def _one_sided(ctx: Context) -> tuple[int, ...]:

@@ -161,9 +161,11 @@ def _repeat_scatter(ctx: Context, fit: FitResult) -> tuple[float | None, int]:
     return (math.sqrt(ss / n) if n else None), ng
 
 
-def remainder_evidence(ctx: Context, fit: FitResult, where: WhereAnalysis) -> Remainder:
+def remainder_evidence(ctx: Context, fit: FitResult, where: WhereAnalysis,
+                       resolution: float = 0.0) -> Remainder:
     """Weigh the explanations of what the final model ``fit`` leaves (see the module
-    docstring), on its fitting poses."""
+    docstring), on its fitting poses; the multivariate test only above 10x the fits'
+    numerical ``resolution`` (below it the residual is rounding, not a remainder)."""
     meas = ctx.meas
     rows = np.flatnonzero(np.isin(meas.pose_index, fit.poses))
     e2 = np.sum(fit.residual.reshape(-1, 3) ** 2, axis=1)
@@ -175,7 +177,8 @@ def remainder_evidence(ctx: Context, fit: FitResult, where: WhereAnalysis) -> Re
     spec = TYPICAL_REPEATABILITY_MM / (1e3 * metres_per_unit(ctx.model.length_unit,
                                                              "model.length_unit"))
     return Remainder(rms, rep, ng, where.order_r2, where.time_r2, dist_r2, where.common_share,
-                     jr, bool(rms > spec), remainder_structure(ctx, fit))
+                     jr, bool(rms > spec),
+                     remainder_structure(ctx, fit) if rms > 10 * resolution else None)
 
 
 def compliance_units(ctx: Context) -> dict[str, Any]:

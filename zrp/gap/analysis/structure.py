@@ -205,7 +205,7 @@ def remainder_structure(ctx: Context, fit: FitResult, *, folds: int = 5,
     lo, hi = (float(v) for v in np.percentile(boot, [2.5, 97.5]))
     sst = float(np.sum((Y - Y.mean(0)) ** 2))
     sse = float(np.sum((Y - P) ** 2))
-    relevance = {nm: (perm_sse[j] - sse) / sst for j, nm in enumerate(names)}
+    relevance = {nm: float((perm_sse[j] - sse) / sst) for j, nm in enumerate(names)}
     structured = bool(lo > 0.0 and share >= MIN_SHARE)
     top = max(relevance.values())
     named = (tuple(nm for nm, v in relevance.items() if v >= NAMED_FRACTION * top and v > 0)
