@@ -114,7 +114,9 @@ class Structure:
             return (f"No structure: the joint angles together predict {_pct(max(self.share, 0))}"
                     f" of what remains on unseen poses (95 % {_pct(lo)} to {_pct(hi)}); it is "
                     "pose-to-pose scatter to these data.")
-        on = _and([n.replace("q", "joint ") for n in self.named])
+        joints = [n[1:] for n in self.named if n.startswith("q")]
+        on = _and(([("joint " if len(joints) == 1 else "joints ") + _and(joints)]
+                   if joints else []) + [n for n in self.named if not n.startswith("q")])
         where = ("" if self.region is None else
                  f"; largest in the {self.region[2]} part of reach "
                  f"{self.region[0]:.3g}-{self.region[1]:.3g} {unit}")

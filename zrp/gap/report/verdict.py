@@ -202,8 +202,12 @@ def _against_floor(diag: Diagnosis) -> list[str]:
         parts += _structure_words(diag, always=True)
         parts += _weighed(diag)
     else:
-        parts.append("What remains is at the noise floor.")
-        parts += _structure_words(diag, always=False)
+        extra = _structure_words(diag, always=False)
+        structured = bool(diag.assessment and diag.assessment.remainder.structure
+                          and diag.assessment.remainder.structure.structured)
+        parts.append("What remains is close to the noise floor, yet not all scatter."
+                     if structured else "What remains is at the noise floor.")
+        parts += extra
     return parts
 
 
