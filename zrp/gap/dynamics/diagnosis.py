@@ -229,10 +229,11 @@ def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, si
     fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, pred)
     for _ in range(len(chosen)):
         bad = [c for c in fitted.bodies.values() if not c.physical]
-        culprits = [k for c in bad for k in c.effects if k != "inertial"]
+        culprits = [k for c in bad for k in c.effects]
         if not culprits:
             break
-        key = culprits[-1]
+        # the link inertias are the last resort: a named part or link stays, they go
+        key = "inertial" if "inertial" in culprits else culprits[-1]
         body = next(c for c in bad if key in c.effects)
         notes.append(f"{key} left out: with it link {body.name} would not be physical (mass "
                      f"{body.phi[0]:.3g} kg, or a centre or inertia no body can have)")
@@ -257,16 +258,19 @@ def _common_gain(found: list[FoundEffect]) -> list[str]:
 
 
 def _unphysical_links(arm: Arm, inert: InertialFit) -> list[str]:
-    """Where the physical link fit cannot follow the data: each link whose unconstrained fit
-    is not a body, and what it would need."""
-    out = []
+    """Where the physical link fit cannot follow the data (farther from the unconstrained fit
+    than the noise explains): each link whose unconstrained fit is not a body, and what it
+    would need."""
+    out: list[str] = []
+    if inert.matched:
+        return out
     for b in inert.unphysical_links():
         ph, ph0 = inert.unconstrained_phi[b], arm.body_params(b)
         out.append(f"link {arm.body_name(b)}: the unconstrained fit needs mass "
                    f"{ph[0]:.3g} kg (model {ph0[0]:.3g} kg) with a centre or inertia no body "
                    "can have (pseudo-inertia not positive definite); the physical fit keeps it "
-                   "a body. A part of the model missing or misplaced on it (a hand, a cable "
-                   "carrier, a counterweight) is the likely cause; check the model there")
+                   "a body. Check the model there: a part missing or misplaced on it (a hand, a "
+                   "cable carrier, a counterweight) asks for such a link")
     return out
 
 
