@@ -19,14 +19,13 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+from numpy.typing import NDArray
 
 from mjcf.attachments import find_attachments
 from mjcf.builder import MJCFOptions, build
 from mjcf.errors import MJCFImportError
 from mjcf.inverse import body_params, gravity_torques, inverse_dynamics, regressor
 from mjcf.shipped import load_shipped_spec
-from numpy.typing import NDArray
-
 from zrp.arrays import F64
 from zrp.errors import InputError, ModelFileError
 from zrp.gap.dynamics.arm import Attachment

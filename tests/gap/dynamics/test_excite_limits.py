@@ -88,7 +88,7 @@ def test_check_names_the_joint_and_value_beyond_a_limit(case, message):
         lim = _limits(torque=np.array([10.0, 10.0]))
     else:
         q[5, 0] = np.nan
-    with pytest.raises(InputError, match="^command") as err:
+    with pytest.raises(InputError, match=r"^command") as err:
         check_command_limits(q, lim, t=t, **kw)
     assert message in str(err.value)
 
@@ -134,7 +134,7 @@ def test_design_sizes_are_bounded_before_any_work(puma, kw, field):
 @pytest.mark.parametrize(("kw", "message"), [
     ({"period_s": 3600.0, "rate_hz": 100000.0}, f"at most {MAX_SAMPLES:,}"),
     ({"period_s": 10.0, "rate_hz": 1.0, "harmonics": 5}, "below 20 samples a cycle"),
-    ({"period_s": 10.0, "rate_hz": 333.33}, "whole number of samples"),
+    ({"period_s": 10.0, "rate_hz": 333.33}, "samples, not a whole number"),
     ({"amplitude": 0.0}, "amplitude: joint 1 is 0"),
     ({"amplitude": [0.5, 0.5, -0.1, 0.5, 0.5, 0.5]}, "amplitude: joint 3 is -0.1"),
     ({"max_velocity": float("inf")}, "max_velocity: joint 1 is inf"),
@@ -160,13 +160,13 @@ def test_q0_outside_the_limits_is_refused_naming_joint_value_and_limits(ur10):
     msg = str(err.value)
     assert "joint 1 (shoulder_pan_joint) is 100 rad" in msg
     assert "[-6.28319, 6.28319] rad" in msg
-    assert "did you type degrees? use --deg" in msg
+    assert "did you type degrees? use deg=True" in msg
 
 
 def test_q0_in_degrees_is_caught_and_deg_reads_it(ur10, tmp_path):
     arm, _ = ur10
     deg = [0.0, -70.0, 70.0, -85.0, -85.0, 0.0]  # joint 2: -70 rad is beyond -2 pi
-    with pytest.raises(InputError, match="joint 2 .*did you type degrees"):
+    with pytest.raises(InputError, match=r"joint 2 .*did you type degrees"):
         excitation_command(arm, ExciteOptions(q0=deg, **FAST))
     cmd = excitation_command(arm, ExciteOptions(q0=deg, amplitude=20.0, deg=True, **FAST))
     np.testing.assert_allclose(cmd.q[0], np.radians(deg), atol=1e-12)
@@ -245,7 +245,7 @@ def test_nothing_replaced_and_the_model_is_never_the_output(ur10, tmp_path):
     arm, path = ur10
     cmd = excitation_command(arm, ExciteOptions(q0=UR10_Q0, **FAST))
     out = write_excitation_command(cmd, tmp_path / "cmd.csv", model=path)
-    with pytest.raises(Exception, match="exist|force"):
+    with pytest.raises(Exception, match=r"exist|force"):
         write_excitation_command(cmd, out, model=path)
     copy = tmp_path / "ur10.urdf"
     copy.write_bytes(path.read_bytes())
@@ -261,7 +261,7 @@ def test_a_tampered_command_is_refused_before_writing(ur10, tmp_path):
     q[7, 2] = 3.2  # beyond elbow_joint's +-pi
     bad = type(cmd)(**{**cmd.__dict__, "q": q})
     out = tmp_path / "bad.csv"
-    with pytest.raises(InputError, match="joint 3 .* reaches 3.2 rad"):
+    with pytest.raises(InputError, match=r"joint 3 .* reaches 3\.2 rad"):
         write_excitation_command(bad, out, model=path)
     assert not out.exists()
 

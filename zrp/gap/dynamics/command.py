@@ -40,21 +40,20 @@ from zrp.gap.dynamics.excitation import (
 )
 from zrp.gap.dynamics.fourier import MAX_HARMONICS
 from zrp.gap.dynamics.limits import JointLimits, check_command_limits
+from zrp.limits import MAX_COMMAND_SAMPLES as MAX_SAMPLES
 from zrp.output import atomic_path
 from zrp.units import angle_bounds
 from zrp.version import __version__
 
 __all__ = ["MAX_SAMPLES", "MIN_SAMPLES_PER_CYCLE", "ExcitationCommand", "ExciteOptions",
-           "command_limits", "excitation_command", "read_command_conditions",
+           "command_limits", "command_summary", "excitation_command", "read_command_conditions",
            "write_excitation_command"]
 
-#: Largest number of samples of one command (about 50 MB of arrays a 7-joint arm).
-MAX_SAMPLES = 200_000
 #: Fewest samples a cycle of the series' highest harmonic.
 MIN_SAMPLES_PER_CYCLE = 20
 _TURN = 2.0 * np.pi
 _MIN_PERIOD, _MAX_PERIOD = 0.5, 3600.0
-_DEG_HINT = "; did you type degrees? use --deg (deg=True), or give radians"
+_DEG_HINT = "; did you type degrees? use deg=True (--deg on the command line), or give radians"
 
 PerJoint = float | list[float] | tuple[float, ...]
 
@@ -150,9 +149,9 @@ def check_sizes(o: ExciteOptions) -> int:
     _whole(o.iterations, 0, MAX_ITERATIONS, "iterations")
     exact = period * rate
     if exact > MAX_SAMPLES:
-        raise InputError(f"period_s x rate_hz: {period:g} s x {rate:g} Hz = {exact:,.0f} "
-                         f"samples; at most {MAX_SAMPLES:,} (a shorter period or a lower "
-                         "rate; play the command several times for a longer run)")
+        raise InputError(f"rate_hz: a period of {period:g} s at {rate:g} Hz is "
+                         f"{exact:,.0f} samples; at most {MAX_SAMPLES:,} (a shorter period or a "
+                         "lower rate; play the command several times for a longer run)")
     top = o.harmonics / period
     if rate < MIN_SAMPLES_PER_CYCLE * top:
         raise InputError(f"rate_hz: {rate:g} Hz is below {MIN_SAMPLES_PER_CYCLE} samples a "
@@ -160,8 +159,8 @@ def check_sizes(o: ExciteOptions) -> int:
                          f"= {top:g} Hz): at least {MIN_SAMPLES_PER_CYCLE * top:g} Hz")
     samples = round(exact)
     if abs(exact - samples) > 1e-6 * max(samples, 1):
-        raise InputError(f"period_s x rate_hz: {exact:g} is not a whole number of samples: "
-                         "the command would not loop smoothly")
+        raise InputError(f"rate_hz: a period of {period:g} s at {rate:g} Hz is {exact:g} "
+                         "samples, not a whole number: the command would not loop smoothly")
     return samples
 
 
@@ -342,6 +341,35 @@ def write_excitation_command(cmd: ExcitationCommand, out: str | os.PathLike[str]
             fh.write(head + ",".join(cols) + "\n")
             np.savetxt(fh, np.column_stack([cmd.t, cmd.q]), delimiter=",", fmt="%.17g")
     return out
+
+
+def command_summary(cmd: ExcitationCommand, notes: tuple[str, ...] = ()
+                    ) -> tuple[dict[str, object], str]:
+    """The command's result as JSON-ready values and as a few lines of text (the headline:
+    its condition number; then its peaks and what the limits could not cover)."""
+    e, lim = cmd.excitation, cmd.limits
+    peak = {"position_rad": np.abs(cmd.q - cmd.q0).max(0), "velocity_rad_s":
+            np.abs(cmd.qd).max(0), "acceleration_rad_s2": np.abs(cmd.qdd).max(0),
+            "torque_nm": np.abs(cmd.tau).max(0)}
+    payload: dict[str, object] = {
+        "condition_number": e.kappa, "condition_number_random_start": e.kappa_start,
+        **{f"peak_{k}": v.tolist() for k, v in peak.items()},
+        "q0": cmd.q0.tolist(), "f0_hz": e.command.f0_hz, "a": e.command.a.tolist(),
+        "b": e.command.b.tolist(), "samples": cmd.samples,
+        "limits": {"lower": lim.lower.tolist(), "upper": lim.upper.tolist(),
+                   "velocity": lim.velocity.tolist(), "acceleration": lim.acceleration.tolist(),
+                   "torque": lim.torque.tolist(), "sources": dict(cmd.sources)},
+        "notes": list(notes)}
+    lines = [f"condition number {e.kappa:.4g} (best random start {e.kappa_start:.4g}); "
+             f"{cmd.samples} samples, every one within the position, velocity, acceleration "
+             "and torque limits",
+             f"peak torque per joint {_row(peak['torque_nm'])} (limits {_row(lim.torque)})"]
+    free = [k + 1 for k in range(lim.n) if not np.isfinite(lim.torque[k])]
+    if free:
+        lines.append(f"no torque limit known for joints {', '.join(map(str, free))}: check the "
+                     "peaks above against the arm's, or give max_torque")
+    lines += [f"note: {one_line(n)}" for n in notes]
+    return payload, "\n".join(lines)
 
 
 def read_command_conditions(path: str | os.PathLike[str]) -> dict[str, str]:

@@ -37,14 +37,12 @@ from zrp.gap.dynamics.fourier import (
     scale_into,
 )
 from zrp.gap.dynamics.inertia import V_EPS, base_directions
+from zrp.limits import MAX_DESIGN_CANDIDATES as MAX_CANDIDATES
+from zrp.limits import MAX_DESIGN_ITERATIONS as MAX_ITERATIONS
 
 __all__ = ["MAX_CANDIDATES", "MAX_HARMONICS", "MAX_ITERATIONS", "Excitation",
            "condition_number", "design_excitation", "structural_rank", "within_torque"]
 
-#: Largest number of random starts of the search.
-MAX_CANDIDATES = 1000
-#: Largest number of hill-climbing steps of the search.
-MAX_ITERATIONS = 10_000
 
 
 @dataclass(frozen=True)

@@ -16,12 +16,10 @@ import numpy as np
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.limits import MAX_HARMONICS  # largest number of harmonics of a series
 
 __all__ = ["MAX_HARMONICS", "Fourier", "random_fourier"]
 
-#: Largest number of harmonics of a series (its highest frequency is L f0): bounds the
-#: memory and time of evaluating and designing it.
-MAX_HARMONICS = 50
 _CHUNK = 1 << 15
 
 
