@@ -74,22 +74,16 @@ def _one(values: list[float] | None) -> float | list[float] | None:
 
 
 def _run(args: argparse.Namespace) -> int:
-    # MuJoCo loads only when this command runs.
-    from mjcf.arm import resolve_arm
-    from zrp.gap.dynamics.command import (
-        ExciteOptions,
-        command_summary,
-        excitation_command,
-        write_excitation_command,
-    )
+    from mjcf.arm import resolve_arm  # MuJoCo: only when this command runs
+    from zrp.gap.dynamics import command as c  # on use: keeps --help quick
 
     arm = resolve_arm(args.model, end_link=args.end_link)
-    cmd = excitation_command(arm, ExciteOptions(
+    cmd = c.excitation_command(arm, c.ExciteOptions(
         q0=args.q0, amplitude=_one(args.amplitude), max_velocity=_one(args.max_velocity),
         max_acceleration=_one(args.max_acceleration), max_torque=_one(args.max_torque),
         deg=args.deg, period_s=args.period, rate_hz=args.rate, harmonics=args.harmonics,
         candidates=args.candidates, iterations=args.iterations, seed=args.seed))
-    out = write_excitation_command(cmd, Path(args.out), model=args.model, overwrite=args.force)
-    payload, text = command_summary(cmd, notes=getattr(arm, "notes", ()))
+    out = c.write_excitation_command(cmd, Path(args.out), model=args.model, overwrite=args.force)
+    payload, text = c.command_summary(cmd, notes=getattr(arm, "notes", ()))
     emit(args, payload, text + f"\nwrote {out}")
     return 0
