@@ -297,8 +297,9 @@ def _conditions(cmd: ExcitationCommand, model: str | os.PathLike[str] | None) ->
         f"zrp: {__version__}",
         f"model: {_model_line(model)}",
         "joints: " + " ".join(f"{k + 1}={one_line(nm)}" for k, nm in enumerate(lim.names)),
-        f"units: t s; positions {u} (hinges rad, slides m); velocities {u}/s; accelerations "
-        f"{u}/s^2; torques N m (slides N)",
+        f"units: t s; positions {u}; velocities {u}/s; accelerations {u}/s^2; torques "
+        + ("N m" if rev.all() else "N m (hinges), N (slides)")
+        + ("" if rev.all() or not rev.any() else "; rad for hinges, m for slides"),
         f"q0 [{u}]: {_row(cmd.q0)}",
         f"period [s]: {o.period_s:g}",
         f"rate [Hz]: {o.rate_hz:g}",
@@ -320,7 +321,8 @@ def write_excitation_command(cmd: ExcitationCommand, out: str | os.PathLike[str]
                              overwrite: bool = False) -> Path:
     """Write ``cmd`` as CSV: ``#`` lines with its conditions (model file and its SHA-256,
     joints, units, q0, period, rate, every limit and its source, zrp version), then
-    ``t [s], qc1 [rad] .. qcn [rad]`` (``[m]`` for slides), positions to the last bit.
+    ``t [s], qc1 [rad] .. qcn [rad]`` (``[m]`` for slides), every number with the shortest
+    digits that read back to the value checked.
     Checked against its limits again first: nothing is written otherwise.
 
     Raises:
@@ -339,7 +341,8 @@ def write_excitation_command(cmd: ExcitationCommand, out: str | os.PathLike[str]
     with atomic_path(out, overwrite=overwrite) as tmp:
         with open(tmp, "w", encoding="utf-8", newline="\n") as fh:
             fh.write(head + ",".join(cols) + "\n")
-            np.savetxt(fh, np.column_stack([cmd.t, cmd.q]), delimiter=",", fmt="%.17g")
+            for row in np.column_stack([cmd.t, cmd.q]).tolist():  # shortest exact digits
+                fh.write(",".join(map(repr, row)) + "\n")
     return out
 
 
