@@ -139,7 +139,7 @@ def _number(value: object, lo: float, hi: float, field: str, unit: str) -> float
     return v
 
 
-def check_sizes(o: ExciteOptions) -> int:
+def _check_sizes(o: ExciteOptions) -> int:
     """The number of samples of the command; every size within its bound (module docstring),
     before anything is allocated."""
     period = _number(o.period_s, _MIN_PERIOD, _MAX_PERIOD, "period_s", "s")
@@ -168,7 +168,9 @@ def _own(given: object, own: F64, default: F64, field: str, limits_names: list[s
          unit: list[str]) -> tuple[F64, str]:
     """A user's limit, refused above the model's own; the default where none given."""
     if given is None:
-        return default, "the model's own" if np.all(default == own) else "default"
+        return default, ("the model's own" if np.all(default == own) else
+                         "default" if np.all(default < own) else
+                         "default, or the model's own where lower")
     v = _per_joint(given, own.size, field)
     above = v > own
     if above.any():
@@ -247,7 +249,7 @@ def excitation_command(arm: Arm, options: ExciteOptions) -> ExcitationCommand:
             or a sample beyond a limit.
     """
     o = options
-    samples = check_sizes(o)
+    samples = _check_sizes(o)
     n = arm.n
     q0_typed = np.asarray(o.q0, dtype=float).ravel()
     if q0_typed.shape != (n,) or not np.all(np.isfinite(q0_typed)):
