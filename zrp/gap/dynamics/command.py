@@ -26,6 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
+from zrp.arguments import check_float, check_int, check_seed
 from zrp.arrays import F64
 from zrp.errors import InputError, UnitError
 from zrp.escape import one_line
@@ -110,7 +111,10 @@ class ExcitationCommand:
 
 
 def _per_joint(value: object, n: int, field: str, *, finite: bool = True) -> F64:
-    a = np.asarray(value, dtype=float).ravel() if value is not None else np.full(n, np.inf)
+    try:
+        a = np.asarray(value, dtype=float).ravel()
+    except (TypeError, ValueError):
+        raise InputError(f"{field}: expected 1 or {n} numbers, got {value!r}") from None
     if a.size == 1:
         a = np.full(n, a[0])
     if a.shape != (n,):
@@ -123,30 +127,15 @@ def _per_joint(value: object, n: int, field: str, *, finite: bool = True) -> F64
     return a
 
 
-def _whole(value: object, lo: int, hi: int, field: str) -> None:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
-            or not lo <= value <= hi:
-        raise InputError(f"{field}: {value!r}; expected a whole number from {lo} to {hi}")
-
-
-def _number(value: object, lo: float, hi: float, field: str, unit: str) -> float:
-    try:
-        v = float(value)  # type: ignore[arg-type]
-    except (TypeError, ValueError):
-        v = float("nan")
-    if not lo <= v <= hi:
-        raise InputError(f"{field}: {value!r}; expected a number from {lo:g} to {hi:g} {unit}")
-    return v
-
-
 def _check_sizes(o: ExciteOptions) -> int:
     """The number of samples of the command; every size within its bound (module docstring),
     before anything is allocated."""
-    period = _number(o.period_s, _MIN_PERIOD, _MAX_PERIOD, "period_s", "s")
-    rate = _number(o.rate_hz, 1e-9, 1e9, "rate_hz", "Hz")
-    _whole(o.harmonics, 2, MAX_HARMONICS, "harmonics")
-    _whole(o.candidates, 1, MAX_CANDIDATES, "candidates")
-    _whole(o.iterations, 0, MAX_ITERATIONS, "iterations")
+    period = check_float(o.period_s, "period_s", _MIN_PERIOD, _MAX_PERIOD, unit="s")
+    rate = check_float(o.rate_hz, "rate_hz", 0.0, open_lo=True, unit="Hz")
+    check_int(o.harmonics, "harmonics", 2, MAX_HARMONICS)
+    check_int(o.candidates, "candidates", 1, MAX_CANDIDATES)
+    check_int(o.iterations, "iterations", 0, MAX_ITERATIONS)
+    check_seed(o.seed)
     exact = period * rate
     if exact > MAX_SAMPLES:
         raise InputError(f"rate_hz: a period of {period:g} s at {rate:g} Hz is "

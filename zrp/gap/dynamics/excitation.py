@@ -26,6 +26,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from zrp.arguments import check_float, check_int
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.dynamics.arm import DynamicArm as Arm
@@ -123,14 +124,6 @@ def _within_torque(arm: Arm, f: Fourier, limit: F64) -> tuple[Fourier, F64]:
     return f, np.abs(tau).max(0)
 
 
-def _whole(value: object, lo: int, hi: int, field: str) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) \
-            or not lo <= value <= hi:
-        raise InputError(f"{field}: {value!r}; expected a whole number in [{lo}, {hi}] (the "
-                         "stated bound keeps the design's time and memory bounded)")
-    return int(value)
-
-
 def _positive(value: object, n: int, field: str, *, finite: bool = True) -> F64:
     try:
         v = np.broadcast_to(np.asarray(value, dtype=float), (n,))
@@ -147,11 +140,11 @@ def _positive(value: object, n: int, field: str, *, finite: bool = True) -> F64:
 def _check_inputs(arm: Arm, q0: F64, harmonics: int, f0_hz: float, candidates: int,
                   iterations: int, step: float) -> F64:
     """q0 (n,), finite, within the position limits; the bounded sizes (module docstring)."""
-    _whole(harmonics, 2, MAX_HARMONICS, "harmonics")
-    _whole(candidates, 1, MAX_CANDIDATES, "candidates")
-    _whole(iterations, 0, MAX_ITERATIONS, "iterations")
-    _positive(f0_hz, 1, "f0_hz")
-    _positive(step, 1, "step")
+    check_int(harmonics, "harmonics", 2, MAX_HARMONICS)
+    check_int(candidates, "candidates", 1, MAX_CANDIDATES)
+    check_int(iterations, "iterations", 0, MAX_ITERATIONS)
+    check_float(f0_hz, "f0_hz", 0.0, open_lo=True, unit="Hz")
+    check_float(step, "step", 0.0, 10.0, open_lo=True)
     q0 = np.asarray(q0, dtype=float)
     if q0.shape != (arm.n,) or not np.all(np.isfinite(q0)):
         raise InputError(f"q0: expected {arm.n} finite joint values, got {q0!r}")
