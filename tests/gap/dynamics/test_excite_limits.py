@@ -279,3 +279,15 @@ def test_fourier_evaluates_in_bounded_chunks():
     q, _, _ = f.evaluate(t)
     q2, _, _ = f._at(t)
     np.testing.assert_allclose(q, q2, rtol=0, atol=1e-12)
+
+
+def test_a_joint_without_limits_still_refuses_more_than_a_turn(puma):
+    """The built-in PUMA has no joint limits: 45 rad on a hinge cannot be a posture."""
+    assert np.all(np.isinf(puma.position_limits()[1]))
+    with pytest.raises(InputError) as err:
+        excitation_command(puma, ExciteOptions(q0=[45, 0, 0, 0, 0, 0], **FAST))
+    msg = str(err.value)
+    assert "joint 1 (q1) is 45 rad, beyond one turn" in msg and "did you type degrees" in msg
+    cmd = excitation_command(puma, ExciteOptions(q0=[45, 0, 0, 0, 0, 0], deg=True, **FAST))
+    np.testing.assert_allclose(cmd.q0, np.radians([45, 0, 0, 0, 0, 0]))
+    assert cmd.sources["torque"] == "the model's own" and np.all(np.isinf(cmd.limits.torque))
