@@ -7,87 +7,51 @@ import argparse
 import tempfile
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
 
-import mujoco
 import numpy as np
 
-from mjcf.arm import Arm, resolve_arm
-from mjcf.corrected import corrected_spec, corrections
-from mjcf.tracking import Servo, tracking_gap
+from mjcf.arm import resolve_arm
+from mjcf.corrected import CorrectedMJCF
 from sim.studies.dynamics import benchmark as bm
 from sim.studies.dynamics.arms import available_arms
 from sim.studies.dynamics.scenarios import KINDS
 from zrp.errors import InputError
-from zrp.gap.dynamics.data import TorqueLog, load_torque_log
-from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, DynamicsOptions, diagnose_dynamics
-from zrp.gap.dynamics.report import diagnosis_json, write_report
-from zrp.output import OutputDir, write_text
+from zrp.gap.dynamics.data import load_torque_log
+from zrp.gap.dynamics.diagnosis import DynamicsOptions
+from zrp.gap.dynamics.report import run_json, write_run
+from zrp.gap.dynamics.run import TrackingOptions, run_dynamics
+from zrp.gap.dynamics.verdict import headline
+from zrp.output import OutputDir
 
 __all__ = ["run_benchmark", "run_diagnosis"]
 
 
-def _servo(arm: Arm, log: TorqueLog, kp: list[float] | None, kv: list[float] | None
-           ) -> tuple[Servo, str]:
-    if (kp is None) != (kv is None):
-        raise InputError("--kp, --kv: give both (the servo's stiffness and damping) or neither")
-    if kp is None:
-        return Servo.tuned(arm, log.qc[0]), "a 4 Hz servo tuned from the model (--kp/--kv: yours)"
-    for name, v in (("--kp", kp), ("--kv", kv)):
-        if len(v) != arm.n:
-            raise InputError(f"{name}: expected {arm.n} values (one a joint), got {len(v)}")
-    return Servo(np.array(kp), np.array(kv)), "the servo gains given"
-
-
-def _truncate(log: TorqueLog, seconds: float | None) -> TorqueLog:
-    if seconds is None:
-        return log
-    k = max(2, int(np.searchsorted(log.t - log.t[0], seconds)))
-    return TorqueLog(log.t[:k], log.q[:k], None if log.qd is None else log.qd[:k], log.tau[:k],
-                     log.qc[:k], None, log.lines[:k], log.source, log.torque_from)
-
-
-def _tracking(arm: Arm, log: TorqueLog, model: mujoco.MjModel, args: argparse.Namespace
-              ) -> dict[str, Any]:
-    if log.qc is None:
-        return {"lines": ["- the log has no commanded positions qc1..qcn: no re-simulation"]}
-    servo, how = _servo(arm, log, args.kp, args.kv)
-    part = _truncate(log, args.seconds)
-    before = tracking_gap(arm.model, arm.model, part, servo)
-    after = tracking_gap(model, arm.model, part, servo)
-    lines = [f"Re-simulation of the logged command (mj_step) with {how}; RMS of simulated minus "
-             "logged joint positions (rad):", "", "| joint | model | corrected model |",
-             "|---|---|---|"]
-    lines += [f"| {k + 1} | {before[k]:.3g} | {after[k]:.3g} |" for k in range(arm.n)]
-    return {"lines": lines, "before_rad": before, "after_rad": after}
-
-
 def run_diagnosis(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
-    """Diagnose, write the report and the corrected MJCF; the JSON and the summary text."""
-    arm = resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site)
-    log = load_torque_log(args.data, torque_constant=args.torque_constant, n_joints=arm.n)
-    diag: DynamicDiagnosis = diagnose_dynamics(
-        arm, log, DynamicsOptions(window_s=args.window, inertial=not args.no_inertial))
-    fix = corrections(arm, diag)
-    spec = corrected_spec(arm, fix)
-    model = spec.compile()
-    track = _tracking(arm, log, model, args)
-    sections = {"Corrected model": [
-        "corrected.xml: the model with the identified frictionloss, damping, armature"
-        + (", payload" if fix.payload_kg else "") + (", link inertias" if fix.inertial else "")
-        + "."] + ([f"- not in MJCF (report only): {', '.join(fix.not_in_model)}"]
-                  if fix.not_in_model else []),
-        "Tracking": track["lines"]}
-    extra = {k: v for k, v in track.items() if k != "lines"}
-    folder = write_report(diag, out, overwrite=args.force, extra={"sections": sections,
-                                                                  "tracking": extra})
-    write_text(folder / "corrected.xml", spec.to_xml(), overwrite=args.force)
-    text = (f"{diag.arm}: " + (", ".join(e.label for e in diag.effects) or "no effect needed")
-            + "\nwithheld torque RMS / noise per joint: "
-            + " ".join(f"{a / s:.2f}" for a, s in zip(diag.rms_after, diag.noise_nm,
-                                                     strict=True))
-            + f"\nwrote {folder}/report.html, report.md, diagnosis.json, corrected.xml")
-    return diagnosis_json(diag, {"tracking": extra}), text
+    """Diagnose (:func:`zrp.gap.dynamics.run.run_dynamics`), write the outputs; the JSON and
+    the summary text."""
+    if (args.kp is None) != (args.kv is None):
+        raise InputError("--kp, --kv: give both (the servo's stiffness and damping) or neither")
+    log = load_torque_log(args.data, torque_constant=args.torque_constant)
+    arm = resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site,
+                      n_joints=log.n_joints)
+    if log.n_joints != arm.n:
+        raise InputError(f"--data: {log.source} has {log.n_joints} joints, but the model "
+                         f"{args.model!r} has {arm.n}")
+    second = None if args.validate is None else load_torque_log(
+        args.validate, torque_constant=args.torque_constant, n_joints=arm.n)
+    run = run_dynamics(arm, log, options=DynamicsOptions(window_s=args.window,
+                                                         inertial=not args.no_inertial),
+                       validation_log=second, writer=CorrectedMJCF(arm),
+                       tracking=TrackingOptions(kp=_gains(args.kp), kv=_gains(args.kv),
+                                                seconds=args.seconds))
+    folder = write_run(run, out, overwrite=args.force)
+    text = headline(run.diagnosis, run.validation) + (
+        f"\nwrote {folder}/report.html, report.md, diagnosis.json, corrected.xml")
+    return run_json(run), text
+
+
+def _gains(values: list[float] | None) -> np.ndarray | None:
+    return None if values is None else np.asarray(values, dtype=float)
 
 
 def run_benchmark(args: argparse.Namespace, out: Path) -> tuple[dict, str]:

@@ -31,7 +31,7 @@ import numpy as np
 
 from zrp.arrays import F64
 from zrp.gap.dynamics.arm import DynamicArm as Arm
-from zrp.gap.dynamics.bodies import body_effects
+from zrp.gap.dynamics.bodies import body_effects, point_mass_columns
 from zrp.gap.dynamics.effect import Effect
 from zrp.gap.dynamics.inertia import V_EPS, base_directions
 
@@ -75,28 +75,8 @@ def _joint_effects(arm: Arm, qd: F64, qdd: F64, tau0: F64) -> list[Effect]:
 
 def payload_columns(arm: Arm, q: F64, qd: F64, qdd: F64) -> F64:
     """The payload block (eq. E2), shape (S, n, 4)."""
-    y, labels = arm.regressor(q, qd, qdd, [arm.tool_body])
-    p = arm.tool_point
-    ym, yh = y[..., 0], y[..., 1:4]
-    yi = y[..., 4:10]
-    # a point mass m at p + d: phi = m [1, p + d, |p+d|^2 - (p+d)_i^2 ..., -(p+d)_i (p+d)_j]
-    # to first order in d; exact in m for d = 0 (the mass column), linear in m d.
-    pp = float(p @ p)
-    inert_m = np.array([pp - p[0] ** 2, pp - p[1] ** 2, pp - p[2] ** 2,
-                        -p[0] * p[1], -p[0] * p[2], -p[1] * p[2]])
-    col_m = ym + yh @ p + yi @ inert_m
-    # d(phi_I)/d(m d) at d = 0: the first moments' own columns plus the inertia's
-    # linear terms 2 p.d - 2 p_i d_i (diagonal) and -(p_i d_j + d_i p_j) (off-diagonal)
-    cols = [col_m]
-    for a in range(3):
-        e = np.zeros(3)
-        e[a] = 1.0
-        di = np.array([2 * p @ e - 2 * p[0] * e[0], 2 * p @ e - 2 * p[1] * e[1],
-                       2 * p @ e - 2 * p[2] * e[2], -(p[0] * e[1] + e[0] * p[1]),
-                       -(p[0] * e[2] + e[0] * p[2]), -(p[1] * e[2] + e[1] * p[2])])
-        cols.append(yh[..., a] + yi @ di)
-    del labels
-    return np.stack(cols, axis=-1)
+    y, _ = arm.regressor(q, qd, qdd, [arm.tool_body])
+    return point_mass_columns(y, np.asarray(arm.tool_point, dtype=float))
 
 
 def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,
