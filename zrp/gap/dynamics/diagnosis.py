@@ -41,7 +41,7 @@ from zrp.gap.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, p
 from zrp.gap.dynamics.fit import cross_validate, design, solve
 from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
-from zrp.gap.dynamics.resulting import BodyChange, resulting_bodies
+from zrp.gap.dynamics.resulting import BodyChange, ChangedArm, link_changes, resulting_bodies
 from zrp.gap.dynamics.results import DynamicDiagnosis, FoundEffect, Param, Samples
 from zrp.gap.dynamics.select import Step, forward_select
 from zrp.gap.dynamics.states import States, derive_states
@@ -198,12 +198,10 @@ def _fit_chosen(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma
     withheld prediction when known, else cross-validated here."""
     d = design(chosen, *b.shape)
     fit = solve(d, b, sigma)
-    values, inert = fit.theta, None
+    values, inert, named = fit.theta, None, None
     if any(e.name == "inertial" for e in chosen):
         # physical by construction (eq. P1); the withheld error is that of the physical fit
-        inert = physical_fit(arm, chosen, b, sigma)
-        values = inert.theta
-        pred, _ = physical_cross_validate(arm, chosen, b, sigma, opt.folds, guard)
+        inert, values, pred, named = _links(arm, chosen, fit.theta, b, sigma, opt, guard)
     elif pred is None:
         pred = cross_validate(d, b, sigma, opt.folds, guard)
     at_bound = np.isclose(values, d.lower) | np.isclose(values, d.upper)
@@ -213,10 +211,40 @@ def _fit_chosen(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma
                          drop.get(e.key, 0.0), _contribution(e, values[sl]))
              for e, sl in zip(chosen, d.slices, strict=True)]
     found = [_with_part_mass(arm, f) for f in found]
+    if named is not None and inert is not None:
+        return _Fitted(found, inert, pred, link_changes(arm, inert.phi, named))
     bodies = resulting_bodies(
         arm, [(f.key, f.name, f.detail, {k: p.value for k, p in f.params.items()})
               for f in found if f.name in BODY_CHANGES], None if inert is None else inert.phi)
     return _Fitted(found, inert, pred, bodies)
+
+
+def _links(arm: Arm, chosen: list[Effect], theta: F64, b: F64, sigma: F64,
+           opt: DynamicsOptions, guard: int
+           ) -> tuple[InertialFit, F64, F64, dict[int, BodyChange] | None]:
+    """The link inertias fitted physically (eq. P1). With a named part or link among the
+    chosen effects (an absent hand, a link's mass, a payload), those are applied to the
+    model first at their least-squares values and the links are fitted on top, so that the
+    physical fit holds the resulting bodies. The fit, every effect's values in ``chosen``
+    order, the withheld prediction and the named changes (None without them)."""
+    d = design(chosen, *b.shape)
+    first = [i for i, e in enumerate(chosen) if e.name in BODY_CHANGES]
+    named = resulting_bodies(arm, [(chosen[i].key, chosen[i].name, chosen[i].detail,
+                                    dict(zip(chosen[i].params, theta[d.slices[i]],
+                                             strict=True))) for i in first])
+    if not first or not all(c.physical for c in named.values()):
+        inert = physical_fit(arm, chosen, b, sigma)
+        pred, _ = physical_cross_validate(arm, chosen, b, sigma, opt.folds, guard)
+        return inert, inert.theta, pred, None
+    offset = sum(chosen[i].columns @ theta[d.slices[i]] for i in first)
+    rest = [e for i, e in enumerate(chosen) if i not in first]
+    changed = ChangedArm(arm, {bb: c.phi for bb, c in named.items()})
+    inert = physical_fit(changed, rest, b - offset, sigma)
+    pred, _ = physical_cross_validate(changed, rest, b - offset, sigma, opt.folds, guard)
+    values = theta.copy()
+    for sl, e in zip(design(rest, *b.shape).slices, rest, strict=True):
+        values[d.slices[chosen.index(e)]] = inert.theta[sl]
+    return inert, values, pred + offset, named
 
 
 def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma: F64,
