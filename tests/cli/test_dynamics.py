@@ -71,9 +71,11 @@ def test_excite_writes_a_command(tmp_path, capsys):
     assert np.isfinite(payload["condition_number"])
     from zrp.units import split_unit
 
-    header = out.read_text().splitlines()[0].split(",")
+    lines = out.read_text().splitlines()
+    n_comments = sum(ln.startswith("#") for ln in lines)  # the command's conditions
+    header = lines[n_comments].split(",")
     assert [split_unit(h, "x") for h in header][:2] == [("t", "s"), ("qc1", "rad")]
-    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    data = np.loadtxt(out, delimiter=",", skiprows=n_comments + 1)
     assert data.shape == (1000, 7)
     np.testing.assert_allclose(data[0, 1:], [0, -0.6, 0.6, 0, 0.6, 0], atol=1e-9)
 

@@ -1,5 +1,5 @@
-"""The work of ``zrp diagnose-dynamics``, ``zrp excite`` and
-``zrp dynamics-benchmark`` (arguments parsed in :mod:`zrp.cli.commands`)."""
+"""The work of ``zrp diagnose-dynamics`` and ``zrp dynamics-benchmark`` (arguments parsed in
+:mod:`zrp.cli.commands`)."""
 
 from __future__ import annotations
 
@@ -18,14 +18,12 @@ from sim.studies.dynamics.scenarios import KINDS
 from zrp.errors import InputError
 from zrp.gap.dynamics.data import load_torque_log
 from zrp.gap.dynamics.diagnosis import DynamicsOptions
-from zrp.gap.dynamics.excitation import design_excitation
 from zrp.gap.dynamics.report import run_json, write_run
 from zrp.gap.dynamics.run import TrackingOptions, run_dynamics
 from zrp.gap.dynamics.verdict import headline
-from zrp.jsonio import to_jsonable
-from zrp.output import OutputDir, atomic_path
+from zrp.output import OutputDir
 
-__all__ = ["run_benchmark", "run_diagnosis", "run_excite"]
+__all__ = ["run_benchmark", "run_diagnosis"]
 
 
 def run_diagnosis(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
@@ -54,38 +52,6 @@ def run_diagnosis(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
 
 def _gains(values: list[float] | None) -> np.ndarray | None:
     return None if values is None else np.asarray(values, dtype=float)
-
-
-def run_excite(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
-    """Design the exciting command and write it as t, qc1..qcn."""
-
-    arm = resolve_arm(args.model, end_link=args.end_link)
-    if len(args.q0) != arm.n:
-        raise InputError(f"--q0: expected {arm.n} joint values, got {len(args.q0)}")
-    tl = None
-    if args.max_torque is not None:
-        if len(args.max_torque) not in (1, arm.n):
-            raise InputError(f"--max-torque: expected 1 or {arm.n} values")
-        tl = np.broadcast_to(np.array(args.max_torque), arm.n)
-    e = design_excitation(arm, np.array(args.q0), args.amplitude, args.max_velocity,
-                          args.max_acceleration, torque_limit=tl, harmonics=args.harmonics,
-                          f0_hz=1.0 / args.period, candidates=args.candidates,
-                          iterations=args.iterations, seed=args.seed)
-    t = np.arange(round(args.period * args.rate)) / args.rate
-    q, _, _ = e.command.evaluate(t)
-    header = "t [s]," + ",".join(f"qc{k + 1} [rad]" for k in range(arm.n))
-    with atomic_path(out, overwrite=args.force) as tmp:
-        np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", fmt="%.12g", header=header,
-                   comments="")
-    dq, dqd, dqdd = e.command.peaks()
-    payload = {"condition_number": e.kappa, "condition_number_random_start": e.kappa_start,
-               "peak_position_rad": dq, "peak_velocity_rad_s": dqd,
-               "peak_acceleration_rad_s2": dqdd, "peak_torque_nm": e.peak_torque,
-               "q0": e.command.q0, "f0_hz": e.command.f0_hz, "a": e.command.a,
-               "b": e.command.b}
-    text = (f"condition number {e.kappa:.4g} (best random start {e.kappa_start:.4g}); peak "
-            f"torque per joint {np.array2string(e.peak_torque, precision=3)} N m\nwrote {out}")
-    return to_jsonable(payload), text
 
 
 def run_benchmark(args: argparse.Namespace, out: Path) -> tuple[dict, str]:

@@ -22,7 +22,7 @@ def panda_arm():
 
     try:
         path = panda_urdf()
-    except Exception as exc:  # noqa: BLE001 - the package is optional
+    except Exception as exc:  # the package is optional: skip without it
         pytest.skip(f"example-robot-data: {exc}")
     return load_arm(path, end_link="panda_link8", name="panda")
 

@@ -41,7 +41,7 @@ from zrp.gap.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, p
 from zrp.gap.dynamics.fit import cross_validate, design, solve
 from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
-from zrp.gap.dynamics.resulting import BodyChange, resulting_bodies
+from zrp.gap.dynamics.resulting import BodyChange, ChangedArm, link_changes, resulting_bodies
 from zrp.gap.dynamics.results import DynamicDiagnosis, FoundEffect, Param, Samples
 from zrp.gap.dynamics.select import Step, forward_select
 from zrp.gap.dynamics.states import States, derive_states
@@ -198,12 +198,10 @@ def _fit_chosen(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma
     withheld prediction when known, else cross-validated here."""
     d = design(chosen, *b.shape)
     fit = solve(d, b, sigma)
-    values, inert = fit.theta, None
+    values, inert, named = fit.theta, None, None
     if any(e.name == "inertial" for e in chosen):
         # physical by construction (eq. P1); the withheld error is that of the physical fit
-        inert = physical_fit(arm, chosen, b, sigma)
-        values = inert.theta
-        pred, _ = physical_cross_validate(arm, chosen, b, sigma, opt.folds, guard)
+        inert, values, pred, named = _links(arm, chosen, fit.theta, b, sigma, opt, guard)
     elif pred is None:
         pred = cross_validate(d, b, sigma, opt.folds, guard)
     at_bound = np.isclose(values, d.lower) | np.isclose(values, d.upper)
@@ -213,10 +211,40 @@ def _fit_chosen(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma
                          drop.get(e.key, 0.0), _contribution(e, values[sl]))
              for e, sl in zip(chosen, d.slices, strict=True)]
     found = [_with_part_mass(arm, f) for f in found]
+    if named is not None and inert is not None:
+        return _Fitted(found, inert, pred, link_changes(arm, inert.phi, named))
     bodies = resulting_bodies(
         arm, [(f.key, f.name, f.detail, {k: p.value for k, p in f.params.items()})
               for f in found if f.name in BODY_CHANGES], None if inert is None else inert.phi)
     return _Fitted(found, inert, pred, bodies)
+
+
+def _links(arm: Arm, chosen: list[Effect], theta: F64, b: F64, sigma: F64,
+           opt: DynamicsOptions, guard: int
+           ) -> tuple[InertialFit, F64, F64, dict[int, BodyChange] | None]:
+    """The link inertias fitted physically (eq. P1). With a named part or link among the
+    chosen effects (an absent hand, a link's mass, a payload), those are applied to the
+    model first at their least-squares values and the links are fitted on top, so that the
+    physical fit holds the resulting bodies. The fit, every effect's values in ``chosen``
+    order, the withheld prediction and the named changes (None without them)."""
+    d = design(chosen, *b.shape)
+    first = [i for i, e in enumerate(chosen) if e.name in BODY_CHANGES]
+    named = resulting_bodies(arm, [(chosen[i].key, chosen[i].name, chosen[i].detail,
+                                    dict(zip(chosen[i].params, theta[d.slices[i]],
+                                             strict=True))) for i in first])
+    if not first or not all(c.physical for c in named.values()):
+        inert = physical_fit(arm, chosen, b, sigma)
+        pred, _ = physical_cross_validate(arm, chosen, b, sigma, opt.folds, guard)
+        return inert, inert.theta, pred, None
+    offset = sum(chosen[i].columns @ theta[d.slices[i]] for i in first)
+    rest = [e for i, e in enumerate(chosen) if i not in first]
+    changed = ChangedArm(arm, {bb: c.phi for bb, c in named.items()})
+    inert = physical_fit(changed, rest, b - offset, sigma)
+    pred, _ = physical_cross_validate(changed, rest, b - offset, sigma, opt.folds, guard)
+    values = theta.copy()
+    for sl, e in zip(design(rest, *b.shape).slices, rest, strict=True):
+        values[d.slices[chosen.index(e)]] = inert.theta[sl]
+    return inert, values, pred + offset, named
 
 
 def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma: F64,
@@ -229,10 +257,11 @@ def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, si
     fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, pred)
     for _ in range(len(chosen)):
         bad = [c for c in fitted.bodies.values() if not c.physical]
-        culprits = [k for c in bad for k in c.effects if k != "inertial"]
+        culprits = [k for c in bad for k in c.effects]
         if not culprits:
             break
-        key = culprits[-1]
+        # the link inertias are the last resort: a named part or link stays, they go
+        key = "inertial" if "inertial" in culprits else culprits[-1]
         body = next(c for c in bad if key in c.effects)
         notes.append(f"{key} left out: with it link {body.name} would not be physical (mass "
                      f"{body.phi[0]:.3g} kg, or a centre or inertia no body can have)")
@@ -257,16 +286,19 @@ def _common_gain(found: list[FoundEffect]) -> list[str]:
 
 
 def _unphysical_links(arm: Arm, inert: InertialFit) -> list[str]:
-    """Where the physical link fit cannot follow the data: each link whose unconstrained fit
-    is not a body, and what it would need."""
-    out = []
+    """Where the physical link fit cannot follow the data (farther from the unconstrained fit
+    than the noise explains): each link whose unconstrained fit is not a body, and what it
+    would need."""
+    out: list[str] = []
+    if inert.matched:
+        return out
     for b in inert.unphysical_links():
         ph, ph0 = inert.unconstrained_phi[b], arm.body_params(b)
         out.append(f"link {arm.body_name(b)}: the unconstrained fit needs mass "
                    f"{ph[0]:.3g} kg (model {ph0[0]:.3g} kg) with a centre or inertia no body "
                    "can have (pseudo-inertia not positive definite); the physical fit keeps it "
-                   "a body. A part of the model missing or misplaced on it (a hand, a cable "
-                   "carrier, a counterweight) is the likely cause; check the model there")
+                   "a body. Check the model there: a part missing or misplaced on it (a hand, a "
+                   "cable carrier, a counterweight) asks for such a link")
     return out
 
 

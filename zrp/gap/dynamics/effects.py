@@ -43,6 +43,11 @@ STRIBECK_SPEEDS = (0.03, 0.1, 0.3)
 #: Relative singular value below which a base combination counts as not excited (eq. R6).
 EXCITED = 1e-2
 
+#: Smoother sign functions tried for Coulomb friction besides tanh(w / V_EPS), rad/s: a
+#: friction that builds up over a few hundredths of a rad/s (lubricated gears, a
+#: controller's own friction observer) is still Coulomb friction.
+SOFT_SIGNS = (0.05,)
+
 JOINT_EFFECTS = ("coulomb", "viscous", "stribeck", "armature", "offset", "gain")
 
 
@@ -67,6 +72,8 @@ def _joint_effects(arm: Arm, qd: F64, qdd: F64, tau0: F64) -> list[Effect]:
                 ("gain", tau0[:, k], "1", -1.0 + 1e-6, inf, "")]
         spec += [("stribeck", sgn * np.exp(-(w / vs) ** 2), "N m", 0.0, inf, f"v_s={vs:g} rad/s")
                  for vs in STRIBECK_SPEEDS]
+        spec += [("coulomb", np.tanh(w / vc), "N m", -float(coulomb[k]), inf,
+                  f"v_c={vc:g} rad/s") for vc in SOFT_SIGNS]
         for name, col, unit, lo, hi, detail in spec:
             out.append(Effect(name, k, _on_joint(col, k, n), (name,), (unit,), np.array([lo]),
                               np.array([hi]), detail))

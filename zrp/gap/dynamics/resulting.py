@@ -26,7 +26,7 @@ from zrp.gap.dynamics.arm import DynamicArm as Arm
 from zrp.gap.dynamics.bodies import link_centre
 from zrp.gap.dynamics.inertia import add_point_mass, pseudo_inertia
 
-__all__ = ["BodyChange", "physical_body", "resulting_bodies"]
+__all__ = ["BodyChange", "ChangedArm", "link_changes", "physical_body", "resulting_bodies"]
 
 
 @dataclass(frozen=True)
@@ -115,4 +115,34 @@ def resulting_bodies(arm: Arm, effects: list[tuple[str, str, str, Mapping[str, f
                  else np.asarray(inertial_phi[b], float)) if prev is None else prev.phi
         out[b] = BodyChange(b, arm.body_name(b), phi0, _apply(arm, name, detail, values, start),
                             (*(prev.effects if prev else ()), key))
+    return out
+
+
+class ChangedArm:
+    """An arm whose model bodies are replaced by ``phi`` (body -> eq. R1 parameters), all
+    else the arm's own: the model the link inertias are fitted against once a named part or
+    link of it has been changed (the physical fit then holds the resulting body)."""
+
+    def __init__(self, arm: Arm, phi: Mapping[int, F64]) -> None:
+        self._arm = arm
+        self._phi = {b: np.asarray(v, dtype=float) for b, v in phi.items()}
+
+    def __getattr__(self, name: str) -> object:
+        return getattr(self._arm, name)
+
+    def body_params(self, b: int) -> F64:
+        return self._phi[b].copy() if b in self._phi else self._arm.body_params(b)
+
+
+def link_changes(arm: Arm, inertial_phi: Mapping[int, F64],
+                 named: Mapping[int, BodyChange]) -> dict[int, BodyChange]:
+    """The bodies after the link inertias fitted on top of named changes (``named``: the
+    bodies a part or link effect changed first), each against the arm's own model."""
+    out: dict[int, BodyChange] = {}
+    for b, phi in inertial_phi.items():
+        phi0 = arm.body_params(b)
+        if np.allclose(phi, phi0, rtol=1e-12, atol=1e-15) and b not in named:
+            continue
+        keys = (*(named[b].effects if b in named else ()), "inertial")
+        out[b] = BodyChange(b, arm.body_name(b), phi0, np.asarray(phi, float), keys)
     return out

@@ -4,8 +4,9 @@ fit never saw (another excitation, another day). Per joint and overall RMS befor
 model) and after (the corrected model), against that log's own noise floor.
 
 The prediction (eq. V1) along the second log's states is the model's inverse dynamics plus
-each found effect's columns (:mod:`.effects`, :mod:`.bodies`) times its fitted values, and
-the link inertias' exact torque change Y (phi - phi0) (eq. R2) when they were fitted.
+the exact torque change Y_b (phi_b - phi0_b) (eq. R2) of every body the diagnosis changed
+(:attr:`DynamicDiagnosis.bodies`: link inertias, a part not on the arm, a link's mass, a
+payload), and each other found effect's columns (:mod:`.effects`) times its fitted values.
 """
 
 from __future__ import annotations
@@ -68,12 +69,15 @@ def _prediction(arm: Arm, diag: DynamicDiagnosis, q: F64, qd: F64, qdd: F64, tau
     cols = {e.key: e for e in candidate_effects(arm, q, qd, qdd, tau0, inertial=False)
             if e.key in keys}
     pred = np.zeros_like(tau0)
+    # the changed bodies at their resulting inertials (eq. R2): every part, link and payload
+    # effect and the link inertias at once
+    in_bodies = {k for c in diag.bodies.values() for k in c.effects}
+    if diag.bodies:
+        bodies = sorted(diag.bodies)
+        y, _ = arm.regressor(q, qd, qdd, bodies)
+        pred += y @ np.concatenate([diag.bodies[b].phi - diag.bodies[b].phi0 for b in bodies])
     for f in diag.effects:
-        if f.name == "inertial":
-            bodies = sorted(diag.inertial_phi)
-            y, _ = arm.regressor(q, qd, qdd, bodies)
-            dphi = np.concatenate([diag.inertial_phi[b] - arm.body_params(b) for b in bodies])
-            pred += y @ dphi
+        if f.key in in_bodies:
             continue
         e = cols.get(f.key)
         if e is None:
