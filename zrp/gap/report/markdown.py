@@ -15,10 +15,11 @@ from zrp.gap.analysis.where import Region, WhereAnalysis
 from zrp.gap.report.backlash import backlash_flank_text
 from zrp.gap.report.fullpose import full_pose_markdown
 from zrp.gap.report.identification import identification_markdown
+from zrp.gap.report.headline import headline_text, summary_markdown
 from zrp.gap.report.verdict import (
     baseline_text,
     final_effects_text,
-    verdict_text,
+    verdict_sections,
 )
 from zrp.gap.results import Candidate, Diagnosis, ParameterEstimate
 
@@ -86,7 +87,9 @@ def _header(diag: Diagnosis) -> list[str]:
     s = diag.settings
     return [f"# Sim-to-real gap diagnosis: {_t(diag.model_name)}\n",
             "## Verdict\n",
-            verdict_text(diag) + "\n",
+            headline_text(diag) + "\n",
+            *summary_markdown(diag), "",
+            *(f"### {title}\n\n{text}\n" for title, text in verdict_sections(diag)),
             "## Data\n",
             f"Data: {_t(diag.context.meas.source)}: {s['n_poses']} poses, {s['n_points']} "
             f"measured points ({', '.join(map(_t, s['point_labels']))}), frame "
