@@ -94,6 +94,7 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "full_pose": full_pose_document(full_pose, cal.fold_rotations()[-1]),
         "conditions": None if cal.conditions is None else cal.conditions.to_dict(),
         "domains_widened": cal.widen,
+        "undetermined": list(cal.undetermined),
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
                   "= R_b (p'(x) + R'_n(x) t'_j) + t_b with p', R'_n the forward kinematics of "
                   "model_file, bodies scaled by 1 + kappa (temp - t_ref)"),
@@ -113,6 +114,10 @@ def _toml_header(cal: CalibratedRobot) -> str:
                   f" angle_unit = {c.angle_unit}",
                   f"#   instrument = {c.instrument}; data_file = {c.data_file}; "
                   f"data_sha256 = {c.data_sha256}"]
+    if cal.undetermined:
+        lines.append("# NOT DETERMINED by the data (kept at nominal or known only loosely; "
+                     "compensation.json 'undetermined'):")
+        lines += [f"#   {' '.join(u.split())}" for u in cal.undetermined]
     return "\n".join(lines) + "\n"
 
 
@@ -249,7 +254,7 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
         else np.array(doc["gravity_side_weights"], dtype=float),
         None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
         None if widen is None else {str(k): float(v) for k, v in dict(widen).items()},
-        _lead(bl.get("lead"), src))
+        _lead(bl.get("lead"), src), tuple(str(u) for u in doc.get("undetermined") or ()))
 
 
 def _lead(value: Any, src: str) -> tuple[bool, ...] | None:

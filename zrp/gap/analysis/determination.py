@@ -33,11 +33,11 @@ from typing import Any
 import numpy as np
 
 from zrp.gap.fit.leastsq import FitResult
-from zrp.gap.fit.uncertainty import Correlations
+from zrp.gap.fit.uncertainty import Correlations, correlations
 from zrp.gap.model.domains import parameter_domain
-from zrp.gap.search.steps import ParameterEstimate
+from zrp.gap.search.steps import ParameterEstimate, parameter_estimates
 
-__all__ = ["PARTNER_RHO", "Determination", "determinations"]
+__all__ = ["PARTNER_RHO", "Determination", "determinations", "fit_determinations"]
 
 #: |correlation| from which a parameter is named as one an undetermined one trades against.
 PARTNER_RHO = 0.9
@@ -66,10 +66,11 @@ class Determination:
         return self.status == "determined"
 
     def describe(self) -> str:
-        """"determined", "held at nominal (...)" or "undetermined (...)"."""
+        """"determined", "in a combination held at nominal (...)" or "undetermined
+        (...)"."""
         if self.determined:
             return "determined"
-        head = "held at nominal" if self.status == "held" else "undetermined"
+        head = "in a combination held at nominal" if self.status == "held" else "undetermined"
         return f"{head} ({self.direction})" if self.direction else head
 
     def to_dict(self) -> dict[str, Any]:
@@ -146,3 +147,14 @@ def determinations(fit: FitResult, estimates: Sequence[ParameterEstimate], *,
         out[p.name] = Determination(p.name, "undetermined",
                                     why + (f"; trades against {partners}" if partners else ""))
     return out
+
+
+def fit_determinations(fit: FitResult, *, gap: float, unit: str, max_tilt_rad: float
+                       ) -> dict[str, Determination]:
+    """:func:`determinations` of every parameter of a fit from its own (normal-theory)
+    intervals and correlations (another estimate than the diagnosis's final model, e.g. a
+    full-pose refit)."""
+    est = parameter_estimates(fit, 0, simultaneous=True)
+    return determinations(fit, est, gap=gap, unit=unit, max_tilt_rad=max_tilt_rad,
+                          correlations=correlations(tuple(s.name for s in fit.specs),
+                                                    fit.cov))
