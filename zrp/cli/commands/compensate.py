@@ -95,9 +95,10 @@ def _run(args: argparse.Namespace) -> int:
             return gravity_torques(args.mjcf, q, field="--mjcf",
                                    joint_names=[j.name for j in cal.model.joints])
     elif cal.compliance_model == "mjcf" and any(
-            t.name.endswith(".compliance") for t in cal.terms):
-        raise InputError("--mjcf: the calibration's compliance was identified with MJCF "
-                         "gravity torques; pass the MJCF")
+            t.effect == "joint_compliance" for t in cal.terms):
+        raise InputError("--mjcf: this calibration used --mjcf (its joint compliance was "
+                         "identified with the MJCF's gravity torques, in rad/(N m)); pass the "
+                         "same MJCF or URDF with --mjcf")
     missing_conditions(cal.terms, cal.compliance_model, cal.kappa, cal.conditions,
                        temp=args.temp, load=args.load)
     T = len(tg.q)
