@@ -30,8 +30,10 @@ from zrp.calibration.conditions import (
     ConditionWarning,
     MissingConditionError,
     check_joint_limits,
+    check_payload,
     missing_conditions,
     out_of_range,
+    payload_separated,
 )
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
@@ -220,20 +222,25 @@ def _checked_targets(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike,
 
 
 def _warn_conditions(cal: CalibratedRobot, base: PoseConditions) -> None:
-    """Warn (at the caller of :func:`compensate`) when thermal expansion was identified but
-    the targets' temperature is not given, when a payload-dependent joint map identified with
-    a payload gets none, and when a temperature or payload lies outside the measured range."""
+    """Refuse a payload the calibration cannot predict (:func:`~zrp.calibration.conditions.
+    check_payload`); warn (at the caller of :func:`compensate`) when thermal expansion was
+    identified but the targets' temperature is not given, when a payload-dependent joint map
+    identified with a payload gets none, and when a temperature or payload lies outside the
+    measured range."""
     if cal.kappa != 0.0 and base.temp is None:
         warnings.warn(f"the calibration found thermal expansion (kappa = {cal.kappa:.3g} "
                       f"1/degC) but no temperature was given (conditions=PoseConditions("
                       f"temp=...)): the commands are for the reference temperature "
                       f"{cal.t_ref:.4g} degC", ThermalWarning, stacklevel=3)
+    check_payload(cal.conditions, cal.compliance_model, base.load, required=False)
     try:
         missing_conditions(cal.terms, cal.compliance_model, 0.0, cal.conditions,
                            temp=base.temp, load=base.load)
     except MissingConditionError as exc:
+        own = not payload_separated(cal.conditions, cal.compliance_model)
         warnings.warn(f"{exc} (conditions=PoseConditions(load=...)); the commands are for "
-                      "no payload", ConditionWarning, stacklevel=3)
+                      + ("the payload of the data" if own else "no payload"),
+                      ConditionWarning, stacklevel=3)
     for msg in out_of_range(cal.conditions, temp=base.temp, load=base.load):
         warnings.warn(msg, ConditionWarning, stacklevel=3)
 
@@ -304,6 +311,8 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
     Raises:
         InputError: bad shapes, or a seed or command beyond a joint limit (naming the target
             and joint).
+        PayloadConditionError: a payload the calibration cannot predict (identified at one
+            payload, never varied, without the MJCF's masses).
     """
     y, q0, ids, rot = _checked_targets(cal, targets, seed, orientations, frame, target_ids)
     lim = joint_limits(cal, limits)
