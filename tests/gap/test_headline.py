@@ -69,7 +69,7 @@ def test_synthetic_headline_names_effects_joints_and_floor(synthetic, tmp_path):
     write_outputs(d, tmp_path, plots=False)
     head = _check_headline(d, (tmp_path / "report.md").read_text(encoding="utf-8"),
                            (tmp_path / "report.html").read_text(encoding="utf-8"))
-    for effect, joints in d.final_joints.items():
+    for effect in d.final_joints:
         assert effect in head
     assert "cyclic_error (joint 2" in head and "backlash (joint 3" in head
     assert not d.unexplained and "at the noise floor" in head

@@ -170,7 +170,7 @@ def summary_rows(diag: Diagnosis) -> tuple[tuple[str, ...], list[tuple[str, ...]
         return (name, f"{rms:.4g}", "" if p95 is None else f"{p95:.4g}",
                 "" if mx is None else f"{mx:.4g}", gone)
 
-    rows = [row("after registration", nom.rms, nom.p95, nom.max)[:4] + ("",)]
+    rows = [(*row("after registration", nom.rms, nom.p95, nom.max)[:4], "")]
     a = diag.assessment
     if a is not None:
         b = a.baseline.withheld

@@ -15,8 +15,8 @@ from zrp.gap.analysis.determination import Determination
 from zrp.gap.analysis.where import Region, WhereAnalysis
 from zrp.gap.report.backlash import backlash_flank_text
 from zrp.gap.report.fullpose import full_pose_markdown
-from zrp.gap.report.identification import identification_markdown
 from zrp.gap.report.headline import headline_text, summary_markdown
+from zrp.gap.report.identification import identification_markdown
 from zrp.gap.report.verdict import (
     baseline_text,
     final_effects_text,
