@@ -177,6 +177,7 @@ def compensate_and_measure(robot: RealRobot, instrument: Instrument, calibration
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         comp = compensate(cal, target, q_prog, point="smr1", frame="instrument",
+                          accept_flagged=True,  # every target measured, flags kept
                           conditions=cond, gravity_torque=None if mjcf_path is None else tau)
     after = measure(robot, comp.q_command, instrument, rng, proc,
                     directions=dirs).measurements

@@ -83,6 +83,8 @@ class Conditions:
         data_file: the data file's name, or None (in-memory data).
         data_sha256: SHA-256 of the data file's bytes, or None.
         software: the toolkit and version that identified the calibration.
+        joint_ranges: per joint the (smallest, largest) value the data measured (rad /
+            length unit), or None (files before 0.5.0: not recorded; nothing is guarded).
     """
 
     payloads_kg: tuple[float, ...] | None
@@ -97,6 +99,7 @@ class Conditions:
     data_file: str | None = None
     data_sha256: str | None = None
     software: str = f"zrp-accuracy {__version__}"
+    joint_ranges: tuple[tuple[float, float] | None, ...] | None = None
 
     @classmethod
     def from_measurements(cls, meas: Measurements, model: Manipulator, *,
@@ -113,7 +116,9 @@ class Conditions:
                    tuple(j.limits for j in model.joints), meas.frame, ANGLE_UNIT,
                    data_angle_unit, instrument,
                    None if data_path is None else Path(data_path).name,
-                   None if data_path is None else file_sha256(data_path))
+                   None if data_path is None else file_sha256(data_path),
+                   joint_ranges=tuple((float(lo), float(hi)) for lo, hi in zip(
+                       meas.q_pose.min(axis=0), meas.q_pose.max(axis=0), strict=True)))
 
     @property
     def load_range_kg(self) -> tuple[float, float] | None:
@@ -131,7 +136,9 @@ class Conditions:
                                  for lim in self.joint_limits],
                 "frame": self.frame, "instrument": self.instrument,
                 "data_file": self.data_file, "data_sha256": self.data_sha256,
-                "software": self.software}
+                "software": self.software,
+                "joint_ranges": None if self.joint_ranges is None else [
+                    None if r is None else list(r) for r in self.joint_ranges]}
 
     @classmethod
     def from_dict(cls, d: object, where: str) -> Conditions:
@@ -149,7 +156,7 @@ class Conditions:
                       str(d["length_unit"]), lims, str(d["frame"]), str(d["angle_unit"]),
                       str(d["data_angle_unit"]), _opt_str(d.get("instrument")),
                       _opt_str(d.get("data_file")), _opt_str(d.get("data_sha256")),
-                      str(d["software"]))
+                      str(d["software"]), _ranges_from(d.get("joint_ranges")))
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"{where}: malformed conditions ({type(exc).__name__}: "
                              f"{exc})") from None
@@ -157,6 +164,13 @@ class Conditions:
             raise InputError(f"{where}.angle_unit: {out.angle_unit!r}; the files' angles are "
                              f"in {ANGLE_UNIT}")
         return out
+
+
+def _ranges_from(v: object) -> tuple[tuple[float, float] | None, ...] | None:
+    """joint_ranges as read (absent in files before 0.5.0)."""
+    if v is None:
+        return None
+    return tuple(None if r is None else (float(r[0]), float(r[1])) for r in v)  # type: ignore[attr-defined]
 
 
 def _opt_str(v: object) -> str | None:
