@@ -101,10 +101,27 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
     }
 
 
-def _toml_header(cal: CalibratedRobot) -> str:
-    """Comment lines heading the model TOML: the version and the conditions (the model format
-    has no keys for them; compensation.json carries them as data)."""
-    lines = [f"# written by zrp-accuracy {__version__}"]
+#: the first words of the line that marks a calibrated model TOML (:func:`calibrated_marker`)
+CALIBRATED_MARKER = "# zrp calibrated model"
+
+
+def calibrated_marker(text: str) -> str | None:
+    """The compensation file a calibrated model TOML names in its marker line, or None when
+    ``text`` is not a calibrated model's."""
+    for line in text.splitlines()[:3]:
+        if line.startswith(CALIBRATED_MARKER):
+            return line.split("compensation file ", 1)[-1].split(";", 1)[0].strip() or None
+    return None
+
+
+def _toml_header(cal: CalibratedRobot, comp_name: str) -> str:
+    """Comment lines heading the model TOML: the marker naming its compensation file, the
+    version and the conditions (the model format has no keys for them; compensation.json
+    carries them as data)."""
+    lines = [f"{CALIBRATED_MARKER}: the geometry only; its joint map, thermal expansion and "
+             f"registration are in the compensation file {comp_name}; export it whole with "
+             f"zrp export --calibration {comp_name}",
+             f"# written by zrp-accuracy {__version__}"]
     c = cal.conditions
     if c is not None:
         lines += ["# calibrated under (compensation.json 'conditions'):",
@@ -144,7 +161,8 @@ def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: s
                          "below it); the compensation file names its model relative to "
                          "itself") from None
     doc = calibration_document(cal, rel, full_pose)
-    m = write_text(model_path, _toml_header(cal) + dumps_model(cal.model), overwrite=overwrite)
+    m = write_text(model_path, _toml_header(cal, Path(comp_path).name) + dumps_model(cal.model),
+                   overwrite=overwrite)
     c = write_text(comp_path, dumps(doc), overwrite=overwrite)
     return m, c
 
