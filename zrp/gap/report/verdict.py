@@ -149,6 +149,14 @@ def identification_text(diag: Diagnosis) -> list[str]:
         more = f" and {len(held) - 3} more" if len(held) > 3 else ""
         parts.append(f"{len(held)} parameter combination(s) the data cannot pin stayed at "
                      f"their nominal values: {shown}{more}.")
+    loose = [d for d in diag.determination.values() if d.status == "undetermined"]
+    if loose:
+        names = ", ".join(d.name for d in loose[:4]) + (
+            f" and {len(loose) - 4} more" if len(loose) > 4 else "")
+        parts.append(f"{len(loose)} parameter(s) the data do not determine (95 % interval wider "
+                     f"than the physical domain, or moving the points by more than the error "
+                     f"before calibration): {names}; the tables say what each trades "
+                     "against.")
     seen: set[str] = set()  # named only while a gap remains: then it says why it was not closed
     for effect, note in (diag.outside_domain if diag.unexplained is not False else ()):
         if effect in seen:
