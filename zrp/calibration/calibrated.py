@@ -237,16 +237,21 @@ class CalibratedRobot:
         delta, terms, kappa = _joint_terms(fit, ctx.model)
         folded, tools_f = _fold(ctx.model, u, bodies, delta, tools)
         bl = None if registration_only else diag.where.backlash
-        return cls(folded, ctx.model, rb, tb, tuple(ctx.meas.point_labels), tools_f, delta,
-                   tuple(terms), kappa, float(ctx.t_ref_degC),
-                   None if bl is None else tuple(bl.switch),
-                   0.0 if bl is None else float(bl.payload_kg), tuple(ctx.gravity_dir),
-                   tuple(ctx.harmonics), ctx.meas.frame,
-                   "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
-                   float(diag.nominal.rms if registration_only else diag.final.rms),
-                   _side_weights(ctx), Conditions.from_measurements(ctx.meas, ctx.model),
-                   None, None if bl is None or not bl.lead else tuple(bl.lead),
-                   _undetermined(diag, fit))
+        return cls(
+            model=folded, nominal=ctx.model, base_rotation=rb, base_translation=tb,
+            tool_labels=tuple(ctx.meas.point_labels), tool_points=tools_f,
+            joint_offsets=delta, terms=tuple(terms), kappa=kappa,
+            t_ref=float(ctx.t_ref_degC),
+            backlash_switch=None if bl is None else tuple(bl.switch),
+            payload_kg=0.0 if bl is None else float(bl.payload_kg),
+            gravity_dir=tuple(ctx.gravity_dir), harmonics=tuple(ctx.harmonics),
+            frame=ctx.meas.frame,
+            compliance_model="mjcf" if ctx.gravity_torque is not None else "lumped_masses",
+            withheld_rms=float(diag.nominal.rms if registration_only else diag.final.rms),
+            gravity_side_weights=_side_weights(ctx),
+            conditions=Conditions.from_measurements(ctx.meas, ctx.model), widen=None,
+            backlash_lead=None if bl is None or not bl.lead else tuple(bl.lead),
+            undetermined=_undetermined(diag, fit))
 
     @classmethod
     def from_corrections(cls, nominal: Manipulator, joint_offsets: ArrayLike,
