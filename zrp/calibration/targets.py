@@ -42,7 +42,7 @@ MAX_TARGETS = 1_000_000
 
 #: The columns :func:`write_commands` writes besides target and q1..qn.
 COMMAND_FLAGS = ("residual", "orientation_residual", "uncompensated", "sigma_min",
-                 "near_singular", "near_limit", "converged")
+                 "near_singular", "near_limit", "converged", "outside_measured")
 
 
 
@@ -235,13 +235,12 @@ def write_commands(comp: Compensation, path: str | Path, *, deg: bool = False,
     w = csv.writer(buf)
     w.writerow(["target", *[f"q{k}{'[deg]' if deg else ''}" for k in range(1, n + 1)],
                 "residual",
-                "orientation_residual", "uncompensated", "sigma_min", "near_singular",
-                "near_limit", "converged"])
+                *COMMAND_FLAGS[1:]])
     ori = comp.orientation_residual
     for i, t in enumerate(comp.target_ids):
         w.writerow([t, *(repr(float(v)) for v in q[i]), repr(float(comp.residual[i])),
                     "" if ori is None else repr(float(ori[i])),
                     repr(float(comp.uncompensated[i])), repr(float(comp.sigma_min[i])),
                     int(comp.near_singular[i]), int(comp.near_limit[i]),
-                    int(comp.converged[i])])
+                    int(comp.converged[i]), int(comp.outside_measured[i])])
     return write_text(path, buf.getvalue(), overwrite=overwrite)
