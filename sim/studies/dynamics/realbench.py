@@ -9,7 +9,7 @@ shipped model itself): the log is read as is by the library's reader
 prepared as a user does by hand today (:func:`sim.studies.dynamics.logprep.prepare_by_hand`),
 and the row says so. Only afterwards does :func:`score` read the truth:
 
-* the first finding: for a scenario with ``hand``, the model's hand named absent with its mass
+* the first finding (and whether it is among the findings at all): for a scenario with ``hand``, the model's hand named absent with its mass
   within 10 % (``absent_part`` with share 0.9 to 1.1, or a payload of minus the hand's mass
   within 10 %); else with ``gravity``, a link's mass or centre (``link_mass`` of the right link;
   ``inertial``: right effect, link not named); else friction on one of the distal joints;
@@ -141,6 +141,7 @@ class RealRow:
     named: str
     right_first: bool
     right_where: bool | None
+    found_anywhere: bool
     friction_found: str
     gains_named: int
     noise: list[float]
@@ -176,11 +177,11 @@ def _expected(truth: dict) -> str:
     return "friction j" + "/".join(str(k + 1) for k in eff["friction"]["joints"])
 
 
-def _first(diag: DynamicDiagnosis, truth: dict) -> tuple[bool, bool | None]:
-    """(right effect, right link/joint; None: the effect names none) of the first finding."""
-    if not diag.effects:
+def _first(diag: DynamicDiagnosis, truth: dict, at: int = 0) -> tuple[bool, bool | None]:
+    """(right effect, right link/joint; None: the effect names none) of finding ``at``."""
+    if len(diag.effects) <= at:
         return False, False
-    e, eff = diag.effects[0], truth["effect"]
+    e, eff = diag.effects[at], truth["effect"]
     if "hand" in eff:
         kg = eff["hand"]["hand_kg"]
         if e.name == "absent_part":
@@ -199,13 +200,14 @@ def score(diag: DynamicDiagnosis, how: str, truth: dict, name: str) -> RealRow:
     """Judge a blind diagnosis against its truth (module docstring)."""
     sc, eff = truth["scenario"], truth["effect"]
     right, where = _first(diag, truth)
+    anywhere = any(_first(diag, truth, i)[0] for i in range(len(diag.effects)))
     fj = eff.get("friction", {}).get("joints", [])
     found = {e.joint for e in diag.effects if e.name in FRICTION}
     d = sc["defects"]
     clean = not (d["jitter"] or d["gaps"] or d["repeat_share"] or d["ripple_sigma"])
     return RealRow(name, sc["arm"], sc["kind"], "clean" if clean else f"real ({d['naming']})",
                    how, _expected(truth), _named(diag.effects[0]) if diag.effects else "none",
-                   right, where, f"{len(found & set(fj))} of {len(fj)}" if fj else "-",
+                   right, where, anywhere, f"{len(found & set(fj))} of {len(fj)}" if fj else "-",
                    sum(e.name == "gain" for e in diag.effects), list(truth["noise_nm"]),
                    list(truth["floor_nm"]), diag.rms_before.tolist(), diag.rms_after.tolist())
 
