@@ -72,7 +72,8 @@ def _scenario_row(r: RealRow) -> list[object]:
 
 
 SCENARIO_COLUMNS = ["scenario", "log", "truth (expected first)", "named first", "right effect",
-                    "right link/joint", "expected among the findings", "friction joints found", "gains named",
+                    "right link/joint", "expected among the findings", "friction joints found",
+                    "gains named",
                     "withheld RMS / noise, before -> after", "floor / noise",
                     "worst joint after / noise", "second log / noise, shipped -> corrected",
                     "second <= 1.2", "FIGAROH withheld / noise", "FIGAROH second / noise",

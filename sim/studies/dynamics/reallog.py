@@ -114,7 +114,7 @@ def log_times(t0: float, t1: float, defects: LogDefects, rng: np.random.Generato
 def _repeat(n: int, share: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     """Row order with ``share`` of the output rows copies of the one before, and their
     output positions."""
-    k = int(round(share * n / (1.0 - share))) if share > 0.0 else 0
+    k = round(share * n / (1.0 - share)) if share > 0.0 else 0
     src = np.sort(rng.choice(np.arange(1, n), k, replace=False)) if k else np.zeros(0, int)
     order = np.insert(np.arange(n), np.searchsorted(np.arange(n), src, side="right"), src)
     pos = np.flatnonzero(np.diff(order) == 0) + 1

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -40,7 +41,7 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.dynamics.fourier import Fourier
 
-__all__ = ["REAL_ARMS", "RealArm", "RealScenario", "arm_without", "draw_truth"]
+__all__ = ["REAL_ARMS", "RealArm", "RealScenario", "arm_without", "draw_truth", "erd_file"]
 
 
 @dataclass(frozen=True)
@@ -61,7 +62,8 @@ class RealArm:
         return np.array(self.q0)
 
 
-def _erd(rel: str):
+def erd_file(rel: str) -> Path:
+    """A file of example-robot-data's robots folder."""
     root = example_robot_data_root()
     if root is None:
         raise InputError("example-robot-data not found (pip install pin example-robot-data)")
@@ -69,7 +71,7 @@ def _erd(rel: str):
 
 
 def _z1() -> Arm:
-    return load_arm(_erd(REAL_ARMS["z1"].urdf or ""), end_link="link06", name="z1")
+    return load_arm(erd_file(REAL_ARMS["z1"].urdf or ""), end_link="link06", name="z1")
 
 
 def _bench(key: str, **kw) -> RealArm:
@@ -92,7 +94,7 @@ def arm_without(real: RealArm) -> Arm:
     its subtree) deleted, loaded as the model is (same end link, static links fused)."""
     if real.urdf is None or real.hand is None:
         raise InputError(f"{real.key}: the model has no hand to take away")
-    spec = load_shipped_spec(_erd(real.urdf))
+    spec = load_shipped_spec(erd_file(real.urdf))
     spec.delete(spec.body(real.hand))  # with its subtree: the fingers and their joints
     spec.compiler.fusestatic = True
     return load_arm(spec, name=f"{real.key} without its hand")
