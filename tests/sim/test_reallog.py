@@ -108,7 +108,7 @@ def _urdf_mass(path: Path, links: set[str]) -> float:
 
 def test_absent_hand_truth_is_the_urdf_hand():
     pytest.importorskip("pinocchio", reason="optional: pip install pin")
-    from sim.studies.dynamics.realscenarios import REAL_ARMS, RealScenario, erd_file, draw_truth
+    from sim.studies.dynamics.realscenarios import REAL_ARMS, RealScenario, draw_truth, erd_file
 
     real = REAL_ARMS["panda"]
     arm = real.load()
