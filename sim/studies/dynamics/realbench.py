@@ -9,11 +9,11 @@ shipped model itself): the log is read as is by the library's reader
 prepared as a user does by hand today (:func:`sim.studies.dynamics.logprep.prepare_by_hand`),
 and the row says so. Only afterwards does :func:`score` read the truth:
 
-* the first finding (and whether it is among the findings at all): for a scenario with
-  ``hand``, the model's hand named absent with its mass within 10 % (``absent_part`` with
-  share 0.9 to 1.1, or a payload of minus the hand's mass within 10 %); else with
-  ``gravity``, a link's mass or centre (``link_mass`` of the right link; ``inertial``: right
-  effect, link not named); else friction on one of the distal joints;
+* the first finding (and whether it is among the findings at all, on the right link): for
+  a scenario with ``hand``, the model's hand named absent with its mass within 10 %
+  (``absent_part`` with share 0.9 to 1.1, or a payload of minus the hand's mass within
+  10 %); else with ``gravity``, a link's mass or centre (``link_mass`` of the right link;
+  ``inertial``: right effect, link not named); else friction on one of the distal joints;
 * friction found: of the true friction joints, those with a friction effect named;
 * torque gains named (none expected: the arm has no sensor error);
 * withheld torque RMS per joint and overall, before and after, over the true noise sigma and
@@ -202,7 +202,8 @@ def score(diag: DynamicDiagnosis, how: str, truth: dict, name: str) -> RealRow:
     """Judge a blind diagnosis against its truth (module docstring)."""
     sc, eff = truth["scenario"], truth["effect"]
     right, where = _first(diag, truth)
-    anywhere = any(_first(diag, truth, i)[0] for i in range(len(diag.effects)))
+    anywhere = any(ok and at is not False for ok, at in
+                   (_first(diag, truth, i) for i in range(len(diag.effects))))
     fj = eff.get("friction", {}).get("joints", [])
     found = {e.joint for e in diag.effects if e.name in FRICTION}
     d = sc["defects"]
