@@ -15,19 +15,23 @@ torque gains, the corrected model's error on the second log <= 1.2x the noise.
 This script reports what it sees; it asserts nothing.
 
 Run: python3 tests/benchmarks/bench_dynamics_reallogs.py [--seconds 20] [--seed 1]
-[--arms panda z1 ur5e puma] [--quick] [--no-peer] [--out FILE.md] [--force]
-(writes renders/benchmarks/bench_dynamics_reallogs.md and .json)
+[--arms panda z1 ur5e puma] [--quick] [--no-peer] [--out FILE.md] [--force] [--no-readme]
+(writes renders/benchmarks/bench_dynamics_reallogs.md and .json; its first table, the
+summary, also replaces the generated block of sim/README.md, not with --quick, --out or
+--no-readme)
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import tempfile
 import warnings
 from pathlib import Path
 
 import numpy as np
-from _report import Report, add_output_arguments, output_path
+from _readme_block import replace_block
+from _report import ROOT, Report, add_output_arguments, output_path
 
 from sim.studies.dynamics.figpeer import figaroh_available, figaroh_peer
 from sim.studies.dynamics.realbench import RealRow, run_real
@@ -38,6 +42,7 @@ from sim.studies.dynamics.realscenarios import RealScenario
 PLAN = [("panda", "hand+friction", "franka"), ("panda", "hand+friction", None),
         ("panda", "gravity", "standard"), ("panda", "friction", "standard"),
         ("z1", "hand+friction", "rtde"), ("z1", "gravity+friction", "standard"),
+        ("z1", "none", None),
         ("ur5e", "gravity+friction", "rtde"), ("ur5e", "friction", "standard"),
         ("puma", "gravity", "standard"), ("puma", "gravity", None)]
 QUICK = [("panda", "hand+friction", "franka"), ("puma", "gravity", "standard")]
@@ -112,6 +117,8 @@ def _summary(rows: list[RealRow]) -> list[list[object]]:
          count(grav, lambda r: r.found_anywhere), "all"],
         ["gravity error named first", count(grav, lambda r: r.right_first), ""],
         ["friction alone: distal joint first", count(fric, lambda r: r.right_first), "all"],
+        ["nothing hidden: nothing named", count([r for r in rows if r.kind == "none"],
+                                                lambda r: r.right_first), "all"],
         ["distal friction joints found (all scenarios with friction)",
          f"{sum(int(a) for a, _ in found)} of {sum(int(b) for _, b in found)}", "all"],
         ["no torque gain named", count(rows, lambda r: r.gains_named == 0), "all"],
@@ -157,6 +164,8 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true",
                     help="two scenarios (Panda hand + friction, PUMA gravity), 8 s logs")
     ap.add_argument("--no-peer", action="store_true", help="do not run FIGAROH")
+    ap.add_argument("--no-readme", action="store_true",
+                    help="leave sim/README.md's generated summary as it is")
     add_output_arguments(ap, "bench_dynamics_reallogs")
     args = ap.parse_args()
     out = output_path(args)
@@ -178,8 +187,11 @@ def main() -> None:
     report = Report("bench_dynamics_reallogs",
                     "blind benchmark of the dynamic gap on real-looking logs")
     why = figaroh_available()
-    report.table(f"{len(rows)} scenarios, {args.seconds:g} s logs, seed {args.seed}"
-                 f"{' (--quick: a smoke run)' * args.quick}", SCENARIO_COLUMNS,
+    heading = (f"{len(rows)} scenarios on {len({r.arm for r in rows})} arms, two "
+               f"{args.seconds:g} s logs each, seed {args.seed}"
+               f"{' (--quick: a smoke run)' * args.quick}")
+    report.table(heading, SUMMARY_COLUMNS, _summary(rows))
+    report.table("Scenarios", SCENARIO_COLUMNS,
                  [_scenario_row(r) for r in rows],
                  note="noise: the true torque noise sigma (overall: RMS over the joints); "
                       "floor: noise, motion-locked ripple and torque quantisation together "
@@ -188,7 +200,6 @@ def main() -> None:
                       "the same arm, the model as shipped -> corrected by the diagnosis; "
                       "FIGAROH: its base parameters and friction identified on the same "
                       "states (- : did not run, see below)")
-    report.table("Summary", ["figure", "value", "target"], _summary(rows))
     report.table("Real-looking log and its clean twin",
                  ["arm, truth", "log", "named first (real)", "named first (clean)", "same",
                   "withheld / noise, real / clean"], _twins(rows),
@@ -208,6 +219,15 @@ def main() -> None:
                                      "second shipped", "second corrected", "FIGAROH after",
                                      "FIGAROH second"], _joint_rows(rows))
     report.write(out, args)
+    if not (args.quick or args.no_readme or args.out):
+        replace_block(README, "bench_dynamics_reallogs", heading, SUMMARY_COLUMNS,
+                      _summary(rows),
+                      json.loads(out.with_suffix(".json").read_text(encoding="utf-8")))
+        print(f"replaced the generated bench_dynamics_reallogs table of {README.name}")
+
+
+README = ROOT / "sim" / "README.md"
+SUMMARY_COLUMNS = ["figure", "value", "target"]
 
 
 if __name__ == "__main__":

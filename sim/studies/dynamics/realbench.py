@@ -14,6 +14,7 @@ and the row says so. Only afterwards does :func:`score` read the truth:
   (``absent_part`` with share 0.9 to 1.1, or a payload of minus the hand's mass within
   10 %); else with ``gravity``, a link's mass or centre (``link_mass`` of the right link;
   ``inertial``: right effect, link not named); else friction on one of the distal joints;
+  for ``none``, nothing named;
 * friction found: of the true friction joints, those with a friction effect named;
 * torque gains named (none expected: the arm has no sensor error);
 * withheld torque RMS per joint and overall, before and after, over the true noise sigma and
@@ -176,14 +177,19 @@ def _expected(truth: dict) -> str:
         return f"absent hand {eff['hand']['hand']} ({eff['hand']['hand_kg']:.2f} kg)"
     if "gravity" in eff:
         return f"link mass/centre {eff['gravity']['link']}"
+    if "friction" not in eff:
+        return "nothing"
     return "friction j" + "/".join(str(k + 1) for k in eff["friction"]["joints"])
 
 
 def _first(diag: DynamicDiagnosis, truth: dict, at: int = 0) -> tuple[bool, bool | None]:
     """(right effect, right link/joint; None: the effect names none) of finding ``at``."""
+    eff = truth["effect"]
+    if eff["kind"] == "none":
+        return not diag.effects, True
     if len(diag.effects) <= at:
         return False, False
-    e, eff = diag.effects[at], truth["effect"]
+    e = diag.effects[at]
     if "hand" in eff:
         kg = eff["hand"]["hand_kg"]
         if e.name == "absent_part":
@@ -203,7 +209,7 @@ def score(diag: DynamicDiagnosis, how: str, truth: dict, name: str) -> RealRow:
     sc, eff = truth["scenario"], truth["effect"]
     right, where = _first(diag, truth)
     anywhere = any(ok and at is not False for ok, at in
-                   (_first(diag, truth, i) for i in range(len(diag.effects))))
+                   (_first(diag, truth, i) for i in range(max(len(diag.effects), 1))))
     fj = eff.get("friction", {}).get("joints", [])
     found = {e.joint for e in diag.effects if e.name in FRICTION}
     d = sc["defects"]

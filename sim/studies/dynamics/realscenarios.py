@@ -13,6 +13,7 @@ Kinds (combinations joined by ``+``):
   parameters minus the model's are the change (a negative mass of the hand's at its centre);
 * ``gravity``: a posture-dependent gravity error: one link among those of joints 2 to 4 (mass
   above 0.3 kg) is 20 % heavier, the extra mass 3 cm off its centre (a point mass, eq. R1);
+* ``none``: nothing hidden (what the log's defects and the simulator alone leave);
 * ``friction``: on each of the last three joints, Coulomb friction F_c = u(0.01, 0.03) max_j
   T_j and viscous friction u(0.3, 1) F_c / RMS(qd_k) (T_j: RMS of joint j's nominal torques;
   a wrist's friction is set by its gear, not by the small torques its links need).
@@ -191,8 +192,10 @@ def draw_truth(sc: RealScenario, arm: Arm) -> tuple[HiddenDynamics, F64, dict]:
         elif part == "friction":
             coulomb, viscous, desc["friction"] = _friction(arm.n, scale, qd_rms, rng)
             continue
+        elif part == "none":
+            continue
         else:
-            raise InputError(f"kind: unknown part {part!r} (hand, gravity, friction)")
+            raise InputError(f"kind: unknown part {part!r} (hand, gravity, friction, none)")
         for b, d in dphi.items():
             inertial[b] = inertial.get(b, np.zeros(10)) + d
     return HiddenDynamics(coulomb=coulomb, viscous=viscous, inertial=inertial), sigma, desc
