@@ -199,7 +199,10 @@ def main() -> None:
                       "predicted by the fit on the others; second log: another excitation of "
                       "the same arm, the model as shipped -> corrected by the diagnosis; "
                       "FIGAROH: its base parameters and friction identified on the same "
-                      "states (- : did not run, see below)")
+                      "states (- : did not run, see below). The Z1's URDF carries joint "
+                      "friction and damping of its own: the simulated arm applies that "
+                      "friction by MuJoCo's frictionloss constraint, the model (and FIGAROH) "
+                      "by a smooth or sign law; the z1 'none' log shows what that alone leaves")
     report.table("Real-looking log and its clean twin",
                  ["arm, truth", "log", "named first (real)", "named first (clean)", "same",
                   "withheld / noise, real / clean"], _twins(rows),
