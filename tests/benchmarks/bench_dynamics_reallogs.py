@@ -210,7 +210,7 @@ def main() -> None:
                       "its clean twin")
     report.table("How each log was read", ["scenario", "read"],
                  [[r.name, r.read] for r in rows])
-    report.table("Effects not carried to the second log", ["scenario", "effects"],
+    report.table("Second log: not validated", ["scenario", "why"],
                  [[r.name, ", ".join(r.not_carried)] for r in rows if r.not_carried])
     report.table("FIGAROH", ["scenario", "ran", "base parameters",
                              "least squares = its double QR's", "seconds", "why not"],

@@ -19,8 +19,9 @@ and the row says so. Only afterwards does :func:`score` read the truth:
 * torque gains named (none expected: the arm has no sensor error);
 * withheld torque RMS per joint and overall, before and after, over the true noise sigma and
   over the floor (noise, vibration and quantisation: what no dynamic model explains);
-* the second log: the corrected model (the diagnosis's effects with their fitted values, the
-  link inertias after it) against the model as shipped, over the noise (target <= 1.2).
+* the second log: the corrected model (:func:`zrp.gap.dynamics.validation.validate`: the
+  diagnosis's effects with their fitted values, the link inertias after it) against the model
+  as shipped, over the true noise (target <= 1.2).
 """
 
 from __future__ import annotations
@@ -33,7 +34,6 @@ from pathlib import Path
 
 import numpy as np
 
-from mjcf.arm import Arm
 from sim.studies.dynamics.logprep import prepare_by_hand
 from sim.studies.dynamics.reallog import controller_log, write_controller_log
 from sim.studies.dynamics.realscenarios import REAL_ARMS, RealScenario, draw_truth
@@ -42,13 +42,11 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.dynamics.data import TorqueLog, load_torque_log
 from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, FoundEffect, diagnose_dynamics
-from zrp.gap.dynamics.effects import candidate_effects
-from zrp.gap.dynamics.states import derive_states
+from zrp.gap.dynamics.validation import validate
 from zrp.jsonio import to_jsonable
 from zrp.output import write_json
 
-__all__ = ["RealRow", "diagnose_real", "read_log", "run_real", "score", "simulate_real",
-           "validate"]
+__all__ = ["RealRow", "diagnose_real", "read_log", "run_real", "score", "simulate_real"]
 
 FRICTION = ("coulomb", "viscous", "stribeck")
 
@@ -101,34 +99,6 @@ def diagnose_real(csv_path: str | Path, arm_key: str) -> tuple[DynamicDiagnosis,
     arm = REAL_ARMS[arm_key].load()
     log, how = read_log(csv_path, arm.n)
     return diagnose_dynamics(arm, log), how
-
-
-def validate(arm: Arm, diag: DynamicDiagnosis, log: TorqueLog, fit_rate_hz: float = 100.0
-             ) -> tuple[F64, F64, list[str]]:
-    """Per joint RMS of measured minus model torques on another log, before (the model as
-    shipped) and after (with the diagnosis's effects at their fitted values and its link
-    inertias); and the effects that could not be carried over (named)."""
-    s = derive_states(log, 0.1)
-    rows = np.arange(0, log.n_samples, max(1, round(1.0 / (fit_rate_hz * log.dt))))
-    q, qd, qdd, tau = s.q[rows], s.qd[rows], s.qdd[rows], s.tau_raw[rows]
-    tau0 = arm.inverse_dynamics(q, qd, qdd)
-    cands = {e.key: e for e in candidate_effects(arm, q, qd, qdd, tau0, inertial=False)}
-    pred, missing = np.zeros_like(tau0), []
-    for found in diag.effects:
-        if found.name == "inertial":
-            continue
-        e = cands.get(found.key)
-        if e is None:
-            missing.append(found.key)
-            continue
-        pred += e.columns @ np.array([found.params[p].value for p in e.params])
-    if diag.inertial_phi:
-        y, _ = arm.regressor(q, qd, qdd)
-        dphi = np.concatenate([diag.inertial_phi[b] - arm.body_params(b)
-                               for b in arm.moving_bodies()])
-        pred += y @ dphi
-    rms = lambda x: np.sqrt(np.mean(x**2, axis=0))  # noqa: E731
-    return rms(tau - tau0), rms(tau - tau0 - pred), missing
 
 
 @dataclass(frozen=True)
@@ -233,7 +203,11 @@ def run_real(sc: RealScenario, work: Path,
     row = score(diag, how, truth, sc.name)
     arm = REAL_ARMS[sc.arm].load()
     log2, _ = read_log(csv2, arm.n)
-    before2, after2, missing = validate(arm, diag, log2)
+    try:  # the library's --validate (zrp.gap.dynamics.validation)
+        v = validate(arm, diag, log2)
+        before2, after2, missing = v.rms_before.tolist(), v.rms_after.tolist(), []
+    except InputError as exc:
+        before2, after2, missing = [], [], [str(exc)]
     extra = {} if peer is None else peer(sc.arm, read_log(csv, arm.n)[0], log2)
-    return replace(row, second_before=before2.tolist(), second_after=after2.tolist(),
+    return replace(row, second_before=before2, second_after=after2,
                    not_carried=missing, seconds=seconds, peer=extra)
