@@ -137,8 +137,8 @@ class RealRow:
 
 
 def _named(e: FoundEffect) -> str:
-    where = e.detail if e.detail else ("" if e.joint is None else f"j{e.joint + 1}")
-    return f"{e.name} {where}".strip()
+    joint = "" if e.joint is None else f" j{e.joint + 1}"
+    return f"{e.name}{joint}{' ' + e.detail if e.detail else ''}"
 
 
 def _expected(truth: dict) -> str:
