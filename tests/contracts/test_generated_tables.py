@@ -15,10 +15,11 @@ import pytest
 ROOT = Path(__file__).resolve().parents[2]
 BENCH = ROOT / "tests" / "benchmarks"
 BLOCKS = (("bench_arms", ROOT / "sim" / "README.md"),
-          ("bench_dynamics", ROOT / "zrp" / "gap" / "dynamics" / "README.md"))
+          ("bench_dynamics", ROOT / "zrp" / "gap" / "dynamics" / "README.md"),
+          ("bench_dynamics_reallogs", ROOT / "sim" / "README.md"))
 #: The benchmarks whose --quick runs leave the README as it is (the others write it, saying
 #: the size they ran at in the block's heading).
-QUICK_SKIPS_README = {"bench_arms"}
+QUICK_SKIPS_README = {"bench_arms", "bench_dynamics_reallogs"}
 
 
 def _block_module():
