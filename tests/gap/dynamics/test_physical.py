@@ -118,7 +118,7 @@ def ur5e_inertial_case(ur5e):
              if e.name not in ("link_mass", "absent_part", "payload")]
     chosen, _, _ = forward_select(links, b, b_raw, sigma, folds=opt.folds, guard=guard,
                                   min_rel=opt.min_rel, min_abs=opt.min_abs,
-                                  max_effects=opt.max_effects)
+                                  max_effects=8)
     return log, sigma_true, sigma, b, b_raw, chosen, guard, opt.folds
 
 

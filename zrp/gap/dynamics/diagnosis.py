@@ -62,7 +62,8 @@ class DynamicsOptions:
     folds: int = 5
     min_rel: float = 0.03
     min_abs: float = 0.05
-    max_effects: int = 8
+    max_effects: int | None = None  # None: 3 a joint and 4 more (friction on every joint
+    # takes up to three effects there, Coulomb, viscous and Stribeck)
     inertial: bool = True
     collinear: float = 0.1
     effects: tuple[str, ...] | None = None  # the effect names tried (None: all)
@@ -229,6 +230,14 @@ def _links(arm: Arm, chosen: list[Effect], theta: F64, b: F64, sigma: F64,
     order, the withheld prediction and the named changes (None without them)."""
     d = design(chosen, *b.shape)
     first = [i for i, e in enumerate(chosen) if e.name in BODY_CHANGES]
+    # the named changes at their values without the link inertias (the forty combinations
+    # overlap a link's mass: fitted together the pair is not determined)
+    simple = [e for e in chosen if e.name != "inertial"]
+    ds = design(simple, *b.shape)
+    theta = theta.copy()
+    theta_s = solve(ds, b, sigma, with_cov=False).theta
+    for sl, e in zip(ds.slices, simple, strict=True):
+        theta[d.slices[chosen.index(e)]] = theta_s[sl]
     named = resulting_bodies(arm, [(chosen[i].key, chosen[i].name, chosen[i].detail,
                                     dict(zip(chosen[i].params, theta[d.slices[i]],
                                              strict=True))) for i in first])
@@ -315,7 +324,7 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     guard = max(1, round(0.5 * opt.window_s * opt.fit_rate_hz))
     chosen, steps, pred = forward_select(effects, b, b_raw, sigma, folds=opt.folds, guard=guard,
                                          min_rel=opt.min_rel, min_abs=opt.min_abs,
-                                         max_effects=opt.max_effects)
+                                         max_effects=opt.max_effects or 3 * arm.n + 4)
     chosen, fitted, gate_notes = _physical_gate(arm, chosen, steps, b, sigma, opt, guard, pred)
     masks = regime_masks(s.qd, arm.gravity_torques(s.q), guard)
     notes = [*getattr(arm, "notes", ()),
