@@ -19,12 +19,13 @@ from sim.studies.dynamics import benchmark as bm
 from sim.studies.dynamics.arms import available_arms
 from sim.studies.dynamics.scenarios import KINDS
 from zrp.errors import InputError
+from zrp.escape import md_line, md_row
 from zrp.gap.dynamics.data import TorqueLog, load_torque_log
 from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, DynamicsOptions, diagnose_dynamics
 from zrp.gap.dynamics.excitation import design_excitation
-from zrp.gap.dynamics.report import diagnosis_json, write_report
+from zrp.gap.dynamics.report import REPORT_FILES, diagnosis_json, write_report
 from zrp.jsonio import to_jsonable
-from zrp.output import OutputDir, atomic_path, write_text
+from zrp.output import OutputDir, atomic_path, check_writable, write_text
 
 __all__ = ["run_benchmark", "run_diagnosis", "run_excite"]
 
@@ -60,12 +61,15 @@ def _tracking(arm: Arm, log: TorqueLog, model: mujoco.MjModel, args: argparse.Na
     lines = [f"Re-simulation of the logged command (mj_step) with {how}; RMS of simulated minus "
              "logged joint positions (rad):", "", "| joint | model | corrected model |",
              "|---|---|---|"]
-    lines += [f"| {k + 1} | {before[k]:.3g} | {after[k]:.3g} |" for k in range(arm.n)]
+    lines += [md_row(k + 1, f"{before[k]:.3g}", f"{after[k]:.3g}") for k in range(arm.n)]
     return {"lines": lines, "before_rad": before, "after_rad": after}
 
 
-def run_diagnosis(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
-    """Diagnose, write the report and the corrected MJCF; the JSON and the summary text."""
+def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = False
+                  ) -> tuple[dict, str]:
+    """Diagnose, write the report and the corrected MJCF; the JSON and the summary text
+    (``overwrite``: replace files in ``out``, from --force or the default folder's mark)."""
+    check_writable([out / n for n in (*REPORT_FILES, "corrected.xml")], overwrite)
     arm = resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site)
     log = load_torque_log(args.data, torque_constant=args.torque_constant, n_joints=arm.n)
     diag: DynamicDiagnosis = diagnose_dynamics(
@@ -77,13 +81,13 @@ def run_diagnosis(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
     sections = {"Corrected model": [
         "corrected.xml: the model with the identified frictionloss, damping, armature"
         + (", payload" if fix.payload_kg else "") + (", link inertias" if fix.inertial else "")
-        + "."] + ([f"- not in MJCF (report only): {', '.join(fix.not_in_model)}"]
+        + "."] + ([md_line("- not in MJCF (report only): {}", ", ".join(fix.not_in_model))]
                   if fix.not_in_model else []),
         "Tracking": track["lines"]}
     extra = {k: v for k, v in track.items() if k != "lines"}
-    folder = write_report(diag, out, overwrite=args.force, extra={"sections": sections,
+    folder = write_report(diag, out, overwrite=overwrite, extra={"sections": sections,
                                                                   "tracking": extra})
-    write_text(folder / "corrected.xml", spec.to_xml(), overwrite=args.force)
+    write_text(folder / "corrected.xml", spec.to_xml(), overwrite=overwrite)
     text = (f"{diag.arm}: " + (", ".join(e.label for e in diag.effects) or "no effect needed")
             + "\nwithheld torque RMS / noise per joint: "
             + " ".join(f"{a / s:.2f}" for a, s in zip(diag.rms_after, diag.noise_nm,
@@ -135,8 +139,8 @@ def run_benchmark(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
     t = bm.tally(rows)
     lines = ["| arm | effect | seed | joint | visibility | named | right | withheld ratio |",
              "|---|---|---|---|---|---|---|---|"]
-    lines += [f"| {r.arm} | {r.kind} | {r.seed} | {'' if r.joint is None else r.joint + 1} | "
-              f"{r.visibility:.1f} | {r.named} | {r.success} | {r.withheld_ratio:.2f} |"
+    lines += [md_row(r.arm, r.kind, r.seed, "" if r.joint is None else r.joint + 1,
+                     f"{r.visibility:.1f}", r.named, r.success, f"{r.withheld_ratio:.2f}")
               for r in rows]
     head = (f"visible single effects right (effect, joint, withheld <= 1.5 sigma): {t['right']}"
             f" of {t['visible_singles']}; 'none' clean: {t['none_clean']} of "

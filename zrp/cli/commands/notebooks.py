@@ -9,7 +9,7 @@ from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.options import real
-from zrp.output import OutputDir
+from zrp.output import OutputDir, check_writable, claim_generated
 from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_described_index, write_index
 
 DEFAULT_OUT = "renders/notebooks"
@@ -68,7 +68,13 @@ def _run(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     names = args.names or None
-    overwrite = args.force or out == Path(DEFAULT_OUT)
+    default = out == Path(DEFAULT_OUT)
+    # the renders/ page and the default folder are replaced only as generated output (their
+    # mark) or with --force: checked before any notebook runs
+    parent_overwrite = args.force or (default and claim_generated(out.parent))
+    if default:
+        check_writable([out.parent / INDEX_NAME], parent_overwrite)
+    overwrite = args.force or (default and claim_generated(out))
     timeout = DEFAULT_TIMEOUT_S if args.timeout is None else args.timeout
     with OutputDir(out, overwrite=overwrite,
                    names=[*notebook_file_names(names), DESCRIPTIONS, INDEX_NAME]) as folder:
@@ -81,8 +87,8 @@ def _run(args: argparse.Namespace) -> int:
             sentences[r.ipynb.name] = (f"Notebook {i}, {r.title}, executed, to open in "
                                        "Jupyter.")
         index = write_described_index(folder, sentences)
-    if out == Path(DEFAULT_OUT):   # the renders/ page links the notebooks too
-        with OutputDir(out.parent, overwrite=True, names=[INDEX_NAME]) as parent:
+    if default:   # the renders/ page links the notebooks too
+        with OutputDir(out.parent, overwrite=parent_overwrite, names=[INDEX_NAME]) as parent:
             index = write_index(parent)
     payload = {"out": str(out), "index": str(index),
                "notebooks": [{"name": r.name, "title": r.title, "ipynb": str(r.ipynb),

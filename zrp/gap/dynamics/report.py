@@ -1,6 +1,13 @@
 """The dynamic gap report: report.md, report.html (self-contained, as the static diagnosis's,
 :func:`zrp.gap.report.html.report_html`), the per-joint torque residuals before and after
-against velocity and position (PNG beside it, SVG inside the page) and diagnosis.json."""
+against velocity and position (PNG beside it, SVG inside the page) and diagnosis.json.
+
+Every name from the model or the log (the arm, its joints and bodies in the effects' labels,
+the notes) reaches the Markdown only through :mod:`zrp.escape` (:func:`~zrp.escape.md_row`,
+:func:`~zrp.escape.md_line`, :func:`~zrp.escape.md_text`): a joint named
+``j1\n\n## Verdict`` stays one table cell, ``|`` adds no cell and ``<script>`` stays text, in
+report.md and in report.html. The ``extra`` sections are Markdown the caller built the same
+way."""
 
 from __future__ import annotations
 
@@ -11,15 +18,18 @@ from typing import Any
 
 import numpy as np
 
+from zrp.escape import md_line, md_row, md_text, one_line
 from zrp.gap.dynamics.diagnosis import DynamicDiagnosis
 from zrp.gap.report.html import report_html
 from zrp.jsonio import to_jsonable
 from zrp.output import OutputDir
 
-__all__ = ["diagnosis_json", "report_markdown", "write_report"]
+__all__ = ["REPORT_FILES", "diagnosis_json", "report_markdown", "write_report"]
 
 FIGURES = {"residuals_velocity.png": ("qd", "joint velocity (rad/s)"),
            "residuals_position.png": ("q", "joint position (rad)")}
+#: the files :func:`write_report` writes
+REPORT_FILES = ("report.md", "report.html", "diagnosis.json", *FIGURES)
 
 
 def _fmt(v: float | None) -> str:
@@ -32,7 +42,7 @@ def _verdict(d: DynamicDiagnosis) -> str:
         return (f"The model's torques match the log down to the noise floor (worst joint "
                 f"{worst + 1}: {d.rms_before[worst]:.3g} N m RMS against a noise of "
                 f"{d.noise_nm[worst]:.3g} N m); no effect is needed.")
-    names = ", ".join(e.label for e in d.effects)
+    names = ", ".join(md_text(e.label) for e in d.effects)
     return (f"The model misses most on joint {worst + 1} ({d.rms_before[worst]:.3g} N m RMS, "
             f"{d.rms_before[worst] / d.noise_nm[worst]:.1f}x its noise). Found: {names}. "
             f"Withheld torque RMS on joint {worst + 1} drops to {d.rms_after[worst]:.3g} N m "
@@ -47,11 +57,11 @@ def _effects(d: DynamicDiagnosis) -> list[str]:
             if k.startswith("beta"):
                 continue
             flag = " (at its bound)" if p.at_bound else ""
-            out.append(f"| {e.label} | {k} | {p.value:.4g}{flag} | {p.low:.4g} .. {p.high:.4g} "
-                       f"| {p.unit} | {e.chi2_drop:.3g} |")
+            out.append(md_row(e.label, k, f"{p.value:.4g}{flag}", f"{p.low:.4g} .. {p.high:.4g}",
+                              p.unit, f"{e.chi2_drop:.3g}"))
         if e.name == "inertial":
-            out.append(f"| {e.label} | {len(e.params)} base combinations | see diagnosis.json "
-                       f"| | | {e.chi2_drop:.3g} |")
+            out.append(md_row(e.label, f"{len(e.params)} base combinations",
+                              "see diagnosis.json", "", "", f"{e.chi2_drop:.3g}"))
     return out
 
 
@@ -61,34 +71,35 @@ def _regimes(d: DynamicDiagnosis) -> list[str]:
            "|---|" + "---|" * n]
     for name, before in d.regimes["before"].items():
         after = d.regimes["after"][name]
-        out.append(f"| {name} | " + " | ".join(f"{_fmt(b)} / {_fmt(a)}"
-                                                for b, a in zip(before, after, strict=True))
-                   + " |")
+        out.append(md_row(name, *(f"{_fmt(b)} / {_fmt(a)}"
+                                   for b, a in zip(before, after, strict=True))))
     return out
 
 
 def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None) -> str:
     """The report's text (``extra``: more sections, heading -> lines)."""
     n = len(d.joints)
-    lines = [f"# Dynamic gap: {d.arm}", "", "## Verdict", "", _verdict(d), "",
+    lines = [md_line("# Dynamic gap: {}", d.arm), "", "## Verdict", "", _verdict(d), "",
              "## Torque residual per joint (N m RMS)", "",
              "| joint | name | noise floor | model | corrected (withheld) | ratio to noise |",
              "|---|---|---|---|---|---|"]
-    lines += [f"| {k + 1} | {d.joints[k]} | {d.noise_nm[k]:.3g} | {d.rms_before[k]:.3g} | "
-              f"{d.rms_after[k]:.3g} | {d.rms_after[k] / d.noise_nm[k]:.2f} |" for k in range(n)]
+    lines += [md_row(k + 1, d.joints[k], f"{d.noise_nm[k]:.3g}", f"{d.rms_before[k]:.3g}",
+                     f"{d.rms_after[k]:.3g}", f"{d.rms_after[k] / d.noise_nm[k]:.2f}")
+              for k in range(n)]
     lines += ["", "## Effects found", ""]
     lines += _effects(d) if d.effects else ["None: the torques are explained to the noise."]
     lines += ["", "## Selection (withheld chi2: 1 is the noise floor)", "",
-              " -> ".join(f"{s.key} {s.chi2:.3g}" for s in d.steps), "",
+              " -> ".join(md_line("{} {}", s.key, f"{s.chi2:.3g}") for s in d.steps), "",
               "## Where: residual RMS per regime (N m; before / after)", ""]
     lines += _regimes(d)
     lines += ["", "## Cannot tell", ""]
-    lines += [f"- {c}" for c in d.cannot_tell] or ["- nothing: every joint effect is excited"]
+    lines += [md_line("- {}", c) for c in d.cannot_tell] or [
+        "- nothing: every joint effect is excited"]
     for heading, body in (extra or {}).items():
-        lines += ["", f"## {heading}", "", *body]
+        lines += ["", md_line("## {}", heading), "", *body]
     lines += ["", "## Residuals", "", *(f"![residual against {v[1]}]({name})"
                                         for name, v in FIGURES.items())]
-    lines += ["", "## Notes", "", *(f"- {s}" for s in d.notes)]
+    lines += ["", "## Notes", "", *(md_line("- {}", s) for s in d.notes)]
     return "\n".join(lines) + "\n"
 
 
@@ -158,7 +169,7 @@ def write_report(d: DynamicDiagnosis, folder: str | Path, *, overwrite: bool = F
             plt.close(fig)
         md = report_markdown(d, sections)
         out.write_text("report.md", md)
-        out.write_text("report.html", report_html(md, svgs, f"Dynamic gap: {d.arm}"))
+        out.write_text("report.html", report_html(md, svgs, f"Dynamic gap: {one_line(d.arm)}"))
         out.write_json("diagnosis.json", diagnosis_json(d, {k: v for k, v in (extra or {}).items()
                                                             if k != "sections"}))
     return Path(folder)
