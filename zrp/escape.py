@@ -153,10 +153,16 @@ def _md_value(v: object) -> str:
     return md_text(v)
 
 
+#: a cell of digits, signs, points, exponents, spaces and slashes (a formatted number, "0.5 /
+#: 0.7", "1 .. 2"): nothing in it has a meaning inside a table cell, which never starts a line
+_MD_NUMERIC_CELL = re.compile(r"[0-9eE.+\- /]*")
+
+
 def md_row(*cells: object) -> str:
     """One Markdown table row: every cell escaped with :func:`md_text` (an :class:`Md` cell
-    as it is), so a name cannot add a cell, a line or a tag."""
-    return "| " + " | ".join(_md_value(c) for c in cells) + " |"
+    as it is, a formatted number too), so a name cannot add a cell, a line or a tag."""
+    return "| " + " | ".join(c if isinstance(c, str) and _MD_NUMERIC_CELL.fullmatch(c)
+                             else _md_value(c) for c in cells) + " |"
 
 
 def md_line(template: str, *values: object) -> str:
