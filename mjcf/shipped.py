@@ -22,8 +22,10 @@ from pathlib import Path
 
 import mujoco
 
+from mjcf.assets import check_asset_file, check_model_files
 from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
+from zrp.textio import read_text
 
 __all__ = ["MESH_SUFFIXES", "example_robot_data_root", "load_shipped", "load_shipped_spec",
            "resolve_mesh", "shipped_urdf_xml"]
@@ -89,6 +91,8 @@ def shipped_urdf_xml(path: str | os.PathLike[str]) -> tuple[str, list[str]]:
                     continue
                 uri = mesh.get("filename", "")
                 file = resolve_mesh(uri, p.parent)
+                if file is not None:  # a regular file of bounded size, or refused by name
+                    check_asset_file(file, f"source {str(p)!r}: mesh {uri!r}")
                 if file is None or file.suffix.lower() not in MESH_SUFFIXES:
                     link.remove(el)
                     dropped.append(uri)
@@ -106,9 +110,13 @@ def _shipped_file(path: str | os.PathLike[str]) -> Path:
         raise InputError(f"path: expected a .urdf or MJCF .xml file name, got "
                          f"{type(path).__name__}")
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise MJCFImportError(f"source: no such file {str(p)!r} (expected a .urdf or an MJCF "
                               ".xml)")
+    if p.suffix.lower() != ".urdf":  # a URDF's meshes are resolved and checked in
+        check_model_files(p)         # shipped_urdf_xml
+    else:
+        read_text(p, label=f"source {str(p)!r}", error=MJCFImportError)  # a regular file
     return p
 
 
