@@ -63,11 +63,13 @@ def check_asset_file(p: Path, what: str, max_bytes: int = MAX_ASSET_BYTES) -> bo
     return True
 
 
-def _parse(text: str, label: str) -> ET.Element:
+def _parse(text: str) -> ET.Element | None:
+    """The XML's root; None when it is not well-formed (MuJoCo refuses it then, by name,
+    before it opens any file it names)."""
     try:
         return ET.fromstring(text)
-    except ET.ParseError as exc:
-        raise MJCFImportError(f"{label}: not well-formed XML: {exc}") from None
+    except ET.ParseError:
+        return None
 
 
 def _dirs(root: ET.Element, base: Path) -> list[Path]:
@@ -97,8 +99,9 @@ def _walk(root: ET.Element, base: Path, dirs: list[Path], label: str, depth: int
                     raise MJCFImportError(f"{what}: more than {MAX_INCLUDE_DEPTH} nested "
                                           "<include> files")
                 inc = found[0]
-                sub = _parse(read_text(inc, label=str(inc), error=MJCFImportError), str(inc))
-                _walk(sub, base, dirs, str(inc), depth + 1, max_bytes)
+                sub = _parse(read_text(inc, label=str(inc), error=MJCFImportError))
+                if sub is not None:
+                    _walk(sub, base, dirs, str(inc), depth + 1, max_bytes)
 
 
 def check_model_files(path: str | os.PathLike[str] | None, *, text: str | None = None,
@@ -108,7 +111,7 @@ def check_model_files(path: str | os.PathLike[str] | None, *, text: str | None =
 
     Raises:
         MJCFImportError: a file named is not a regular file or is too large (the message
-            names the element, the attribute and the path), or the XML is not well-formed.
+            names the element, the attribute and the path).
     """
     base = Path.cwd() if path is None else Path(path).parent
     label = "source XML" if path is None else f"source {str(path)!r}"
@@ -116,5 +119,6 @@ def check_model_files(path: str | os.PathLike[str] | None, *, text: str | None =
         if path is None:
             raise MJCFImportError("source: give a model file or its XML text")
         text = read_text(path, label=label, error=MJCFImportError)
-    root = _parse(text, label)
-    _walk(root, base, _dirs(root, base), label, 0, max_bytes)
+    root = _parse(text)
+    if root is not None:
+        _walk(root, base, _dirs(root, base), label, 0, max_bytes)

@@ -56,18 +56,19 @@ def resolve_mesh(uri: str, urdf_dir: Path) -> Path | None:
 
     ``package://PKG/rel``: ``A/rel`` for the first folder A above ``urdf_dir`` (itself
     included) named PKG, or ``A/PKG/rel`` for the first A holding a folder PKG;
-    ``file://abs`` and plain paths (relative to ``urdf_dir``) as they are.
+    ``file://abs`` and plain paths (relative to ``urdf_dir``) as they are. A path that
+    exists but is no regular file (a FIFO) is returned: :func:`shipped_urdf_xml` refuses it.
     """
     if uri.startswith("package://"):
         pkg, _, rel = uri[len("package://"):].partition("/")
         for a in (urdf_dir, *urdf_dir.parents):
             for cand in ((a / rel) if a.name == pkg else None, a / pkg / rel):
-                if cand is not None and cand.is_file():
+                if cand is not None and cand.exists():
                     return cand.resolve()
         return None
     path = Path(uri[len("file://"):] if uri.startswith("file://") else uri)
     path = path if path.is_absolute() else urdf_dir / path
-    return path.resolve() if path.is_file() else None
+    return path.resolve() if path.exists() else None
 
 
 def shipped_urdf_xml(path: str | os.PathLike[str]) -> tuple[str, list[str]]:
