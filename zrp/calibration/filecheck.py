@@ -91,9 +91,13 @@ def loads_bounded(text: str, src: str) -> Any:
         raise InputError(f"{src}: JSON nested {depth} deep; a calibration file nests at most "
                          f"{MAX_JSON_DEPTH} deep")
     try:
-        return json.loads(text)
+        return json.loads(text, parse_constant=_no_constant)
     except (ValueError, RecursionError) as exc:
         raise InputError(f"{src}: cannot read the compensation file: {exc}") from None
+
+
+def _no_constant(name: str) -> None:
+    raise ValueError(f"{name} is not a JSON number (the files hold finite numbers only)")
 
 
 def _reach(cal: CalibratedRobot) -> float:
@@ -204,7 +208,8 @@ def field_problems(cal: CalibratedRobot, length_unit: object) -> list[str]:
     elif length_unit != cal.model.length_unit:
         out.append(f"length_unit: {length_unit!r}, but the model file's is "
                    f"{cal.model.length_unit!r} (was the model file changed?)")
-    return out + _lengths(cal) + _scalars(cal) + _conditions(cal)
+    with np.errstate(over="ignore", invalid="ignore"):  # 1e300 squared: inf, refused
+        return out + _lengths(cal) + _scalars(cal) + _conditions(cal)
 
 
 def check_fields(cal: CalibratedRobot, length_unit: object, src: str) -> None:
@@ -223,7 +228,7 @@ def document_sha256(doc: dict[str, Any]) -> str:
     """SHA-256 of the compensation document's canonical JSON (sorted keys, no spaces), its
     ``model_sha256`` left out."""
     body = {k: v for k, v in doc.items() if k != _HASH_KEY}
-    text = json.dumps(body, sort_keys=True, separators=(",", ":"), allow_nan=False)
+    text = json.dumps(body, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode("utf-8")).hexdigest()
 
 
