@@ -155,6 +155,11 @@ def _scalars(cal: CalibratedRobot) -> list[str]:
     g = np.asarray(cal.gravity_dir, dtype=float)
     if g.shape != (3,) or not abs(float(np.linalg.norm(g)) - 1.0) <= 1e-6:
         out.append(f"gravity_dir: {cal.gravity_dir!r}; expected a unit vector of 3 values")
+    return out + _shapes(cal)
+
+
+def _shapes(cal: CalibratedRobot) -> list[str]:
+    out = []
     h = cal.harmonics
     if not h or len(set(h)) != len(h) or not all(1 <= v <= MAX_HARMONIC for v in h):
         out.append(f"harmonics: {list(h)[:8]!r}; expected distinct whole numbers "

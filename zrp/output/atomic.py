@@ -25,7 +25,8 @@ from zrp.output.lock import pid_alive
 from zrp.output.paths import as_path, check_regular, check_writable, make_folder
 
 __all__ = ["GENERATED_MARK", "STALE_AFTER_S", "atomic_path", "claim_generated",
-           "clean_stale_temporaries", "write_bytes", "write_json", "write_text"]
+           "clean_stale_temporaries", "default_overwrite", "write_bytes", "write_json",
+           "write_text"]
 
 #: Mark of a folder created for generated output (the commands' default folders, such as
 #: ``renders/``): see :func:`claim_generated`.
@@ -120,6 +121,21 @@ def write_json(path: str | os.PathLike[str], obj: Any, *, overwrite: bool = Fals
     from zrp.jsonio import dumps  # NumPy: on use, so that `zrp --help` does not load it
 
     return write_text(path, dumps(obj, indent), overwrite=overwrite)
+
+
+def default_overwrite(folder: str | os.PathLike[str], *, default: bool, force: bool,
+                      page: str | None = None) -> bool:
+    """May a command replace files in ``folder``: with ``force``, or when ``folder`` is the
+    command's default folder and :func:`claim_generated` claims it. ``page``: a file in
+    ``folder`` that will be written (the ``renders/`` index page), checked now, before any work.
+
+    Raises:
+        OutputExistsError: ``page`` exists and may not be replaced.
+    """
+    overwrite = force or (default and claim_generated(folder))
+    if page is not None:
+        check_writable([Path(folder) / page], overwrite)
+    return overwrite
 
 
 def claim_generated(folder: str | os.PathLike[str]) -> bool:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.options import DURATION, real
+from zrp.output import claim_generated, safe_name
 
 DEFAULT_OUT = Path("renders") / "dynamics"
 GAIN = real(0.0, 1e9, open_lo=True)
@@ -48,7 +49,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo: only when this command runs.
     from zrp.cli.dynamics_runs import run_diagnosis
-    from zrp.output import claim_generated, safe_name
 
     out = Path(args.out) if args.out else DEFAULT_OUT / safe_name(Path(args.data).stem,
                                                                   default="log")

@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.output import OutputDir, check_writable, claim_generated
+from zrp.output import OutputDir, default_overwrite
 from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_described_index, write_index
 
 DEFAULT_OUT = "renders/lessons"
@@ -42,10 +42,9 @@ def _run(args: argparse.Namespace) -> int:
     default = out == Path(DEFAULT_OUT)
     # the renders/ page and the default folder are replaced only as generated output (their
     # mark) or with --force: checked before any lesson runs
-    parent_overwrite = args.force or (default and claim_generated(out.parent))
-    if default:
-        check_writable([out.parent / INDEX_NAME], parent_overwrite)
-    overwrite = args.force or (default and claim_generated(out))
+    parent_overwrite = default_overwrite(out.parent, default=default, force=args.force,
+                                         page=INDEX_NAME if default else None)
+    overwrite = default_overwrite(out, default=default, force=args.force)
     files = [*lesson_file_names(names), DESCRIPTIONS, INDEX_NAME]
     with OutputDir(out, overwrite=overwrite, names=files) as folder:
         lessons = run_lessons(folder, names, small=args.small)
