@@ -52,6 +52,8 @@ CASES = [
      r"base_translation: 1e\+06 mm .* at most 100 x the arm's reach"),
     ("tool 1000 km", _set(["tool_points", "s1"], [1e9, 0, 0]), r"tool_points\['s1'\]"),
     ("furlong", _set(["length_unit"], "furlong"), r"length_unit: 'furlong'; expected one of"),
+    # found by the fuzzer (5,000-case run): a list as the unit was a TypeError
+    ("unit as a list", _set(["length_unit"], []), r"length_unit: \[\]; expected one of"),
     ("file in metres", _set(["length_unit"], "m"), r"length_unit: 'mm', but the model file's is 'm'"),
     ("conditions furlong", _set(["conditions", "length_unit"], "furlong"),
      r"conditions.length_unit: 'furlong'"),

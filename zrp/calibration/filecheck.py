@@ -208,7 +208,7 @@ def field_problems(cal: CalibratedRobot, length_unit: object) -> list[str]:
     """Every field of ``cal`` (read from a file whose ``length_unit`` is given) outside its
     domain (module docstring), one message each; empty: none."""
     out = []
-    if length_unit not in LENGTH_UNITS:
+    if not isinstance(length_unit, str) or length_unit not in LENGTH_UNITS:
         out.append(f"length_unit: {length_unit!r}; expected one of {sorted(LENGTH_UNITS)}")
     elif length_unit != cal.model.length_unit:
         out.append(f"length_unit: {length_unit!r}, but the model file's is "
