@@ -127,3 +127,19 @@ def test_an_older_pair_without_hashes_is_read_with_a_warning(pair):
     c.write_text(json.dumps(doc))
     with warnings.catch_warnings(), pytest.raises(TamperedPairError):
         read_calibration(c)
+
+
+def test_user_strings_cannot_add_keys_to_calibrated_toml(tmp_path):
+    """The conditions' instrument and data file name head calibrated.toml as comments: a
+    line break in them must not end the comment (it would add TOML keys)."""
+    hostile = 'x\nlength_unit = "m"\n[[joint]]'
+    cal = CalibratedRobot(
+        PUMA, PUMA, np.eye(3), np.zeros(3), ("s1",), np.array([[0.0, 0, 50]]), np.zeros(6),
+        conditions=Conditions((0.0,), ("s1",), None, "mm", tuple(None for _ in range(6)),
+                              instrument=hostile, data_file=hostile + ".csv"))
+    m, c = write_calibration(cal, tmp_path / "calibrated.toml", tmp_path / "c.json")
+    head = m.read_text().split("\nname = ")[0].splitlines()
+    assert all(line.startswith("#") for line in head), head
+    back = read_calibration(c)
+    assert back.model.length_unit == "mm" and back.n == 6
+    assert back.conditions.data_file == hostile + ".csv"  # kept whole in the JSON

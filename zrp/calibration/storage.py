@@ -25,6 +25,7 @@ from zrp.calibration.filecheck import bind_pair, check_fields, check_pair, loads
 from zrp.calibration.jointmap import Term
 from zrp.calibration.validation import validate_calibration
 from zrp.errors import InputError, ZRPError
+from zrp.escape import one_line
 from zrp.gap.fit.fullpose import FullPoseFit
 from zrp.jsonio import dumps, to_jsonable
 from zrp.model.files import dumps_model, load_model, loads_model
@@ -105,7 +106,9 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
 
 def _toml_header(cal: CalibratedRobot) -> str:
     """Comment lines heading the model TOML: the version and the conditions (the model format
-    has no keys for them; compensation.json carries them as data)."""
+    has no keys for them; compensation.json carries them as data). The user's strings (the
+    instrument, the data file's name) pass through :func:`zrp.escape.one_line`: a name with a
+    line break cannot end the comment and add TOML keys."""
     lines = [f"# written by zrp-accuracy {__version__}"]
     c = cal.conditions
     if c is not None:
@@ -114,7 +117,8 @@ def _toml_header(cal: CalibratedRobot) -> str:
                   f"; tool_points = {list(c.tool_points)}",
                   f"#   temp_range_degC = {c.temp_range_degC}; length_unit = {c.length_unit};"
                   f" angle_unit = {c.angle_unit}",
-                  f"#   instrument = {c.instrument}; data_file = {c.data_file}; "
+                  f"#   instrument = {one_line(c.instrument)}; data_file = "
+                  f"{one_line(c.data_file)}; "
                   f"data_sha256 = {c.data_sha256}"]
     return "\n".join(lines) + "\n"
 
