@@ -10,8 +10,10 @@ CI runs a seeded slice of ``ZRP_FUZZ_EXAMPLES`` cases (default 60). The document
 
     ZRP_FUZZ_EXAMPLES=5000 python3 -m pytest -q tests/contracts/test_fuzz_calibration_files.py
 
-Run on the final code of issue 35 (shared 2-core machine): see zrp/CHANGELOG.md 0.5.0
-("Hostile input, round three") for the count and the time.
+The first 5,000-case run found one escape (a list as ``length_unit``: TypeError; fixed, kept
+in tests/calibration/test_file_domains.py); the run on the final code of issue 35: 5,000
+cases, none escaped (89 s on the shared 2-core machine; 2,347 malformed, 1,366 tampered
+pairs, 834 broken model files, 40 fields out of domain, 2 implausible values, 411 read).
 """
 
 from __future__ import annotations
