@@ -54,7 +54,8 @@ CASES = [
     ("furlong", _set(["length_unit"], "furlong"), r"length_unit: 'furlong'; expected one of"),
     # found by the fuzzer (5,000-case run): a list as the unit was a TypeError
     ("unit as a list", _set(["length_unit"], []), r"length_unit: \[\]; expected one of"),
-    ("file in metres", _set(["length_unit"], "m"), r"length_unit: 'mm', but the model file's is 'm'"),
+    ("file in metres", _set(["length_unit"], "m"),
+     r"length_unit: 'mm', but the model file's is 'm'"),
     ("conditions furlong", _set(["conditions", "length_unit"], "furlong"),
      r"conditions.length_unit: 'furlong'"),
     ("negative payload", _set(["conditions", "payloads_kg"], [-5.0]),

@@ -135,15 +135,15 @@ def test_the_unmutated_pair_loads_and_each_file_alone_is_refused(pair):
     (folder / "calibrated.toml").write_text(toml)
     (folder / "c.json").write_text(comp)
     assert read_calibration(folder / "c.json").n == 6
-    text, t = _rebind(json.loads(comp), toml)
+    text, _ = _rebind(json.loads(comp), toml)
     (folder / "c.json").write_text(text)
     assert read_calibration(folder / "c.json").n == 6  # the test's re-binding is the writer's
     (folder / "c.json").write_text(comp.replace('"withheld_rms": null',
                                                 '"withheld_rms": 0.001'))
-    with pytest.raises(TamperedPairError, match="c.json: its content"):
+    with pytest.raises(TamperedPairError, match=r"c\.json: its content"):
         read_calibration(folder / "c.json")
     (folder / "c.json").write_text(comp)
     (folder / "calibrated.toml").write_text(toml.replace("[[joint]]", "[[joint]]\n", 1))
-    with pytest.raises(TamperedPairError, match="calibrated.toml: its SHA-256"):
+    with pytest.raises(TamperedPairError, match=r"calibrated\.toml: its SHA-256"):
         read_calibration(folder / "c.json")
     (folder / "calibrated.toml").write_text(toml)
