@@ -10,6 +10,7 @@ inertias (:func:`arm_from_manipulator`).
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import os
 from collections.abc import Iterable
@@ -18,6 +19,7 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+from numpy.typing import NDArray
 
 from mjcf.attachments import find_attachments
 from mjcf.builder import MJCFOptions, build
@@ -25,12 +27,14 @@ from mjcf.errors import MJCFImportError
 from mjcf.inverse import body_params, gravity_torques, inverse_dynamics, regressor
 from mjcf.shipped import load_shipped_spec
 from zrp.arrays import F64
-from zrp.errors import InputError
+from zrp.errors import InputError, ModelFileError
 from zrp.gap.dynamics.arm import Attachment
 from zrp.model.files import load_model
 from zrp.model.manipulator import Manipulator
+from zrp.model.urdf import read_urdf
+from zrp.units import metres_per_unit
 
-__all__ = ["Arm", "arm_from_manipulator", "load_arm", "resolve_arm"]
+__all__ = ["Arm", "arm_from_manipulator", "load_arm", "resolve_arm", "urdf_velocity_limits"]
 
 _DOF = (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE))
 
@@ -48,6 +52,9 @@ class Arm:
         tool_point: the payload point in the tool body's frame, m, shape (3,).
         attachments: the parts carried rigidly on the tool body (:mod:`mjcf.attachments`).
         notes: what loading did to the file's model, in words (joints made fixed).
+        velocity: the source's joint velocity limits, rad/s (m/s), shape (n,), inf where none
+            (MuJoCo keeps none: a URDF's ``<limit velocity=>``, a ZRP model's
+            ``velocity_limit``), or None: none known.
     """
 
     name: str
@@ -57,6 +64,7 @@ class Arm:
     tool_point: F64
     attachments: tuple[Attachment, ...] = ()
     notes: tuple[str, ...] = ()
+    velocity: F64 | None = None
 
     @property
     def n(self) -> int:
@@ -89,6 +97,14 @@ class Arm:
         lim = np.array(m.jnt_range, dtype=float)
         limited = np.array(m.jnt_limited, dtype=bool) & (lim[:, 1] > lim[:, 0])
         return (np.where(limited, lim[:, 0], -np.inf), np.where(limited, lim[:, 1], np.inf))
+
+    def velocity_limits(self) -> F64:
+        if self.velocity is None:
+            return np.full(self.n, np.inf)
+        return np.array(self.velocity, dtype=float)
+
+    def revolute(self) -> NDArray[np.bool_]:
+        return np.array(self.model.jnt_type, dtype=int) == int(mujoco.mjtJoint.mjJNT_HINGE)
 
     def torque_limits(self) -> F64:
         m = self.model
@@ -128,7 +144,7 @@ def _tool(m: mujoco.MjModel, tool_site: str | None, field: str) -> tuple[int, F6
 
 
 def _from_spec(spec: mujoco.MjSpec, name: str, tool_site: str | None, field: str,
-               notes: tuple[str, ...] = ()) -> Arm:
+               notes: tuple[str, ...] = (), velocity: dict[str, float] | None = None) -> Arm:
     parts = find_attachments(spec, tool_site)  # before static bodies are fused
     try:
         m = spec.compile()
@@ -136,7 +152,19 @@ def _from_spec(spec: mujoco.MjSpec, name: str, tool_site: str | None, field: str
         raise InputError(f"{field}: MuJoCo could not compile it: {exc}") from exc
     _check(m, field)
     body, point = _tool(m, tool_site, field)
-    return Arm(name, spec, m, body, point, parts, notes)
+    vel = None
+    if velocity is not None:
+        names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, k) for k in range(m.njnt)]
+        vel = np.array([velocity.get(j or "", np.inf) for j in names])
+    return Arm(name, spec, m, body, point, parts, notes, vel)
+
+
+def urdf_velocity_limits(path: Path) -> dict[str, float]:
+    """The ``<limit velocity=>`` of each joint of a URDF (MuJoCo's URDF reader drops them),
+    by joint name; a velocity of 0 or none is left out (unknown)."""
+    tree = read_urdf(path)
+    return {j.name: float(j.velocity_limit) for j in tree.joints.values()
+            if j.velocity_limit is not None}
 
 
 def _chain_end(spec: mujoco.MjSpec, n_joints: int, field: str) -> str | None:
@@ -211,12 +239,17 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
                      f"link {end_link!r} (e.g. a gripper's fingers) are made fixed",)
     if end_link is not None:
         _fix_off_chain(spec, end_link)
+    velocity = None
     if path.suffix.lower() == ".urdf":
+        try:
+            velocity = urdf_velocity_limits(path)
+        except ModelFileError as exc:
+            notes += (f"the URDF's velocity limits could not be read ({exc}): none known",)
         # one body per moving link (MuJoCo's URDF default): links on fixed joints (a flange,
         # a hand, fingers made fixed) fuse into their parent, as the inertial regressor has
         # one set of 10 parameters per body
         spec.compiler.fusestatic = True
-    return _from_spec(spec, name or path.stem, tool_site, field, notes)
+    return _from_spec(spec, name or path.stem, tool_site, field, notes, velocity)
 
 
 def arm_from_manipulator(model: Manipulator, inertia: str = "puma560") -> Arm:
@@ -226,7 +259,11 @@ def arm_from_manipulator(model: Manipulator, inertia: str = "puma560") -> Arm:
     spec = built.spec
     for act in list(spec.actuators):
         spec.delete(act)
-    return _from_spec(spec, model.name, built.site_name, f"manipulator {model.name}")
+    arm = _from_spec(spec, model.name, built.site_name, f"manipulator {model.name}")
+    m_per = metres_per_unit(model.length_unit)
+    vel = [np.inf if j.velocity_limit is None else
+           j.velocity_limit * (m_per if j.is_prismatic else 1.0) for j in model.joints]
+    return dataclasses.replace(arm, velocity=np.array(vel, dtype=float))
 
 
 def resolve_arm(model: str, *, end_link: str | None = None, tool_site: str | None = None,

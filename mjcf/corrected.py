@@ -3,10 +3,12 @@ re-simulation of the logged command through it is :mod:`mjcf.tracking`).
 
 Written into the MJCF: Coulomb friction (``frictionloss``), viscous friction (``damping``),
 armature (``armature``), each added to the model's own value; a payload (a child body of the
-tool body, a point mass at the fitted centre); link inertial parameters (``mass``, ``ipos``,
-``fullinertia`` of each moving body). Not written, because MJCF has no place for them: a
-Stribeck bump, a torque sensor's offset and gain (they are listed in
-:attr:`Corrections.not_in_model` and reported).
+tool body, a point mass at the fitted centre); the resulting inertial (``mass``, ``ipos``,
+principal inertias and their frame) of every body the diagnosis changes: link inertias, a
+link's mass, a modelled part (a hand) not on the arm, a payload taken away
+(:attr:`zrp.gap.dynamics.diagnosis.DynamicDiagnosis.bodies`, all physical). Not written,
+because MJCF has no place for them: a Stribeck bump, a torque sensor's offset and gain (they
+are listed in :attr:`Corrections.not_in_model` and reported).
 """
 
 from __future__ import annotations
@@ -19,12 +21,17 @@ import mujoco
 import numpy as np
 
 from mjcf.arm import Arm
+from mjcf.tracking import TrackingGap, track_log
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.diagnosis import DynamicDiagnosis
 from zrp.output import write_text
 
-__all__ = ["Corrections", "corrected_spec", "corrections", "write_corrected_mjcf"]
+__all__ = ["CorrectedMJCF", "Corrections", "corrected_spec", "corrections", "write_corrected_mjcf"]
+
+#: The smallest mass written for a body (kg): MuJoCo refuses a moving body without mass.
+MIN_MASS_KG = 1e-6
 
 _JOINT_FIELDS = {"coulomb": "frictionloss", "viscous": "damping", "armature": "armature"}
 
@@ -42,22 +49,35 @@ class Corrections:
     not_in_model: list[str] = field(default_factory=list)
 
 
+def _separate_payload(arm: Arm, diag: DynamicDiagnosis) -> tuple[float, F64]:
+    """A payload added as a body of its own (mass > 0 and nothing else changes the tool
+    body): its mass and position in the tool body's frame; (0, tool point) otherwise."""
+    pos = np.array(arm.tool_point, dtype=float)
+    e = diag.effect("payload")
+    change = diag.bodies.get(arm.tool_body)
+    if e is None or e.params["mass"].value <= 0.0 or (change and change.effects != (e.key,)):
+        return 0.0, pos
+    mass = e.params["mass"].value
+    return mass, pos + np.array([e.params[k].value for k in ("m*dx", "m*dy", "m*dz")]) / mass
+
+
 def corrections(arm: Arm, diag: DynamicDiagnosis) -> Corrections:
-    """The model changes of a diagnosis."""
+    """The model changes of a diagnosis: joint terms added to the model's, a positive
+    payload as a body of its own, every other body the effects change (link inertias, a
+    link's mass, a part not on the arm, a payload taken away) with its resulting inertial."""
     add = {f: np.zeros(arm.n) for f in _JOINT_FIELDS.values()}
-    payload, pos, skipped = 0.0, np.array(arm.tool_point, dtype=float), []
+    skipped = []
     for e in diag.effects:
         if e.name in _JOINT_FIELDS and e.joint is not None:
             add[_JOINT_FIELDS[e.name]][e.joint] += e.params[e.name].value
-        elif e.name == "payload":
-            payload = e.params["mass"].value
-            if payload > 0.0:
-                pos = pos + np.array([e.params[k].value for k in ("m*dx", "m*dy", "m*dz")]) \
-                    / payload
-        elif e.name != "inertial":
+        elif e.name not in ("payload", "inertial", "absent_part", "link_mass"):
             skipped.append(e.label)
+    payload, pos = _separate_payload(arm, diag)
+    bodies = {b: c.phi for b, c in diag.bodies.items() if not (payload and b == arm.tool_body)}
+    if not diag.bodies:
+        bodies = dict(diag.inertial_phi)
     return Corrections(add["frictionloss"], add["damping"], add["armature"], payload, pos,
-                       dict(diag.inertial_phi), skipped)
+                       bodies, skipped)
 
 
 def _body_name(m: mujoco.MjModel, b: int) -> str:
@@ -69,11 +89,12 @@ def _body_name(m: mujoco.MjModel, b: int) -> str:
 
 def _set_inertial(body: mujoco.MjsBody, phi: F64) -> None:
     """Write phi_b (eq. R1) as mass, centre, principal inertias and their frame."""
-    mass = float(phi[0])
+    mass = max(float(phi[0]), MIN_MASS_KG)  # a link emptied of its mass stays compilable
     c = phi[1:4] / mass
     io = np.array([[phi[4], phi[7], phi[8]], [phi[7], phi[5], phi[9]],
                    [phi[8], phi[9], phi[6]]])
     w, v = np.linalg.eigh(io - mass * (float(c @ c) * np.eye(3) - np.outer(c, c)))
+    w = np.maximum(w, 0.0)  # rounding of a physical body (eq. R5) never below zero
     if np.linalg.det(v) < 0:
         v[:, 0] = -v[:, 0]
     quat = np.empty(4)
@@ -117,3 +138,31 @@ def write_corrected_mjcf(arm: Arm, diag: DynamicDiagnosis, path: str | os.PathLi
     return write_text(path, spec.to_xml(), overwrite=overwrite)
 
 
+@dataclass(frozen=True)
+class CorrectedMJCF:
+    """The corrected model of a MuJoCo arm, as :func:`zrp.gap.dynamics.run.run_dynamics`
+    asks for it (:class:`zrp.gap.dynamics.run.ModelWriter`): the MJCF text and the
+    re-simulation of the logged command through it."""
+
+    arm: Arm
+
+    def corrected_model(self, diag: DynamicDiagnosis) -> tuple[str, list[str]]:
+        """The MJCF text of the model with the diagnosis written in (:mod:`mjcf.corrected`)
+        and what it holds, in words."""
+        fix = corrections(self.arm, diag)
+        spec = corrected_spec(self.arm, fix)
+        spec.compile()
+        held = ["frictionloss, damping, armature"]
+        held += ["an identified payload body"] if fix.payload_kg else []
+        held += [f"the inertial of {', '.join(self.arm.body_name(b) for b in fix.inertial)}"
+                 ] if fix.inertial else []
+        notes = [f"corrected.xml: the model with {'; '.join(held)}."]
+        if fix.not_in_model:
+            notes.append(f"not in MJCF (report only): {', '.join(fix.not_in_model)}")
+        return spec.to_xml(), notes
+
+    def track(self, corrected_xml: str, log: TorqueLog, *, kp: F64 | None = None,
+              kv: F64 | None = None, seconds: float | None = None) -> TrackingGap | None:
+        """The logged command re-simulated through the model and ``corrected_xml``
+        (:func:`mjcf.tracking.track_log`)."""
+        return track_log(self.arm, corrected_xml, log, kp=kp, kv=kv, seconds=seconds)

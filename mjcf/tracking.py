@@ -19,8 +19,8 @@ from zrp.errors import InputError
 from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.inertia import V_EPS
 
-__all__ = ["TRUTH_V_EPS", "Command", "Run", "SampledCommand", "Servo", "run_servo",
-           "tracking_gap"]
+__all__ = ["TRUTH_V_EPS", "Command", "Run", "SampledCommand", "Servo", "TrackingGap",
+           "run_servo", "track_log", "tracking_gap"]
 
 #: Velocity scale of an applied Stribeck bump's sign, rad/s (not the diagnosis's V_EPS).
 TRUTH_V_EPS = 0.02
@@ -141,3 +141,48 @@ def tracking_gap(model: mujoco.MjModel, nominal: mujoco.MjModel, log: TorqueLog,
     run = run_servo(copy.deepcopy(model), nominal, servo, command,
                     log.n_samples / (1.0 / log.dt), 1.0 / log.dt)
     return np.sqrt(np.mean((run.q - log.q) ** 2, axis=0))
+
+
+@dataclass(frozen=True)
+class TrackingGap:
+    """The logged command re-simulated through the model and the corrected model with one
+    servo: RMS of simulated minus logged joint positions per joint (rad), and how the servo
+    was chosen."""
+
+    before_rad: F64
+    after_rad: F64
+    servo: str
+
+
+def _servo(arm: Arm, q0: F64, kp: F64 | None, kv: F64 | None) -> tuple[Servo, str]:
+    if (kp is None) != (kv is None):
+        raise InputError("kp, kv: give both (the servo's stiffness and damping) or neither")
+    if kp is None or kv is None:
+        return Servo.tuned(arm, q0), "a 4 Hz servo tuned from the model (kp/kv: yours)"
+    for name, v in (("kp", kp), ("kv", kv)):
+        if np.asarray(v).shape != (arm.n,):
+            raise InputError(f"{name}: expected {arm.n} values (one a joint), got "
+                             f"{np.asarray(v).size}")
+    return Servo(np.asarray(kp, dtype=float), np.asarray(kv, dtype=float)), "the servo gains given"
+
+
+def _first_seconds(log: TorqueLog, seconds: float | None) -> TorqueLog:
+    if seconds is None:
+        return log
+    k = max(2, int(np.searchsorted(log.t - log.t[0], seconds)))
+    return TorqueLog(log.t[:k], log.q[:k], None if log.qd is None else log.qd[:k], log.tau[:k],
+                     None if log.qc is None else log.qc[:k], None, log.lines[:k], log.source,
+                     log.torque_from)
+
+
+def track_log(arm: Arm, corrected_xml: str, log: TorqueLog, *, kp: F64 | None = None,
+              kv: F64 | None = None, seconds: float | None = None) -> TrackingGap | None:
+    """The tracking gap of the model and of ``corrected_xml`` along the log's commanded
+    positions (None: the log has none), the first ``seconds`` only when given."""
+    if log.qc is None:
+        return None
+    servo, how = _servo(arm, log.qc[0], kp, kv)
+    part = _first_seconds(log, seconds)
+    corrected = mujoco.MjModel.from_xml_string(corrected_xml)
+    return TrackingGap(tracking_gap(arm.model, arm.model, part, servo),
+                       tracking_gap(corrected, arm.model, part, servo), how)

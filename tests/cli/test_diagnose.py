@@ -96,3 +96,19 @@ def test_real_irb120_report_is_believable(irb120_real):
     # every reported interval is finite and contains its value
     for p in d.final_parameters:
         assert np.isfinite(p.stderr) and p.ci95[0] <= p.value <= p.ci95[1]
+
+
+def test_cli_residual_model_reports_the_learned_term(csv_file, tmp_path):
+    """--residual-model: diagnosis.json carries the learned term's withheld test beside the
+    physical model's (here nothing remains to learn: not kept) and the option in settings."""
+    out = tmp_path / "out"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        rc = main(["diagnose", "--model", "puma", "--data", str(csv_file), "--deg",
+                   "--out", str(out), "--seed", "4", "--residual-model", "--no-plots"])
+    assert rc == 0
+    doc = json.loads((out / "diagnosis.json").read_text(), parse_constant=_no_nan)
+    rm = doc["residual_model"]
+    assert doc["settings"]["residual_model"] is True
+    assert rm["kept"] is False and rm["withheld_rms_physical"] == doc["final"]["rms"]
+    assert doc["remainder"]["structure"]["structured"] is False

@@ -47,7 +47,8 @@ def test_diagnose_dynamics(puma_log, tmp_path, capsys):
 
 def test_diagnose_dynamics_named_errors(puma_log, tmp_path, capsys):
     bad = tmp_path / "bad.csv"
-    bad.write_text("t,q1,q2,tau1,tau2\n0,0,0,0,0\n")
+    bad.write_text("t,q1,q2,tau1,tau2\n" + "".join(f"{0.001 * i},{0.01 * i},0,0,0\n"
+                                                    for i in range(400)))
     code = main(["diagnose-dynamics", "--model", "puma", "--data", str(bad), "--out",
                  str(tmp_path / "o")])
     err = capsys.readouterr().err
@@ -70,8 +71,41 @@ def test_excite_writes_a_command(tmp_path, capsys):
     assert np.isfinite(payload["condition_number"])
     from zrp.units import split_unit
 
-    header = out.read_text().splitlines()[0].split(",")
+    lines = out.read_text().splitlines()
+    n_comments = sum(ln.startswith("#") for ln in lines)  # the command's conditions
+    header = lines[n_comments].split(",")
     assert [split_unit(h, "x") for h in header][:2] == [("t", "s"), ("qc1", "rad")]
-    data = np.loadtxt(out, delimiter=",", skiprows=1)
+    data = np.loadtxt(out, delimiter=",", skiprows=n_comments + 1)
     assert data.shape == (1000, 7)
     np.testing.assert_allclose(data[0, 1:], [0, -0.6, 0.6, 0, 0.6, 0], atol=1e-9)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("flags", [[], ["--no-inertial"]], ids=["default", "no-inertial"])
+def test_shipped_panda_without_its_hand_end_to_end(tmp_path, capsys, flags):
+    """The shipped URDF as is (fingers and all, no --end-link), the hand not on the arm: named
+    first with its mass, no gain, no traceback; --validate scores a second log."""
+    from sim.studies.dynamics.arms import panda_urdf
+    from tests.gap.dynamics._panda_cases import HAND_KG, panda_arm, simulated_log
+    from tests.gap.dynamics._panda_cases import truth_without_hand as truth
+    from zrp.gap.dynamics import write_torque_log
+
+    arm, plant = panda_arm(), truth()
+    logs = [write_torque_log(simulated_log(arm, plant, seed, 12.0)[0], tmp_path / f"{seed}.csv")
+            for seed in (1, 2)]
+    code = main(["diagnose-dynamics", "--model", str(panda_urdf()), "--data", str(logs[0]),
+                 "--validate", str(logs[1]), "--out", str(tmp_path / "o"), "--json", *flags])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    payload = json.loads(captured.out)
+    first = payload["effects"][0]
+    assert (first["name"], first["detail"]) == ("absent_part", "panda_hand")
+    assert first["params"]["mass"]["value"] == pytest.approx(HAND_KG, rel=0.1)
+    assert not [e for e in payload["effects"] if e["name"] == "gain"]
+    assert payload["verdict"].startswith("Withheld torque error")
+    assert "is not on the arm" in payload["verdict"]
+    v = payload["validation"]
+    assert v["overall_after_nm"] <= 1.2 * v["overall_noise_nm"]
+    assert any("made fixed" in n for n in payload["notes"])  # the fingers, said in words
+    m = mujoco.MjModel.from_xml_path(str(tmp_path / "o" / "corrected.xml"))
+    assert m.body_mass.sum() == pytest.approx(arm.model.body_mass.sum() - HAND_KG, abs=0.08)

@@ -165,7 +165,8 @@ def _hostile_dynamics():
     n = len(MD_HOSTILE)
     ones = np.ones(n)
     eff = FoundEffect("absent_part", "absent_part", 1, FORGED,
-                      {"m": Param(1.0, 0.5, 1.5, "kg|<b>")}, 3.0)
+                      {"share": Param(1.0, 0.9, 1.0, "1"),
+                       "mass": Param(1.0, 0.5, 1.5, "kg|<b>")}, 3.0)
     s = Samples(np.arange(5.0), np.zeros((5, n)), np.zeros((5, n)), np.zeros((5, n)),
                 np.zeros((5, n)))
     return DynamicDiagnosis(FORGED, list(MD_HOSTILE), ones, ones, ones,

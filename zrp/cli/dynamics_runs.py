@@ -1,5 +1,5 @@
-"""The work of ``zrp diagnose-dynamics``, ``zrp excite`` and
-``zrp dynamics-benchmark`` (arguments parsed in :mod:`zrp.cli.commands`)."""
+"""The work of ``zrp diagnose-dynamics`` and ``zrp dynamics-benchmark`` (arguments parsed in
+:mod:`zrp.cli.commands`)."""
 
 from __future__ import annotations
 
@@ -7,125 +7,55 @@ import argparse
 import tempfile
 from dataclasses import asdict
 from pathlib import Path
-from typing import Any
 
-import mujoco
 import numpy as np
 
-from mjcf.arm import Arm, resolve_arm
-from mjcf.corrected import corrected_spec, corrections
-from mjcf.tracking import Servo, tracking_gap
+from mjcf.arm import resolve_arm
+from mjcf.corrected import CorrectedMJCF
 from sim.studies.dynamics import benchmark as bm
 from sim.studies.dynamics.arms import available_arms
 from sim.studies.dynamics.scenarios import KINDS
 from zrp.errors import InputError
-from zrp.escape import md_line, md_row
-from zrp.gap.dynamics.data import TorqueLog, load_torque_log
-from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, DynamicsOptions, diagnose_dynamics
-from zrp.gap.dynamics.excitation import design_excitation
-from zrp.gap.dynamics.report import REPORT_FILES, diagnosis_json, write_report
-from zrp.jsonio import to_jsonable
-from zrp.output import OutputDir, atomic_path, check_writable, write_text
+from zrp.escape import md_row
+from zrp.gap.dynamics.data import load_torque_log
+from zrp.gap.dynamics.diagnosis import DynamicsOptions
+from zrp.gap.dynamics.report import REPORT_FILES, run_json, write_run
+from zrp.gap.dynamics.run import TrackingOptions, run_dynamics
+from zrp.gap.dynamics.verdict import headline
+from zrp.output import OutputDir, check_writable
 
-__all__ = ["run_benchmark", "run_diagnosis", "run_excite"]
-
-
-def _servo(arm: Arm, log: TorqueLog, kp: list[float] | None, kv: list[float] | None
-           ) -> tuple[Servo, str]:
-    if (kp is None) != (kv is None):
-        raise InputError("--kp, --kv: give both (the servo's stiffness and damping) or neither")
-    if kp is None:
-        return Servo.tuned(arm, log.qc[0]), "a 4 Hz servo tuned from the model (--kp/--kv: yours)"
-    for name, v in (("--kp", kp), ("--kv", kv)):
-        if len(v) != arm.n:
-            raise InputError(f"{name}: expected {arm.n} values (one a joint), got {len(v)}")
-    return Servo(np.array(kp), np.array(kv)), "the servo gains given"
-
-
-def _truncate(log: TorqueLog, seconds: float | None) -> TorqueLog:
-    if seconds is None:
-        return log
-    k = max(2, int(np.searchsorted(log.t - log.t[0], seconds)))
-    return TorqueLog(log.t[:k], log.q[:k], None if log.qd is None else log.qd[:k], log.tau[:k],
-                     log.qc[:k], None, log.lines[:k], log.source, log.torque_from)
-
-
-def _tracking(arm: Arm, log: TorqueLog, model: mujoco.MjModel, args: argparse.Namespace
-              ) -> dict[str, Any]:
-    if log.qc is None:
-        return {"lines": ["- the log has no commanded positions qc1..qcn: no re-simulation"]}
-    servo, how = _servo(arm, log, args.kp, args.kv)
-    part = _truncate(log, args.seconds)
-    before = tracking_gap(arm.model, arm.model, part, servo)
-    after = tracking_gap(model, arm.model, part, servo)
-    lines = [f"Re-simulation of the logged command (mj_step) with {how}; RMS of simulated minus "
-             "logged joint positions (rad):", "", "| joint | model | corrected model |",
-             "|---|---|---|"]
-    lines += [md_row(k + 1, f"{before[k]:.3g}", f"{after[k]:.3g}") for k in range(arm.n)]
-    return {"lines": lines, "before_rad": before, "after_rad": after}
+__all__ = ["run_benchmark", "run_diagnosis"]
 
 
 def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = False
                   ) -> tuple[dict, str]:
-    """Diagnose, write the report and the corrected MJCF; the JSON and the summary text
-    (``overwrite``: replace files in ``out``, from --force or the default folder's mark)."""
-    check_writable([out / n for n in (*REPORT_FILES, "corrected.xml")], overwrite)
-    arm = resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site)
-    log = load_torque_log(args.data, torque_constant=args.torque_constant, n_joints=arm.n)
-    diag: DynamicDiagnosis = diagnose_dynamics(
-        arm, log, DynamicsOptions(window_s=args.window, inertial=not args.no_inertial))
-    fix = corrections(arm, diag)
-    spec = corrected_spec(arm, fix)
-    model = spec.compile()
-    track = _tracking(arm, log, model, args)
-    sections = {"Corrected model": [
-        "corrected.xml: the model with the identified frictionloss, damping, armature"
-        + (", payload" if fix.payload_kg else "") + (", link inertias" if fix.inertial else "")
-        + "."] + ([md_line("- not in MJCF (report only): {}", ", ".join(fix.not_in_model))]
-                  if fix.not_in_model else []),
-        "Tracking": track["lines"]}
-    extra = {k: v for k, v in track.items() if k != "lines"}
-    folder = write_report(diag, out, overwrite=overwrite, extra={"sections": sections,
-                                                                  "tracking": extra})
-    write_text(folder / "corrected.xml", spec.to_xml(), overwrite=overwrite)
-    text = (f"{diag.arm}: " + (", ".join(e.label for e in diag.effects) or "no effect needed")
-            + "\nwithheld torque RMS / noise per joint: "
-            + " ".join(f"{a / s:.2f}" for a, s in zip(diag.rms_after, diag.noise_nm,
-                                                     strict=True))
-            + f"\nwrote {folder}/report.html, report.md, diagnosis.json, corrected.xml")
-    return diagnosis_json(diag, {"tracking": extra}), text
+    """Diagnose (:func:`zrp.gap.dynamics.run.run_dynamics`), write the outputs; the JSON and
+    the summary text (``overwrite``: replace files in ``out``, from --force or the default
+    folder's mark; checked before any work)."""
+    check_writable([out / n for n in REPORT_FILES], overwrite)
+    if (args.kp is None) != (args.kv is None):
+        raise InputError("--kp, --kv: give both (the servo's stiffness and damping) or neither")
+    log = load_torque_log(args.data, torque_constant=args.torque_constant)
+    arm = resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site,
+                      n_joints=log.n_joints)
+    if log.n_joints != arm.n:
+        raise InputError(f"--data: {log.source} has {log.n_joints} joints, but the model "
+                         f"{args.model!r} has {arm.n}")
+    second = None if args.validate is None else load_torque_log(
+        args.validate, torque_constant=args.torque_constant, n_joints=arm.n)
+    run = run_dynamics(arm, log, options=DynamicsOptions(window_s=args.window,
+                                                         inertial=not args.no_inertial),
+                       validation_log=second, writer=CorrectedMJCF(arm),
+                       tracking=TrackingOptions(kp=_gains(args.kp), kv=_gains(args.kv),
+                                                seconds=args.seconds))
+    folder = write_run(run, out, overwrite=overwrite)
+    text = headline(run.diagnosis, run.validation) + (
+        f"\nwrote {folder}/report.html, report.md, diagnosis.json, corrected.xml")
+    return run_json(run), text
 
 
-def run_excite(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
-    """Design the exciting command and write it as t, qc1..qcn."""
-
-    arm = resolve_arm(args.model, end_link=args.end_link)
-    if len(args.q0) != arm.n:
-        raise InputError(f"--q0: expected {arm.n} joint values, got {len(args.q0)}")
-    tl = None
-    if args.max_torque is not None:
-        if len(args.max_torque) not in (1, arm.n):
-            raise InputError(f"--max-torque: expected 1 or {arm.n} values")
-        tl = np.broadcast_to(np.array(args.max_torque), arm.n)
-    e = design_excitation(arm, np.array(args.q0), args.amplitude, args.max_velocity,
-                          args.max_acceleration, torque_limit=tl, harmonics=args.harmonics,
-                          f0_hz=1.0 / args.period, candidates=args.candidates,
-                          iterations=args.iterations, seed=args.seed)
-    t = np.arange(round(args.period * args.rate)) / args.rate
-    q, _, _ = e.command.evaluate(t)
-    header = "t [s]," + ",".join(f"qc{k + 1} [rad]" for k in range(arm.n))
-    with atomic_path(out, overwrite=args.force) as tmp:
-        np.savetxt(tmp, np.column_stack([t, q]), delimiter=",", fmt="%.12g", header=header,
-                   comments="")
-    dq, dqd, dqdd = e.command.peaks()
-    payload = {"condition_number": e.kappa, "condition_number_random_start": e.kappa_start,
-               "peak_position_rad": dq, "peak_velocity_rad_s": dqd,
-               "peak_acceleration_rad_s2": dqdd, "peak_torque_nm": e.peak_torque,
-               "q0": e.command.q0, "f0_hz": e.command.f0_hz, "a": e.command.a,
-               "b": e.command.b}
-    text = (f"condition number {e.kappa:.4g} (best random start {e.kappa_start:.4g}); peak "
-            f"torque per joint {np.array2string(e.peak_torque, precision=3)} N m\nwrote {out}")
-    return to_jsonable(payload), text
+def _gains(values: list[float] | None) -> np.ndarray | None:
+    return None if values is None else np.asarray(values, dtype=float)
 
 
 def run_benchmark(args: argparse.Namespace, out: Path) -> tuple[dict, str]:

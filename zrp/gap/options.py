@@ -38,6 +38,8 @@ class DiagnosisOptions:
         max_tilt_rad: the largest axis tilt accepted (rad; default a few mrad of a machined
             part, :data:`zrp.gap.model.domains.DEFAULT_MAX_TILT_RAD`): widen it for a robot
             known to carry a larger tilt.
+        residual_model: also train a learned residual term on the joint angles after the final
+            model and test it on the withheld poses (:mod:`zrp.gap.analysis.residual`).
 
     Raises:
         InputError: naming the argument at fault.
@@ -54,6 +56,7 @@ class DiagnosisOptions:
     gravity_dir: tuple[float, float, float] = (0.0, 0.0, -1.0)
     progress: bool = False
     max_tilt_rad: float = DEFAULT_MAX_TILT_RAD
+    residual_model: bool = False
 
     def __post_init__(self) -> None:
         bad = [e for e in self.effects if e not in EFFECTS]
@@ -66,6 +69,9 @@ class DiagnosisOptions:
         check_float(self.min_gain, "min_gain", 0.0, 1.0, open_hi=True)
         check_int(self.max_steps, "max_steps", 1, len(EFFECTS))
         check_float(self.max_tilt_rad, "max_tilt_rad", 0.0, 0.5, open_lo=True, unit="rad")
+        if not isinstance(self.residual_model, bool):
+            raise InputError(f"residual_model: expected True or False, got "
+                             f"{self.residual_model!r}")
         if self.noise_sigma is not None:
             check_float(self.noise_sigma, "noise_sigma", 0.0, open_lo=True, unit="length unit")
         if not self.harmonics or not all(isinstance(h, numbers.Integral) and 1 <= h <= 100
@@ -84,4 +90,4 @@ class DiagnosisOptions:
         return {"effects": list(self.effects), "alpha": self.alpha, "min_gain": self.min_gain,
                 "max_steps": self.max_steps, "folds": self.folds,
                 "harmonics": list(self.harmonics), "gravity_dir": list(self.gravity_dir),
-                "max_tilt_rad": self.max_tilt_rad}
+                "max_tilt_rad": self.max_tilt_rad, "residual_model": self.residual_model}

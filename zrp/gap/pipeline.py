@@ -38,6 +38,7 @@ from zrp.gap.analysis.checks import (
 from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.fallback import FinalChoice, choose_final
 from zrp.gap.analysis.identifiability import ReferencePoses, registration_identifiable, survey
+from zrp.gap.analysis.residual import fit_residual_model
 from zrp.gap.analysis.where import WhereAnalysis, where_analysis
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.data.noise import noise_floor
@@ -82,7 +83,8 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
              max_points: int | None = MAX_POINTS,
              use_orientation: bool = True,
              orientation_sigma: float | None = None,
-             max_tilt_rad: float = DEFAULT_MAX_TILT_RAD) -> Diagnosis:
+             max_tilt_rad: float = DEFAULT_MAX_TILT_RAD,
+             residual_model: bool = False) -> Diagnosis:
     """Diagnose the gap between ``model`` and ``measurements``.
 
     Args:
@@ -111,6 +113,9 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         max_tilt_rad: the largest axis tilt a fitted model may carry (rad; the domain of
             ``axis_misalignment``, :mod:`zrp.gap.model.domains`): widen it for a part known
             to be tilted.
+        residual_model: also train a learned residual term after the final model, kept only
+            when it lowers the withheld error clearly (:mod:`zrp.gap.analysis.residual`);
+            the final model stays the physical one.
 
     Returns:
         the :class:`Diagnosis`.
@@ -130,7 +135,7 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
                          f"{effects!r}")
     opts = DiagnosisOptions(tuple(effects), withheld_fraction, folds, alpha, min_gain,
                             max_steps, noise_sigma, tuple(harmonics), tuple(gravity_dir),
-                            progress, max_tilt_rad)
+                            progress, max_tilt_rad, residual_model)
     if measurements.n_joints != model.n:
         raise InputError(f"{measurements.source}: {measurements.n_joints} joint columns, but "
                          f"the model {model.name!r} has {model.n} joints")
@@ -300,6 +305,9 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
                   found.pruned, where_analysis(ctx, final_fit) if changed else None)
     assessment = _assess(ctx, baseline, choice, final_fit, len(reg.specs),
                          where.after_final_model or where_nominal, resolution)
+    if opts.residual_model:
+        assessment = dataclasses.replace(assessment, residual_model=fit_residual_model(
+            ctx, final_fit, prep.withheld, after))
     return Diagnosis(model.name, model.length_unit, Metrics.of(regd.withheld_residual),
                      regd.fitting, parameter_estimates(regd.fit, 0), found.steps, final, floor,
                      unexplained, _split_ids(meas, prep, opts), where, found.aliased, (),
@@ -338,8 +346,8 @@ def _assess(ctx: Context, baseline: GeometricBaseline, choice: FinalChoice, fina
     names = tuple(sp.name for sp in final.specs)
     frame = registration_of(final, se, cov, ctx.meas.point_labels, ctx.model.length_unit)
     return Assessment(baseline, frame, correlations(names, cov), se, implausible, unexcited,
-                      remainder_evidence(ctx, final, where_final), resolution, choice,
-                      compliance_units(ctx), _one_sided(ctx))
+                      remainder_evidence(ctx, final, where_final, resolution), resolution,
+                      choice, compliance_units(ctx), _one_sided(ctx))
 
 
 def _one_sided(ctx: Context) -> tuple[int, ...]:

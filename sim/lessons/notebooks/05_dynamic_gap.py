@@ -20,8 +20,8 @@ import mujoco
 import numpy as np
 
 from mjcf.corrected import write_corrected_mjcf
-from mjcf.tracking import SampledCommand, tracking_gap
 from mjcf.inverse import inverse_dynamics
+from mjcf.tracking import SampledCommand, tracking_gap
 from sim.studies.dynamics.arms import BENCH_ARMS
 from sim.studies.dynamics.scenarios import scenario_command
 from sim.studies.dynamics.truth import HiddenDynamics, Servo, run_servo, simulate

@@ -11,7 +11,8 @@ anything derived from them. Only afterwards does :func:`score` read the truth:
   an effect below 1 is not visible and "none" is a right answer for it;
 * right effect: the first effect named is the hidden one (for ``none``: nothing named), or an
   arm-wide effect named first is reported tied with the hidden one (e.g. a payload and a wrist
-  link's mass: the log cannot tell them apart, and the report says so);
+  link's mass: the log cannot tell them apart, and the report says so); a hidden link
+  inertial error (a point mass added to one link) named as that link's ``link_mass``;
 * right joint: for a joint effect, the joint of the first effect named;
 * withheld ratio: the worst joint's withheld torque RMS after correction over its true noise
   (target <= 1.5).
@@ -113,6 +114,26 @@ class Row:
         return self.right_effect and self.right_joint and self.withheld_ratio <= 1.5
 
 
+def _right_link(first: dict, eff: dict) -> bool:
+    """A hidden link inertial error named as that link's mass (a point mass added to it):
+    the more specific right answer."""
+    return (eff["kind"] == "inertial" and first["name"] == "link_mass"
+            and first.get("detail") == eff.get("body_name"))
+
+
+def _right(diag: dict, first: dict | None, eff: dict, visible: bool) -> tuple[bool, bool]:
+    """(right effect, right joint) of a diagnosis (module docstring)."""
+    kind, joint = eff["kind"], eff["joint"]
+    if kind == "none" or not visible:
+        return first is None or (kind != "none" and first["name"] == kind), True
+    tied = [] if len(diag["steps"]) < 2 else [t.split("_j")[0] for t in diag["steps"][1][2]]
+    # named first, or reported as a tie with the first (the log cannot tell them apart)
+    right = first is not None and (first["name"] == kind or
+                                   (kind in tied and first["joint"] is None) or
+                                   _right_link(first, eff))
+    return right, joint is None or (first is not None and first["joint"] == joint)
+
+
 def score(diag: dict, truth: dict, seconds: float = 0.0) -> Row:
     """Judge a blind diagnosis against its truth (module docstring)."""
     sc, eff = truth["scenario"], truth["effect"]
@@ -120,16 +141,7 @@ def score(diag: dict, truth: dict, seconds: float = 0.0) -> Row:
     named = "none" if first is None else (
         first["name"] + ("" if first["joint"] is None else f" j{first['joint'] + 1}"))
     kind, joint = eff["kind"], eff["joint"]
-    tied = [] if len(diag["steps"]) < 2 else [t.split("_j")[0] for t in diag["steps"][1][2]]
-    visible = truth["visibility"] >= 1.0
-    if kind == "none" or not visible:
-        right = first is None or (kind != "none" and first["name"] == kind)
-        right_joint = True
-    else:
-        # named first, or reported as a tie with the first (the log cannot tell them apart)
-        right = first is not None and (first["name"] == kind or
-                                       (kind in tied and first["joint"] is None))
-        right_joint = joint is None or (first is not None and first["joint"] == joint)
+    right, right_joint = _right(diag, first, eff, truth["visibility"] >= 1.0)
     sigma = np.asarray(truth["noise_nm"])
     after, before = np.asarray(diag["rms_after"]), np.asarray(diag["rms_before"])
     return Row(sc["arm"], kind, sc["seed"], joint, float(truth["visibility"]), named, right,

@@ -106,6 +106,7 @@ def draw_hidden(arm: Arm, command: Fourier, kind: str, seed: int
     elif kind == "inertial":
         h = HiddenDynamics(inertial=_inertial(arm, rng))
         desc["body"] = int(next(iter(h.inertial)))
+        desc["body_name"] = arm.body_name(desc["body"])
     else:
         h = HiddenDynamics()
     return h, sigma, desc

@@ -56,6 +56,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "default: estimated from the orientation residuals")
     p.add_argument("--no-orientation", action="store_true",
                    help="ignore measured orientations (qw..qz): no full-pose refit")
+    p.add_argument("--residual-model", action="store_true",
+                   help="also train a learned residual term on the joint angles after the "
+                        "final model; kept only when it lowers the withheld error clearly "
+                        "(its withheld RMS beside the physical model's)")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
                    help="show progress on stderr: a bar on a terminal, a line every 10 s "
@@ -121,7 +125,8 @@ def _run(args: argparse.Namespace) -> int:
                             alpha=args.alpha, max_steps=args.max_steps, noise_sigma=args.noise,
                             progress=args.progress, max_points=args.max_points or None,
                             use_orientation=not args.no_orientation,
-                            orientation_sigma=args.orientation_sigma)
+                            orientation_sigma=args.orientation_sigma,
+                            residual_model=args.residual_model)
             files = write_outputs(diag, out, plots=not args.no_plots)
     except BaseException:
         if created:  # a failed run leaves no empty folder it made

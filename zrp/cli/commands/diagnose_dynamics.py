@@ -28,6 +28,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tool-site", metavar="SITE", help="MJCF site where a payload sits")
     p.add_argument("--torque-constant", type=GAIN, nargs="+", metavar="KT",
                    help="N m/A per joint, when the log has currents i1..in")
+    p.add_argument("--validate", metavar="LOG2.csv",
+                   help="a second torque log of the same arm (another run): the corrected "
+                   "model, fitted on --data, is scored on it (nothing refitted)")
     p.add_argument("--window", type=real(0.0, 10.0, open_lo=True, unit="s"), default=0.1,
                    help="Savitzky-Golay window for the accelerations, s (default 0.1)")
     p.add_argument("--no-inertial", action="store_true",

@@ -14,7 +14,9 @@ own evidence (``Remainder``):
   instrument (range-dependent instrument error; instrument-frame data only);
 * **per-pose rigid shift** - share of the residual common to all points of a pose (a shift of
   the whole tool: any error of the robot's position, or of the instrument's, looks so);
-* **pose-dependent model error** - R^2 against the joint angles.
+* **pose-dependent model error** - the multivariate, cross-validated test of
+  :mod:`.structure` (all joint angles together, and time, temperature, load where logged);
+  the largest R^2 against one joint angle stays as a hint beside it.
 """
 
 from __future__ import annotations
@@ -28,6 +30,8 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.gap.analysis.baseline import GeometricBaseline
 from zrp.gap.analysis.fallback import FinalChoice
+from zrp.gap.analysis.residual import ResidualModel
+from zrp.gap.analysis.structure import Structure, remainder_structure
 from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.fit.registration import Registration
@@ -60,6 +64,7 @@ class Remainder:
         common_share: share common to the points of a pose (None with one point per pose).
         joint_r2: largest R^2 against one joint angle, and that joint.
         exceeds_spec: rms is above :data:`TYPICAL_REPEATABILITY_MM` (in the model's unit).
+        structure: the multivariate test of :mod:`.structure` (None with too few poses).
     """
 
     rms: float
@@ -71,6 +76,7 @@ class Remainder:
     common_share: float | None
     joint_r2: tuple[int, float]
     exceeds_spec: bool
+    structure: Structure | None = None
 
     def findings(self) -> list[tuple[str, str, str]]:
         """(explanation, "supported" / "not supported" / "cannot tell", evidence) per
@@ -98,10 +104,7 @@ class Remainder:
             out.append(("instrument error growing with distance",
                         "supported" if self.distance_r2 >= SUPPORT_R2 else "not supported",
                         f"R^2 of the squared error against the distance {self.distance_r2:.2f}"))
-        j, r2 = self.joint_r2
-        out.append(("a missing pose-dependent model term",
-                    "supported" if r2 >= SUPPORT_R2 else "not supported",
-                    f"largest R^2 against one joint angle {r2:.2f} (q{j})"))
+        out.append(self._pose_dependent())
         if self.common_share is not None:
             out.append(("a shift of the whole tool per pose (robot positioning or instrument)",
                         "supported" if self.common_share >= 0.8 else "not supported",
@@ -109,8 +112,23 @@ class Remainder:
                         "points of a pose; this does not separate robot from instrument"))
         return out
 
+    def _pose_dependent(self) -> tuple[str, str, str]:
+        j, r2 = self.joint_r2
+        hint = f"largest R^2 against one joint angle {r2:.2f} (q{j})"
+        s = self.structure
+        if s is None:
+            return ("a missing pose-dependent model term",
+                    "supported" if r2 >= SUPPORT_R2 else "not supported", hint)
+        on = f" on {', '.join(s.named)}" if s.named else ""
+        return ("a missing pose-dependent model term",
+                "supported" if s.structured else "not supported",
+                f"cross-validated share predicted from the joint angles together "
+                f"{100 * s.share:.0f} % (95 % {100 * s.interval[0]:.0f} to "
+                f"{100 * s.interval[1]:.0f} %){on}; hint: {hint}")
+
     def to_dict(self) -> dict[str, Any]:
-        return {**dict_from_dataclass(self, exclude=("joint_r2", "exceeds_spec")),
+        return {**dict_from_dataclass(self, exclude=("joint_r2", "exceeds_spec", "structure")),
+                "structure": None if self.structure is None else self.structure.to_dict(),
                 "joint_r2": {"joint": self.joint_r2[0], "r2": self.joint_r2[1]},
                 "exceeds_typical_repeatability": self.exceeds_spec,
                 "findings": [{"explanation": e, "status": s, "evidence": v}
@@ -143,9 +161,11 @@ def _repeat_scatter(ctx: Context, fit: FitResult) -> tuple[float | None, int]:
     return (math.sqrt(ss / n) if n else None), ng
 
 
-def remainder_evidence(ctx: Context, fit: FitResult, where: WhereAnalysis) -> Remainder:
+def remainder_evidence(ctx: Context, fit: FitResult, where: WhereAnalysis,
+                       resolution: float = 0.0) -> Remainder:
     """Weigh the explanations of what the final model ``fit`` leaves (see the module
-    docstring), on its fitting poses."""
+    docstring), on its fitting poses; the multivariate test only above 10x the fits'
+    numerical ``resolution`` (below it the residual is rounding, not a remainder)."""
     meas = ctx.meas
     rows = np.flatnonzero(np.isin(meas.pose_index, fit.poses))
     e2 = np.sum(fit.residual.reshape(-1, 3) ** 2, axis=1)
@@ -157,7 +177,8 @@ def remainder_evidence(ctx: Context, fit: FitResult, where: WhereAnalysis) -> Re
     spec = TYPICAL_REPEATABILITY_MM / (1e3 * metres_per_unit(ctx.model.length_unit,
                                                              "model.length_unit"))
     return Remainder(rms, rep, ng, where.order_r2, where.time_r2, dist_r2, where.common_share,
-                     jr, bool(rms > spec))
+                     jr, bool(rms > spec),
+                     remainder_structure(ctx, fit) if rms > 10 * resolution else None)
 
 
 def compliance_units(ctx: Context) -> dict[str, Any]:
@@ -199,6 +220,8 @@ class Assessment:
         one_sided: joints whose MJCF gravity torque keeps one sign in every pose: a play that
             gravity holds on its loaded flank there shifts the joint by a constant, which these
             data cannot tell from its offset (empty without MJCF torques).
+        residual_model: the learned residual term and its withheld test, when asked for
+            (:mod:`zrp.gap.analysis.residual`).
     """
 
     baseline: GeometricBaseline
@@ -212,6 +235,7 @@ class Assessment:
     choice: FinalChoice | None = None
     compliance: dict[str, Any] | None = None
     one_sided: tuple[int, ...] = ()
+    residual_model: ResidualModel | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return dict_from_dataclass(self, exclude=("stderr",), rename={

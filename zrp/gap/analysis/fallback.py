@@ -56,7 +56,8 @@ from zrp.gap.model.context import Context
 from zrp.gap.model.problem import Problem
 from zrp.jsonio import dict_from_dataclass
 
-__all__ = ["COMBINED", "EQUAL_RATIO", "SOURCES", "FinalChoice", "choose_final", "final_source"]
+__all__ = ["COMBINED", "EQUAL_RATIO", "SOURCES", "FinalChoice", "choose_final", "clearly_better",
+           "final_source", "paired_z"]
 
 #: the third candidate: the complete geometric calibration plus the search's non-geometric effects.
 COMBINED = "geometric_plus_non_geometric"
@@ -282,3 +283,13 @@ def choose_final(ctx: Context, search_fit: FitResult, baseline: GeometricBaselin
     choice = FinalChoice(final_source(s_rms, b_rms, c_rms, cz), s_rms, b_rms, z, search_fit,
                          c_rms, cz, baseline.non_geometric)
     return (c, r_comb, choice) if choice.source == COMBINED else (two, r_two, choice)
+
+
+def clearly_better(z: float, worse_rms: float, better_rms: float) -> bool:
+    """``better_rms`` is lower and not "equally good" (the rule of (F2)): the test a learned
+    residual term must pass too (:mod:`zrp.gap.analysis.residual`)."""
+    return better_rms < worse_rms and not _equally_good(z, worse_rms, better_rms)
+
+
+#: the paired z of (F3), public for the residual model's test.
+paired_z = _paired_z

@@ -51,6 +51,9 @@ class Injection:
         tilt: axis tilts (rad) towards the tangents t1, t2 (zrp.manufacturing.axis_tangents).
         thermal: kappa, 1/deg C (bodies scale by 1 + kappa (temp - t_ref)).
         t_ref: reference temperature, deg C.
+        sag: length unit; every tool point sags along the base -z by
+            ``sag sin(q2) cos(q3)`` (actual joint values): a bending of the arm with a shape
+            no effect in the library has, to test what the diagnosis says remains.
     """
 
     joint_offset: Mapping[int, float] = field(default_factory=dict)
@@ -67,6 +70,7 @@ class Injection:
     tilt: Mapping[int, tuple[float, float]] = field(default_factory=dict)
     thermal: float = 0.0
     t_ref: float = 20.0
+    sag: float = 0.0
 
 
 def _gravity_torque(model: Manipulator, q: F64, masses: Mapping[str, float],
@@ -182,6 +186,8 @@ def synthesize(model: Manipulator, q: ArrayLike, injection: Injection, *,
     t = np.asarray(tool_offsets, dtype=float)
     temp_arr = None if temp is None else np.asarray(temp, dtype=float)
     pts = _tool_points(model, qa, injection, t, temp_arr)
+    if injection.sag:
+        pts[:, :, 2] -= (injection.sag * np.sin(qa[:, 1]) * np.cos(qa[:, 2]))[:, None]
     if frame == "instrument":
         rb = matrix_from_rotvec(base_rotvec)
         pts = pts @ rb.T + np.asarray(base_translation, dtype=float)

@@ -14,6 +14,9 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
+import numpy as np
+from numpy.typing import NDArray
+
 from zrp.arrays import F64
 
 __all__ = ["Attachment", "DynamicArm"]
@@ -86,6 +89,15 @@ class DynamicArm(Protocol):
 
     def position_limits(self) -> tuple[F64, F64]:
         """Lower and upper joint limits, rad or m, each (n,); -inf/+inf where none."""
+        ...
+
+    def velocity_limits(self) -> F64:
+        """Largest joint speed the model allows, rad/s (m/s), shape (n,); inf where none is
+        known."""
+        ...
+
+    def revolute(self) -> NDArray[np.bool_]:
+        """Which joints are hinges (rad); the others slide (m), shape (n,)."""
         ...
 
     def torque_limits(self) -> F64:

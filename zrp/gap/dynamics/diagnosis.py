@@ -26,7 +26,8 @@ Steps:
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import itertools
+from dataclasses import dataclass, replace
 
 import numpy as np
 from scipy.signal import savgol_coeffs, savgol_filter
@@ -37,13 +38,19 @@ from zrp.errors import InputError
 from zrp.gap.dynamics.arm import DynamicArm as Arm
 from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, payload_columns
-from zrp.gap.dynamics.fit import design, solve
+from zrp.gap.dynamics.fit import cross_validate, design, solve
 from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
+from zrp.gap.dynamics.resulting import BodyChange, ChangedArm, link_changes, resulting_bodies
+from zrp.gap.dynamics.results import DynamicDiagnosis, FoundEffect, Param, Samples
 from zrp.gap.dynamics.select import Step, forward_select
 from zrp.gap.dynamics.states import States, derive_states
 
-__all__ = ["DynamicDiagnosis", "DynamicsOptions", "FoundEffect", "diagnose_dynamics"]
+__all__ = ["EFFECT_NAMES", "DynamicDiagnosis", "DynamicsOptions", "FoundEffect", "decimated_states",
+           "diagnose_dynamics", "model_torques", "torque_noise"]
+
+#: The effects that change a body of the model (their resulting bodies must be physical).
+BODY_CHANGES = ("payload", "absent_part", "link_mass")
 
 
 @dataclass(frozen=True)
@@ -58,89 +65,7 @@ class DynamicsOptions:
     max_effects: int = 8
     inertial: bool = True
     collinear: float = 0.1
-
-
-@dataclass(frozen=True)
-class Param:
-    """A fitted parameter: value, 95 % interval, unit, and whether it sits on its bound."""
-
-    value: float
-    low: float
-    high: float
-    unit: str
-    at_bound: bool = False
-
-
-@dataclass(frozen=True)
-class FoundEffect:
-    """A chosen effect: its key, name, joint (0-based or None), detail, parameters and the
-    withheld chi2 drop it brought."""
-
-    key: str
-    name: str
-    joint: int | None
-    detail: str
-    params: dict[str, Param]
-    chi2_drop: float
-
-    @property
-    def label(self) -> str:
-        where = "arm" if self.joint is None else f"joint {self.joint + 1}"
-        return f"{self.name} ({where}{', ' + self.detail if self.detail else ''})"
-
-
-@dataclass(frozen=True)
-class Samples:
-    """The states and residuals at the fit rate, for plots: q, qd, and measured (raw) minus
-    model torques before and after (withheld), each (S, n)."""
-
-    t: F64
-    q: F64
-    qd: F64
-    before: F64
-    after: F64
-
-
-@dataclass(frozen=True)
-class DynamicDiagnosis:
-    """The result (all torques in N m, per joint arrays of shape (n,)).
-
-    Attributes:
-        arm, joints: names.
-        noise_nm: the torque noise floor sigma_k (eq. N1).
-        rms_before: RMS of measured minus model torques (raw torques).
-        rms_after: RMS of measured minus corrected torques, each time segment predicted by
-            the fit on the others (withheld).
-        steps: the forward selection (nominal first) with the withheld chi2 after each.
-        effects: the chosen effects, in order of choice.
-        cannot_tell: what this log cannot separate, in words.
-        regimes: {"before"|"after": {regime: [rms or None per joint]}}.
-        inertial_fit: the physically consistent link inertia fit (None: no inertial effect
-            chosen), with how far it is from the unconstrained one
-            (:class:`zrp.gap.dynamics.physical.InertialFit`).
-        inertial_phi: phi_b (eq. R1) of each moving body after it.
-        notes: what else the user should know.
-    """
-
-    arm: str
-    joints: list[str]
-    noise_nm: F64
-    rms_before: F64
-    rms_after: F64
-    steps: list[Step]
-    effects: list[FoundEffect]
-    cannot_tell: list[str]
-    regimes: dict[str, dict[str, list[float | None]]]
-    inertial_fit: InertialFit | None = None
-    inertial_phi: dict[int, F64] = field(default_factory=dict)
-    notes: list[str] = field(default_factory=list)
-    samples: Samples | None = None
-
-    def effect(self, name: str, joint: int | None = None) -> FoundEffect | None:
-        for e in self.effects:
-            if e.name == name and e.joint == joint:
-                return e
-        return None
+    effects: tuple[str, ...] | None = None  # the effect names tried (None: all)
 
 
 def torque_noise(log: TorqueLog, window_s: float, polyorder: int = 3) -> F64:
@@ -153,6 +78,22 @@ def torque_noise(log: TorqueLog, window_s: float, polyorder: int = 3) -> F64:
     return np.maximum(sigma, 1e-9)
 
 
+def decimated_states(log: TorqueLog, opt: DynamicsOptions) -> tuple[States, int]:
+    """The states at the fit rate and the stride taken (step 1 of the module docstring)."""
+    return _decimated(log, opt)
+
+
+def model_torques(arm: Arm, log: TorqueLog, s: States, stride: int) -> F64:
+    """The model's torques along the states (step 2): inverse dynamics plus the logged
+    payload, a point mass at the tool point (the log declares it: it is part of the
+    model)."""
+    tau0 = arm.inverse_dynamics(s.q, s.qd, s.qdd)
+    if log.payload is not None and np.any(log.payload > 0.0):
+        known = log.payload[::stride][:, None]
+        tau0 = tau0 + payload_columns(arm, s.q, s.qd, s.qdd)[..., 0] * known
+    return tau0
+
+
 def _decimated(log: TorqueLog, opt: DynamicsOptions) -> tuple[States, int]:
     states = derive_states(log, opt.window_s)
     stride = max(1, round(1.0 / (opt.fit_rate_hz * log.dt)))
@@ -160,9 +101,12 @@ def _decimated(log: TorqueLog, opt: DynamicsOptions) -> tuple[States, int]:
 
 
 def _params(e: Effect, theta: F64, cov: F64, at_bound: np.ndarray) -> dict[str, Param]:
+    """The fitted parameters with 95 % intervals, each held inside its domain (an interval
+    never reaches values the parameter cannot have)."""
     sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    return {p: Param(float(theta[i]), float(theta[i] - 1.96 * sd[i]),
-                     float(theta[i] + 1.96 * sd[i]), e.units[i], bool(at_bound[i]))
+    return {p: Param(float(theta[i]), float(max(theta[i] - 1.96 * sd[i], e.lower[i])),
+                     float(min(theta[i] + 1.96 * sd[i], e.upper[i])), e.units[i],
+                     bool(at_bound[i]))
             for i, p in enumerate(e.params)}
 
 
@@ -196,6 +140,18 @@ def _cannot_tell(effects: list[Effect], sigma: F64, limit: float) -> list[str]:
     return out
 
 
+#: Every effect name the diagnosis can try.
+EFFECT_NAMES = (*JOINT_EFFECTS, "payload", *BODY_CHANGES[1:], "inertial")
+
+
+def _known_effects(names: tuple[str, ...]) -> tuple[str, ...]:
+    bad = sorted(set(names) - set(EFFECT_NAMES))
+    if bad:
+        raise InputError(f"effects: unknown effect(s) {', '.join(bad)}; known: "
+                         f"{', '.join(EFFECT_NAMES)}")
+    return names
+
+
 def _check_inputs(arm: Arm, log: TorqueLog) -> None:
     if log.n_joints != arm.n:
         raise InputError(f"{log.source}: {log.n_joints} joints (q1..q{log.n_joints}), but the "
@@ -210,47 +166,175 @@ def diagnose_dynamics(arm: Arm, log: TorqueLog, options: DynamicsOptions | None 
         return _diagnose(arm, log, options)
 
 
+@dataclass(frozen=True)
+class _Fitted:
+    """The chosen effects fitted: found effects, the physical link fit, the withheld
+    prediction and the resulting bodies."""
+
+    found: list[FoundEffect]
+    inert: InertialFit | None
+    pred: F64
+    bodies: dict[int, BodyChange]
+
+
+def _contribution(e: Effect, theta: F64) -> F64:
+    """The RMS torque effect ``e`` adds on each joint with parameters ``theta`` (n,)."""
+    return np.sqrt(np.mean((e.columns @ theta) ** 2, axis=0))
+
+
+def _with_part_mass(arm: Arm, f: FoundEffect) -> FoundEffect:
+    """An absent part's share as the mass missing too (kg, same interval)."""
+    if f.name != "absent_part":
+        return f
+    part = next(a for a in arm.attachments if a.name == f.detail)
+    s = f.params["share"]
+    mass = Param(s.value * part.mass, s.low * part.mass, s.high * part.mass, "kg", s.at_bound)
+    return replace(f, params={**f.params, "mass": mass})
+
+
+def _fit_chosen(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma: F64,
+                opt: DynamicsOptions, guard: int, pred: F64 | None) -> _Fitted:
+    """Fit ``chosen`` on the whole log (eq. F2; the links physically, eq. P1); ``pred`` the
+    withheld prediction when known, else cross-validated here."""
+    d = design(chosen, *b.shape)
+    fit = solve(d, b, sigma)
+    values, inert, named = fit.theta, None, None
+    if any(e.name == "inertial" for e in chosen):
+        # physical by construction (eq. P1); the withheld error is that of the physical fit
+        inert, values, pred, named = _links(arm, chosen, fit.theta, b, sigma, opt, guard)
+    elif pred is None:
+        pred = cross_validate(d, b, sigma, opt.folds, guard)
+    at_bound = np.isclose(values, d.lower) | np.isclose(values, d.upper)
+    drop = {st.key: prev.chi2 - st.chi2 for prev, st in itertools.pairwise(steps)}
+    found = [FoundEffect(e.key, e.name, e.joint, e.detail,
+                         _params(e, values[sl], fit.cov[sl, sl], at_bound[sl]),
+                         drop.get(e.key, 0.0), _contribution(e, values[sl]))
+             for e, sl in zip(chosen, d.slices, strict=True)]
+    found = [_with_part_mass(arm, f) for f in found]
+    if named is not None and inert is not None:
+        return _Fitted(found, inert, pred, link_changes(arm, inert.phi, named))
+    bodies = resulting_bodies(
+        arm, [(f.key, f.name, f.detail, {k: p.value for k, p in f.params.items()})
+              for f in found if f.name in BODY_CHANGES], None if inert is None else inert.phi)
+    return _Fitted(found, inert, pred, bodies)
+
+
+def _links(arm: Arm, chosen: list[Effect], theta: F64, b: F64, sigma: F64,
+           opt: DynamicsOptions, guard: int
+           ) -> tuple[InertialFit, F64, F64, dict[int, BodyChange] | None]:
+    """The link inertias fitted physically (eq. P1). With a named part or link among the
+    chosen effects (an absent hand, a link's mass, a payload), those are applied to the
+    model first at their least-squares values and the links are fitted on top, so that the
+    physical fit holds the resulting bodies. The fit, every effect's values in ``chosen``
+    order, the withheld prediction and the named changes (None without them)."""
+    d = design(chosen, *b.shape)
+    first = [i for i, e in enumerate(chosen) if e.name in BODY_CHANGES]
+    named = resulting_bodies(arm, [(chosen[i].key, chosen[i].name, chosen[i].detail,
+                                    dict(zip(chosen[i].params, theta[d.slices[i]],
+                                             strict=True))) for i in first])
+    if not first or not all(c.physical for c in named.values()):
+        inert = physical_fit(arm, chosen, b, sigma)
+        pred, _ = physical_cross_validate(arm, chosen, b, sigma, opt.folds, guard)
+        return inert, inert.theta, pred, None
+    offset = sum(chosen[i].columns @ theta[d.slices[i]] for i in first)
+    rest = [e for i, e in enumerate(chosen) if i not in first]
+    changed = ChangedArm(arm, {bb: c.phi for bb, c in named.items()})
+    inert = physical_fit(changed, rest, b - offset, sigma)
+    pred, _ = physical_cross_validate(changed, rest, b - offset, sigma, opt.folds, guard)
+    values = theta.copy()
+    for sl, e in zip(design(rest, *b.shape).slices, rest, strict=True):
+        values[d.slices[chosen.index(e)]] = inert.theta[sl]
+    return inert, values, pred + offset, named
+
+
+def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma: F64,
+                   opt: DynamicsOptions, guard: int, pred: F64
+                   ) -> tuple[list[Effect], _Fitted, list[str]]:
+    """Fit the chosen effects; an effect of the masses that leaves a body non-physical (eq.
+    R5) is dropped and the rest refitted, said in the notes: impossible values never reach
+    the result."""
+    notes: list[str] = []
+    fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, pred)
+    for _ in range(len(chosen)):
+        bad = [c for c in fitted.bodies.values() if not c.physical]
+        culprits = [k for c in bad for k in c.effects]
+        if not culprits:
+            break
+        # the link inertias are the last resort: a named part or link stays, they go
+        key = "inertial" if "inertial" in culprits else culprits[-1]
+        body = next(c for c in bad if key in c.effects)
+        notes.append(f"{key} left out: with it link {body.name} would not be physical (mass "
+                     f"{body.phi[0]:.3g} kg, or a centre or inertia no body can have)")
+        chosen = [e for e in chosen if e.key != key]
+        fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, None)
+    return chosen, fitted, notes
+
+
+def _common_gain(found: list[FoundEffect]) -> list[str]:
+    """Gains of one sign on several joints: a symptom to explain, not a sensor finding."""
+    gains = [e for e in found if e.name == "gain"]
+    signs = {np.sign(e.params["gain"].value) for e in gains}
+    if len(gains) < 2 or len(signs) != 1:
+        return []
+    vals = [e.params["gain"].value for e in gains]
+    joints = ", ".join(str(e.joint + 1) for e in gains if e.joint is not None)
+    return [f"torque gains of {min(vals):+.0%} .. {max(vals):+.0%} on joints {joints}: a gain "
+            "common to several joints is a symptom, not a sensor finding: a mass the model has "
+            "and the arm lacks (a hand, a tool), or the reverse, or one torque constant wrong "
+            "on every motor. Check the model's masses and the torque constants before "
+            "calibrating the sensors"]
+
+
+def _unphysical_links(arm: Arm, inert: InertialFit) -> list[str]:
+    """Where the physical link fit cannot follow the data (farther from the unconstrained fit
+    than the noise explains): each link whose unconstrained fit is not a body, and what it
+    would need."""
+    out: list[str] = []
+    if inert.matched:
+        return out
+    for b in inert.unphysical_links():
+        ph, ph0 = inert.unconstrained_phi[b], arm.body_params(b)
+        out.append(f"link {arm.body_name(b)}: the unconstrained fit needs mass "
+                   f"{ph[0]:.3g} kg (model {ph0[0]:.3g} kg) with a centre or inertia no body "
+                   "can have (pseudo-inertia not positive definite); the physical fit keeps it "
+                   "a body. Check the model there: a part missing or misplaced on it (a hand, a "
+                   "cable carrier, a counterweight) asks for such a link")
+    return out
+
+
 def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> DynamicDiagnosis:
     opt = options or DynamicsOptions()
     _check_inputs(arm, log)
     sigma = torque_noise(log, opt.window_s)
     s, stride = _decimated(log, opt)
-    tau0 = arm.inverse_dynamics(s.q, s.qd, s.qdd)
-    if log.payload is not None and np.any(log.payload > 0.0):
-        # the logged (known) payload is part of the model: a point mass at the tool point
-        known = log.payload[::stride][:, None]
-        tau0 = tau0 + payload_columns(arm, s.q, s.qd, s.qdd)[..., 0] * known
+    tau0 = model_torques(arm, log, s, stride)
     b, b_raw = s.tau - tau0, s.tau_raw - tau0
     effects = candidate_effects(arm, s.q, s.qd, s.qdd, tau0, inertial=opt.inertial)
+    if opt.effects is not None:
+        effects = [e for e in effects if e.name in _known_effects(opt.effects)]
     guard = max(1, round(0.5 * opt.window_s * opt.fit_rate_hz))
     chosen, steps, pred = forward_select(effects, b, b_raw, sigma, folds=opt.folds, guard=guard,
                                          min_rel=opt.min_rel, min_abs=opt.min_abs,
                                          max_effects=opt.max_effects)
-    d = design(chosen, *b.shape)
-    fit = solve(d, b, sigma)
-    values, inert = fit.theta, None
-    if any(e.name == "inertial" for e in chosen):
-        # physical by construction (eq. P1); the withheld error is that of the physical fit
-        inert = physical_fit(arm, chosen, b, sigma)
-        values = inert.theta
-        pred, _ = physical_cross_validate(arm, chosen, b, sigma, opt.folds, guard)
-    at_bound = np.isclose(values, d.lower) | np.isclose(values, d.upper)
-    found = [FoundEffect(e.key, e.name, e.joint, e.detail,
-                         _params(e, values[sl], fit.cov[sl, sl], at_bound[sl]),
-                         steps[i].chi2 - steps[i + 1].chi2)
-             for i, (e, sl) in enumerate(zip(chosen, d.slices, strict=True))]
+    chosen, fitted, gate_notes = _physical_gate(arm, chosen, steps, b, sigma, opt, guard, pred)
     masks = regime_masks(s.qd, arm.gravity_torques(s.q), guard)
-    notes = [f"accelerations by Savitzky-Golay, window {s.window_s:.3g} s; fit at "
-             f"{1.0 / (stride * log.dt):.4g} Hz"]
+    notes = [*getattr(arm, "notes", ()),
+             f"accelerations by Savitzky-Golay, window {s.window_s:.3g} s; fit at "
+             f"{1.0 / (stride * log.dt):.4g} Hz", *gate_notes]
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
             "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
+    inert, pred = fitted.inert, fitted.pred
+    notes += _common_gain(fitted.found)
     if inert is not None:
-        notes.append(inert.describe())
+        notes += [inert.describe(), *_unphysical_links(arm, inert)]
+    bodies = {b: replace(c, torque_rms=np.sqrt(np.mean(
+        (arm.regressor(s.q, s.qd, s.qdd, [b])[0] @ (c.phi - c.phi0)) ** 2, axis=0)))
+        for b, c in fitted.bodies.items()}
     return DynamicDiagnosis(
         arm.name, arm.joint_names, sigma, np.sqrt(np.mean(b_raw**2, 0)),
-        np.sqrt(np.mean((b_raw - pred) ** 2, 0)), steps, found,
+        np.sqrt(np.mean((b_raw - pred) ** 2, 0)), steps, fitted.found,
         ties + _cannot_tell([e for e in effects if e.name in JOINT_EFFECTS], sigma,
                             opt.collinear),
         {"before": regime_rms(b_raw, masks), "after": regime_rms(b_raw - pred, masks)},
         inert, {} if inert is None else inert.phi, notes,
-        Samples(s.t, s.q, s.qd, b_raw, b_raw - pred))
+        Samples(s.t, s.q, s.qd, b_raw, b_raw - pred), bodies)

@@ -31,7 +31,7 @@ import numpy as np
 
 from zrp.arrays import F64
 from zrp.gap.dynamics.arm import DynamicArm as Arm
-from zrp.gap.dynamics.bodies import body_effects
+from zrp.gap.dynamics.bodies import body_effects, point_mass_columns
 from zrp.gap.dynamics.effect import Effect
 from zrp.gap.dynamics.inertia import V_EPS, base_directions
 
@@ -42,6 +42,11 @@ STRIBECK_SPEEDS = (0.03, 0.1, 0.3)
 
 #: Relative singular value below which a base combination counts as not excited (eq. R6).
 EXCITED = 1e-2
+
+#: Smoother sign functions tried for Coulomb friction besides tanh(w / V_EPS), rad/s: a
+#: friction that builds up over a few hundredths of a rad/s (lubricated gears, a
+#: controller's own friction observer) is still Coulomb friction.
+SOFT_SIGNS = (0.05,)
 
 JOINT_EFFECTS = ("coulomb", "viscous", "stribeck", "armature", "offset", "gain")
 
@@ -67,6 +72,8 @@ def _joint_effects(arm: Arm, qd: F64, qdd: F64, tau0: F64) -> list[Effect]:
                 ("gain", tau0[:, k], "1", -1.0 + 1e-6, inf, "")]
         spec += [("stribeck", sgn * np.exp(-(w / vs) ** 2), "N m", 0.0, inf, f"v_s={vs:g} rad/s")
                  for vs in STRIBECK_SPEEDS]
+        spec += [("coulomb", np.tanh(w / vc), "N m", -float(coulomb[k]), inf,
+                  f"v_c={vc:g} rad/s") for vc in SOFT_SIGNS]
         for name, col, unit, lo, hi, detail in spec:
             out.append(Effect(name, k, _on_joint(col, k, n), (name,), (unit,), np.array([lo]),
                               np.array([hi]), detail))
@@ -75,28 +82,8 @@ def _joint_effects(arm: Arm, qd: F64, qdd: F64, tau0: F64) -> list[Effect]:
 
 def payload_columns(arm: Arm, q: F64, qd: F64, qdd: F64) -> F64:
     """The payload block (eq. E2), shape (S, n, 4)."""
-    y, labels = arm.regressor(q, qd, qdd, [arm.tool_body])
-    p = arm.tool_point
-    ym, yh = y[..., 0], y[..., 1:4]
-    yi = y[..., 4:10]
-    # a point mass m at p + d: phi = m [1, p + d, |p+d|^2 - (p+d)_i^2 ..., -(p+d)_i (p+d)_j]
-    # to first order in d; exact in m for d = 0 (the mass column), linear in m d.
-    pp = float(p @ p)
-    inert_m = np.array([pp - p[0] ** 2, pp - p[1] ** 2, pp - p[2] ** 2,
-                        -p[0] * p[1], -p[0] * p[2], -p[1] * p[2]])
-    col_m = ym + yh @ p + yi @ inert_m
-    # d(phi_I)/d(m d) at d = 0: the first moments' own columns plus the inertia's
-    # linear terms 2 p.d - 2 p_i d_i (diagonal) and -(p_i d_j + d_i p_j) (off-diagonal)
-    cols = [col_m]
-    for a in range(3):
-        e = np.zeros(3)
-        e[a] = 1.0
-        di = np.array([2 * p @ e - 2 * p[0] * e[0], 2 * p @ e - 2 * p[1] * e[1],
-                       2 * p @ e - 2 * p[2] * e[2], -(p[0] * e[1] + e[0] * p[1]),
-                       -(p[0] * e[2] + e[0] * p[2]), -(p[1] * e[2] + e[1] * p[2])])
-        cols.append(yh[..., a] + yi @ di)
-    del labels
-    return np.stack(cols, axis=-1)
+    y, _ = arm.regressor(q, qd, qdd, [arm.tool_body])
+    return point_mass_columns(y, np.asarray(arm.tool_point, dtype=float))
 
 
 def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,

@@ -14,6 +14,10 @@ steps of stochastic hill climbing on the best one (each step perturbs all coeffi
 not a global optimum; it reports the kappa it reached and the random start's for comparison.
 Torque limits (the model's actuator force ranges, or ``torque_limit``) are met by shrinking
 the series until the nominal model's torques stay inside them.
+
+Work is bounded before anything is allocated: at most :data:`MAX_HARMONICS` harmonics,
+:data:`MAX_CANDIDATES` random starts and :data:`MAX_ITERATIONS` steps; each evaluation takes
+max(200, 20 L) samples of one period (400 and 40 L for the torques).
 """
 
 from __future__ import annotations
@@ -22,13 +26,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from zrp.arguments import check_float, check_int
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.dynamics.arm import DynamicArm as Arm
-from zrp.gap.dynamics.fourier import Fourier, _rest_projector, random_fourier, scale_into
+from zrp.gap.dynamics.fourier import (
+    MAX_HARMONICS,
+    Fourier,
+    _rest_projector,
+    random_fourier,
+    scale_into,
+)
 from zrp.gap.dynamics.inertia import V_EPS, base_directions
+from zrp.limits import MAX_DESIGN_CANDIDATES as MAX_CANDIDATES
+from zrp.limits import MAX_DESIGN_ITERATIONS as MAX_ITERATIONS
 
-__all__ = ["Excitation", "condition_number", "design_excitation", "structural_rank"]
+__all__ = ["MAX_CANDIDATES", "MAX_HARMONICS", "MAX_ITERATIONS", "Excitation",
+           "condition_number", "design_excitation", "structural_rank", "within_torque"]
+
 
 
 @dataclass(frozen=True)
@@ -71,10 +86,11 @@ def structural_rank(arm: Arm, basis: tuple[F64, F64], seed: int = 0) -> int:
     return int(np.sum(s > 1e-9 * s[0]))
 
 
-def condition_number(arm: Arm, f: Fourier, samples: int = 200,
+def condition_number(arm: Arm, f: Fourier, samples: int | None = None,
                      basis: tuple[F64, F64] | None = None, rank: int | None = None) -> float:
-    """kappa of eq. X2 along one period of ``f``: the largest over the ``rank``-th singular
-    value (``rank``: :func:`structural_rank`)."""
+    """kappa of eq. X2 along one period of ``f`` (``samples``: default max(200, 20 L)): the
+    largest over the ``rank``-th singular value (``rank``: :func:`structural_rank`)."""
+    samples = samples or max(200, 20 * f.a.shape[1])
     basis = basis or base_directions(arm)
     a = _identification_matrix(arm, f, basis, samples)
     norms = np.linalg.norm(a, axis=0)
@@ -85,34 +101,85 @@ def condition_number(arm: Arm, f: Fourier, samples: int = 200,
     return float(s[0] / s[r - 1]) if s[r - 1] > 0 else float("inf")
 
 
-def _torque_limits(arm: Arm, torque_limit: F64 | None) -> F64:
-    if torque_limit is not None:
-        return np.broadcast_to(np.asarray(torque_limit, dtype=float), (arm.n,))
-    return arm.torque_limits()
+def within_torque(arm: Arm, f: Fourier, limit: F64, t: F64 | None = None
+                  ) -> tuple[Fourier, F64]:
+    """``f``, shrunk about q0 by steps of 10 % (at most 40) until the model's torques at the
+    times ``t`` (default: max(400, 40 L) samples of one period) stay within ``limit``, and
+    those torques (S, n)."""
+    if t is None:
+        t = np.linspace(0.0, 1.0 / f.f0_hz, max(400, 40 * f.a.shape[1]), endpoint=False)
+    for _ in range(40):
+        tau = arm.inverse_dynamics(*f.evaluate(t))
+        if np.all(np.abs(tau) <= limit):
+            return f, tau
+        f = Fourier(f.q0, 0.9 * f.a, 0.9 * f.b, f.f0_hz)
+    k = int(np.argmax(np.abs(tau).max(0) / limit))
+    raise InputError(f"torque_limit: even a small exciting motion needs more torque than the "
+                     f"limits allow (joint {k + 1}: {np.abs(tau[:, k]).max():.4g} over "
+                     f"{limit[k]:.4g}; gravity alone at q0?); choose another posture q0")
 
 
 def _within_torque(arm: Arm, f: Fourier, limit: F64) -> tuple[Fourier, F64]:
-    t = np.linspace(0.0, 1.0 / f.f0_hz, 400, endpoint=False)
-    for _ in range(40):
-        peak = np.abs(arm.inverse_dynamics(*f.evaluate(t))).max(0)
-        if np.all(peak <= limit):
-            return f, peak
-        f = Fourier(f.q0, 0.9 * f.a, 0.9 * f.b, f.f0_hz)
-    raise InputError("torque_limit: even a small exciting motion needs more torque than the "
-                     "limits allow at q0 (gravity alone?); choose another posture q0")
+    f, tau = within_torque(arm, f, limit)
+    return f, np.abs(tau).max(0)
+
+
+def _positive(value: object, n: int, field: str, *, finite: bool = True) -> F64:
+    try:
+        v = np.broadcast_to(np.asarray(value, dtype=float), (n,))
+    except (TypeError, ValueError):
+        raise InputError(f"{field}: expected 1 or {n} numbers > 0, got {value!r}") from None
+    bad = np.isnan(v) | (v <= 0) | (~np.isfinite(v) if finite else False)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(f"{field}: joint {k + 1} is {v[k]!r}; expected a "
+                         f"{'finite ' if finite else ''}number > 0")
+    return v
+
+
+def _check_inputs(arm: Arm, q0: F64, harmonics: int, f0_hz: float, candidates: int,
+                  iterations: int, step: float) -> F64:
+    """q0 (n,), finite, within the position limits; the bounded sizes (module docstring)."""
+    check_int(harmonics, "harmonics", 2, MAX_HARMONICS)
+    check_int(candidates, "candidates", 1, MAX_CANDIDATES)
+    check_int(iterations, "iterations", 0, MAX_ITERATIONS)
+    check_float(f0_hz, "f0_hz", 0.0, open_lo=True, unit="Hz")
+    check_float(step, "step", 0.0, 10.0, open_lo=True)
+    q0 = np.asarray(q0, dtype=float)
+    if q0.shape != (arm.n,) or not np.all(np.isfinite(q0)):
+        raise InputError(f"q0: expected {arm.n} finite joint values, got {q0!r}")
+    return q0
+
+
+def _check_envelope(arm: Arm, q0: F64, q_amp: F64) -> None:
+    lo, hi = arm.position_limits()
+    bad = (q0 - q_amp < lo) | (q0 + q_amp > hi)
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(f"q0, q_amp: joint {k + 1} would move over [{q0[k] - q_amp[k]:.6g}, "
+                         f"{q0[k] + q_amp[k]:.6g}], beyond its position limits "
+                         f"[{lo[k]:.6g}, {hi[k]:.6g}]")
 
 
 def design_excitation(arm: Arm, q0: F64, q_amp: F64 | float, qd_max: F64 | float,
                       qdd_max: F64 | float, *, torque_limit: F64 | None = None,
                       harmonics: int = 5, f0_hz: float = 0.1, candidates: int = 8,
                       iterations: int = 20, step: float = 0.2, seed: int = 0) -> Excitation:
-    """Design the exciting command (module docstring); limits per joint (or one for all)."""
+    """Design the exciting command (module docstring); limits per joint (or one for all).
+
+    Raises:
+        InputError: q0 not n finite values, q0 +- q_amp beyond the arm's position limits, a
+            limit that is not a finite number > 0 (torque: inf allowed), harmonics,
+            candidates or iterations beyond their bounds, or torque limits that even a small
+            motion exceeds.
+    """
     n = arm.n
-    q0 = np.asarray(q0, dtype=float)
-    if q0.shape != (n,):
-        raise InputError(f"q0: expected {n} joint values, got shape {q0.shape}")
-    lims = [np.broadcast_to(np.asarray(v, dtype=float), (n,)) for v in (q_amp, qd_max, qdd_max)]
-    tlim = _torque_limits(arm, torque_limit)
+    q0 = _check_inputs(arm, q0, harmonics, f0_hz, candidates, iterations, step)
+    lims = [_positive(v, n, f) for v, f in ((q_amp, "q_amp"), (qd_max, "qd_max"),
+                                            (qdd_max, "qdd_max"))]
+    _check_envelope(arm, q0, lims[0])
+    tlim = _positive(arm.torque_limits() if torque_limit is None else torque_limit, n,
+                     "torque_limit", finite=False)
     basis = base_directions(arm)
     rank = structural_rank(arm, basis)
     rng = np.random.default_rng(seed)

@@ -16,8 +16,11 @@ import numpy as np
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.limits import MAX_HARMONICS  # largest number of harmonics of a series
 
-__all__ = ["Fourier", "random_fourier"]
+__all__ = ["MAX_HARMONICS", "Fourier", "random_fourier"]
+
+_CHUNK = 1 << 15
 
 
 @dataclass(frozen=True)
@@ -35,6 +38,14 @@ class Fourier:
 
     def evaluate(self, t: F64) -> tuple[F64, F64, F64]:
         """q, qd, qdd at times ``t`` (s), each (S, n)."""
+        t = np.asarray(t, dtype=float)
+        q, qd, qdd = (np.empty((t.size, self.q0.size)) for _ in range(3))
+        for i in range(0, t.size, _CHUNK):  # bounded temporaries: (chunk, L) at a time
+            part = slice(i, i + _CHUNK)
+            q[part], qd[part], qdd[part] = self._at(t[part])
+        return q, qd, qdd
+
+    def _at(self, t: F64) -> tuple[F64, F64, F64]:
         w = self.omegas
         s, c = np.sin(np.outer(t, w)), np.cos(np.outer(t, w))
         q = self.q0 + s @ (self.a / w).T - c @ (self.b / w).T
@@ -43,10 +54,20 @@ class Fourier:
         return q, qd, qdd
 
     def peaks(self, n_samples: int = 2000) -> tuple[F64, F64, F64]:
-        """max |q - q0|, max |qd|, max |qdd| over one period, each (n,)."""
-        t = np.linspace(0.0, 1.0 / self.f0_hz, n_samples, endpoint=False)
+        """Upper bounds of max |q - q0|, max |qd|, max |qdd| over one period, each (n,).
+
+        Each is a trigonometric polynomial of degree L (the harmonics) in x = omega_1 t; its
+        largest |value| on M equally spaced samples (M = max(``n_samples``, 32 L)) lies
+        within ||p|| (1 - pi^2 L^2 / (2 M^2)) of its true peak ||p|| (Bernstein's inequality
+        ||p''|| <= L^2 ||p|| and a sample within pi / M of the peak), so the sampled peak
+        divided by that factor bounds the peak between the samples too.
+        """
+        L = self.a.shape[1]
+        m = max(int(n_samples), 32 * L)
+        t = np.linspace(0.0, 1.0 / self.f0_hz, m, endpoint=False)
         q, qd, qdd = self.evaluate(t)
-        return (np.abs(q - self.q0).max(0), np.abs(qd).max(0), np.abs(qdd).max(0))
+        k = 1.0 / (1.0 - (np.pi * L / m) ** 2 / 2.0)
+        return (k * np.abs(q - self.q0).max(0), k * np.abs(qd).max(0), k * np.abs(qdd).max(0))
 
 
 def _rest_projector(w: F64) -> F64:
@@ -72,9 +93,11 @@ def scale_into(f: Fourier, q_amp: F64, qd_max: F64, qdd_max: F64) -> Fourier:
 def random_fourier(q0: F64, q_amp: F64, qd_max: F64, qdd_max: F64, *, harmonics: int = 5,
                    f0_hz: float = 0.1, seed: int | np.random.Generator = 0) -> Fourier:
     """A random exciting trajectory about q0 within the limits (each (n,))."""
-    if harmonics < 2:
-        raise InputError(f"harmonics: {harmonics}; need at least 2 (the start-at-rest "
-                         "conditions take three coefficients a joint)")
+    if isinstance(harmonics, bool) or not isinstance(harmonics, (int, np.integer)) \
+            or not 2 <= harmonics <= MAX_HARMONICS:
+        raise InputError(f"harmonics: {harmonics!r}; expected a whole number from 2 (the "
+                         "start-at-rest conditions take three coefficients a joint) to "
+                         f"{MAX_HARMONICS} (the stated bound on the series' size)")
     rng = np.random.default_rng(seed)
     q0 = np.asarray(q0, dtype=float)
     n = q0.size

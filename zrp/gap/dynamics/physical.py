@@ -38,7 +38,7 @@ the distance in standard errors, eq. P4) and the weighted residual RMS of both.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy.linalg import block_diag
@@ -85,6 +85,7 @@ class InertialFit:
             unconstrained fit along the rows fitted, in noise units (1 = the noise floor).
         min_margin: the smallest pseudo-inertia eigenvalue over the body's mass, all bodies.
         converged: whether the optimiser met its tolerances.
+        unconstrained_phi: phi_b of each moving body in the unconstrained fit (eq. P3).
     """
 
     theta: F64
@@ -95,6 +96,12 @@ class InertialFit:
     torque_gap: float
     min_margin: float
     converged: bool = True
+    unconstrained_phi: dict[int, F64] = field(default_factory=dict)
+
+    def unphysical_links(self) -> list[int]:
+        """The bodies whose unconstrained fit (eq. P3) is not physical (eq. R5): where the
+        physical set cannot follow the data."""
+        return [b for b, ph in self.unconstrained_phi.items() if pseudo_inertia_min(ph) <= 0.0]
 
     @property
     def matched(self) -> bool:
@@ -313,7 +320,8 @@ def physical_fit(arm: Arm, effects: list[Effect], b: F64, sigma: F64,
                        float(np.sqrt(rise / se2)),
                        float(np.sqrt(chi2.ppf(MATCHED_QUANTILE, v.shape[1]))),
                        float(np.sqrt(gap @ gap / gap.size)), min(_margin(ph) for ph in phis),
-                       converged)
+                       converged, dict(zip(arm.moving_bodies(), _phis(p, z_u[p.p_other:]),
+                                           strict=True)))
 
 
 def predict(arm: Arm, effects: list[Effect], fit: InertialFit, rows: np.ndarray) -> F64:

@@ -2,12 +2,12 @@
 :func:`zrp.gap.report.html.report_html`), the per-joint torque residuals before and after
 against velocity and position (PNG beside it, SVG inside the page) and diagnosis.json.
 
-Every name from the model or the log (the arm, its joints and bodies in the effects' labels,
-the notes) reaches the Markdown only through :mod:`zrp.escape` (:func:`~zrp.escape.md_row`,
-:func:`~zrp.escape.md_line`, :func:`~zrp.escape.md_text`): a joint named
-``j1\n\n## Verdict`` stays one table cell, ``|`` adds no cell and ``<script>`` stays text, in
-report.md and in report.html. The ``extra`` sections are Markdown the caller built the same
-way."""
+Every name from the model or the logs (the arm, its joints and bodies in the effects' labels
+and words, a log's file name, the notes) reaches the Markdown only through :mod:`zrp.escape`
+(:func:`~zrp.escape.md_row`, :func:`~zrp.escape.md_line`, :func:`~zrp.escape.md_text`): a
+joint named ``j1\n\n## Verdict`` stays one table cell, ``|`` adds no cell and ``<script>``
+stays text, in report.md and in report.html. The ``extra`` sections are Markdown the caller
+built the same way."""
 
 from __future__ import annotations
 
@@ -16,37 +16,34 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from zrp.escape import md_line, md_row, md_text, one_line
 from zrp.gap.dynamics.diagnosis import DynamicDiagnosis
+from zrp.gap.dynamics.run import DynamicsRun
+from zrp.gap.dynamics.validation import Validation
+from zrp.gap.dynamics.verdict import effect_words, headline, overall_rms, validation_words
 from zrp.gap.report.html import report_html
 from zrp.jsonio import to_jsonable
-from zrp.output import OutputDir
+from zrp.output import OutputDir, write_text
 
-__all__ = ["REPORT_FILES", "diagnosis_json", "report_markdown", "write_report"]
+__all__ = ["REPORT_FILES", "diagnosis_json", "report_markdown", "run_json", "write_report",
+           "write_run"]
 
 FIGURES = {"residuals_velocity.png": ("qd", "joint velocity (rad/s)"),
            "residuals_position.png": ("q", "joint position (rad)")}
-#: the files :func:`write_report` writes
-REPORT_FILES = ("report.md", "report.html", "diagnosis.json", *FIGURES)
+#: the files :func:`write_run` writes (corrected.xml when there is a corrected model)
+REPORT_FILES = ("report.md", "report.html", "diagnosis.json", *FIGURES, "corrected.xml")
 
 
 def _fmt(v: float | None) -> str:
     return "-" if v is None else f"{v:.3g}"
 
 
-def _verdict(d: DynamicDiagnosis) -> str:
-    worst = int(np.argmax(d.rms_before / d.noise_nm))
-    if not d.effects:
-        return (f"The model's torques match the log down to the noise floor (worst joint "
-                f"{worst + 1}: {d.rms_before[worst]:.3g} N m RMS against a noise of "
-                f"{d.noise_nm[worst]:.3g} N m); no effect is needed.")
-    names = ", ".join(md_text(e.label) for e in d.effects)
-    return (f"The model misses most on joint {worst + 1} ({d.rms_before[worst]:.3g} N m RMS, "
-            f"{d.rms_before[worst] / d.noise_nm[worst]:.1f}x its noise). Found: {names}. "
-            f"Withheld torque RMS on joint {worst + 1} drops to {d.rms_after[worst]:.3g} N m "
-            f"({d.rms_after[worst] / d.noise_nm[worst]:.2f}x the noise).")
+def _verdict(d: DynamicDiagnosis, validation: Validation | None) -> list[str]:
+    """The headline, then one line per finding in words."""
+    out = [md_text(headline(d, validation))]
+    if d.effects:
+        out += ["", *(md_line("- {}", effect_words(d, e)) for e in d.effects)]
+    return out
 
 
 def _effects(d: DynamicDiagnosis) -> list[str]:
@@ -76,16 +73,35 @@ def _regimes(d: DynamicDiagnosis) -> list[str]:
     return out
 
 
-def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None) -> str:
-    """The report's text (``extra``: more sections, heading -> lines)."""
+def _validation(v: Validation, joints: list[str]) -> list[str]:
+    out = [md_text(validation_words(v)), "",
+           "| joint | noise floor | model | corrected | ratio to noise |", "|---|---|---|---|---|"]
+    out += [f"| {k + 1} | {v.noise_nm[k]:.3g} | {v.rms_before[k]:.3g} | {v.rms_after[k]:.3g} "
+            f"| {v.rms_after[k] / v.noise_nm[k]:.2f} |" for k in range(len(joints))]
+    out.append(f"| all | {v.overall_noise:.3g} | {v.overall_before:.3g} | "
+               f"{v.overall_after:.3g} | {v.overall_after / v.overall_noise:.2f} |")
+    return out
+
+
+def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
+                    validation: Validation | None = None) -> str:
+    """The report's text (``extra``: more sections, heading -> lines; ``validation``: the
+    corrected model on a second log)."""
     n = len(d.joints)
-    lines = [md_line("# Dynamic gap: {}", d.arm), "", "## Verdict", "", _verdict(d), "",
+    lines = [md_line("# Dynamic gap: {}", d.arm), "", "## Verdict", "", *_verdict(d, validation),
+             "",
              "## Torque residual per joint (N m RMS)", "",
              "| joint | name | noise floor | model | corrected (withheld) | ratio to noise |",
              "|---|---|---|---|---|---|"]
     lines += [md_row(k + 1, d.joints[k], f"{d.noise_nm[k]:.3g}", f"{d.rms_before[k]:.3g}",
                      f"{d.rms_after[k]:.3g}", f"{d.rms_after[k] / d.noise_nm[k]:.2f}")
               for k in range(n)]
+    lines.append(f"| all | | {overall_rms(d.noise_nm):.3g} | {overall_rms(d.rms_before):.3g} | "
+                 f"{overall_rms(d.rms_after):.3g} | "
+                 f"{overall_rms(d.rms_after) / overall_rms(d.noise_nm):.2f} |")
+    if validation is not None:
+        lines += ["", "## Validation on another log (N m RMS)", "",
+                  *_validation(validation, d.joints)]
     lines += ["", "## Effects found", ""]
     lines += _effects(d) if d.effects else ["None: the torques are explained to the noise."]
     lines += ["", "## Selection (withheld chi2: 1 is the noise floor)", "",
@@ -144,9 +160,29 @@ def _inertial_fit(d: DynamicDiagnosis) -> dict[str, Any] | None:
             "matched": f.matched, "summary": f.describe()}
 
 
-def diagnosis_json(d: DynamicDiagnosis, extra: dict[str, Any] | None = None) -> dict:
-    out = {"arm": d.arm, "joints": d.joints, "noise_nm": d.noise_nm,
+def _validation_json(v: Validation | None) -> dict[str, Any] | None:
+    if v is None:
+        return None
+    return {"source": v.source, "samples": v.samples, "noise_nm": v.noise_nm,
+            "rms_before_nm": v.rms_before, "rms_after_nm": v.rms_after,
+            "overall_before_nm": v.overall_before, "overall_after_nm": v.overall_after,
+            "overall_noise_nm": v.overall_noise}
+
+
+def _bodies_json(d: DynamicDiagnosis) -> list[dict[str, Any]]:
+    return [{"body": c.name, "effects": list(c.effects), "mass_change_kg": c.mass_change,
+             "centre_shift_m": c.centre_shift_m, "phi_model": c.phi0, "phi": c.phi,
+             "torque_rms_nm": c.torque_rms} for c in d.bodies.values()]
+
+
+def diagnosis_json(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
+                   validation: Validation | None = None) -> dict:
+    out = {"verdict": headline(d, validation), "arm": d.arm, "joints": d.joints,
+           "noise_nm": d.noise_nm, "overall_nm": {
+               "noise": overall_rms(d.noise_nm), "before": overall_rms(d.rms_before),
+               "after_withheld": overall_rms(d.rms_after)},
            "rms_before_nm": d.rms_before, "rms_after_withheld_nm": d.rms_after,
+           "validation": _validation_json(validation), "bodies": _bodies_json(d),
            "steps": [asdict(s) for s in d.steps],
            "effects": [asdict(e) for e in d.effects], "cannot_tell": d.cannot_tell,
            "regimes": d.regimes, "inertial_fit": _inertial_fit(d),
@@ -155,7 +191,8 @@ def diagnosis_json(d: DynamicDiagnosis, extra: dict[str, Any] | None = None) -> 
 
 
 def write_report(d: DynamicDiagnosis, folder: str | Path, *, overwrite: bool = False,
-                 extra: dict[str, Any] | None = None) -> Path:
+                 extra: dict[str, Any] | None = None, validation: Validation | None = None
+                 ) -> Path:
     """Write report.md, report.html, the residual PNGs and diagnosis.json into ``folder``."""
     svgs: dict[str, bytes] = {}
     sections = (extra or {}).get("sections")
@@ -167,9 +204,49 @@ def write_report(d: DynamicDiagnosis, folder: str | Path, *, overwrite: bool = F
             fig.savefig(buf, format="svg")
             svgs[name] = buf.getvalue()
             plt.close(fig)
-        md = report_markdown(d, sections)
+        md = report_markdown(d, sections, validation)
         out.write_text("report.md", md)
         out.write_text("report.html", report_html(md, svgs, f"Dynamic gap: {one_line(d.arm)}"))
-        out.write_json("diagnosis.json", diagnosis_json(d, {k: v for k, v in (extra or {}).items()
-                                                            if k != "sections"}))
+        out.write_json("diagnosis.json", diagnosis_json(
+            d, {k: v for k, v in (extra or {}).items() if k != "sections"}, validation))
     return Path(folder)
+
+
+def _tracking_lines(track: Any, joints: int) -> list[str]:
+    if track is None:
+        return ["- the log has no commanded positions qc1..qcn: no re-simulation"]
+    lines = [md_line("Re-simulation of the logged command with {}; RMS of simulated minus "
+                     "logged joint positions (rad):", track.servo), "",
+             "| joint | model | corrected model |", "|---|---|---|"]
+    return lines + [md_row(k + 1, f"{track.before_rad[k]:.3g}", f"{track.after_rad[k]:.3g}")
+                    for k in range(joints)]
+
+
+def _extra(run: DynamicsRun) -> dict[str, Any]:
+    n = len(run.diagnosis.joints)
+    sections: dict[str, list[str]] = {}
+    data: dict[str, Any] = {}
+    if run.corrected_model is not None:
+        sections["Corrected model"] = [md_text(s) for s in run.model_notes]
+        sections["Tracking"] = _tracking_lines(run.tracking, n)
+        if run.tracking is not None:
+            data["tracking"] = {"before_rad": run.tracking.before_rad,
+                                "after_rad": run.tracking.after_rad,
+                                "servo": run.tracking.servo}
+    return {"sections": sections, **data}
+
+
+def write_run(run: DynamicsRun, folder: str | Path, *, overwrite: bool = False) -> Path:
+    """Write report.html/.md, the residual plots, diagnosis.json and (when there is one)
+    corrected.xml into ``folder``; existing files only with ``overwrite``."""
+    out = write_report(run.diagnosis, folder, overwrite=overwrite, extra=_extra(run),
+                       validation=run.validation)
+    if run.corrected_model is not None:
+        write_text(Path(out) / "corrected.xml", run.corrected_model, overwrite=overwrite)
+    return Path(out)
+
+
+def run_json(run: DynamicsRun) -> dict:
+    """diagnosis.json of the run (as written)."""
+    extra = {k: v for k, v in _extra(run).items() if k != "sections"}
+    return diagnosis_json(run.diagnosis, extra, validation=run.validation)

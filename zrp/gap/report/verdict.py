@@ -183,7 +183,8 @@ def _against_floor(diag: Diagnosis) -> list[str]:
     floor, final, unit = diag.noise_floor, diag.final, diag.length_unit
     if floor.rms is None:
         return ["No noise floor can be estimated from these data (one point per pose and no "
-                "repeated poses), so whether a gap remains cannot be judged."]
+                "repeated poses), so whether a gap remains cannot be judged.",
+                *_structure_words(diag, always=True)]
     if floor.rms <= (diag.assessment.resolution if diag.assessment else 0.0):
         parts = [f"The noise floor is {floor.rms:.3g} {unit} (noise-free data)."]
         if diag.unexplained:
@@ -198,10 +199,27 @@ def _against_floor(diag: Diagnosis) -> list[str]:
         parts.append(f"A gap of {final.rms:.4g} {unit} RMS remains that no effect in the "
                      "library explains.")
         parts.append(remains_text(diag.where_final, unit))
+        parts += _structure_words(diag, always=True)
         parts += _weighed(diag)
     else:
-        parts.append("What remains is at the noise floor.")
+        extra = _structure_words(diag, always=False)
+        structured = bool(diag.assessment and diag.assessment.remainder.structure
+                          and diag.assessment.remainder.structure.structured)
+        parts.append("What remains is close to the noise floor, yet not all scatter."
+                     if structured else "What remains is at the noise floor.")
+        parts += extra
     return parts
+
+
+def _structure_words(diag: Diagnosis, *, always: bool) -> list[str]:
+    """The multivariate test of what remains in one sentence (``always``: also when it finds
+    no structure)."""
+    a = diag.assessment
+    s = None if a is None else a.remainder.structure
+    out = [] if s is None or not (always or s.structured) else [s.words(diag.length_unit)]
+    if a is not None and a.residual_model is not None:
+        out.append(a.residual_model.words(diag.length_unit))
+    return out
 
 
 def _weighed(diag: Diagnosis) -> list[str]:

@@ -1,0 +1,202 @@
+"""Kernel ridge regression of a residual on the joint angles, for what remains after the
+final model (:mod:`.structure`, :mod:`.residual`).
+
+* **inputs** (:class:`Inputs`) - per pose (sin q, cos q) of each revolute joint that moves
+  (q of a prismatic one), and time, temperature and load where logged; each input's columns
+  centred and scaled to unit spread on the poses the inputs are set on (the fitting poses);
+* **targets** (:func:`pose_targets`) - per pose the residual of all its measured points
+  (x, y, z of each), complete poses only;
+* **model** (:func:`fit_kernel_ridge`) - a Gaussian (RBF) kernel on the inputs scaled by
+  per-input length scales (ARD) that a scikit-learn Gaussian process sets on at most
+  :data:`ARD_POSES` poses (its leading :data:`ARD_COMPONENTS` principal components of the
+  targets: its cost grows with their number); then the kernel width and the ridge of least
+  exact leave-one-out error (eigendecomposition of the kernel matrix: every ridge value costs
+  O(n^2)).
+
+scikit-learn is imported inside the functions, so that ``import zrp`` stays fast.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.arrays import F64
+from zrp.gap.model.context import MIN_EXCITATION_RAD, Context
+
+__all__ = ["Inputs", "KernelModel", "fit_kernel_ridge", "length_scales", "pose_inputs",
+           "pose_targets"]
+
+#: most poses the Gaussian process that sets the length scales sees.
+ARD_POSES = 200
+#: leading principal components of the residual the Gaussian process fits.
+ARD_COMPONENTS = 3
+#: kernel widths tried on the inputs scaled by their length scales: RBF
+#: exp(-gamma |x - x'|^2) (0.5: the Gaussian process's own).
+GAMMAS = (0.125, 0.5, 2.0)
+#: ridge values tried, relative to the mean eigenvalue of the kernel matrix.
+RIDGES = tuple(10.0 ** np.arange(-5.0, 1.5, 0.5))
+
+
+@dataclass(frozen=True)
+class Inputs:
+    """The inputs of the regression, as set on the training poses.
+
+    Attributes:
+        names: "q1".."qn" (joints that move), "time", "temperature", "load".
+        center, scale: per column, from the training poses.
+        ranges: per input, its smallest and largest raw value on the training poses (rad or
+            length unit for joints, s, deg C, kg).
+        widths: per input, its number of columns (2 for a revolute joint).
+    """
+
+    names: tuple[str, ...]
+    center: F64
+    scale: F64
+    ranges: tuple[tuple[float, float], ...]
+    widths: tuple[int, ...]
+
+    @property
+    def groups(self) -> list[list[int]]:
+        """The columns of each input."""
+        out, i = [], 0
+        for w in self.widths:
+            out.append(list(range(i, i + w)))
+            i += w
+        return out
+
+    def __call__(self, ctx: Context, rows: NDArray[np.int64]) -> F64:
+        """The scaled inputs of the poses of ``rows`` (one row per pose)."""
+        return (_raw(ctx, rows, self.names) - self.center) / self.scale
+
+
+def _column(ctx: Context, rows: NDArray[np.int64], name: str) -> F64:
+    meas = ctx.meas
+    if name.startswith("q"):
+        k = int(name[1:]) - 1
+        qk = ctx.q[meas.pose_index[rows], k]
+        return qk[:, None] if ctx.model.prismatic[k] else np.column_stack([np.sin(qk),
+                                                                           np.cos(qk)])
+    arr = {"time": meas.t, "temperature": meas.temp, "load": meas.load}[name]
+    assert arr is not None
+    return arr[rows][:, None]
+
+
+def _raw(ctx: Context, rows: NDArray[np.int64], names: tuple[str, ...]) -> F64:
+    cols = [_column(ctx, rows, n) for n in names]
+    return np.column_stack(cols) if cols else np.zeros((len(rows), 0))
+
+
+def _raw_value(ctx: Context, rows: NDArray[np.int64], name: str) -> F64:
+    if name.startswith("q"):
+        return ctx.q[ctx.meas.pose_index[rows], int(name[1:]) - 1]
+    return _column(ctx, rows, name)[:, 0]
+
+
+def pose_inputs(ctx: Context, rows: NDArray[np.int64]) -> Inputs:
+    """The inputs set on the poses of ``rows`` (one row per pose): joints that move at least
+    the excitation threshold, and the logged columns that vary."""
+    meas = ctx.meas
+    names = [f"q{k + 1}" for k in range(ctx.n)
+             if ctx.excited[k] and np.ptp(ctx.q[meas.pose_index[rows], k]) >= MIN_EXCITATION_RAD]
+    names += [n for n, a in (("time", meas.t), ("temperature", meas.temp), ("load", meas.load))
+              if a is not None and np.ptp(a[rows]) > 0]
+    center, scale, widths = [], [], []
+    for n in names:
+        f = _column(ctx, rows, n)
+        widths.append(f.shape[1])
+        s = math.sqrt(float(np.sum(f.var(0))))
+        center.append(f.mean(0))
+        scale.append(np.full(f.shape[1], s if s > 0 else 1.0))
+    ranges = tuple((float(v.min()), float(v.max()))
+                   for v in (_raw_value(ctx, rows, n) for n in names))
+    return Inputs(tuple(names), _cat(center), _cat(scale), ranges, tuple(widths))
+
+
+def _cat(parts: list[F64]) -> F64:
+    return np.concatenate(parts) if parts else np.zeros(0)
+
+
+def pose_targets(ctx: Context, poses: NDArray[np.int64], residual: F64
+                 ) -> tuple[F64, NDArray[np.int64]]:
+    """Per complete pose of ``poses`` the residual (3R,) of all its points, shape (P, 3M), and
+    one row of each such pose (for its inputs)."""
+    meas = ctx.meas
+    rows = np.flatnonzero(np.isin(meas.pose_index, poses))
+    r = residual[: 3 * rows.size].reshape(-1, 3)
+    M = len(meas.point_labels)
+    up, inv = np.unique(meas.pose_index[rows], return_inverse=True)
+    Y = np.full((up.size, M, 3), np.nan)
+    Y[inv, meas.point_index[rows]] = r
+    first = np.full(up.size, -1, dtype=np.int64)
+    first[inv[::-1]] = rows[::-1]
+    full = np.all(np.isfinite(Y.reshape(up.size, -1)), axis=1)
+    return Y[full].reshape(int(full.sum()), -1), first[full]
+
+
+def length_scales(X: F64, Y: F64, rng: np.random.Generator) -> F64:
+    """Per-column length scales (ARD) of a scikit-learn Gaussian process on at most
+    :data:`ARD_POSES` poses: an input the residual does not depend on gets a long one."""
+    from sklearn.gaussian_process import GaussianProcessRegressor
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+
+    sub = rng.choice(len(X), min(len(X), ARD_POSES), replace=False)
+    Ys = Y[sub] - Y[sub].mean(0)
+    u, sv, _ = np.linalg.svd(Ys, full_matrices=False)
+    Ys = u[:, :ARD_COMPONENTS] * sv[:ARD_COMPONENTS]
+    Ys = Ys / max(float(Ys.std()), 1e-300)
+    kernel = (ConstantKernel(0.1, (1e-4, 1e2)) * RBF(np.ones(X.shape[1]), (1e-1, 1e3))
+              + WhiteKernel(1.0, (1e-4, 1e1)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # a bound reached: an irrelevant input, as it should
+        gp = GaussianProcessRegressor(kernel, random_state=0).fit(X[sub], Ys)
+    return np.asarray(gp.kernel_.k1.k2.length_scale, dtype=float).reshape(-1)
+
+
+def _kernel(A: F64, B: F64, gamma: float) -> F64:
+    from sklearn.metrics.pairwise import rbf_kernel
+    return rbf_kernel(A, B, gamma=gamma)
+
+
+@dataclass(frozen=True)
+class KernelModel:
+    """A fitted kernel ridge regression (training inputs scaled, dual coefficients)."""
+
+    Xtr: F64
+    coef: F64
+    mean: F64
+    gamma: float
+    scale: F64
+
+    def predict(self, X: F64) -> F64:
+        """Predicted targets at the (scaled) inputs X."""
+        return self.mean + _kernel(X * self.scale, self.Xtr, self.gamma) @ self.coef
+
+
+def fit_kernel_ridge(X: F64, Y: F64, scale: F64) -> KernelModel:
+    """Kernel ridge on the inputs multiplied by ``scale`` (1 / length scales), with the width
+    and ridge of least exact leave-one-out error."""
+    Xs = X * scale
+    mean = Y.mean(0)
+    Yc = Y - mean
+    best: tuple[float, float, float, F64, F64] | None = None
+    for gamma in GAMMAS:
+        w, V = np.linalg.eigh(_kernel(Xs, Xs, gamma))
+        w = np.clip(w, 0.0, None)
+        VtY = V.T @ Yc
+        V2 = V**2
+        for lam in RIDGES:
+            lam_abs = lam * max(float(w.mean()), 1e-12)
+            h = w / (w + lam_abs)
+            loo = (Yc - V @ (h[:, None] * VtY)) / (1.0 - V2 @ h)[:, None]
+            sse = float(np.sum(loo**2))
+            if best is None or sse < best[0]:
+                best = (sse, gamma, lam_abs, w, V)
+    assert best is not None
+    _, gamma, lam_abs, w, V = best
+    coef = V @ ((1.0 / (w + lam_abs))[:, None] * (V.T @ Yc))
+    return KernelModel(Xs, coef, mean, gamma, scale)

@@ -1,0 +1,110 @@
+"""A residual model that earns its place: a learned term on top of the final physical model.
+
+With ``residual_model=True`` (``zrp diagnose --residual-model``), a kernel ridge regression of
+the final model's residual on the joint angles (and logged time, temperature, load;
+:mod:`.kernel`) is fitted on the fitting poses after the physical model, its width and ridge
+chosen by leave-one-out cross-validation there. It is **kept** only when it lowers the
+withheld error clearly, by the rule the choice of the final model uses
+(:mod:`.fallback`): a lower withheld RMS that is not "equally good" (paired z of the per-pose
+squared errors of at least 2, or an RMS ratio above 1.1). Its withheld RMS is shown beside the
+physical model's either way; the physical model stays the final model whose effects the
+report names, and the learned term only adds to it. The training ranges of its inputs are
+recorded: outside them it is not valid.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from zrp.arrays import F64
+from zrp.gap.analysis.fallback import clearly_better, paired_z
+from zrp.gap.analysis.kernel import fit_kernel_ridge, length_scales, pose_inputs, pose_targets
+from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.fit.metrics import Metrics
+from zrp.gap.model.context import Context
+
+__all__ = ["MAX_POSES", "ResidualModel", "fit_residual_model"]
+
+#: most fitting poses the learned term is trained on (a seeded subsample beyond).
+MAX_POSES = 2000
+#: fewest complete fitting poses to train on.
+MIN_POSES = 30
+SEED = 20261
+
+
+@dataclass(frozen=True)
+class ResidualModel:
+    """The learned residual term and its withheld test (see the module docstring).
+
+    Attributes:
+        kept: it lowers the withheld error clearly.
+        withheld_rms_physical: the final physical model's withheld RMS (length unit).
+        withheld_rms_hybrid: with the learned term added.
+        paired_z: paired z of the withheld per-pose squared errors, physical minus hybrid.
+        inputs: its inputs ("q1", ..., "time", "temperature", "load").
+        training_ranges: per input, the smallest and largest value it was trained on (rad for
+            revolute joints, length unit for prismatic ones, s, deg C, kg).
+        n_poses: fitting poses it was trained on.
+    """
+
+    kept: bool
+    withheld_rms_physical: float
+    withheld_rms_hybrid: float
+    paired_z: float
+    inputs: tuple[str, ...]
+    training_ranges: tuple[tuple[float, float], ...]
+    n_poses: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"kept": self.kept, "withheld_rms_physical": self.withheld_rms_physical,
+                "withheld_rms_hybrid": self.withheld_rms_hybrid, "paired_z": self.paired_z,
+                "n_poses": self.n_poses,
+                "training_ranges": {n: list(r) for n, r in zip(
+                    self.inputs, self.training_ranges, strict=True)},
+                "method": "kernel ridge (RBF, ARD length scales) on (sin q, cos q) and logged "
+                          "time/temperature/load, trained on the fitting poses"}
+
+    def words(self, unit: str) -> str:
+        """One short sentence for the verdict."""
+        how = ("kept: it lowers the withheld error clearly" if self.kept else
+               "not kept: it does not lower the withheld error clearly")
+        return (f"A learned residual term on the joint angles gives {self.withheld_rms_hybrid:.4g}"
+                f" {unit} withheld RMS beside the physical model's "
+                f"{self.withheld_rms_physical:.4g} {unit} (paired z = {self.paired_z:.2g}); "
+                f"{how}.")
+
+
+def _hybrid_residual(ctx: Context, withheld: NDArray[np.int64], r_after: F64,
+                     predict: Any, inputs: Any) -> F64:
+    """The withheld residual (3Rw,) minus the learned term's prediction for each row."""
+    meas = ctx.meas
+    rows = np.flatnonzero(np.isin(meas.pose_index, withheld))
+    pred = predict(inputs(ctx, rows)).reshape(rows.size, -1, 3)
+    per_row = pred[np.arange(rows.size), meas.point_index[rows]]
+    return r_after - per_row.reshape(-1)
+
+
+def fit_residual_model(ctx: Context, final: FitResult, withheld: NDArray[np.int64],
+                       r_after: F64) -> ResidualModel | None:
+    """Train the learned term on ``final``'s residual over its fitting poses and test it on
+    the ``withheld`` poses (whose final residual is ``r_after``, 3Rw); None with too few
+    complete poses or no input that varies."""
+    Y, first = pose_targets(ctx, final.poses, final.residual)
+    rng = np.random.default_rng(SEED)
+    if Y.shape[0] > MAX_POSES:
+        keep = np.sort(rng.choice(Y.shape[0], MAX_POSES, replace=False))
+        Y, first = Y[keep], first[keep]
+    inputs = pose_inputs(ctx, first)
+    X = inputs(ctx, first)
+    if Y.shape[0] < MIN_POSES or X.shape[1] == 0 or not np.any(Y):
+        return None
+    model = fit_kernel_ridge(X, Y, 1.0 / length_scales(X, Y, rng))
+    r_hybrid = _hybrid_residual(ctx, withheld, r_after, model.predict, inputs)
+    phys, hyb = Metrics.of(r_after).rms, Metrics.of(r_hybrid).rms
+    z = paired_z(ctx, withheld, r_after, r_hybrid)
+    return ResidualModel(clearly_better(z, phys, hyb), phys, hyb, z, inputs.names,
+                         inputs.ranges, int(Y.shape[0]))
