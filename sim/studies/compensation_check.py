@@ -36,8 +36,16 @@ from sim.robot.measurement import Procedure, _nominal_static_torque, measure
 from sim.robot.real import RealRobot
 from sim.studies.trajectories import circle_poses
 from zrp.arrays import F64
-from zrp.calibration import CalibratedRobot, Compensation, PoseConditions, compensate
-from zrp.gap import Diagnosis, Measurements, diagnose
+from zrp.calibration import (
+    CalibratedRobot,
+    Calibration,
+    CalibrationOptions,
+    Compensation,
+    PoseConditions,
+    calibrate,
+    compensate,
+)
+from zrp.gap import Diagnosis, Measurements
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
@@ -129,17 +137,18 @@ def run_compensation_check(model: Manipulator, effects: HiddenEffects, *, poses:
         meas = run.measurements
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            diag = diagnose(model, meas, gravity_torque=gravity_torques(xml, meas.q_pose),
-                            rng=np.random.default_rng(seed))
-        return compensate_and_measure(robot, inst, diag, xml, rng, n_random=n_random,
+            calibration = calibrate(model, meas, options=CalibrationOptions(
+                gravity_torque=gravity_torques(xml, meas.q_pose), seed=seed))
+        return compensate_and_measure(robot, inst, calibration, xml, rng, n_random=n_random,
                                       n_circle=n_circle)
 
 
-def compensate_and_measure(robot: RealRobot, instrument: Instrument, diag: Diagnosis,
+def compensate_and_measure(robot: RealRobot, instrument: Instrument, calibration: Calibration,
                            mjcf_path: str | Path | None, rng: np.random.Generator, *,
                            n_random: int = 40, n_circle: int = 24, chosen_side: bool = False
                            ) -> CompensationCheck:
-    """Steps 3-4 of the module doc for a diagnosis of ``robot`` measured with ``instrument``.
+    """Steps 3-4 of the module doc for a calibration of ``robot`` measured with
+    ``instrument`` (:func:`zrp.calibration.calibrate`, the recipe every caller shares).
 
     The program is commanded first as it is ("before"); its logged temperatures are the
     conditions the compensated commands are computed for (thermal expansion), as when a
@@ -149,7 +158,7 @@ def compensate_and_measure(robot: RealRobot, instrument: Instrument, diag: Diagn
     moves go straight from target to target and the directions come from the order.
     """
     model = robot.nominal
-    cal = CalibratedRobot.from_diagnosis(diag)
+    diag, cal = calibration.diagnosis, calibration.robot
     baseline = CalibratedRobot.from_diagnosis(diag, registration_only=True)
     q_prog, labels = _targets(model, rng, n_random, n_circle)
     target = baseline.predict(q_prog, "smr1")
@@ -168,6 +177,7 @@ def compensate_and_measure(robot: RealRobot, instrument: Instrument, diag: Diagn
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         comp = compensate(cal, target, q_prog, point="smr1", frame="instrument",
+                          accept_flagged=True,  # every target measured, flags kept
                           conditions=cond, gravity_torque=None if mjcf_path is None else tau)
     after = measure(robot, comp.q_command, instrument, rng, proc,
                     directions=dirs).measurements

@@ -40,10 +40,17 @@ from sim.studies.benchmark.runner import _nominal_mjcf
 from sim.studies.benchmark.scenarios import BenchmarkConfig, Scenario, draw_scenarios
 from sim.studies.benchmark.scoring import score
 from zrp.arrays import F64
-from zrp.calibration import CalibratedRobot, PoseConditions, plan_poses
+from zrp.calibration import (
+    CalibratedRobot,
+    Calibration,
+    CalibrationOptions,
+    PoseConditions,
+    calibrate,
+    plan_poses,
+)
 from zrp.calibration.planning import design_std
 from zrp.errors import InputError
-from zrp.gap import EFFECTS, Measurements, diagnose
+from zrp.gap import EFFECTS, Measurements
 from zrp.kinematics import reachable_poses
 from zrp.model.manipulator import Manipulator
 
@@ -132,20 +139,21 @@ def validation_rms(cal: CalibratedRobot, meas: Measurements, tau: F64) -> float:
     return float(np.sqrt(np.mean(err ** 2)))
 
 
-def _diagnose(model: Manipulator, meas: Measurements, xml: Path, seed: int) -> Any:
+def _calibrate(model: Manipulator, meas: Measurements, xml: Path, seed: int) -> Calibration:
+    """The one calibration recipe (:func:`zrp.calibration.calibrate`), as ``zrp calibrate``."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return diagnose(model, meas, gravity_torque=gravity_torques(xml, meas.q_pose),
-                        seed=seed)
+        return calibrate(model, meas, options=CalibrationOptions(
+            gravity_torque=gravity_torques(xml, meas.q_pose), seed=seed))
 
 
 def _score_design(model: Manipulator, scn: Scenario, design: str, meas: Measurements,
                   val: tuple[Measurements, F64, dict[str, Any]], xml: Path,
                   config: BenchmarkConfig, std: dict[str, float]) -> DesignScore:
-    diag = _diagnose(model, meas, xml, scn.index)
+    calibration = _calibrate(model, meas, xml, scn.index)
     val_meas, val_tau, val_truth = val
-    sc = score(model, val_truth, diag.to_dict(), config)
-    rms = validation_rms(CalibratedRobot.from_diagnosis(diag), val_meas, val_tau)
+    sc = score(model, val_truth, calibration.diagnosis.to_dict(), config)
+    rms = validation_rms(calibration.robot, val_meas, val_tau)
     ratio = rms / sc.noise_rms
     temps = meas.per_pose("temp")
     return DesignScore(scn.index, scn.labels, design, len(meas.pose_ids), sc.expected,

@@ -1,6 +1,6 @@
 """The blind gap benchmark on real arms simulated as themselves: one row per arm.
 
-Runs ``zrp gap-benchmark --model M --arm FILE --scenarios K --seed S`` (the command line, in a
+Runs ``zrp gap-benchmark --model M --mjcf FILE --scenarios K --seed S`` (the command line, in a
 fresh process per arm): the simulated robot of each arm takes the inertias, damping, friction
 and tool of its own shipped URDF/MJCF (example-robot-data's UR5, UR10, Panda, xArm7, Kinova
 Jaco and Unitree Z1 through Pinocchio's install, the MuJoCo Menagerie UR5e from
@@ -119,7 +119,7 @@ def _run_arm(name: str, arm: Arm, extra: tuple[str, ...], folder: Path,
     cmd = [sys.executable, "-m", "zrp", "gap-benchmark", "--model", str(model_file),
            "--scenarios", str(args.scenarios), "--seed", str(args.seed), "--poses",
            str(args.poses), "--out", str(folder), "--no-plots", "--no-progress", "--force",
-           *(("--arm", str(own)) if own is not None else ()), *extra]
+           *(("--mjcf", str(own)) if own is not None else ()), *extra]
     if args.workers:
         cmd += ["--workers", str(args.workers)]
     t0 = time.perf_counter()

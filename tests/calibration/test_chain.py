@@ -4,7 +4,7 @@ here describes (example-robot-data): import -> plan -> measure --poses plan.csv 
 written. It ends when the compensated program, commanded on the simulated robot, misses its
 targets by at most 1.5x the tracker's pure noise.
 
-The simulated robot is the arm as itself: `zrp measure --arm URDF` gives it the inertias,
+The simulated robot is the arm as itself: `zrp measure --mjcf URDF` gives it the inertias,
 damping, friction and tool of the shipped URDF, and `zrp verify` rebuilds that same robot from
 the truth file (which names the URDF and its SHA-256); diagnose, calibrate and compensate get the
 same URDF's gravity torques (--mjcf), and so does `zrp plan`, which plans the joint compliance
@@ -79,7 +79,7 @@ def test_plan_to_verify_on_an_unseen_urdf(tmp_path, capsys, arm):
 
     hidden = [a for spec in HIDDEN for a in ("--effect", spec)]
     meas = _run(capsys, ["measure", "--model", model_file, "--poses", str(tmp_path / "plan.csv"),
-                         "--arm", urdf, *hidden, "--out", str(tmp_path / "meas.csv"),
+                         "--mjcf", urdf, *hidden, "--out", str(tmp_path / "meas.csv"),
                          "--seed", "3"])
     assert meas["poses"] == POSES and meas["trajectory"] == "plan"
     build = json.loads((tmp_path / "meas.truth.json").read_text())["robot"]

@@ -104,7 +104,8 @@ def test_compensate_refuses_seeds_in_degrees(tmp_path, capsys, measured_csv):
     assert "looks like degrees" in err and "--deg" in err
     assert not (tmp_path / "c.csv").exists()
     res = _json(capsys, ["compensate", "--calibration", str(tmp_path / "cal/compensation.json"),
-                         "--targets", str(t), "--out", str(tmp_path / "c.csv"), "--deg"])
+                         "--targets", str(t), "--out", str(tmp_path / "c.csv"), "--deg",
+                         "--accept-flagged"])
     assert res["not_converged"] == 0
 
 
@@ -117,7 +118,7 @@ def test_verify_refuses_mismatched_inputs(tmp_path, capsys, measured_csv):
     t.write_text("target,q1,q2,q3,q4,q5,q6\n" + "".join(
         f"T{i},{','.join(repr(float(v)) for v in r)}\n" for i, r in enumerate(q)))
     _json(capsys, ["compensate", "--calibration", comp, "--targets", str(t), "--out",
-                   str(tmp_path / "c.csv")])
+                   str(tmp_path / "c.csv"), "--accept-flagged"])
     truth = tmp_path / "truth.json"
     truth.write_text(json.dumps({"format": "zrp-real-robot-truth", "model": "stanford",
                                  "length_unit": "mm"}))

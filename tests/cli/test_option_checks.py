@@ -68,7 +68,7 @@ def test_option_ranges(capsys, argv, match):
     ["measure", "--poses", "10"],
 ])
 def test_bogus_mujoco_gl_is_a_named_error(tmp_path, command):
-    out = ["--out-dir", str(tmp_path / "v")] if command[0] == "render" else \
+    out = ["--out", str(tmp_path / "v")] if command[0] == "render" else \
         ["--out", str(tmp_path / ("m.xml" if command[0] == "mjcf" else "m.csv"))]
     proc = subprocess.run([sys.executable, "-m", "zrp", *command, *out], cwd=ROOT,
                           capture_output=True, text=True, timeout=300,
@@ -80,7 +80,7 @@ def test_bogus_mujoco_gl_is_a_named_error(tmp_path, command):
 
 def test_render_gif_writes_a_gif(tmp_path, capsys):
     assert main(["render", "--format", "gif", "--steps", "20", "--seconds", "0.2",
-                 "--no-dynamics", "--quiet", "--out-dir", str(tmp_path)]) == 0
+                 "--no-dynamics", "--no-progress", "--out", str(tmp_path)]) == 0
     assert [p.suffix for p in tmp_path.iterdir() if not p.name.startswith(".")] == [".gif"]
 
 
@@ -88,7 +88,7 @@ def test_render_keeps_an_existing_video(tmp_path, capsys):
     video = tmp_path / "puma_circle_JE2_0.1pct.gif"
     video.write_bytes(b"mine")
     _refused(capsys, ["render", "--format", "gif", "--steps", "20", "--seconds", "0.2",
-                      "--no-dynamics", "--quiet", "--out-dir", str(tmp_path)], "--force")
+                      "--no-dynamics", "--no-progress", "--out", str(tmp_path)], "--force")
     assert video.read_bytes() == b"mine"
 
 

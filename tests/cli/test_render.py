@@ -19,8 +19,8 @@ def backend() -> str:
 
 
 def test_render_command_writes_video_and_reports(backend, tmp_path, capsys):
-    code = main(["render", "--out-dir", str(tmp_path), "--width", "160", "--height", "120",
-                 "--fps", "10", "--seconds", "0.3", "--steps", "60", "--quiet", "--json",
+    code = main(["render", "--out", str(tmp_path), "--width", "160", "--height", "120",
+                 "--fps", "10", "--seconds", "0.3", "--steps", "60", "--no-progress", "--json",
                  "--backend", backend])
     assert code == 0
     payload = json.loads(capsys.readouterr().out)
@@ -32,6 +32,6 @@ def test_render_command_writes_video_and_reports(backend, tmp_path, capsys):
 
 
 def test_render_unknown_backend(tmp_path, capsys):
-    assert main(["render", "--out-dir", str(tmp_path), "--backend", "vulkan", "--quiet"]) == 2
+    assert main(["render", "--out", str(tmp_path), "--backend", "vulkan", "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "vulkan" in err and "egl" in err and "osmesa" in err

@@ -56,7 +56,7 @@ def test_verdict_tables_and_json_describe_the_final_model(tmp_path):
     listed = {e["effect"]: tuple(e["joints"]) for e in out["final"]["effects"]}
     assert listed == d.final_joints
     # the verdict names the final model's effects and its withheld RMS, nothing else
-    assert verdict_text(d).startswith("Final model (after pruning): ")
+    assert "\n\nEffects found:\nFinal model (after pruning): " in verdict_text(d)
     assert f"{d.final.rms:.4g}" in verdict_text(d)
     # the result's JSON holds no prose; diagnosis.json's document adds the verdict after
     # "unexplained", the rest unchanged

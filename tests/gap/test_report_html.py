@@ -16,6 +16,7 @@ import pytest
 import zrp
 from zrp.gap import Injection, diagnose, synthesize, write_outputs
 from zrp.gap.report import verdict_text
+from zrp.gap.report.headline import headline_text
 from zrp.kinematics import uniform_joint_values
 
 BROWSER = next((b for b in ("chromium", "chromium-browser", "google-chrome")
@@ -121,7 +122,7 @@ def test_report_html_synthetic(tmp_path):
     meas = synthesize(model, q, Injection(joint_offset={2: 1e-3}), rng=rng, noise_sigma=0.02)
     d = diagnose(model, meas, seed=0)
     write_outputs(d, tmp_path / "out")
-    _check_page(tmp_path / "out", verdict_text(d), tmp_path)
+    _check_page(tmp_path / "out", headline_text(d), tmp_path)
     _check_zoom(tmp_path / "out", tmp_path)
 
 
@@ -130,7 +131,7 @@ def test_report_html_real_irb120(irb120_real, tmp_path):
     d = irb120_real.diagnosis
     assert any(issubclass(w.category, zrp.gap.GapWarning) for w in irb120_real.warnings)
     write_outputs(d, tmp_path / "out")
-    _check_page(tmp_path / "out", verdict_text(d), tmp_path)
+    _check_page(tmp_path / "out", headline_text(d), tmp_path)
     md = (tmp_path / "out" / "report.md").read_text(encoding="utf-8")
     assert "complete geometric calibration" in md
     a = d.assessment

@@ -41,7 +41,7 @@ def test_cli_takes_the_arms_file_and_announces_a_fallback(tmp_path, capsys):
     toml = zrp.save_model(model, tmp_path / "ur5.toml")
     base = ["gap-benchmark", "--model", str(toml), "--scenarios", "1", "--poses", "16",
             "--none", "1", "--pairs", "0", "--no-plots", "--no-progress", "--json"]
-    assert main([*base, "--arm", str(path), "--out", str(tmp_path / "own")]) == 0
+    assert main([*base, "--mjcf", str(path), "--out", str(tmp_path / "own")]) == 0
     own = json.loads((tmp_path / "own" / "results.json").read_text(encoding="utf-8"))
     assert own["dynamics_fallback"] is False and "ur5_robot.urdf" in own["dynamics"]
     assert own["config"]["arm_file"] == str(path)

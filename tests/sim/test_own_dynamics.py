@@ -177,7 +177,7 @@ def test_diagnose_takes_the_shipped_urdf_as_mjcf(name, tmp_path, capsys):
 
 
 def test_measure_takes_the_arms_file(tmp_path, capsys):
-    """zrp measure --arm: the truth file says the robot had the arm's own inertias; without
+    """zrp measure --mjcf: the truth file says the robot had the arm's own inertias; without
     it the fallback is announced in the truth file."""
     import json
 
@@ -186,7 +186,7 @@ def test_measure_takes_the_arms_file(tmp_path, capsys):
     path, model = shipped_arm("xarm7")
     toml = zrp.save_model(model, tmp_path / "arm.toml")
     base = ["measure", "--model", str(toml), "--poses", "8", "--seed", "1"]
-    assert main([*base, "--arm", str(path), "--out", str(tmp_path / "own.csv")]) == 0
+    assert main([*base, "--mjcf", str(path), "--out", str(tmp_path / "own.csv")]) == 0
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", DynamicsFallbackWarning)
         assert main([*base, "--out", str(tmp_path / "fb.csv")]) == 0

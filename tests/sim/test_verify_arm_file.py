@@ -1,7 +1,7 @@
 """zrp verify rebuilds the robot a measurement ran on, with the arm's own file: the truth file
 names it and records its SHA-256 (hashlib of the bytes, independently), the rebuilt robot has
 the same servo gains and static torques, and a file gone or changed is a named error. The
-robot in motion (measure --stream --arm) is built from the same file."""
+robot in motion (measure --stream --mjcf) is built from the same file."""
 
 from __future__ import annotations
 
@@ -48,7 +48,7 @@ def test_the_truth_names_the_arm_file_and_rebuilds_the_same_robot(tmp_path):
 
 
 def test_the_robot_in_motion_is_the_arm_itself():
-    """measure --stream --arm: the moving robot has the file's dynamics and says so."""
+    """measure --stream --mjcf: the moving robot has the file's dynamics and says so."""
     path, model = shipped_arm("ur5")
     dyn = mjcf.arm_dynamics(path, model)
     mv = exercise_moves(np.radians([0, -60, 60, 0, 60, 0]), np.random.default_rng(1), moves=1)

@@ -1,12 +1,14 @@
 """Closing the calibration loop (README.md in this folder): the calibrated robot taken out of
 a gap diagnosis (model TOML + compensation JSON) and compensation of targets.
 
-In-process use::
+In-process use (the one recipe, :func:`calibrate`, that ``zrp calibrate``, the notebooks and
+the studies call)::
 
-    from zrp.calibration import CalibratedRobot, write_calibration, compensate
-    cal = CalibratedRobot.from_diagnosis(diag)
-    write_calibration(cal, "calibrated.toml", "compensation.json")
-    comp = compensate(cal, targets_xyz, seed_q, point="s1", frame="instrument", limits=lim)
+    from zrp.calibration import CalibrationOptions, calibrate, compensate
+    result = calibrate(model, meas, options=CalibrationOptions(gravity_torque=tau))
+    result.write("calibrated.toml", "compensation.json")
+    comp = compensate(result.robot, targets_xyz, seed_q, point="s1", frame="instrument",
+                      limits=lim)
 """
 
 from typing import TYPE_CHECKING
@@ -16,6 +18,9 @@ from zrp.lazy import lazy_names
 #: public name -> (module, name there): imported on first use (zrp/lazy.py)
 _LAZY = {
     "CalibratedRobot": "zrp.calibration.calibrated",
+    "Calibration": "zrp.calibration.recipe",
+    "CalibrationOptions": "zrp.calibration.recipe",
+    "calibrate": "zrp.calibration.recipe",
     "PoseConditions": "zrp.calibration.calibrated",
     "Compensation": "zrp.calibration.compensation",
     "ThermalWarning": "zrp.calibration.compensation",
@@ -47,11 +52,16 @@ if TYPE_CHECKING:  # type checkers and IDEs see the same names, imported eagerly
     from zrp.calibration.planning import PlanWarning as PlanWarning
     from zrp.calibration.planning import design_std as design_std
     from zrp.calibration.planning import plan_poses as plan_poses
+    from zrp.calibration.recipe import Calibration as Calibration
+    from zrp.calibration.recipe import CalibrationOptions as CalibrationOptions
+    from zrp.calibration.recipe import calibrate as calibrate
     from zrp.calibration.storage import read_calibration as read_calibration
     from zrp.calibration.storage import write_calibration as write_calibration
 
 __all__ = [
     "CalibratedRobot",
+    "Calibration",
+    "CalibrationOptions",
     "Compensation",
     "Plan",
     "PlanWarning",
@@ -59,6 +69,7 @@ __all__ = [
     "PoseConditions",
     "Term",
     "ThermalWarning",
+    "calibrate",
     "compensate",
     "compensate_program",
     "design_std",

@@ -31,6 +31,7 @@ from zrp.arrays import F64
 from zrp.calibration.conditions import Conditions
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
+from zrp.gap.analysis.determination import fit_determinations
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.model.context import Context
@@ -115,6 +116,15 @@ class PoseConditions:
     load: ArrayLike | None = None
 
 
+def _undetermined(diag: Diagnosis, fit: FitResult) -> tuple[str, ...]:
+    """``name: what the data say`` of the parameters of ``fit`` the data did not determine
+    (the diagnosis's robust story for its final fit; the fit's own intervals otherwise)."""
+    det = (diag.determination if fit is diag.final_fit else fit_determinations(
+        fit, gap=diag.nominal.rms, unit=diag.length_unit,
+        max_tilt_rad=diag.context.max_tilt_rad))
+    return tuple(f"{d.name}: {d.describe()}" for d in det.values() if not d.determined)
+
+
 @dataclass(frozen=True, eq=False)
 class CalibratedRobot:
     """A calibrated robot: folded geometry plus the non-geometric corrections.
@@ -149,6 +159,10 @@ class CalibratedRobot:
             :mod:`zrp.gap.model.domains`), or None.
         backlash_lead: per joint, whether the approach leaves the load on the leading flank
             of its play (the diagnosis's profiled flank, eq. B1), or None (lagging everywhere).
+        undetermined: the parameters the data did not determine, as
+            ``name: held at nominal (...)`` / ``name: undetermined (...)``
+            (:mod:`zrp.gap.analysis.determination`): an undetermined tool or base direction is
+            flagged so in the files a controller reads.
     """
 
     model: Manipulator
@@ -172,6 +186,7 @@ class CalibratedRobot:
     conditions: Conditions | None = None
     widen: dict[str, float] | None = None
     backlash_lead: tuple[bool, ...] | None = None
+    undetermined: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         n = self.model.n
@@ -222,15 +237,21 @@ class CalibratedRobot:
         delta, terms, kappa = _joint_terms(fit, ctx.model)
         folded, tools_f = _fold(ctx.model, u, bodies, delta, tools)
         bl = None if registration_only else diag.where.backlash
-        return cls(folded, ctx.model, rb, tb, tuple(ctx.meas.point_labels), tools_f, delta,
-                   tuple(terms), kappa, float(ctx.t_ref_degC),
-                   None if bl is None else tuple(bl.switch),
-                   0.0 if bl is None else float(bl.payload_kg), tuple(ctx.gravity_dir),
-                   tuple(ctx.harmonics), ctx.meas.frame,
-                   "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
-                   float(diag.nominal.rms if registration_only else diag.final.rms),
-                   _side_weights(ctx), Conditions.from_measurements(ctx.meas, ctx.model),
-                   None, None if bl is None or not bl.lead else tuple(bl.lead))
+        return cls(
+            model=folded, nominal=ctx.model, base_rotation=rb, base_translation=tb,
+            tool_labels=tuple(ctx.meas.point_labels), tool_points=tools_f,
+            joint_offsets=delta, terms=tuple(terms), kappa=kappa,
+            t_ref=float(ctx.t_ref_degC),
+            backlash_switch=None if bl is None else tuple(bl.switch),
+            payload_kg=0.0 if bl is None else float(bl.payload_kg),
+            gravity_dir=tuple(ctx.gravity_dir), harmonics=tuple(ctx.harmonics),
+            frame=ctx.meas.frame,
+            compliance_model="mjcf" if ctx.gravity_torque is not None else "lumped_masses",
+            withheld_rms=float(diag.nominal.rms if registration_only else diag.final.rms),
+            gravity_side_weights=_side_weights(ctx),
+            conditions=Conditions.from_measurements(ctx.meas, ctx.model), widen=None,
+            backlash_lead=None if bl is None or not bl.lead else tuple(bl.lead),
+            undetermined=_undetermined(diag, fit))
 
     @classmethod
     def from_corrections(cls, nominal: Manipulator, joint_offsets: ArrayLike,

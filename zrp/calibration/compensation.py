@@ -30,9 +30,12 @@ from zrp.calibration.conditions import (
     ConditionWarning,
     MissingConditionError,
     check_joint_limits,
+    check_payload,
     missing_conditions,
     out_of_range,
+    payload_separated,
 )
+from zrp.calibration.guards import guard, reference_poses
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import hand_frame
@@ -58,9 +61,12 @@ class Compensation:
         uncompensated: predicted position error of the seed commands (T,) (length unit).
         sigma_min: smallest singular value of the Jacobian [u; J_v / L] (L: the model's
             characteristic length) at the command, shape (T,).
-        near_singular: sigma_min below the threshold, shape (T,).
+        near_singular: sigma_min below the threshold (a share of the arm's own median,
+            :mod:`zrp.calibration.guards`), shape (T,).
         near_limit: a joint within the margin of its limit, shape (T,) (False without limits).
         converged: the solve met its tolerance, shape (T,).
+        outside_measured: a command outside the joint ranges the calibration measured,
+            shape (T,) (compensated only with ``accept_flagged``).
     """
 
     target_ids: tuple[str, ...]
@@ -74,6 +80,7 @@ class Compensation:
     near_singular: NDArray[np.bool_]
     near_limit: NDArray[np.bool_]
     converged: NDArray[np.bool_]
+    outside_measured: NDArray[np.bool_]
 
     def __post_init__(self) -> None:
         T = len(self.target_ids)
@@ -88,7 +95,8 @@ class Compensation:
                 "max_after": float(self.residual.max()),
                 "not_converged": int((~self.converged).sum()),
                 "near_singular": int(self.near_singular.sum()),
-                "near_limit": int(self.near_limit.sum())}
+                "near_limit": int(self.near_limit.sum()),
+                "outside_measured": int(self.outside_measured.sum())}
 
 
 @dataclass(frozen=True)
@@ -126,15 +134,22 @@ def _subset(cond: PoseConditions, tg: _Targets, idx: NDArray[np.int64]
             _Targets(tg.y[idx], None if tg.rot is None else tg.rot[idx], tg.tool))
 
 
+def _kinematics(cal: CalibratedRobot, x: F64, tool: F64, scale: F64 | None
+                ) -> tuple[F64, F64, F64, F64]:
+    """Tool point y (T, 3), hand rotation (T, 3, 3) and the columns of the position and
+    rotation Jacobians, J_v and J_w (T, n, 3), at actual joint values x."""
+    pos, rn, pts, axes = chain(cal.model, x, scale)
+    y = pos + rn @ tool
+    prism = cal.model.prismatic[None, :, None]
+    jv = np.where(prism, axes, np.cross(axes, y[:, None, :] - pts))      # (T, n, 3)
+    return y, rn, jv, np.where(prism, 0.0, axes)
+
+
 def _errors(cal: CalibratedRobot, q: F64, cond: PoseConditions, tg: _Targets
             ) -> tuple[F64, F64, F64]:
     """Error vector (T, 3 or 6), Jacobian (T, 3 or 6, n) and the 6-row scaled Jacobian."""
     x = cal.actual_joint_values(q, cond)
-    pos, rn, pts, axes = chain(cal.model, x, cal.body_scale(len(x), cond.temp))
-    y = pos + rn @ tg.tool
-    prism = cal.model.prismatic[None, :, None]
-    jv = np.where(prism, axes, np.cross(axes, y[:, None, :] - pts))      # (T, n, 3)
-    jw = np.where(prism, 0.0, axes)
+    y, rn, jv, jw = _kinematics(cal, x, tg.tool, cal.body_scale(len(x), cond.temp))
     L = cal.model.characteristic_length
     full = np.concatenate([jw, jv / L], axis=2).transpose(0, 2, 1)      # (T, 6, n)
     e = y - tg.y
@@ -220,20 +235,25 @@ def _checked_targets(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike,
 
 
 def _warn_conditions(cal: CalibratedRobot, base: PoseConditions) -> None:
-    """Warn (at the caller of :func:`compensate`) when thermal expansion was identified but
-    the targets' temperature is not given, when a payload-dependent joint map identified with
-    a payload gets none, and when a temperature or payload lies outside the measured range."""
+    """Refuse a payload the calibration cannot predict (:func:`~zrp.calibration.conditions.
+    check_payload`); warn (at the caller of :func:`compensate`) when thermal expansion was
+    identified but the targets' temperature is not given, when a payload-dependent joint map
+    identified with a payload gets none, and when a temperature or payload lies outside the
+    measured range."""
     if cal.kappa != 0.0 and base.temp is None:
         warnings.warn(f"the calibration found thermal expansion (kappa = {cal.kappa:.3g} "
                       f"1/degC) but no temperature was given (conditions=PoseConditions("
                       f"temp=...)): the commands are for the reference temperature "
                       f"{cal.t_ref:.4g} degC", ThermalWarning, stacklevel=3)
+    check_payload(cal.conditions, cal.compliance_model, base.load, required=False)
     try:
         missing_conditions(cal.terms, cal.compliance_model, 0.0, cal.conditions,
                            temp=base.temp, load=base.load)
     except MissingConditionError as exc:
+        own = not payload_separated(cal.conditions, cal.compliance_model)
         warnings.warn(f"{exc} (conditions=PoseConditions(load=...)); the commands are for "
-                      "no payload", ConditionWarning, stacklevel=3)
+                      + ("the payload of the data" if own else "no payload"),
+                      ConditionWarning, stacklevel=3)
     for msg in out_of_range(cal.conditions, temp=base.temp, load=base.load):
         warnings.warn(msg, ConditionWarning, stacklevel=3)
 
@@ -273,9 +293,10 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
                orientations: ArrayLike | None = None, point: str | None = None,
                frame: str = "base", conditions: PoseConditions | None = None,
                gravity_torque: GravityFn | None = None, limits: ArrayLike | None = None,
-               limit_margin: float = np.radians(1.0), singular_tol: float = 1e-3,
+               limit_margin: float = np.radians(1.0), singular_tol: float | None = None,
                tol: float = 1e-9, max_iter: int = 30, max_rounds: int = 5,
-               target_ids: tuple[str, ...] | None = None) -> Compensation:
+               target_ids: tuple[str, ...] | None = None,
+               accept_flagged: bool = False) -> Compensation:
     """Joint commands that put ``point`` of the calibrated robot on ``targets``.
 
     Args:
@@ -293,7 +314,10 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
             model's own (from the model file; none for a joint without). Every seed (the
             program) and every command is checked against them.
         limit_margin: a command closer than this to a limit is flagged.
-        singular_tol: sigma_min below this is flagged near-singular.
+        singular_tol: an absolute sigma_min threshold for near-singular; None (default):
+            a share of the arm's own median conditioning (:mod:`zrp.calibration.guards`).
+        accept_flagged: compensate commands outside the measured joint ranges and
+            near-singular ones too, flagged per row (default: refused).
         tol: convergence tolerance on the error (length unit; orientation scaled by L).
 
     Warns:
@@ -304,6 +328,11 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
     Raises:
         InputError: bad shapes, or a seed or command beyond a joint limit (naming the target
             and joint).
+        PayloadConditionError: a payload the calibration cannot predict (identified at one
+            payload, never varied, without the MJCF's masses).
+        UnmeasuredTargetError: a command outside the measured joint ranges (unless
+            ``accept_flagged``).
+        NearSingularTargetError: a near-singular command (unless ``accept_flagged``).
     """
     y, q0, ids, rot = _checked_targets(cal, targets, seed, orientations, frame, target_ids)
     lim = joint_limits(cal, limits)
@@ -318,11 +347,21 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
     ok = np.linalg.norm(e, axis=1) < tol
     near_limit = _check_limits(q, lim, limit_margin, ids)
     smin = np.linalg.svd(full, compute_uv=False)[:, -1]
+    outside, near = guard(ids, q, smin, cal.conditions, lambda: _reference_sigma(cal, tg),
+                          accept_flagged=accept_flagged, singular_tol=singular_tol)
     L = cal.model.characteristic_length
     return Compensation(ids, q, q0, y + e[:, :3], np.linalg.norm(e[:, :3], axis=1),
                         None if rot is None else np.linalg.norm(e[:, 3:], axis=1) / L,
-                        np.linalg.norm(e0[:, :3], axis=1), smin, smin < singular_tol,
-                        near_limit, ok)
+                        np.linalg.norm(e0[:, :3], axis=1), smin, near, near_limit, ok,
+                        outside)
+
+
+def _reference_sigma(cal: CalibratedRobot, tg: _Targets) -> float:
+    """The median sigma_min of the calibrated geometry over the reference poses (eq. G1 of
+    :mod:`zrp.calibration.guards`)."""
+    _, _, jv, jw = _kinematics(cal, reference_poses(cal.model, cal.conditions), tg.tool, None)
+    full = np.concatenate([jw, jv / cal.model.characteristic_length], axis=2)
+    return float(np.median(np.linalg.svd(full, compute_uv=False)[:, -1]))
 
 
 def compensate_program(cal: CalibratedRobot, q_program: ArrayLike, **kwargs: object

@@ -28,8 +28,8 @@ from zrp.model.manipulator import Manipulator
 from zrp.version import __version__
 
 __all__ = ["ANGLE_UNIT", "ConditionWarning", "Conditions", "MissingConditionError",
-           "check_joint_limits", "file_sha256", "load_dependent", "missing_conditions",
-           "out_of_range"]
+           "PayloadConditionError", "check_joint_limits", "check_payload", "file_sha256",
+           "load_dependent", "missing_conditions", "out_of_range", "payload_separated"]
 
 #: the angle unit of every angle in the calibration files (a data file may be in degrees).
 ANGLE_UNIT = "rad"
@@ -37,6 +37,11 @@ ANGLE_UNIT = "rad"
 
 class MissingConditionError(InputError):
     """A compensation request leaves out a condition the calibrated model depends on."""
+
+
+class PayloadConditionError(InputError):
+    """A request at a payload the calibration cannot predict: its data never varied the
+    payload and no MJCF gave the masses, so the payload's effect is baked into the model."""
 
 
 class ConditionWarning(ZRPWarning):
@@ -78,6 +83,8 @@ class Conditions:
         data_file: the data file's name, or None (in-memory data).
         data_sha256: SHA-256 of the data file's bytes, or None.
         software: the toolkit and version that identified the calibration.
+        joint_ranges: per joint the (smallest, largest) value the data measured (rad /
+            length unit), or None (files before 0.5.0: not recorded; nothing is guarded).
     """
 
     payloads_kg: tuple[float, ...] | None
@@ -92,6 +99,7 @@ class Conditions:
     data_file: str | None = None
     data_sha256: str | None = None
     software: str = f"zrp-accuracy {__version__}"
+    joint_ranges: tuple[tuple[float, float] | None, ...] | None = None
 
     @classmethod
     def from_measurements(cls, meas: Measurements, model: Manipulator, *,
@@ -108,7 +116,9 @@ class Conditions:
                    tuple(j.limits for j in model.joints), meas.frame, ANGLE_UNIT,
                    data_angle_unit, instrument,
                    None if data_path is None else Path(data_path).name,
-                   None if data_path is None else file_sha256(data_path))
+                   None if data_path is None else file_sha256(data_path),
+                   joint_ranges=tuple((float(lo), float(hi)) for lo, hi in zip(
+                       meas.q_pose.min(axis=0), meas.q_pose.max(axis=0), strict=True)))
 
     @property
     def load_range_kg(self) -> tuple[float, float] | None:
@@ -126,7 +136,9 @@ class Conditions:
                                  for lim in self.joint_limits],
                 "frame": self.frame, "instrument": self.instrument,
                 "data_file": self.data_file, "data_sha256": self.data_sha256,
-                "software": self.software}
+                "software": self.software,
+                "joint_ranges": None if self.joint_ranges is None else [
+                    None if r is None else list(r) for r in self.joint_ranges]}
 
     @classmethod
     def from_dict(cls, d: object, where: str) -> Conditions:
@@ -144,7 +156,7 @@ class Conditions:
                       str(d["length_unit"]), lims, str(d["frame"]), str(d["angle_unit"]),
                       str(d["data_angle_unit"]), _opt_str(d.get("instrument")),
                       _opt_str(d.get("data_file")), _opt_str(d.get("data_sha256")),
-                      str(d["software"]))
+                      str(d["software"]), _ranges_from(d.get("joint_ranges")))
         except (KeyError, TypeError, ValueError, IndexError) as exc:
             raise InputError(f"{where}: malformed conditions ({type(exc).__name__}: "
                              f"{exc})") from None
@@ -152,6 +164,13 @@ class Conditions:
             raise InputError(f"{where}.angle_unit: {out.angle_unit!r}; the files' angles are "
                              f"in {ANGLE_UNIT}")
         return out
+
+
+def _ranges_from(v: object) -> tuple[tuple[float, float] | None, ...] | None:
+    """joint_ranges as read (absent in files before 0.5.0)."""
+    if v is None:
+        return None
+    return tuple(None if r is None else (float(r[0]), float(r[1])) for r in v)  # type: ignore[attr-defined]
 
 
 def _opt_str(v: object) -> str | None:
@@ -166,14 +185,66 @@ def load_dependent(terms: tuple[Term, ...], compliance_model: str) -> tuple[str,
                                            and compliance_model == "mjcf"))
 
 
+def payload_separated(conditions: Conditions | None, compliance_model: str) -> bool:
+    """Whether the data separated the payload's effect: the masses came from an MJCF
+    (``compliance_model == "mjcf"``), or the data measured several payloads."""
+    return compliance_model == "mjcf" or (
+        conditions is not None and conditions.payloads_kg is not None
+        and len(set(conditions.payloads_kg)) > 1)
+
+
+def check_payload(conditions: Conditions | None, compliance_model: str, load: object, *,
+                  required: bool) -> None:
+    """Refuse a payload the calibration cannot predict: when the
+    data never varied the payload and no MJCF gave the masses, the model holds at the one
+    payload measured only.
+
+    Args:
+        load: the request's payload(s), kg, or None (not given).
+        required: a missing ``load`` is refused when the data measured a non-zero payload
+            (the command line); the API takes a missing one as the calibration's own.
+
+    Raises:
+        PayloadConditionError: another payload than the one measured (or a non-zero one
+            when the data recorded none).
+        MissingConditionError: ``load`` missing, ``required`` and a non-zero payload in the
+            data (naming ``--load``).
+    """
+    if conditions is None or payload_separated(conditions, compliance_model):
+        return
+    pay = conditions.payloads_kg
+    if load is None:
+        if required and pay is not None and pay[0] != 0.0:
+            raise MissingConditionError(
+                f"--load: the calibration was identified with a payload of {pay[0]:g} kg in "
+                "every pose and holds at that payload only; give --load "
+                f"{pay[0]:g} (the payload the commands will run with)")
+        return
+    v = np.atleast_1d(np.asarray(load, dtype=float))
+    held = 0.0 if pay is None else pay[0]
+    if np.any(v != held):
+        other = float(v[np.argmax(v != held)])
+        what = ("no payload was recorded (no load column)" if pay is None else
+                f"its data had {held:g} kg in every pose")
+        raise PayloadConditionError(
+            f"--load {other:g}: the calibration holds at one payload only ({what}, and no "
+            f"MJCF gave the masses), so it cannot predict {other:g} kg; measure at several "
+            "payloads or calibrate with --mjcf to separate the payload's effect"
+            + ("" if pay is None else f", or run at --load {held:g}"))
+
+
 def missing_conditions(terms: tuple[Term, ...], compliance_model: str, kappa: float,
                        conditions: Conditions | None, *, temp: object, load: object) -> None:
     """Refuse a request that leaves out a condition the model needs.
 
     Raises:
         MissingConditionError: a payload-dependent joint map identified on data with a
-            payload, and no ``load``; thermal expansion and no ``temp`` (naming the option).
+            payload, and no ``load``; a model identified at one non-zero payload and no
+            ``load``; thermal expansion and no ``temp`` (naming the option).
+        PayloadConditionError: a payload other than the one a model identified at one
+            payload holds at (:func:`check_payload`).
     """
+    check_payload(conditions, compliance_model, load, required=True)
     dep = load_dependent(terms, compliance_model)
     loaded = conditions is not None and conditions.payloads_kg is not None and any(
         p != 0.0 for p in conditions.payloads_kg)

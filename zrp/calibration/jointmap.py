@@ -84,7 +84,7 @@ def term_basis(term: Term, ctx: Context) -> F64:
     Raises:
         InputError: a term this library does not know, or missing pose conditions.
     """
-    if term.effect == "joint_compliance" and term.what == "compliance" and \
+    if term.effect == "joint_compliance" and term.what.startswith("compliance") and \
             ctx.gravity_torque is None:
         raise InputError(f"{term.name}: needs the gravity torque of every pose "
                          "(gravity_torque=, from mjcf.gravity.gravity_torques)")

@@ -98,18 +98,37 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "full_pose": full_pose_document(full_pose, cal.fold_rotations()[-1]),
         "conditions": None if cal.conditions is None else cal.conditions.to_dict(),
         "domains_widened": cal.widen,
+        "undetermined": list(cal.undetermined),
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
                   "= R_b (p'(x) + R'_n(x) t'_j) + t_b with p', R'_n the forward kinematics of "
                   "model_file, bodies scaled by 1 + kappa (temp - t_ref)"),
     }
 
 
-def _toml_header(cal: CalibratedRobot) -> str:
-    """Comment lines heading the model TOML: the version and the conditions (the model format
-    has no keys for them; compensation.json carries them as data). The user's strings (the
-    instrument, the data file's name) pass through :func:`zrp.escape.one_line`: a name with a
-    line break cannot end the comment and add TOML keys."""
-    lines = [f"# written by zrp-accuracy {__version__}"]
+#: the first words of the line that marks a calibrated model TOML (:func:`calibrated_marker`)
+CALIBRATED_MARKER = "# zrp calibrated model"
+
+
+def calibrated_marker(text: str) -> str | None:
+    """The compensation file a calibrated model TOML names in its marker line, or None when
+    ``text`` is not a calibrated model's."""
+    for line in text.splitlines()[:3]:
+        if line.startswith(CALIBRATED_MARKER):
+            return line.split("compensation file ", 1)[-1].split(";", 1)[0].strip() or None
+    return None
+
+
+def _toml_header(cal: CalibratedRobot, comp_name: str) -> str:
+    """Comment lines heading the model TOML: the marker naming its compensation file, the
+    version and the conditions (the model format has no keys for them; compensation.json
+    carries them as data). The user's strings (the file names, the instrument) pass through
+    :func:`zrp.escape.one_line`: a name with a line break cannot end the comment and add TOML
+    keys."""
+    comp_name = one_line(comp_name)
+    lines = [f"{CALIBRATED_MARKER}: the geometry only; its joint map, thermal expansion and "
+             f"registration are in the compensation file {comp_name}; export it whole with "
+             f"zrp export --calibration {comp_name}",
+             f"# written by zrp-accuracy {__version__}"]
     c = cal.conditions
     if c is not None:
         lines += ["# calibrated under (compensation.json 'conditions'):",
@@ -120,6 +139,10 @@ def _toml_header(cal: CalibratedRobot) -> str:
                   f"#   instrument = {one_line(c.instrument)}; data_file = "
                   f"{one_line(c.data_file)}; "
                   f"data_sha256 = {c.data_sha256}"]
+    if cal.undetermined:
+        lines.append("# NOT DETERMINED by the data (kept at nominal or known only loosely; "
+                     "compensation.json 'undetermined'):")
+        lines += [f"#   {' '.join(u.split())}" for u in cal.undetermined]
     return "\n".join(lines) + "\n"
 
 
@@ -146,7 +169,7 @@ def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: s
                          "below it); the compensation file names its model relative to "
                          "itself") from None
     doc, toml = bind_pair(to_jsonable(calibration_document(cal, rel, full_pose)),
-                          _toml_header(cal) + dumps_model(cal.model))
+                          _toml_header(cal, Path(comp_path).name) + dumps_model(cal.model))
     m = write_text(model_path, toml, overwrite=overwrite)
     c = write_text(comp_path, dumps(doc), overwrite=overwrite)
     return m, c
@@ -265,7 +288,7 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
         else np.array(doc["gravity_side_weights"], dtype=float),
         None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
         None if widen is None else {str(k): float(v) for k, v in dict(widen).items()},
-        _lead(bl.get("lead"), src))
+        _lead(bl.get("lead"), src), tuple(str(u) for u in doc.get("undetermined") or ()))
 
 
 def _lead(value: Any, src: str) -> tuple[bool, ...] | None:

@@ -42,7 +42,7 @@ MAX_TARGETS = 1_000_000
 
 #: The columns :func:`write_commands` writes besides target and q1..qn.
 COMMAND_FLAGS = ("residual", "orientation_residual", "uncompensated", "sigma_min",
-                 "near_singular", "near_limit", "converged")
+                 "near_singular", "near_limit", "converged", "outside_measured")
 
 
 
@@ -232,12 +232,12 @@ def write_commands(comp: Compensation, path: str | Path, *, deg: bool = False,
     n = comp.q_command.shape[1]
     q = np.degrees(comp.q_command) if deg else comp.q_command
     header = ["target", *[f"q{k}{'[deg]' if deg else ''}" for k in range(1, n + 1)],
-              "residual", "orientation_residual", "uncompensated", "sigma_min",
-              "near_singular", "near_limit", "converged"]
+              "residual", *COMMAND_FLAGS[1:]]
     ori = comp.orientation_residual
     rows = ([t, *(repr(float(v)) for v in q[i]), repr(float(comp.residual[i])),
              "" if ori is None else repr(float(ori[i])),
              repr(float(comp.uncompensated[i])), repr(float(comp.sigma_min[i])),
-             int(comp.near_singular[i]), int(comp.near_limit[i]), int(comp.converged[i])]
+             int(comp.near_singular[i]), int(comp.near_limit[i]), int(comp.converged[i]),
+             int(comp.outside_measured[i])]
             for i, t in enumerate(comp.target_ids))
     return write_text(path, csv_text(header, rows), overwrite=overwrite)

@@ -133,9 +133,11 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
     if isinstance(effects, str):
         raise InputError(f"effects: expected a sequence of effect names, got the string "
                          f"{effects!r}")
-    opts = DiagnosisOptions(tuple(effects), withheld_fraction, folds, alpha, min_gain,
-                            max_steps, noise_sigma, tuple(harmonics), tuple(gravity_dir),
-                            progress, max_tilt_rad, residual_model)
+    opts = DiagnosisOptions(effects=tuple(effects), withheld_fraction=withheld_fraction,
+                            folds=folds, alpha=alpha, min_gain=min_gain, max_steps=max_steps,
+                            noise_sigma=noise_sigma, harmonics=tuple(harmonics),
+                            gravity_dir=tuple(gravity_dir), progress=progress,
+                            max_tilt_rad=max_tilt_rad, residual_model=residual_model)
     if measurements.n_joints != model.n:
         raise InputError(f"{measurements.source}: {measurements.n_joints} joint columns, but "
                          f"the model {model.name!r} has {model.n} joints")

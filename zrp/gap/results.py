@@ -25,6 +25,7 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.analysis.assessment import Assessment
 from zrp.gap.analysis.checks import GapWarning as GapWarning
+from zrp.gap.analysis.determination import Determination, determinations
 from zrp.gap.analysis.identifiability import EffectIdentifiability as EffectIdentifiability
 from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.data.noise import NoiseFloor
@@ -226,6 +227,17 @@ class Diagnosis(EffectsFound):
         return self.final_fit.held
 
     @property
+    def determination(self) -> dict[str, Determination]:
+        """Parameter name -> what the data determine about it (registration and final model:
+        held, undetermined with the direction it belongs to, or determined;
+        :mod:`zrp.gap.analysis.determination`)."""
+        a = self.assessment
+        return determinations(self.final_fit, self.registration + self.final_parameters,
+                              gap=self.nominal.rms, unit=self.length_unit,
+                              max_tilt_rad=self.context.max_tilt_rad,
+                              correlations=None if a is None else a.correlations)
+
+    @property
     def solver_stops(self) -> tuple[str, ...]:
         """Fits that stopped before converging, in words (empty when every fit converged):
         the final model's, the geometric baseline's and any fit whose warning was caught."""
@@ -254,6 +266,8 @@ class Diagnosis(EffectsFound):
                 "solver": {"converged": f.converged, "iterations": f.iterations,
                            "reason": f.stop_reason},
                 "stopped_early": list(self.solver_stops),
+                "undetermined": [d.to_dict() for d in self.determination.values()
+                                 if not d.determined],
                 "outside_domain": [{"effect": e, "note": n} for e, n in self.outside_domain],
                 "max_tilt_rad": self.context.max_tilt_rad,
                 "full_pose": None if self.full_pose is None else {

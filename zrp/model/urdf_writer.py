@@ -3,7 +3,8 @@
 Links ``base``, ``link1``..``linkn`` and ``tool``; every joint frame is parallel to the base
 frame at q = 0, so joint k's ``origin`` is b_{k,0} (in metres, no rotation) and its ``axis`` is
 u_{k,0}; the fixed joint ``tool_joint`` carries b_{n+1,0} and the hand frame (columns
-u_t x u_a, u_t, u_a) as roll-pitch-yaw. Limited revolute joints are ``revolute``, unlimited
+u_t x u_a, u_t, u_a) as roll-pitch-yaw; the robot's name is made a valid XML name
+(:func:`robot_name`). Limited revolute joints are ``revolute``, unlimited
 ones ``continuous``; prismatic joints carry their limits when they have them. No geometry is
 written, and each moving link gets a nominal 1 g mass only so that MuJoCo loads the file (a
 kinematic description; a ``<mujoco>`` element keeps MuJoCo from fusing the tool link).
@@ -15,6 +16,7 @@ kept).
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 
@@ -26,7 +28,7 @@ from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.units import metres_per_unit
 
-__all__ = ["save_urdf", "urdf_xml"]
+__all__ = ["robot_name", "save_urdf", "urdf_xml"]
 
 
 #: A nominal 1 g point-like mass per moving link: MuJoCo refuses massless moving bodies.
@@ -55,6 +57,14 @@ def _limit(model: Manipulator, k: int, scale: float) -> str:
             f'effort="0" velocity="{vel}"/>\n')
 
 
+def robot_name(name: str) -> str:
+    """A valid URDF robot name (an XML name: letters, digits, ``_``, ``-``, ``.``, not
+    starting with a digit, ``-`` or ``.``) for a model's name: every other run of characters
+    becomes one ``_`` ("ABB IRB 120 (calibrated)" -> "ABB_IRB_120_calibrated")."""
+    out = re.sub(r"[^A-Za-z0-9_.-]+", "_", name).strip("_")
+    return out if out and re.match(r"[A-Za-z_]", out) else f"robot_{out}".rstrip("_")
+
+
 def urdf_xml(model: Manipulator) -> str:
     """URDF text of ``model`` (lengths converted to metres).
 
@@ -65,7 +75,7 @@ def urdf_xml(model: Manipulator) -> str:
     if len(set(names)) != len(names):
         raise ModelError(f"joint names: must be unique in a URDF, got {list(names)}")
     scale = metres_per_unit(model.length_unit)
-    out = [f'<?xml version="1.0"?>\n<robot name={quoteattr(model.name)}>\n',
+    out = [f'<?xml version="1.0"?>\n<robot name={quoteattr(robot_name(model.name))}>\n',
            '  <mujoco><compiler fusestatic="false"/></mujoco>\n',  # keep the tool body
            '  <link name="base"/>\n']
     out += [f'  <link name="link{k}">{_INERTIAL}</link>\n' for k in range(1, model.n + 1)]

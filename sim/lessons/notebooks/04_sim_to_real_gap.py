@@ -26,7 +26,7 @@ import sim
 import zrp
 from mjcf.gravity import gravity_torques
 from sim.studies.compensation_check import compensate_and_measure
-from zrp.calibration import CalibratedRobot
+from zrp.calibration import CalibrationOptions, calibrate
 from zrp.gap.report import verdict_text
 
 mediapy.set_ffmpeg(imageio_ffmpeg.get_ffmpeg_exe())
@@ -71,7 +71,10 @@ xml = mjcf.save_mjcf(mjcf.build(model, mjcf.MJCFOptions(inertia="puma560", visua
                                                         floor=False)), work / "nominal.xml")
 with warnings.catch_warnings():
     warnings.simplefilter("ignore")   # the diagnosis's warnings are in diag.warnings
-    diag = zrp.diagnose(model, meas, gravity_torque=gravity_torques(xml, meas.q_pose), seed=0)
+    # the one calibration recipe (as `zrp calibrate`): diagnose, then the calibrated robot
+    calibration = calibrate(model, meas, options=CalibrationOptions(
+        gravity_torque=gravity_torques(xml, meas.q_pose), seed=0))
+diag = calibration.diagnosis
 print(verdict_text(diag))
 
 labels = ["nominal\n(registered)"] + [f"+ {s.effect}\njoints {list(s.joints)}"
@@ -93,7 +96,7 @@ plt.show()
 # robot differs from the drawing.
 
 # %%
-cal = CalibratedRobot.from_diagnosis(diag)
+cal = calibration.robot
 path = zrp.circle_joint_path(model, steps=60)
 frames = list(sim.video_frames(
     [sim.VideoSegment(model, cal.model, path.t, path.q, "identified geometry")],
@@ -109,7 +112,8 @@ mediapy.show_video(frames, fps=15, height=320)
 # tracker measures both.
 
 # %%
-check = compensate_and_measure(robot, tracker, diag, xml, rng, n_random=30, n_circle=24)
+check = compensate_and_measure(robot, tracker, calibration, xml, rng, n_random=30,
+                               n_circle=24)
 s = check.summary()
 print(f"RMS error before {s['rms_before']:.3f} mm, after {s['rms_after']:.3f} mm "
       f"(tracker noise {s['noise_rms']:.3f} mm)")

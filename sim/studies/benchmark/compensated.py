@@ -26,6 +26,7 @@ from sim.robot.model import RealRobotOptions
 from sim.robot.real import RealRobot
 from sim.studies.benchmark.scenarios import Scenario
 from sim.studies.compensation_check import compensate_and_measure
+from zrp.calibration import calibrate
 from zrp.errors import InputError
 from zrp.gap import Diagnosis
 from zrp.model.manipulator import Manipulator
@@ -60,14 +61,15 @@ def compensated_column(model: Manipulator, scenario: Scenario, truth: dict[str, 
     rng = np.random.default_rng([scenario.seed, 11])
     n_circle = targets // 2 if model.n == 6 and targets // 2 >= 8 else 0
     nan = float("nan")
+    calibration = calibrate(model, diagnosis.context.meas, diagnosis=diagnosis)
     try:
         try:
-            r = compensate_and_measure(robot, inst, diagnosis, mjcf_path, rng,
+            r = compensate_and_measure(robot, inst, calibration, mjcf_path, rng,
                                        n_random=targets, n_circle=n_circle, chosen_side=True)
         except InputError as exc:
             if n_circle == 0 or "circle" not in str(exc):
                 raise
-            r = compensate_and_measure(robot, inst, diagnosis, mjcf_path, rng,
+            r = compensate_and_measure(robot, inst, calibration, mjcf_path, rng,
                                        n_random=targets, n_circle=0, chosen_side=True)
     except InputError as exc:  # e.g. a command beyond a limit: reported, not a crash
         return {"comp_targets": 0, "comp_rms_before": nan, "comp_rms_after": nan,

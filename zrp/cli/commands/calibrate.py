@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import dataclasses
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -15,7 +14,7 @@ from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
 from zrp.errors import InputError
 from zrp.gap.model.choices import EFFECTS
-from zrp.gap.model.domains import DEFAULT_MAX_TILT_RAD, DOMAINS  # light: no NumPy
+from zrp.gap.model.domains import DOMAINS  # light: no NumPy
 from zrp.output import OutputDir
 
 FILES = ("calibrated.toml", "compensation.json")
@@ -53,6 +52,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="raise a physical domain's upper bound (zrp/gap/model/domains.py: "
                    f"{', '.join(DOMAINS)}), e.g. --widen axis_tilt=0.02, for an arm known "
                    "to need it; repeatable")
+    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
+                   help="show the diagnosis's progress on stderr (default on; --no-progress: "
+                        "silent)")
     p.add_argument("--json", action="store_true", help="print the compensation file")
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "seed": "--seed",
                                          "effects": "--effects", "max_steps": "--max-steps",
@@ -80,11 +82,9 @@ def _widen(items: list[str]) -> dict[str, float] | None:
 def _run(args: argparse.Namespace) -> int:
     # mjcf loads MuJoCo (+0.25 s): only when this command runs
     from mjcf.gravity import gravity_torques
-    from zrp.calibration import CalibratedRobot, write_calibration  # on use: keeps --help quick
-    from zrp.calibration.conditions import Conditions  # on use: keeps --help quick
-    from zrp.calibration.fullpose import full_pose_calibration  # on use: keeps --help quick
+    from zrp.calibration import CalibrationOptions, calibrate  # on use: keeps --help quick
     from zrp.calibration.storage import calibration_document  # on use: keeps --help quick
-    from zrp.gap import diagnose, load_measurements  # on use: keeps --help quick
+    from zrp.gap import load_measurements  # on use: keeps --help quick
     from zrp.gap.model.domains import ImplausibleValueError  # on use: keeps --help quick
     from zrp.gap.report import OUTPUT_FILES, write_outputs  # on use: keeps --help quick
     from zrp.model.files import load_model  # on use: keeps --help quick
@@ -94,30 +94,23 @@ def _run(args: argparse.Namespace) -> int:
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame)
     tau = None if args.mjcf is None else gravity_torques(
         args.mjcf, meas.q_pose, field="--mjcf", joint_names=[j.name for j in model.joints])
+    opt = CalibrationOptions(
+        gravity_torque=tau, effects=args.effects, seed=args.seed, max_steps=args.max_steps,
+        noise_sigma=args.noise, use_orientation=not args.no_orientation,
+        orientation_sigma=args.orientation_sigma, widen=widen, data_path=args.data,
+        data_angle_unit="deg" if args.deg else "rad", instrument=args.instrument,
+        progress=args.progress)
     out_dir = Path(args.out)
     created = not out_dir.exists()
     try:
         with OutputDir(out_dir, overwrite=args.force, names=OUTPUT_FILES + FILES,
                        prune=True) as out:
-            diag = diagnose(model, meas, gravity_torque=tau, effects=args.effects,
-                            seed=args.seed, max_steps=args.max_steps, noise_sigma=args.noise,
-                            use_orientation=not args.no_orientation,
-                            orientation_sigma=args.orientation_sigma,
-                            # --widen axis_tilt=B is also the search's tilt domain
-                            max_tilt_rad=(widen or {}).get("axis_tilt", DEFAULT_MAX_TILT_RAD))
-            cal = CalibratedRobot.from_diagnosis(diag)
-            full = None
-            if diag.full_pose is not None:
-                full = full_pose_calibration(diag, args.orientation_sigma)
-                cal = full.robot
-            cal = dataclasses.replace(cal, widen=widen, conditions=Conditions.from_measurements(
-                meas, model, data_path=args.data, data_angle_unit="deg" if args.deg else "rad",
-                instrument=args.instrument))
+            result = calibrate(model, meas, options=opt)
+            diag, full = result.diagnosis, result.full_pose
             files = write_outputs(diag, out, plots=False)
             try:
-                cal_files = list(write_calibration(
-                    cal, out_dir / FILES[0], out_dir / FILES[1], overwrite=True,
-                    full_pose=None if full is None else full.fit))
+                cal_files = result.write(out_dir / FILES[0], out_dir / FILES[1],
+                                         overwrite=True)
                 out.written += cal_files  # this run's (the folder's prune keeps them)
                 files += cal_files
             except ImplausibleValueError as exc:
@@ -133,7 +126,8 @@ def _run(args: argparse.Namespace) -> int:
             f"{model.length_unit} (effects: {', '.join(diag.effects)})\n"
             + ("" if full is None else _full_pose_line(full, model.length_unit))
             + "\n".join(f"wrote {f}" for f in files))
-    emit(args, calibration_document(cal, FILES[0], None if full is None else full.fit), text)
+    emit(args, calibration_document(result.robot, FILES[0], None if full is None else
+                                    full.fit), text)
     return 0
 
 

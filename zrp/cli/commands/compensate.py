@@ -47,10 +47,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--load", type=real(0.0, 1e4), metavar="KG",
                    help="payload when the commands run, kg (required when the calibration's "
                    "joint map depends on a payload measured in the data)")
+    p.add_argument("--accept-flagged", action="store_true",
+                   help="compensate targets whose commands lie outside the joint ranges the "
+                   "calibration measured, or near a singularity (relative to the arm's own "
+                   "conditioning), too, flagged per row (outside_measured, near_singular); "
+                   "default: refused")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=_run, api_names={"limits": "--limits", "point": "--point",
                                          "gravity_torque": "--mjcf", "temp": "--temp",
-                                         "load": "--load"})
+                                         "load": "--load",
+                                         "accept_flagged": "--accept-flagged"})
 
 
 def _limits(args: argparse.Namespace, model: Manipulator) -> np.ndarray | None:
@@ -95,9 +101,10 @@ def _run(args: argparse.Namespace) -> int:
             return gravity_torques(args.mjcf, q, field="--mjcf",
                                    joint_names=[j.name for j in cal.model.joints])
     elif cal.compliance_model == "mjcf" and any(
-            t.name.endswith(".compliance") for t in cal.terms):
-        raise InputError("--mjcf: the calibration's compliance was identified with MJCF "
-                         "gravity torques; pass the MJCF")
+            t.effect == "joint_compliance" for t in cal.terms):
+        raise InputError("--mjcf: this calibration used --mjcf (its joint compliance was "
+                         "identified with the MJCF's gravity torques, in rad/(N m)); pass the "
+                         "same MJCF or URDF with --mjcf")
     missing_conditions(cal.terms, cal.compliance_model, cal.kappa, cal.conditions,
                        temp=args.temp, load=args.load)
     T = len(tg.q)
@@ -105,16 +112,19 @@ def _run(args: argparse.Namespace) -> int:
                           load=None if args.load is None else np.full(T, args.load))
     if tg.xyz is None:
         comp = compensate_program(cal, tg.q, limits=lim, gravity_torque=grav,
-                                  target_ids=tg.ids, conditions=cond)
+                                  target_ids=tg.ids, conditions=cond,
+                                  accept_flagged=args.accept_flagged)
     else:
         comp = compensate_targets(cal, tg.xyz, tg.q, orientations=tg.rotation, point=args.point,
                           frame=args.frame, limits=lim, gravity_torque=grav,
-                          target_ids=tg.ids, conditions=cond)
+                          target_ids=tg.ids, conditions=cond,
+                          accept_flagged=args.accept_flagged)
     path = write_commands(comp, args.out, deg=args.deg, overwrite=args.force)
     s = comp.summary()
     text = (f"{s['targets']} targets: predicted RMS error {s['rms_before']:.4g} -> "
             f"{s['rms_after']:.3g} {cal.model.length_unit} (max {s['max_after']:.3g}); "
             f"{s['not_converged']} not converged, {s['near_singular']} near a singularity, "
-            f"{s['near_limit']} near a limit\nwrote {path}")
+            f"{s['near_limit']} near a limit, {s['outside_measured']} outside the measured "
+            f"joint ranges\nwrote {path}")
     emit(args, s, text)
     return 0

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.options import FRACTION, SEED, real, whole
@@ -52,11 +53,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--reflectors", type=whole(1, 3), default=3, metavar="M",
                    help="reflectors on the tool, 1-3 (default 3; with 1 the diagnosis has no "
                         "noise floor from rigid links)")
-    p.add_argument("--arm", default=None, metavar="FILE",
-                   help="the arm's shipped URDF or MJCF (its joints named as the model's): the "
-                        "simulated robot takes its inertias, damping, friction and tool, and "
-                        "the diagnosis gets it as its MJCF. Without it an arm with no inertias "
-                        "of its own borrows the PUMA 560's (6R) or rods', announced")
+    arm = p.add_argument("--mjcf", default=None, metavar="FILE",
+                         help="the arm's shipped URDF or MJCF (its joints named as the "
+                              "model's): the simulated robot takes its inertias, damping, "
+                              "friction and tool, and the diagnosis gets it as its MJCF. "
+                              "Without it an arm with no inertias of its own borrows the PUMA "
+                              "560's (6R) or rods', announced")
+    deprecated_alias(p, "--arm", arm)
     p.add_argument("--no-mjcf", action="store_true",
                    help="do not give the diagnosis the nominal MJCF (lumped-mass compliance)")
     p.add_argument("--out", default=None, metavar="DIR",
@@ -105,7 +108,7 @@ def _run(args: argparse.Namespace) -> int:
                           noise=None if args.noise is None else tuple(args.noise),
                           poses_from=args.poses_from, approach=args.approach,
                           use_mjcf=not args.no_mjcf, compensate=args.compensate,
-                          reflectors=args.reflectors, arm_file=args.arm)
+                          reflectors=args.reflectors, arm_file=args.mjcf)
     model = load_model(args.model)
     # the folder is locked and its files checked before the (long) run
     with OutputDir(out, overwrite=overwrite, names=output_names(True), prune=True) as folder:

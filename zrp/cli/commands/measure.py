@@ -12,6 +12,7 @@ if TYPE_CHECKING:
 
     from zrp.model.manipulator import Manipulator
 
+from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, add_deg, real, whole
 from zrp.errors import InputError
@@ -20,7 +21,8 @@ from zrp.output import check_writable, write_text
 
 
 def _robot_options(arm: str | None, model: object) -> object:
-    """The real robot's options: the arm's own dynamics from ``--arm`` (None: the default)."""
+    """The real robot's options: the arm's own dynamics from ``--mjcf`` (None: the
+    default)."""
     if arm is None:
         return None
     import mjcf  # loads MuJoCo: only when this command runs
@@ -40,7 +42,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--model", default="puma", metavar="M.toml",
                    help=f"model TOML file or built-in name ({', '.join(sorted(builtin_models()))}"
                         "; default puma)")
-    p.add_argument("--arm", default=None, metavar="FILE",
+    arm = p.add_argument("--mjcf", default=None, metavar="FILE",
                    help="the arm's shipped URDF or MJCF (joints named as the model's): the "
                         "simulated robot (at rest or with --stream) takes its inertias, "
                         "damping, friction and tool (the truth file names it and its "
@@ -56,8 +58,10 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "link_length:4=0.1,0.2,-0.1mm, axis_misalignment:3=0.5,0.2mrad, "
                         "joint_compliance:2=20urad/Nm, backlash:1=0.8mrad, "
                         "thermal_expansion=12ppm/K")
-    p.add_argument("--payload", type=real(0.0, 1e4, unit="kg"), default=0.0, metavar="KG",
-                   help="payload at the tool point, kg (logged in the load column)")
+    load = p.add_argument("--load", type=real(0.0, 1e4, unit="kg"), default=0.0, metavar="KG",
+                          help="payload at the tool point, kg (logged in the load column)")
+    deprecated_alias(p, "--payload", load)
+    deprecated_alias(p, "--arm", arm)
     p.add_argument("--poses", type=_count_or_plan, default=200, metavar="N|PLAN.csv",
                    help="number of poses (default 200), or a plan file of zrp plan: its poses "
                         "and approach directions, in its order")
@@ -153,13 +157,13 @@ def _run(args: argparse.Namespace) -> int:
         if isinstance(args.poses, str):
             raise InputError("--poses: a plan file is measured at rest; drop --stream")
         return _stream(args, model, out, truth)
-    effects = sim.parse_effects(args.effect, model, args.payload, field="--effect")
+    effects = sim.parse_effects(args.effect, model, args.load, field="--effect")
     rng = np.random.default_rng(args.seed)
     q, directions = _poses(args, model, rng)
     args.approach = args.approach or "gravity"
     inst = sim.random_instrument(model, rng, args.noise)
     t0 = time.perf_counter()
-    robot = sim.RealRobot(model, effects, _robot_options(args.arm, model))
+    robot = sim.RealRobot(model, effects, _robot_options(args.mjcf, model))
     procedure = sim.Procedure(approach=args.approach, temp_rise=args.temp_rise)
     run = sim.measure(robot, q, inst, rng, procedure, progress=args.progress,
                       directions=directions)
@@ -190,7 +194,7 @@ def _stream(args: argparse.Namespace, model: object, out: Path, truth: Path) -> 
                          "--motion-effect")
     traj_name = "moves" if args.trajectory == "random" else args.trajectory
     t0 = time.perf_counter()
-    opts = _robot_options(args.arm, model)
+    opts = _robot_options(args.mjcf, model)
     run = measure_stream(model, traj_name, args.motion_effect, args.stream,  # type: ignore[arg-type]
                          args.noise, args.seed, field="--motion-effect",
                          dynamics=getattr(opts, "dynamics", None))

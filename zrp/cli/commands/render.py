@@ -7,6 +7,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
 from zrp.cli.options import MAX_FPS, MAX_HEIGHT, MAX_SECONDS, MAX_WIDTH, PERCENT, real, whole
 from zrp.output import OutputDir, claim_generated
@@ -35,12 +36,12 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="levels of the sweep (default the paper's)")
     p.add_argument("--steps", type=whole(2, 100_000),
                    default=360, help="inverse-kinematics steps (360)")
-    p.add_argument("--out-dir", default=None, metavar="DIR",
+    out = p.add_argument("--out", default=None, metavar="DIR",
                    help=f"output folder (default {DEFAULT_OUT}/, generated output whose videos "
                         "are replaced; in any other folder an existing video needs --force). "
                         "One run at a time per folder: a second run into it is refused")
     p.add_argument("--force", action="store_true",
-                   help="replace existing videos in --out-dir (checked before rendering)")
+                   help="replace existing videos in --out (checked before rendering)")
     p.add_argument("--width", type=whole(16, MAX_WIDTH), default=640,
                    help=f"pixels, 16 to {MAX_WIDTH} (default 640)")
     p.add_argument("--height", type=whole(16, MAX_HEIGHT), default=480,
@@ -57,7 +58,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "the first that works)")
     p.add_argument("--no-dynamics", action="store_true",
                    help="skip the dynamic playback (PD servos under gravity, PUMA 560 inertias)")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    progress = p.add_argument("--progress", action=argparse.BooleanOptionalAction,
+                              default=True, help="show a progress bar (default on; "
+                              "--no-progress: silent)")
+    deprecated_alias(p, "--out-dir", out)
+    deprecated_alias(p, "--quiet", progress, "--no-progress")
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=_run)
 
@@ -126,13 +131,13 @@ def _run(args: argparse.Namespace) -> int:
 
     videos = _videos(args, sim.VideoOptions)
     names = [sim.video_path(scene.file_name, o).name for scene, o in videos]
-    overwrite = args.force or (args.out_dir is None and claim_generated(DEFAULT_OUT))
-    with OutputDir(Path(args.out_dir or DEFAULT_OUT), overwrite=overwrite, names=names) as out:
+    overwrite = args.force or (args.out is None and claim_generated(DEFAULT_OUT))
+    with OutputDir(Path(args.out or DEFAULT_OUT), overwrite=overwrite, names=names) as out:
         seg = videos[0][0].segments[0]
         checks = [sim.consistency_check(m, seg.q) for m in (seg.nominal, seg.perturbed)]
         dyn = None if args.no_dynamics else sim.dynamic_playback(seg.perturbed, seg.t, seg.q)
         results = [sim.render_video(scene.segments, out.root / name, title=scene.title,
-                                    options=o, overwrite=overwrite, progress=not args.quiet)
+                                    options=o, overwrite=overwrite, progress=args.progress)
                    for (scene, o), name in zip(videos, names, strict=True)]
     emit(args, _payload(results, checks, dyn, seg), _text(results, checks, dyn))
     return 0

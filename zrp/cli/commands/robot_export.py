@@ -103,6 +103,28 @@ def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]
     return cal.model, side
 
 
+def _refuse_calibrated_model(model: str) -> None:
+    """A calibrated model TOML holds the geometry only: its cyclic-error, backlash and other
+    joint-map terms live in its compensation file, which --calibration exports whole."""
+    from zrp.calibration.storage import calibrated_marker  # on use: keeps --help quick
+    from zrp.textio import read_text  # on use: keeps --help quick
+
+    path = Path(model)
+    if not path.is_file():
+        return
+    try:
+        comp = calibrated_marker(read_text(path))
+    except (OSError, UnicodeDecodeError):
+        return  # load_model names what is wrong with the file
+    if comp is not None:
+        raise InputError(
+            f"--model {model}: a calibrated model holds the geometry only; its joint-map "
+            "terms (encoder scale, cyclic error, compliance, backlash), thermal expansion and "
+            f"registration are in {comp} beside it and would be dropped; export with "
+            f"--calibration {path.parent / comp}, which keeps them (the format, plus a side "
+            "file of what it cannot hold)")
+
+
 def _run(args: argparse.Namespace) -> int:
     from zrp.model.files import load_model  # on use: keeps --help quick
 
@@ -110,6 +132,8 @@ def _run(args: argparse.Namespace) -> int:
                                      or args.site):
         raise InputError("--urdf, --mjcf: patch the robot's file with a calibration; give "
                          "--calibration C.json")
+    if args.calibration is None:
+        _refuse_calibrated_model(args.model)
     src = args.calibration or args.model
     stem = safe_name(Path(src).stem, lower=True)
     out = Path(args.out or f"renders/{stem}{FORMATS[args.to]}")

@@ -132,10 +132,11 @@ def _run_end(lines: list[str], i: int, keep: Callable[[str], bool]) -> int:
 
 
 def _verdict(lines: list[str], i: int) -> tuple[str, int]:
-    """The verdict paragraph: the non-blank lines from ``i`` to the next heading, as one."""
-    j = _run_end(lines, i, lambda s: not s.startswith("#"))
-    para = [s for s in lines[i:j] if s.strip()]
-    return f'<div id="verdict">{_inline(" ".join(para))}</div>', j
+    """The verdict's headline: the first paragraph from ``i`` (its lines up to a blank line
+    or a heading, as one); the table and the detail sections after it are ordinary blocks."""
+    i = _run_end(lines, i, lambda s: not s.strip())
+    j = _run_end(lines, i, lambda s: bool(s.strip()) and not s.startswith(("#", "|")))
+    return f'<div id="verdict">{_inline(" ".join(lines[i:j]))}</div>', j
 
 
 def _block(lines: list[str], i: int, svgs: Mapping[str, bytes]) -> tuple[str, int]:

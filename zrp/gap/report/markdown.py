@@ -8,17 +8,19 @@ HTML punctuation escaped, so a label can add neither a section nor a table cell 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from zrp.escape import md_text as _t
+from zrp.gap.analysis.determination import Determination
 from zrp.gap.analysis.where import Region, WhereAnalysis
 from zrp.gap.report.backlash import backlash_flank_text
 from zrp.gap.report.fullpose import full_pose_markdown
+from zrp.gap.report.headline import headline_text, summary_markdown
 from zrp.gap.report.identification import identification_markdown
 from zrp.gap.report.verdict import (
     baseline_text,
     final_effects_text,
-    verdict_text,
+    verdict_sections,
 )
 from zrp.gap.results import Candidate, Diagnosis, ParameterEstimate
 
@@ -49,18 +51,36 @@ def _joints(joints: Sequence[int]) -> str:
     return ", ".join(map(str, joints)) or "-"
 
 
-def _parameter_table(params: Sequence[ParameterEstimate], *, flags: Sequence[str] = ()
-                     ) -> list[str]:
+def _status(p: ParameterEstimate, det: Mapping[str, Determination], bad: bool) -> str:
+    """What the data say about one parameter, in a table cell."""
+    d = det.get(p.name)
+    if bad:
+        return "NO: outside its physical domain"
+    if d is None or d.determined:
+        return "determined, plausible"
+    if d.status == "held":
+        return f"in a combination held at nominal: {_t(d.direction.split(' (')[0])}"
+    return f"undetermined: {_t(d.direction)}"
+
+
+def _parameter_table(params: Sequence[ParameterEstimate], *, flags: Sequence[str] = (),
+                     det: Mapping[str, Determination] | None = None) -> list[str]:
+    """One row per parameter: value, interval (none for a held one: the data did not move
+    it) and what the data say (:mod:`zrp.gap.analysis.determination`)."""
+    det = det or {}
     joint = any(p.ci95_effect is not None for p in params)
-    out = (["| parameter | value | 95 % interval | 95 % for the whole effect | plausible |",
+    out = (["| parameter | value | 95 % interval | 95 % for the whole effect | the data |",
             "|---|---|---|---|---|"] if joint else
-           ["| parameter | value | 95 % interval | plausible |", "|---|---|---|---|"])
+           ["| parameter | value | 95 % interval | the data |", "|---|---|---|---|"])
     for p in params:
         v, ci = value_ci(p.value, *p.ci95, p.unit)
+        held = p.name in det and det[p.name].status == "held"
         bad = any(f.startswith(p.name + " = ") for f in flags)
         both = "" if not joint else (
             f"{value_ci(p.value, *p.ci95_effect, p.unit)[1]} | " if p.ci95_effect else "| ")
-        out.append(f"| {_t(p.name)} | {v} | {ci} | {both}{'NO' if bad else 'yes'} |")
+        if held:
+            ci, both = "not pinned (held)", ("not pinned (held) | " if joint else "")
+        out.append(f"| {_t(p.name)} | {v} | {ci} | {both}{_status(p, det, bad)} |")
     return out
 
 
@@ -86,7 +106,9 @@ def _header(diag: Diagnosis) -> list[str]:
     s = diag.settings
     return [f"# Sim-to-real gap diagnosis: {_t(diag.model_name)}\n",
             "## Verdict\n",
-            verdict_text(diag) + "\n",
+            headline_text(diag) + "\n",
+            *summary_markdown(diag), "",
+            *(f"### {title}\n\n{text}\n" for title, text in verdict_sections(diag)),
             "## Data\n",
             f"Data: {_t(diag.context.meas.source)}: {s['n_poses']} poses, {s['n_points']} "
             f"measured points ({', '.join(map(_t, s['point_labels']))}), frame "
@@ -159,6 +181,7 @@ def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
 
 def _parameters(diag: Diagnosis) -> list[str]:
     flags = diag.assessment.implausible if diag.assessment is not None else ()
+    det = diag.determination
     L = ["## Identified parameters (final model, robust 95 % intervals)\n",
          "Estimated jointly in the final model (the per-step values in diagnosis.json were "
          "each estimated before the later effects were added). Intervals: the largest of the "
@@ -172,7 +195,7 @@ def _parameters(diag: Diagnosis) -> list[str]:
         by_eff.setdefault(p.effect, []).append(p)
     for eff, params in by_eff.items():
         L.append(f"### {eff} (joints {_joints(diag.final_joints.get(eff, ()))})\n")
-        L += _parameter_table(params, flags=flags)
+        L += _parameter_table(params, flags=flags, det=det)
         L.append("")
         if eff == "backlash" and backlash_flank_text(diag):
             L.append(backlash_flank_text(diag) + "\n")
@@ -196,7 +219,8 @@ def _parameters(diag: Diagnosis) -> list[str]:
 def _frame(diag: Diagnosis) -> list[str]:
     a = diag.assessment
     if a is None:
-        return ["Registration:\n", *_parameter_table(diag.registration), ""]
+        return ["Registration:\n", *_parameter_table(diag.registration,
+                                                     det=diag.determination), ""]
     f, u = a.frame, diag.length_unit
     L = ["## Registration (final model, robust 95 % intervals)\n"]
     if f.frame == "base":
@@ -221,6 +245,12 @@ def _frame(diag: Diagnosis) -> list[str]:
             cells.append(f"{v.strip()} {ci.strip()}")
         L.append(f"| {_t(lab)} | " + " | ".join(cells) + " |")
     L.append("")
+    det = diag.determination
+    loose = [det[p.name] for p in diag.registration if not det[p.name].determined]
+    if loose:
+        L.append("Not determined by these data (the controller files flag them):\n")
+        L += [f"- {_t(d.name)}: {_t(d.describe())}" for d in loose]
+        L.append("")
     return L
 
 

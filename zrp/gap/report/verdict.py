@@ -6,10 +6,12 @@ from __future__ import annotations
 import numpy as np
 
 from zrp.gap.analysis.where import WhereAnalysis
+from zrp.gap.report.headline import headline_text, summary_terminal
+from zrp.gap.report.headline import ranges as _ranges
 from zrp.gap.results import Diagnosis
 
 __all__ = ["baseline_text", "final_effects_text", "full_pose_text", "remains_text",
-           "verdict_text"]
+           "verdict_sections", "verdict_text"]
 
 #: R^2 below which the residual is said to depend on nothing in particular.
 NO_TREND_R2 = 0.1
@@ -67,17 +69,6 @@ def remains_text(w: WhereAnalysis, unit: str) -> str:
         out += (" No correction of the joint angles or geometry in the library reproduces a "
                 "residual of this shape.")
     return out
-
-
-def _ranges(joints: tuple[int, ...]) -> str:
-    """1, 2, 3, 5 -> "1-3, 5"."""
-    runs: list[list[int]] = []
-    for j in joints:
-        if runs and runs[-1][1] == j - 1:
-            runs[-1][1] = j
-        else:
-            runs.append([j, j])
-    return ", ".join(f"{a}" if a == b else f"{a}-{b}" for a, b in runs) or "-"
 
 
 def final_effects_text(diag: Diagnosis) -> str:
@@ -158,6 +149,14 @@ def identification_text(diag: Diagnosis) -> list[str]:
         more = f" and {len(held) - 3} more" if len(held) > 3 else ""
         parts.append(f"{len(held)} parameter combination(s) the data cannot pin stayed at "
                      f"their nominal values: {shown}{more}.")
+    loose = [d for d in diag.determination.values() if d.status == "undetermined"]
+    if loose:
+        names = ", ".join(d.name for d in loose[:4]) + (
+            f" and {len(loose) - 4} more" if len(loose) > 4 else "")
+        parts.append(f"{len(loose)} parameter(s) the data do not determine (95 % interval wider "
+                     f"than the physical domain, or moving the points by more than the error "
+                     f"before calibration): {names}; the tables say what each trades "
+                     "against.")
     seen: set[str] = set()  # named only while a gap remains: then it says why it was not closed
     for effect, note in (diag.outside_domain if diag.unexplained is not False else ()):
         if effect in seen:
@@ -271,21 +270,32 @@ def full_pose_text(diag: Diagnosis) -> str:
             f"{base}." + reveal + final)
 
 
-def verdict_text(diag: Diagnosis) -> str:
-    """One paragraph: the effects of the final model (and ties), how far the withheld error
-    shrinks, the geometric baseline beside it, how the error compares with the noise floor
-    (with the weighed evidence on an unexplained remainder) and what not to trust."""
+def verdict_sections(diag: Diagnosis) -> list[tuple[str, str]]:
+    """The details under the headline, as (title, paragraph): the effects found and how far
+    the withheld error shrinks beside the geometric calibration; what remains against the
+    noise floor (with the weighed evidence on an unexplained remainder); what the data could
+    not pin; what not to trust; what measured orientations add. Empty sections are left
+    out."""
     nominal, final, unit = diag.nominal, diag.final, diag.length_unit
     shrunk = 100 * (1 - final.rms / nominal.rms) if nominal.rms > 0 else 0
-    parts = _effects_found(diag)
-    parts.append(f"Withheld RMS {nominal.rms:.4g} {unit} after registration, "
+    found = _effects_found(diag)
+    found.append(f"Withheld RMS {nominal.rms:.4g} {unit} after registration, "
                  f"{final.rms:.4g} {unit} with the final model ({shrunk:.0f} % smaller).")
     bl = baseline_text(diag)
     if bl:
-        parts.append(bl)
-    parts += _against_floor(diag)
-    parts += identification_text(diag)
-    parts += _trust(diag)
-    if diag.full_pose is not None:
-        parts.append(full_pose_text(diag))
-    return " ".join(parts)
+        found.append(bl)
+    out = [("Effects found", found), ("What remains", _against_floor(diag)),
+           ("What the data cannot pin", identification_text(diag)),
+           ("What not to trust", _trust(diag)),
+           ("Measured orientations", [full_pose_text(diag)] if diag.full_pose else [])]
+    return [(title, " ".join(parts)) for title, parts in out if parts]
+
+
+def verdict_text(diag: Diagnosis) -> str:
+    """The verdict for the terminal and diagnosis.json: the headline (at most 80 words,
+    :func:`~zrp.gap.report.headline.headline_text`), the table of withheld errors, then the
+    details, each section a titled paragraph (:func:`verdict_sections`), separated by blank
+    lines."""
+    blocks = [headline_text(diag), summary_terminal(diag)]
+    blocks += [f"{title}:\n{text}" for title, text in verdict_sections(diag)]
+    return "\n\n".join(blocks)
