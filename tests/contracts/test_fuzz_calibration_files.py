@@ -12,8 +12,8 @@ CI runs a seeded slice of ``ZRP_FUZZ_EXAMPLES`` cases (default 60). The document
 
 The first 5,000-case run found one escape (a list as ``length_unit``: TypeError; fixed, kept
 in tests/calibration/test_file_domains.py); the run on the final code of issue 35: 5,000
-cases, none escaped (89 s on the shared 2-core machine; 2,347 malformed, 1,366 tampered
-pairs, 834 broken model files, 40 fields out of domain, 2 implausible values, 411 read).
+cases, none escaped (48 s on the shared 2-core machine; 2,408 malformed, 1,411 tampered
+pairs, 684 broken model files, 34 fields out of domain, 463 read).
 """
 
 from __future__ import annotations
