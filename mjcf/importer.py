@@ -18,6 +18,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from mjcf.assets import check_model_files
 from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
@@ -37,6 +38,7 @@ def load_mujoco_model(source: str | os.PathLike[str] | mujoco.MjModel) -> mujoco
     if isinstance(source, mujoco.MjModel):
         return source
     if isinstance(source, str) and source.lstrip().startswith("<"):
+        check_model_files(None, text=source)
         try:
             return mujoco.MjModel.from_xml_string(source)
         except ValueError as exc:
@@ -49,6 +51,7 @@ def load_mujoco_model(source: str | os.PathLike[str] | mujoco.MjModel) -> mujoco
         raise MJCFImportError(f"source: no such file {str(path)!r} (expected an MJCF .xml or a "
                               f".urdf file)")
     _check_utf8(path)
+    check_model_files(path)
     try:
         return mujoco.MjModel.from_xml_path(str(path))
     except ValueError as exc:

@@ -22,8 +22,10 @@ from pathlib import Path
 
 import mujoco
 
+from mjcf.assets import check_asset_file, check_model_files
 from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
+from zrp.textio import read_text
 
 __all__ = ["MESH_SUFFIXES", "example_robot_data_root", "load_shipped", "load_shipped_spec",
            "resolve_mesh", "shipped_urdf_xml"]
@@ -54,18 +56,19 @@ def resolve_mesh(uri: str, urdf_dir: Path) -> Path | None:
 
     ``package://PKG/rel``: ``A/rel`` for the first folder A above ``urdf_dir`` (itself
     included) named PKG, or ``A/PKG/rel`` for the first A holding a folder PKG;
-    ``file://abs`` and plain paths (relative to ``urdf_dir``) as they are.
+    ``file://abs`` and plain paths (relative to ``urdf_dir``) as they are. A path that
+    exists but is no regular file (a FIFO) is returned: :func:`shipped_urdf_xml` refuses it.
     """
     if uri.startswith("package://"):
         pkg, _, rel = uri[len("package://"):].partition("/")
         for a in (urdf_dir, *urdf_dir.parents):
             for cand in ((a / rel) if a.name == pkg else None, a / pkg / rel):
-                if cand is not None and cand.is_file():
+                if cand is not None and cand.exists():
                     return cand.resolve()
         return None
     path = Path(uri[len("file://"):] if uri.startswith("file://") else uri)
     path = path if path.is_absolute() else urdf_dir / path
-    return path.resolve() if path.is_file() else None
+    return path.resolve() if path.exists() else None
 
 
 def shipped_urdf_xml(path: str | os.PathLike[str]) -> tuple[str, list[str]]:
@@ -89,6 +92,8 @@ def shipped_urdf_xml(path: str | os.PathLike[str]) -> tuple[str, list[str]]:
                     continue
                 uri = mesh.get("filename", "")
                 file = resolve_mesh(uri, p.parent)
+                if file is not None:  # a regular file of bounded size, or refused by name
+                    check_asset_file(file, f"source {str(p)!r}: mesh {uri!r}")
                 if file is None or file.suffix.lower() not in MESH_SUFFIXES:
                     link.remove(el)
                     dropped.append(uri)
@@ -106,9 +111,13 @@ def _shipped_file(path: str | os.PathLike[str]) -> Path:
         raise InputError(f"path: expected a .urdf or MJCF .xml file name, got "
                          f"{type(path).__name__}")
     p = Path(path)
-    if not p.is_file():
+    if not p.exists():
         raise MJCFImportError(f"source: no such file {str(p)!r} (expected a .urdf or an MJCF "
                               ".xml)")
+    if p.suffix.lower() != ".urdf":  # a URDF's meshes are resolved and checked in
+        check_model_files(p)         # shipped_urdf_xml
+    else:
+        read_text(p, label=f"source {str(p)!r}", error=MJCFImportError)  # a regular file
     return p
 
 

@@ -23,7 +23,6 @@ blind benchmark never shows to the diagnosis.
 
 from __future__ import annotations
 
-import csv
 import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -38,6 +37,7 @@ from sim.robot.instrument import Instrument, check_number
 from sim.robot.real import Reading, RealRobot, Session
 from zrp.arrays import F64
 from zrp.errors import InputError, OutputExistsError
+from zrp.escape import csv_text
 from zrp.gap.data.measurements import Measurements
 from zrp.kinematics.ik import track_trajectory
 from zrp.kinematics.trajectory import Circle
@@ -366,17 +366,16 @@ def write_measurements(run: MeasurementRun, path: str | os.PathLike[str], *, deg
                                for k in range(1, n + 1)], "x", "y", "z", "t", "temp", "load"]
     if run.direction is not None:
         cols += [f"dir{k}" for k in range(1, n + 1)]
-    with atomic_path(path, overwrite=overwrite) as tmp, \
-            open(tmp, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(cols)
-        for i in range(meas.n_rows):
-            row = [meas.pose[i], meas.point[i], *(repr(float(v)) for v in q[i]),
-                   *(repr(float(v)) for v in meas.xyz[i]), repr(float(meas.t[i])),  # type: ignore[index]
-                   repr(float(meas.temp[i])), repr(float(meas.load[i]))]  # type: ignore[index]
-            if run.direction is not None:
-                row += [str(int(v)) for v in meas.direction[i]]  # type: ignore[index]
-            w.writerow(row)
+    rows = []
+    for i in range(meas.n_rows):
+        row = [meas.pose[i], meas.point[i], *(repr(float(v)) for v in q[i]),
+               *(repr(float(v)) for v in meas.xyz[i]), repr(float(meas.t[i])),  # type: ignore[index]
+               repr(float(meas.temp[i])), repr(float(meas.load[i]))]  # type: ignore[index]
+        if run.direction is not None:
+            row += [str(int(v)) for v in meas.direction[i]]  # type: ignore[index]
+        rows.append(row)
+    with atomic_path(path, overwrite=overwrite) as tmp:
+        tmp.write_text(csv_text(cols, rows), encoding="utf-8", newline="")
     return path
 
 

@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import zrp
+from tests.calibration.pairs import write_bound
 from tests.gap.test_fallback import stopped_early_panda
 from zrp.calibration import (
     CalibratedRobot,
@@ -22,6 +23,7 @@ from zrp.calibration import (
     read_calibration,
     write_calibration,
 )
+from zrp.calibration.filecheck import PairWarning
 from zrp.errors import InputError, OutputExistsError
 from zrp.gap import Injection, diagnose, synthesize
 from zrp.kinematics import uniform_joint_values
@@ -99,25 +101,26 @@ def test_a_leading_flank_is_written_read_and_checked(leading, tmp_path):
     assert doc["backlash"]["lead"][2] is True
     assert read_calibration(c).backlash_lead == cal.backlash_lead
     doc["backlash"]["lead"] = ["yes"] * 6
-    c.write_text(json.dumps(doc))
+    write_bound(c, doc)  # the pair re-bound: the field check meets the edit
     with pytest.raises(InputError, match=r"backlash\.lead"):
         read_calibration(c)
     doc["backlash"]["lead"] = [True] * 5
-    c.write_text(json.dumps(doc))
+    write_bound(c, doc)
     with pytest.raises(InputError, match="backlash_lead: 5 flags for 6 joints"):
         read_calibration(c)
     # a version-1 file (0.3.0) has no leading flanks: read as lagging, and a lead in it refused
     doc["schema_version"] = 1
     del doc["backlash"]["lead"]
     c.write_text(json.dumps(doc))
-    assert read_calibration(c).backlash_lead is None
+    with pytest.warns(PairWarning, match="before schema_version 3"):
+        assert read_calibration(c).backlash_lead is None
     doc["backlash"]["lead"] = list(cal.backlash_lead)
     c.write_text(json.dumps(doc))
     with pytest.raises(InputError, match=r"backlash\.lead in a schema_version 1 file"):
         read_calibration(c)
-    doc["schema_version"] = 3
+    doc["schema_version"] = 4
     c.write_text(json.dumps(doc))
-    with pytest.raises(InputError, match="schema_version 3, expected one of 1, 2"):
+    with pytest.raises(InputError, match="schema_version 4, expected one of 1, 2, 3"):
         read_calibration(c)
 
 

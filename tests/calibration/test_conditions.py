@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import zrp
+from tests.calibration.pairs import write_bound
 from zrp.calibration import (
     CalibratedRobot,
     PoseConditions,
@@ -181,7 +182,7 @@ def test_implausible_values_are_refused_by_the_writer(run, tmp_path, term, match
     _, c = write_calibration(cal, tmp_path / "c.toml", tmp_path / "c.json")
     doc = json.loads(c.read_text())
     doc["joint_map"].append(term.to_dict())
-    c.write_text(json.dumps(doc))
+    write_bound(c, doc)  # the pair re-bound: the domain check, not the hash, meets the edit
     with pytest.raises(ImplausibleValueError, match=match):
         read_calibration(c)
 
@@ -218,7 +219,10 @@ def test_model_file_cannot_leave_the_folder(run, tmp_path, model_file):
     (tmp_path / "outside.toml").write_text((folder / "c.toml").read_text())
     doc = json.loads(c.read_text())
     doc["model_file"] = model_file
-    c.write_text(json.dumps(doc))
+    if model_file == "../outside.toml":  # bound to the file outside: only the path is wrong
+        write_bound(c, doc, tmp_path / "outside.toml")
+    else:
+        c.write_text(json.dumps(doc))
     with pytest.raises(InputError, match="model_file"):
         read_calibration(c)
     if model_file == "../outside.toml":

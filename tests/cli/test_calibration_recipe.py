@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 import zrp
+from tests.calibration.pairs import write_bound
 from zrp.calibration import CalibrationOptions, calibrate
 from zrp.cli.app import main
 from zrp.gap import Injection, load_measurements, synthesize
@@ -82,7 +83,7 @@ def test_a_forgotten_mjcf_is_named(data, tmp_path, capsys):
     doc["compliance_model"] = "mjcf"
     doc["joint_map"].append({"name": "q2.compliance_payload", "effect": "joint_compliance",
                              "joint": 2, "unit": "rad/(N m)", "value": 1e-5, "stderr": 0.0})
-    comp.write_text(json.dumps(doc), encoding="utf-8")
+    write_bound(comp, doc)  # the pair re-bound: the check meets the edit, not the hash
     prog = tmp_path / "prog.csv"
     prog.write_text("target,q1,q2,q3,q4,q5,q6\nT0,10,20,-30,5,40,0\n", encoding="utf-8")
     rc = main(["compensate", "--calibration", str(comp), "--targets", str(prog), "--deg",

@@ -19,6 +19,7 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.calibration.planning import Plan
 from zrp.errors import InputError
+from zrp.escape import csv_text
 from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.textio import read_text
@@ -48,14 +49,11 @@ def write_plan(plan: Plan, model: Manipulator, path: str | Path, *, deg: bool = 
     n = model.n
     rev = ~np.asarray(model.prismatic)
     q = np.where(rev, np.degrees(plan.q), plan.q) if deg else plan.q
-    buf = io.StringIO()
-    w = csv.writer(buf)
-    w.writerow(["pose", *[f"q{k}[deg]" if deg and rev[k - 1] else f"q{k}"
-                          for k in range(1, n + 1)], *[f"dir{k}" for k in range(1, n + 1)]])
-    for i in range(len(q)):
-        w.writerow([f"P{i + 1:03d}", *(repr(float(v)) for v in q[i]),
-                    *(int(v) for v in plan.direction[i])])
-    return write_text(path, buf.getvalue(), overwrite=overwrite)
+    header = ["pose", *[f"q{k}[deg]" if deg and rev[k - 1] else f"q{k}"
+                        for k in range(1, n + 1)], *[f"dir{k}" for k in range(1, n + 1)]]
+    rows = ([f"P{i + 1:03d}", *(repr(float(v)) for v in q[i]),
+             *(int(v) for v in plan.direction[i])] for i in range(len(q)))
+    return write_text(path, csv_text(header, rows), overwrite=overwrite)
 
 
 def _number(text: str, src: str, line: int, col: str) -> float:

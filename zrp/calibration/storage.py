@@ -1,16 +1,18 @@
 """Write and read a calibrated robot: a model TOML (geometry) and a compensation JSON.
 
-The compensation file (``schema_version`` 2, lengths in the model's ``length_unit``, angles
-in rad; version 1, written by 0.3.0 and earlier, is read too: it has no ``backlash.lead``, so
-every joint lags behind its approach) holds everything the model file cannot: the nominal
-model, the instrument-from-base transform, the tool points in full, the folded offsets, the
-joint map, thermal expansion, the backlash flank model and, after a full-pose fit, the probe
-rotation and noise weights; its keys are documented in zrp/calibration/README.md.
+The compensation file (``schema_version`` 3, lengths in the model's ``length_unit``, angles
+in rad; version 3 adds ``model_sha256``, the SHA-256 of the model file, which names the
+compensation file's own hash in turn (:mod:`zrp.calibration.filecheck`); versions 1 and 2 are
+read with a warning that the pair cannot be checked; version 1, written by 0.3.0 and earlier,
+has no ``backlash.lead``, so every joint lags behind its approach) holds everything the
+model file cannot: the nominal model, the instrument-from-base transform, the tool points in
+full, the folded offsets, the joint map, thermal expansion, the backlash flank model and,
+after a full-pose fit, the probe rotation and noise weights; its keys are documented in
+zrp/calibration/README.md.
 """
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -19,11 +21,13 @@ from numpy.typing import ArrayLike
 
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.conditions import Conditions
+from zrp.calibration.filecheck import bind_pair, check_fields, check_pair, loads_bounded
 from zrp.calibration.jointmap import Term
 from zrp.calibration.validation import validate_calibration
 from zrp.errors import InputError, ZRPError
+from zrp.escape import one_line
 from zrp.gap.fit.fullpose import FullPoseFit
-from zrp.jsonio import dumps
+from zrp.jsonio import dumps, to_jsonable
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
@@ -34,9 +38,9 @@ from zrp.version import __version__
 __all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "model_file_path",
            "read_calibration", "write_calibration"]
 
-SCHEMA_VERSION = 2
-#: the versions this reader understands (1: no ``backlash.lead``)
-READABLE_VERSIONS = (1, 2)
+SCHEMA_VERSION = 3
+#: the versions this reader understands (1: no ``backlash.lead``; 1, 2: no hashes)
+READABLE_VERSIONS = (1, 2, 3)
 
 
 def full_pose_document(fp: FullPoseFit | None,
@@ -117,7 +121,10 @@ def calibrated_marker(text: str) -> str | None:
 def _toml_header(cal: CalibratedRobot, comp_name: str) -> str:
     """Comment lines heading the model TOML: the marker naming its compensation file, the
     version and the conditions (the model format has no keys for them; compensation.json
-    carries them as data)."""
+    carries them as data). The user's strings (the file names, the instrument) pass through
+    :func:`zrp.escape.one_line`: a name with a line break cannot end the comment and add TOML
+    keys."""
+    comp_name = one_line(comp_name)
     lines = [f"{CALIBRATED_MARKER}: the geometry only; its joint map, thermal expansion and "
              f"registration are in the compensation file {comp_name}; export it whole with "
              f"zrp export --calibration {comp_name}",
@@ -129,7 +136,8 @@ def _toml_header(cal: CalibratedRobot, comp_name: str) -> str:
                   f"; tool_points = {list(c.tool_points)}",
                   f"#   temp_range_degC = {c.temp_range_degC}; length_unit = {c.length_unit};"
                   f" angle_unit = {c.angle_unit}",
-                  f"#   instrument = {c.instrument}; data_file = {c.data_file}; "
+                  f"#   instrument = {one_line(c.instrument)}; data_file = "
+                  f"{one_line(c.data_file)}; "
                   f"data_sha256 = {c.data_sha256}"]
     if cal.undetermined:
         lines.append("# NOT DETERMINED by the data (kept at nominal or known only loosely; "
@@ -160,9 +168,9 @@ def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: s
         raise InputError(f"model_path: {model_path} is not in the folder of {comp_path} (or "
                          "below it); the compensation file names its model relative to "
                          "itself") from None
-    doc = calibration_document(cal, rel, full_pose)
-    m = write_text(model_path, _toml_header(cal, Path(comp_path).name) + dumps_model(cal.model),
-                   overwrite=overwrite)
+    doc, toml = bind_pair(to_jsonable(calibration_document(cal, rel, full_pose)),
+                          _toml_header(cal, Path(comp_path).name) + dumps_model(cal.model))
+    m = write_text(model_path, toml, overwrite=overwrite)
     c = write_text(comp_path, dumps(doc), overwrite=overwrite)
     return m, c
 
@@ -217,13 +225,12 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
         ImplausibleValueError: a value outside its physical domain.
     """
     src = str(comp_path)
-    try:
-        doc = json.loads(read_text(comp_path, label=src))  # a regular file, size checked
-    except (OSError, ValueError) as exc:
-        raise InputError(f"{src}: cannot read the compensation file: {exc}") from exc
+    # a regular file, size checked; nesting bounded (zrp.calibration.filecheck)
+    doc = loads_bounded(read_text(comp_path, label=src), src)
     if not isinstance(doc, dict):
         raise InputError(f"{src}: expected a JSON object")
-    if doc.get("schema_version") not in READABLE_VERSIONS:
+    version = doc.get("schema_version")
+    if isinstance(version, bool) or version not in READABLE_VERSIONS:
         raise InputError(f"{src}: schema_version {doc.get('schema_version')!r}, expected one "
                          f"of {', '.join(map(str, READABLE_VERSIONS))} (a file from a newer "
                          f"zrp-accuracy? zrp_version {doc.get('zrp_version')!r})")
@@ -235,6 +242,7 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
                              allow_outside=allow_outside)
              if model_path is None else Path(model_path))
     model = load_model(mpath)
+    check_pair(doc, src, mpath, _bytes(mpath))
     try:
         cal = _robot(doc, model, src)
     except (KeyError, TypeError, ValueError, IndexError, AttributeError, OverflowError) as exc:
@@ -242,8 +250,16 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
             raise
         raise InputError(f"{src}: malformed compensation file ({type(exc).__name__}: "
                          f"{exc})") from None
+    check_fields(cal, doc.get("length_unit"), src)
     validate_calibration(cal, cal.widen, src)
     return cal
+
+
+def _bytes(path: Path) -> bytes:
+    try:
+        return path.read_bytes()  # load_model checked it: a regular file of bounded size
+    except OSError as exc:
+        raise InputError(f"{path}: cannot read ({exc.strerror or exc})") from exc
 
 
 def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot:

@@ -12,7 +12,6 @@ radians are refused). Errors name the file, line and column.
 from __future__ import annotations
 
 import csv
-import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +21,7 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.calibration.compensation import Compensation
 from zrp.errors import InputError
+from zrp.escape import csv_text, csv_uncell
 from zrp.model.manipulator import Manipulator
 from zrp.output import write_text
 from zrp.rotations import matrix_from_er
@@ -145,7 +145,7 @@ def load_targets(path: str | Path, n: int, *, deg: bool = False,
         if len(r) != len(header):
             raise InputError(f"{src}, line {i}: {len(r)} fields, expected {len(header)}")
         rec = dict(zip(header, (c.strip() for c in r), strict=True))
-        ids.append(rec["target"])
+        ids.append(csv_uncell(rec["target"]))
         vals.append([_number(rec[c], src, i, c) for c in cols[1:]])
     if len(set(ids)) != len(ids):
         raise InputError(f"{src}: repeated target ids")
@@ -215,7 +215,7 @@ def load_commands(path: str | Path, model: Manipulator, *, deg: bool = False) ->
     for i, r in enumerate(rows[1:], start=2):
         if len(r) != len(header):
             raise InputError(f"{src}, line {i}: {len(r)} fields, expected {len(header)}")
-        ids.append(r[col["target"]].strip())
+        ids.append(csv_uncell(r[col["target"]].strip()))
         vals.append([_number(r[col[c]], src, i, c) for c in joints])
         conv.append(_number(r[col["converged"]], src, i, "converged") == 1.0)
     q = _joints(np.array(vals), [unit[c] for c in joints], deg, model, src)
@@ -231,16 +231,13 @@ def write_commands(comp: Compensation, path: str | Path, *, deg: bool = False,
     """
     n = comp.q_command.shape[1]
     q = np.degrees(comp.q_command) if deg else comp.q_command
-    buf = io.StringIO()
-    w = csv.writer(buf)
-    w.writerow(["target", *[f"q{k}{'[deg]' if deg else ''}" for k in range(1, n + 1)],
-                "residual",
-                *COMMAND_FLAGS[1:]])
+    header = ["target", *[f"q{k}{'[deg]' if deg else ''}" for k in range(1, n + 1)],
+              "residual", *COMMAND_FLAGS[1:]]
     ori = comp.orientation_residual
-    for i, t in enumerate(comp.target_ids):
-        w.writerow([t, *(repr(float(v)) for v in q[i]), repr(float(comp.residual[i])),
-                    "" if ori is None else repr(float(ori[i])),
-                    repr(float(comp.uncompensated[i])), repr(float(comp.sigma_min[i])),
-                    int(comp.near_singular[i]), int(comp.near_limit[i]),
-                    int(comp.converged[i]), int(comp.outside_measured[i])])
-    return write_text(path, buf.getvalue(), overwrite=overwrite)
+    rows = ([t, *(repr(float(v)) for v in q[i]), repr(float(comp.residual[i])),
+             "" if ori is None else repr(float(ori[i])),
+             repr(float(comp.uncompensated[i])), repr(float(comp.sigma_min[i])),
+             int(comp.near_singular[i]), int(comp.near_limit[i]), int(comp.converged[i]),
+             int(comp.outside_measured[i])]
+            for i, t in enumerate(comp.target_ids))
+    return write_text(path, csv_text(header, rows), overwrite=overwrite)

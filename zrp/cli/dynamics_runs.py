@@ -16,19 +16,23 @@ from sim.studies.dynamics import benchmark as bm
 from sim.studies.dynamics.arms import available_arms
 from sim.studies.dynamics.scenarios import KINDS
 from zrp.errors import InputError
+from zrp.escape import md_row
 from zrp.gap.dynamics.data import load_torque_log
 from zrp.gap.dynamics.diagnosis import DynamicsOptions
-from zrp.gap.dynamics.report import run_json, write_run
+from zrp.gap.dynamics.report import REPORT_FILES, run_json, write_run
 from zrp.gap.dynamics.run import TrackingOptions, run_dynamics
 from zrp.gap.dynamics.verdict import headline
-from zrp.output import OutputDir
+from zrp.output import OutputDir, check_writable
 
 __all__ = ["run_benchmark", "run_diagnosis"]
 
 
-def run_diagnosis(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
+def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = False
+                  ) -> tuple[dict, str]:
     """Diagnose (:func:`zrp.gap.dynamics.run.run_dynamics`), write the outputs; the JSON and
-    the summary text."""
+    the summary text (``overwrite``: replace files in ``out``, from --force or the default
+    folder's mark; checked before any work)."""
+    check_writable([out / n for n in REPORT_FILES], overwrite)
     if (args.kp is None) != (args.kv is None):
         raise InputError("--kp, --kv: give both (the servo's stiffness and damping) or neither")
     log = load_torque_log(args.data, torque_constant=args.torque_constant)
@@ -44,7 +48,7 @@ def run_diagnosis(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
                        validation_log=second, writer=CorrectedMJCF(arm),
                        tracking=TrackingOptions(kp=_gains(args.kp), kv=_gains(args.kv),
                                                 seconds=args.seconds))
-    folder = write_run(run, out, overwrite=args.force)
+    folder = write_run(run, out, overwrite=overwrite)
     text = headline(run.diagnosis, run.validation) + (
         f"\nwrote {folder}/report.html, report.md, diagnosis.json, corrected.xml")
     return run_json(run), text
@@ -65,8 +69,8 @@ def run_benchmark(args: argparse.Namespace, out: Path) -> tuple[dict, str]:
     t = bm.tally(rows)
     lines = ["| arm | effect | seed | joint | visibility | named | right | withheld ratio |",
              "|---|---|---|---|---|---|---|---|"]
-    lines += [f"| {r.arm} | {r.kind} | {r.seed} | {'' if r.joint is None else r.joint + 1} | "
-              f"{r.visibility:.1f} | {r.named} | {r.success} | {r.withheld_ratio:.2f} |"
+    lines += [md_row(r.arm, r.kind, r.seed, "" if r.joint is None else r.joint + 1,
+                     f"{r.visibility:.1f}", r.named, r.success, f"{r.withheld_ratio:.2f}")
               for r in rows]
     head = (f"visible single effects right (effect, joint, withheld <= 1.5 sigma): {t['right']}"
             f" of {t['visible_singles']}; 'none' clean: {t['none_clean']} of "

@@ -11,8 +11,6 @@ error shows its order of accuracy).
 
 from __future__ import annotations
 
-import csv
-import io
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -32,6 +30,7 @@ from zrp.errors import (
     TrackingWarning,
     UnreachableError,
 )
+from zrp.escape import csv_text
 from zrp.kinematics import _ik_kernels as IKK
 from zrp.kinematics.choices import CORRECTIONS, TASKS
 from zrp.kinematics.forward import _karrays, check_q, end_effector_pose
@@ -120,16 +119,11 @@ class IKResult:
         header = (["t_s", *names, *[f"{nm}_dot" for nm in names], "position_error",
                    "orientation_error_rad", "drift_position", "drift_orientation_rad",
                    "correction", "manipulability", "damping"])
-        buf = io.StringIO(newline="")
-        w = csv.writer(buf)
-        w.writerow(header)
         cols = np.column_stack([self.t, self.q, self.qdot, self.position_error,
                                 self.orientation_error, self.drift_position,
                                 self.drift_orientation, self.correction,
                                 self.manipulability, self.damping])
-        for row in cols:
-            w.writerow([repr(float(x)) for x in row])
-        return buf.getvalue()
+        return csv_text(header, ([repr(float(x)) for x in row] for row in cols))
 
     def save_csv(self, path: str | Path, *, overwrite: bool = False) -> Path:
         """Write :meth:`csv_text` to ``path`` (atomically, through :mod:`zrp.output`).

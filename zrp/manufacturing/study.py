@@ -13,7 +13,6 @@ from a CSV file written by ``zrp ik`` (:func:`load_joint_csv`).
 from __future__ import annotations
 
 import csv
-import io
 import math
 import warnings
 from collections.abc import Sequence
@@ -26,6 +25,7 @@ from numpy.typing import ArrayLike
 
 from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
+from zrp.escape import csv_text
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import check_q, end_effector_pose
@@ -309,12 +309,7 @@ class StudyResult:
             raise InputError(f"fmt: expected 'csv' or 'md', got {fmt!r}")
         header, rows = self.table(quantity, parameters, xi_rows)
         if fmt == "csv":
-            buf = io.StringIO(newline="")
-            w = csv.writer(buf)
-            w.writerow(header)
-            for r in rows:
-                w.writerow([f"{r[0]:g}", *[f"{v:.6e}" for v in r[1:]]])
-            return buf.getvalue()
+            return csv_text(header, ([f"{r[0]:g}", *[f"{v:.6e}" for v in r[1:]]] for r in rows))
         lines = [caption, ""] if caption else []
         lines.append("| xi (%) | " + " | ".join(header[1:]) + " |")
         lines.append("|---:|" + "---:|" * (len(header) - 1))

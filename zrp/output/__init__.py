@@ -29,8 +29,13 @@ Typical use::
             fig.savefig(tmp)
     out.written                                  # the paths written, in order
 
-The policy lives in four modules: :mod:`zrp.output.paths` (names and file kinds, the refusal to
+* A default output name built from an input's name goes through :func:`safe_name` (a log
+  named ``...csv`` cannot write into the folder above), and a command's default folder is
+  replaced without ``--force`` only when :func:`claim_generated` says it is generated output.
+
+The policy lives in five modules: :mod:`zrp.output.paths` (names and file kinds, the refusal to
 replace), :mod:`zrp.output.atomic` (the atomic writes, the default folders' mark),
+:mod:`zrp.output.names` (default names from inputs, no links on the way),
 :mod:`zrp.output.lock` (one run a folder) and :mod:`zrp.output.folder` (:class:`OutputDir`);
 import the names from here.
 """
@@ -41,12 +46,14 @@ from zrp.output.atomic import (
     GENERATED_MARK,
     atomic_path,
     claim_generated,
+    default_overwrite,
     write_bytes,
     write_json,
     write_text,
 )
 from zrp.output.folder import OutputDir
 from zrp.output.lock import LOCK_NAME, LOCK_WAIT_S
+from zrp.output.names import check_no_links, safe_name
 from zrp.output.paths import NAME_MAX_BYTES, check_regular, check_writable
 
 __all__ = [
@@ -56,9 +63,12 @@ __all__ = [
     "NAME_MAX_BYTES",
     "OutputDir",
     "atomic_path",
+    "check_no_links",
     "check_regular",
     "check_writable",
     "claim_generated",
+    "default_overwrite",
+    "safe_name",
     "write_bytes",
     "write_json",
     "write_text",

@@ -2,21 +2,30 @@
 written under a temporary name in the same folder and moved into place with
 :func:`os.replace` (atomic on POSIX and Windows), so an interrupted run never leaves half a
 CSV behind; and :func:`claim_generated`, which marks a command's default folder as generated
-output."""
+output.
+
+A process killed mid-write (``kill -9``, power loss) leaves its temporary file
+(``.zrp-PID-N.tmp.SUFFIX``); :func:`clean_stale_temporaries` removes, at the next write into
+the folder, those whose process no longer runs on this host or that are older than
+:data:`STALE_AFTER_S` (a writer on another host of a shared folder), never anything else."""
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
+import stat
 import time
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 from zrp.errors import InputError, OutputExistsError
+from zrp.output.lock import pid_alive
 from zrp.output.paths import as_path, check_regular, check_writable, make_folder
 
-__all__ = ["GENERATED_MARK", "atomic_path", "claim_generated", "write_bytes", "write_json",
+__all__ = ["GENERATED_MARK", "STALE_AFTER_S", "atomic_path", "claim_generated",
+           "clean_stale_temporaries", "default_overwrite", "write_bytes", "write_json",
            "write_text"]
 
 #: Mark of a folder created for generated output (the commands' default folders, such as
@@ -24,12 +33,46 @@ __all__ = ["GENERATED_MARK", "atomic_path", "claim_generated", "write_bytes", "w
 GENERATED_MARK = ".zrp-generated"
 #: Longest suffix the temporary file keeps (so writers that infer the format from it can).
 _SUFFIX_MAX = 16
+#: A temporary file of the toolkit's own older than this is stale whatever its process.
+STALE_AFTER_S = 24 * 3600.0
+_TEMP_NAME = re.compile(r"\.zrp-(\d+)-\d+\.tmp(\.[^/\\]{1,15})?")
+
+
+def clean_stale_temporaries(folder: str | os.PathLike[str]) -> list[Path]:
+    """Remove the temporary files (``.zrp-PID-N.tmp[.SUFFIX]``, regular files only) that a
+    writer killed mid-write left in ``folder``: its process has ended (on this host) or the
+    file is older than :data:`STALE_AFTER_S`. Returns the files removed; an unreadable folder
+    or a file that cannot be removed is left as it is."""
+    removed: list[Path] = []
+    now = time.time()
+    try:
+        entries = [e for e in os.scandir(folder) if e.name.startswith(".zrp-")]
+    except OSError:
+        return removed
+    for e in entries:
+        m = _TEMP_NAME.fullmatch(e.name)
+        if m is None:
+            continue
+        try:
+            st = e.stat(follow_symlinks=False)
+            if not stat.S_ISREG(st.st_mode):
+                continue
+            if pid_alive(int(m.group(1))) and now - st.st_mtime < STALE_AFTER_S:
+                continue
+            os.unlink(e.path)
+        except OSError:
+            continue
+        removed.append(Path(e.path))
+    return removed
 
 
 @contextlib.contextmanager
-def atomic_path(path: str | os.PathLike[str], *, overwrite: bool = False) -> Iterator[Path]:
+def atomic_path(path: str | os.PathLike[str], *, overwrite: bool = False,
+                clean: bool = True) -> Iterator[Path]:
     """A temporary file name beside ``path`` (same suffix, so writers can infer the format);
     on a clean exit it is moved onto ``path`` in one step, on an error it is removed.
+    ``clean``: first remove the stale temporaries of killed writers in the folder
+    (:func:`clean_stale_temporaries`; an :class:`~zrp.output.OutputDir` does it once).
 
     Raises:
         OutputExistsError: ``path`` exists and ``overwrite`` is False.
@@ -37,6 +80,8 @@ def atomic_path(path: str | os.PathLike[str], *, overwrite: bool = False) -> Ite
     """
     (p,) = check_writable([path], overwrite)
     make_folder(p.parent)
+    if clean:
+        clean_stale_temporaries(p.parent)
     suffix = p.suffix if len(p.suffix) <= _SUFFIX_MAX else ""
     tmp = p.with_name(f".zrp-{os.getpid()}-{time.monotonic_ns()}.tmp{suffix}")
     try:
@@ -76,6 +121,21 @@ def write_json(path: str | os.PathLike[str], obj: Any, *, overwrite: bool = Fals
     from zrp.jsonio import dumps  # NumPy: on use, so that `zrp --help` does not load it
 
     return write_text(path, dumps(obj, indent), overwrite=overwrite)
+
+
+def default_overwrite(folder: str | os.PathLike[str], *, default: bool, force: bool,
+                      page: str | None = None) -> bool:
+    """May a command replace files in ``folder``: with ``force``, or when ``folder`` is the
+    command's default folder and :func:`claim_generated` claims it. ``page``: a file in
+    ``folder`` that will be written (the ``renders/`` index page), checked now, before any work.
+
+    Raises:
+        OutputExistsError: ``page`` exists and may not be replaced.
+    """
+    overwrite = force or (default and claim_generated(folder))
+    if page is not None:
+        check_writable([Path(folder) / page], overwrite)
+    return overwrite
 
 
 def claim_generated(folder: str | os.PathLike[str]) -> bool:

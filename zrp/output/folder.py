@@ -12,7 +12,13 @@ from pathlib import Path
 from typing import Any
 
 from zrp.errors import InputError, OutputKindError
-from zrp.output.atomic import atomic_path, write_bytes, write_json, write_text
+from zrp.output.atomic import (
+    atomic_path,
+    clean_stale_temporaries,
+    write_bytes,
+    write_json,
+    write_text,
+)
 from zrp.output.lock import LOCK_WAIT_S, acquire, release
 from zrp.output.paths import as_path, check_regular, check_writable, make_folder
 
@@ -55,6 +61,7 @@ class OutputDir:
                              "folder")
         make_folder(self.root)
         self._lock = acquire(self.root, self.lock_wait_s)
+        clean_stale_temporaries(self.root)
         try:
             check_writable([self.root / n for n in self.names], self.overwrite)
         except BaseException:
@@ -104,7 +111,7 @@ class OutputDir:
     def path(self, name: str) -> Iterator[Path]:
         """A temporary path for ``name``, moved into place on a clean exit."""
         target = self._target(name)
-        with atomic_path(target, overwrite=self.overwrite) as tmp:
+        with atomic_path(target, overwrite=self.overwrite, clean=False) as tmp:
             yield tmp
         self.written.append(target)
 

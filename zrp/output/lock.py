@@ -15,7 +15,7 @@ from pathlib import Path
 
 from zrp.errors import InputError, OutputBusyError, OutputKindError
 
-__all__ = ["LOCK_NAME", "LOCK_WAIT_S", "acquire", "release"]
+__all__ = ["LOCK_NAME", "LOCK_WAIT_S", "acquire", "pid_alive", "release"]
 
 #: Name of the lock file an :class:`~zrp.output.OutputDir` holds while a run writes into it.
 LOCK_NAME = ".zrp-output.lock"
@@ -23,7 +23,8 @@ LOCK_NAME = ".zrp-output.lock"
 LOCK_WAIT_S = 3.0
 
 
-def _pid_alive(pid: int) -> bool:
+def pid_alive(pid: int) -> bool:
+    """Does process ``pid`` run on this host?"""
     try:
         os.kill(pid, 0)
     except ProcessLookupError:
@@ -77,7 +78,7 @@ def acquire(root: Path, wait_s: float = LOCK_WAIT_S) -> Path:
             fd = os.open(lock, os.O_CREAT | os.O_EXCL | os.O_WRONLY, 0o644)
         except FileExistsError:
             pid, host = _holder(lock)
-            if pid > 0 and (host != socket.gethostname() or _pid_alive(pid)):
+            if pid > 0 and (host != socket.gethostname() or pid_alive(pid)):
                 waited = time.monotonic() - t0
                 if waited >= wait_s:
                     raise OutputBusyError(root, pid, host, lock, waited) from None

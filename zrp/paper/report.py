@@ -10,7 +10,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from zrp.escape import md_text
+from zrp.escape import csv_text, md_text
 from zrp.output import OutputDir
 from zrp.paper.circles import RECOVERED_FIGURES, circles_markdown
 from zrp.paper.comparison import kind_columns
@@ -264,11 +264,9 @@ def _captions(ex: PaperExample) -> dict[str, str]:
 
 def comparison_csv(ex: PaperExample) -> str:
     """The comparison cells as CSV text."""
-    lines = ["table,column,xi_percent,ours,published,ratio,status\n"]
-    for c in ex.cells:
-        lines.append(f"{c.table},{c.column},{c.xi_percent:g},{c.ours:.6e},{c.published:.3e},"
-                     f"{c.ratio:.6f},{c.status}\n")
-    return "".join(lines)
+    return csv_text(["table", "column", "xi_percent", "ours", "published", "ratio", "status"],
+                    ([c.table, c.column, f"{c.xi_percent:g}", f"{c.ours:.6e}",
+                      f"{c.published:.3e}", f"{c.ratio:.6f}", c.status] for c in ex.cells))
 
 
 def _write(ex: PaperExample, out: OutputDir, figures: bool,

@@ -1,12 +1,11 @@
 """Blind benchmark, part 6: the report - Markdown text, CSV tables, JSON and the confusion
 plot - written through :class:`zrp.output.OutputDir` (checked up front, atomic, one run at a
 time per folder). Text cells reach summary.md through :func:`zrp.escape.md_text` and the CSV
-tables through :func:`zrp.escape.csv_cell`: a model name or an error message is only text.
+tables through :func:`zrp.escape.csv_text`: a model name or an error message is only text.
 """
 
 from __future__ import annotations
 
-import csv
 import math
 import os
 from collections.abc import Sequence
@@ -20,7 +19,7 @@ from sim.studies.benchmark.results import BenchmarkResult, confusion_matrix, sum
 from sim.studies.benchmark.scenarios import DEFAULT_NOISE_MM, BenchmarkConfig
 from sim.studies.benchmark.scoring import ScenarioScore
 from zrp.errors import OutputExistsError
-from zrp.escape import csv_cell, md_text
+from zrp.escape import csv_text, md_text
 from zrp.output import OutputDir
 
 if TYPE_CHECKING:
@@ -219,8 +218,7 @@ def _scenario_rows(result: BenchmarkResult) -> list[list[Any]]:
 
 
 def _write_csv(out: OutputDir, name: str, rows: list[list[Any]]) -> None:
-    with out.path(name) as tmp, open(tmp, "w", newline="", encoding="utf-8") as fh:
-        csv.writer(fh).writerows([csv_cell(c) for c in r] for r in rows)
+    out.write_text(name, csv_text(rows[0], rows[1:]))
 
 
 def _write_all(result: BenchmarkResult, out: OutputDir, plots: bool) -> list[Path]:

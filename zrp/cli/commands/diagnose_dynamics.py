@@ -7,6 +7,7 @@ from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.options import DURATION, real
+from zrp.output import claim_generated, safe_name
 
 DEFAULT_OUT = Path("renders") / "dynamics"
 GAIN = real(0.0, 1e9, open_lo=True)
@@ -39,7 +40,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--kv", type=GAIN, nargs="+", help="servo damping per joint (N m s/rad)")
     p.add_argument("--seconds", type=DURATION, default=None,
                    help="re-simulate only the first SECONDS of the log")
-    p.add_argument("--out", metavar="DIR", help=f"output folder (default {DEFAULT_OUT}/LOG)")
+    p.add_argument("--out", metavar="DIR",
+                   help=f"output folder (default {DEFAULT_OUT}/LOG: generated output, "
+                   "replaced; elsewhere existing files need --force)")
     p.add_argument("--force", action="store_true", help="replace outputs in --out")
     p.add_argument("--json", action="store_true", help="print diagnosis.json")
     p.set_defaults(func=_run, api_names={"torque_constant": "--torque-constant",
@@ -50,7 +53,9 @@ def _run(args: argparse.Namespace) -> int:
     # sim loads MuJoCo: only when this command runs.
     from zrp.cli.dynamics_runs import run_diagnosis
 
-    out = Path(args.out) if args.out else DEFAULT_OUT / Path(args.data).stem
-    payload, text = run_diagnosis(args, out)
+    out = Path(args.out) if args.out else DEFAULT_OUT / safe_name(Path(args.data).stem,
+                                                                  default="log")
+    overwrite = args.force or (args.out is None and claim_generated(out))
+    payload, text = run_diagnosis(args, out, overwrite=overwrite)
     emit(args, payload, text)
     return 0

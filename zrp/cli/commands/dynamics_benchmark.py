@@ -7,6 +7,7 @@ from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, real, whole
+from zrp.output import default_overwrite
 
 DEFAULT_OUT = Path("renders") / "dynamics_benchmark"
 ARMS = ("ur5e", "puma", "panda")
@@ -37,8 +38,8 @@ def _run(args: argparse.Namespace) -> int:
     from zrp.cli.dynamics_runs import run_benchmark
 
     out = Path(args.out) if args.out else DEFAULT_OUT
-    if args.out is None:
-        args.force = True  # the default folder is generated output
+    # the default folder is replaced as generated output only when it carries the mark
+    args.force = default_overwrite(out, default=args.out is None, force=args.force)
     payload, text = run_benchmark(args, out)
     emit(args, payload, text)
     return 0

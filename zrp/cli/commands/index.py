@@ -7,7 +7,7 @@ from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.errors import InputError
-from zrp.output import OutputDir
+from zrp.output import OutputDir, claim_generated
 from zrp.paper.index import INDEX_NAME, index_entries, write_index
 
 DEFAULT_OUT = "renders"
@@ -31,7 +31,8 @@ def _run(args: argparse.Namespace) -> int:
     out = Path(args.out)
     if not out.is_dir():
         raise InputError(f"--out: {str(out)!r} is not a folder; run `zrp paper` first")
-    with OutputDir(out, overwrite=args.force or out == Path(DEFAULT_OUT),
+    with OutputDir(out, overwrite=args.force or (out == Path(DEFAULT_OUT)
+                                                 and claim_generated(out)),
                    names=[INDEX_NAME]) as folder:
         path = write_index(folder)
     entries = index_entries(out)

@@ -27,7 +27,7 @@ from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.choices import CORRECTIONS, TIME_LAWS
 from zrp.limits import MAX_LENGTH
 from zrp.model.builtin import builtin_models
-from zrp.output import check_writable, claim_generated
+from zrp.output import check_writable, claim_generated, safe_name
 from zrp.paper.choices import PUMA_DURATION_S, PUMA_Q0_DEG, PUMA_RADIUS_MM
 
 
@@ -155,7 +155,7 @@ def _ik(args: argparse.Namespace) -> int:
         q0 = _joint_values(model, args.q0, args.deg, "--q0")
     if args.target is not None:
         return _ik_target(args, model, q0)
-    stem = Path(args.model).stem
+    stem = safe_name(Path(args.model).stem)
     out = Path(args.out) if args.out else Path("renders") / f"{stem}_{args.trajectory}_joints.csv"
     overwrite = args.force or (args.out is None and claim_generated(out.parent))
     check_writable([out], overwrite)

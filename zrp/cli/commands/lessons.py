@@ -7,7 +7,7 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.output import OutputDir
+from zrp.output import OutputDir, default_overwrite
 from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_described_index, write_index
 
 DEFAULT_OUT = "renders/lessons"
@@ -39,14 +39,19 @@ def _run(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     names = args.names or None
-    overwrite = args.force or out == Path(DEFAULT_OUT)
+    default = out == Path(DEFAULT_OUT)
+    # the renders/ page and the default folder are replaced only as generated output (their
+    # mark) or with --force: checked before any lesson runs
+    parent_overwrite = default_overwrite(out.parent, default=default, force=args.force,
+                                         page=INDEX_NAME if default else None)
+    overwrite = default_overwrite(out, default=default, force=args.force)
     files = [*lesson_file_names(names), DESCRIPTIONS, INDEX_NAME]
     with OutputDir(out, overwrite=overwrite, names=files) as folder:
         lessons = run_lessons(folder, names, small=args.small)
         sentences = {k: v for les in lessons for k, v in les.sentences.items()}
         index = write_described_index(folder, sentences)
-    if out == Path(DEFAULT_OUT):   # the renders/ page links the lessons too
-        with OutputDir(out.parent, overwrite=True, names=[INDEX_NAME]) as parent:
+    if default:   # the renders/ page links the lessons too
+        with OutputDir(out.parent, overwrite=parent_overwrite, names=[INDEX_NAME]) as parent:
             index = write_index(parent)
     payload = {"out": str(out), "index": str(index) if index else None,
                "lessons": [{"name": les.name, "concept": les.concept,

@@ -10,6 +10,7 @@ from zrp.cli.app import emit
 from zrp.cli.options import real
 from zrp.errors import InputError
 from zrp.model.builtin import builtin_models
+from zrp.output import safe_name
 
 
 def _perturbations(items: list[str] | None) -> dict[str, float]:
@@ -58,7 +59,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _slug(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_").lower() or "model"
+    return safe_name(text, lower=True)
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -8,6 +8,7 @@ from pathlib import Path
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, whole
 from zrp.errors import InputError
+from zrp.output import claim_generated
 
 DEFAULT_OUT = Path("renders") / "motion_benchmark"
 
@@ -40,7 +41,9 @@ def _run(args: argparse.Namespace) -> int:
         raise InputError(f"--moves: expected at least 2 moves, got {args.moves}")
     out = Path(args.out) if args.out else DEFAULT_OUT
     summary = run_motion_benchmark(load_model(args.model), args.scenarios, args.seed, out,
-                                   moves=args.moves, overwrite=args.force or args.out is None,
+                                   moves=args.moves,
+                                   overwrite=args.force or (args.out is None
+                                                            and claim_generated(out)),
                                    progress=not args.no_progress)
     emit(args, summary, markdown(summary) + f"wrote {out}/summary.json, {out}/summary.md")
     return 0

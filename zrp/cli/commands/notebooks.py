@@ -9,7 +9,7 @@ from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.options import real
-from zrp.output import OutputDir
+from zrp.output import OutputDir, default_overwrite
 from zrp.paper.index import DESCRIPTIONS, INDEX_NAME, write_described_index, write_index
 
 DEFAULT_OUT = "renders/notebooks"
@@ -68,7 +68,12 @@ def _run(args: argparse.Namespace) -> int:
 
     out = Path(args.out)
     names = args.names or None
-    overwrite = args.force or out == Path(DEFAULT_OUT)
+    default = out == Path(DEFAULT_OUT)
+    # the renders/ page and the default folder are replaced only as generated output (their
+    # mark) or with --force: checked before any notebook runs
+    parent_overwrite = default_overwrite(out.parent, default=default, force=args.force,
+                                         page=INDEX_NAME if default else None)
+    overwrite = default_overwrite(out, default=default, force=args.force)
     timeout = DEFAULT_TIMEOUT_S if args.timeout is None else args.timeout
     with OutputDir(out, overwrite=overwrite,
                    names=[*notebook_file_names(names), DESCRIPTIONS, INDEX_NAME]) as folder:
@@ -81,8 +86,8 @@ def _run(args: argparse.Namespace) -> int:
             sentences[r.ipynb.name] = (f"Notebook {i}, {r.title}, executed, to open in "
                                        "Jupyter.")
         index = write_described_index(folder, sentences)
-    if out == Path(DEFAULT_OUT):   # the renders/ page links the notebooks too
-        with OutputDir(out.parent, overwrite=True, names=[INDEX_NAME]) as parent:
+    if default:   # the renders/ page links the notebooks too
+        with OutputDir(out.parent, overwrite=parent_overwrite, names=[INDEX_NAME]) as parent:
             index = write_index(parent)
     payload = {"out": str(out), "index": str(index),
                "notebooks": [{"name": r.name, "title": r.title, "ipynb": str(r.ipynb),

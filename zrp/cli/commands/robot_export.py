@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -12,7 +11,7 @@ if TYPE_CHECKING:
 from zrp.cli.app import emit
 from zrp.errors import InputError
 from zrp.model.builtin import builtin_models
-from zrp.output import check_writable, write_text
+from zrp.output import check_writable, safe_name, write_text
 
 FORMATS = {"urdf": ".urdf", "mjcf": ".xml", "dh": ".dh.toml", "mdh": ".mdh.toml",
            "toml": ".toml"}
@@ -136,7 +135,7 @@ def _run(args: argparse.Namespace) -> int:
     if args.calibration is None:
         _refuse_calibrated_model(args.model)
     src = args.calibration or args.model
-    stem = re.sub(r"[^A-Za-z0-9]+", "_", Path(src).stem).strip("_").lower() or "model"
+    stem = safe_name(Path(src).stem, lower=True)
     out = Path(args.out or f"renders/{stem}{FORMATS[args.to]}")
     side = None
     if args.calibration is not None:

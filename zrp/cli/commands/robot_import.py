@@ -12,7 +12,7 @@ from zrp.errors import InputError, ModelFileError
 
 if TYPE_CHECKING:
     from zrp.model.manipulator import Manipulator
-from zrp.output import check_writable
+from zrp.output import check_writable, safe_name
 from zrp.textio import read_text
 
 
@@ -43,7 +43,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _slug(text: str) -> str:
-    return re.sub(r"[^A-Za-z0-9]+", "_", text).strip("_").lower() or "model"
+    return safe_name(text, lower=True)
 
 
 def _kind(text: str) -> str:

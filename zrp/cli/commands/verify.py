@@ -3,12 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import csv
-import io
 
 from zrp.cli.app import emit
 from zrp.cli.options import SEED, add_deg
 from zrp.errors import InputError
+from zrp.escape import csv_text
 from zrp.output import check_writable, write_text
 
 
@@ -68,11 +67,9 @@ def _run(args: argparse.Namespace) -> int:
         lines.append(f"warning: {s['not_converged']} command(s) did not converge in zrp "
                      "compensate (commanded as written)")
     if args.out:
-        buf = io.StringIO()
-        w = csv.writer(buf)
-        w.writerow(["target", f"error_before[{u}]", f"error_after[{u}]"])
-        for t, b, a in zip(tg.ids, res.error_before, res.error_after, strict=True):
-            w.writerow([t, repr(float(b)), repr(float(a))])
-        lines.append(f"wrote {write_text(args.out, buf.getvalue(), overwrite=args.force)}")
+        rows = ([t, repr(float(b)), repr(float(a))]
+                for t, b, a in zip(tg.ids, res.error_before, res.error_after, strict=True))
+        text = csv_text(["target", f"error_before[{u}]", f"error_after[{u}]"], rows)
+        lines.append(f"wrote {write_text(args.out, text, overwrite=args.force)}")
     emit(args, s, "\n".join(lines))
     return 0 if np.isfinite(s["rms_after"]) else 1

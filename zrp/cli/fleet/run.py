@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import glob
 import json
+import os
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -15,7 +16,7 @@ from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor
 from zrp.cli.fleet.summary import fleet_csv, fleet_figure, fleet_markdown, fleet_summary
 from zrp.cli.options import LENGTH
 from zrp.errors import InputError
-from zrp.output import OutputDir, check_writable
+from zrp.output import OutputDir, check_no_links, check_writable, safe_name
 from zrp.tasks import TaskFailure, map_tasks
 
 if TYPE_CHECKING:
@@ -58,10 +59,14 @@ def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[Robot
     from zrp.model.files import load_model  # on use: keeps --help quick
 
     model = load_model(args.model)
-    names = [f.stem for f in files]
+    # a robot's folder is OUT/robots/NAME: NAME from the file's stem through the one
+    # sanitiser, and neither robots/ nor NAME/ may be a link (even with --resume)
+    names = [safe_name(f.stem, default="robot") for f in files]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
-        raise InputError(f"--data: robot names (file stems) must be unique; repeated: {dup}")
+        raise InputError(f"--data: robot names (file stems, as folder names) must be unique; "
+                         f"repeated: {dup}")
+    base = Path(os.path.abspath(out))  # not resolved: a link on the way is refused below
     mjcf = None if args.mjcf is None else Path(args.mjcf)
     if mjcf is not None and not mjcf.is_file():
         raise InputError(f"--mjcf: {mjcf} is not a file")
@@ -71,8 +76,8 @@ def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[Robot
             "use_orientation": not args.no_orientation,
             "orientation_sigma": args.orientation_sigma}
     read = {"deg": args.deg, "frame": args.frame}
-    return [RobotTask(f.stem, f.resolve(), (out / "robots" / f.stem).resolve(), model, mjcf,
-                      read, opts, not args.no_plots) for f in files]
+    return [RobotTask(n, f.resolve(), check_no_links(base, base / "robots" / n), model, mjcf,
+                      read, opts, not args.no_plots) for n, f in zip(names, files, strict=True)]
 
 
 def _previous(tasks: list[RobotTask]) -> dict[str, dict[str, Any]]:

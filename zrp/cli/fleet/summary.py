@@ -2,17 +2,15 @@
 document (fleet.json), a table (CSV, Markdown) and a plot (Matplotlib, imported on use).
 
 Robot names are the users' file names: every one (and every failure message) reaches fleet.md
-through :func:`zrp.escape.md_text` and fleet.csv through :func:`zrp.escape.csv_cell`."""
+through :func:`zrp.escape.md_text` and fleet.csv through :func:`zrp.escape.csv_text`."""
 
 from __future__ import annotations
 
-import csv
-import io
 import math
 from collections import Counter
 from typing import Any
 
-from zrp.escape import csv_cell
+from zrp.escape import csv_text
 from zrp.escape import md_text as _t
 from zrp.tasks import TaskFailure
 
@@ -74,13 +72,8 @@ def fleet_summary(rows: list[dict[str, Any]], failures: list[TaskFailure], toler
 
 
 def fleet_csv(doc: dict[str, Any]) -> str:
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COLUMNS)
-    for r in doc["rows"]:
-        w.writerow([csv_cell(";".join(map(str, r[c])) if isinstance(r[c], list) else r[c])
-                    for c in COLUMNS])
-    return buf.getvalue()
+    return csv_text(COLUMNS, ([";".join(map(str, r[c])) if isinstance(r[c], list) else r[c]
+                               for c in COLUMNS] for r in doc["rows"]))
 
 
 def _f(x: Any) -> str:

@@ -14,6 +14,7 @@ from numpy.typing import NDArray
 
 from zrp.arrays import F64
 from zrp.errors import InputError
+from zrp.escape import csv_uncell
 from zrp.gap.data.measurements import OPTIONAL_SCALARS, QUAT_COLUMNS
 from zrp.model.manipulator import Manipulator
 from zrp.units import split_unit
@@ -120,7 +121,7 @@ def check_header(header: list[str], src: str, model: Manipulator) -> Header:
 
 
 def _label(rec: list[str], i: int, name: str, what: str, src: str, lineno: int) -> str:
-    text = rec[i].strip()
+    text = csv_uncell(rec[i].strip())
     if not text:
         raise InputError(f"{src} line {lineno}: column {name} is empty; expected {what}")
     return text

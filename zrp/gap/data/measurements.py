@@ -8,8 +8,6 @@ pose with different joint values are errors naming the source and line.
 
 from __future__ import annotations
 
-import csv
-import io
 import os
 from dataclasses import dataclass
 from functools import cached_property
@@ -20,6 +18,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from zrp.arrays import F64
 from zrp.errors import InputError, ZRPWarning
+from zrp.escape import csv_text
 from zrp.model.manipulator import MAX_LENGTH
 from zrp.output import write_text
 
@@ -296,12 +295,9 @@ class Measurements:
         cols = ["pose", "point", *[f"q{k}{unit}" for k in range(1, n + 1)], "x", "y", "z"]
         extra = [c for c in OPTIONAL_SCALARS if getattr(self, c) is not None]
         quat = ["qw", "qx", "qy", "qz"] if self.quat is not None else []
-        buf = io.StringIO()
-        w = csv.writer(buf)
-        w.writerow(cols + extra + quat)
-        for i in range(self.n_rows):
-            w.writerow([self.pose[i], self.point[i], *(repr(float(v)) for v in q[i]),
-                        *(repr(float(v)) for v in self.xyz[i]),
-                        *(repr(float(getattr(self, c)[i])) for c in extra),
-                        *([] if self.quat is None else (repr(float(v)) for v in self.quat[i]))])
-        return write_text(path, buf.getvalue(), overwrite=overwrite)
+        rows = ([self.pose[i], self.point[i], *(repr(float(v)) for v in q[i]),
+                 *(repr(float(v)) for v in self.xyz[i]),
+                 *(repr(float(getattr(self, c)[i])) for c in extra),
+                 *([] if self.quat is None else (repr(float(v)) for v in self.quat[i]))]
+                for i in range(self.n_rows))
+        return write_text(path, csv_text(cols + extra + quat, rows), overwrite=overwrite)

@@ -1,6 +1,13 @@
 """The dynamic gap report: report.md, report.html (self-contained, as the static diagnosis's,
 :func:`zrp.gap.report.html.report_html`), the per-joint torque residuals before and after
-against velocity and position (PNG beside it, SVG inside the page) and diagnosis.json."""
+against velocity and position (PNG beside it, SVG inside the page) and diagnosis.json.
+
+Every name from the model or the logs (the arm, its joints and bodies in the effects' labels
+and words, a log's file name, the notes) reaches the Markdown only through :mod:`zrp.escape`
+(:func:`~zrp.escape.md_row`, :func:`~zrp.escape.md_line`, :func:`~zrp.escape.md_text`): a
+joint named ``j1\n\n## Verdict`` stays one table cell, ``|`` adds no cell and ``<script>``
+stays text, in report.md and in report.html. The ``extra`` sections are Markdown the caller
+built the same way."""
 
 from __future__ import annotations
 
@@ -9,6 +16,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import Any
 
+from zrp.escape import md_line, md_row, md_text, one_line
 from zrp.gap.dynamics.diagnosis import DynamicDiagnosis
 from zrp.gap.dynamics.run import DynamicsRun
 from zrp.gap.dynamics.validation import Validation
@@ -17,10 +25,13 @@ from zrp.gap.report.html import report_html
 from zrp.jsonio import to_jsonable
 from zrp.output import OutputDir, write_text
 
-__all__ = ["diagnosis_json", "report_markdown", "run_json", "write_report", "write_run"]
+__all__ = ["REPORT_FILES", "diagnosis_json", "report_markdown", "run_json", "write_report",
+           "write_run"]
 
 FIGURES = {"residuals_velocity.png": ("qd", "joint velocity (rad/s)"),
            "residuals_position.png": ("q", "joint position (rad)")}
+#: the files :func:`write_run` writes (corrected.xml when there is a corrected model)
+REPORT_FILES = ("report.md", "report.html", "diagnosis.json", *FIGURES, "corrected.xml")
 
 
 def _fmt(v: float | None) -> str:
@@ -29,9 +40,9 @@ def _fmt(v: float | None) -> str:
 
 def _verdict(d: DynamicDiagnosis, validation: Validation | None) -> list[str]:
     """The headline, then one line per finding in words."""
-    out = [headline(d, validation)]
+    out = [md_text(headline(d, validation))]
     if d.effects:
-        out += ["", *(f"- {effect_words(d, e)}" for e in d.effects)]
+        out += ["", *(md_line("- {}", effect_words(d, e)) for e in d.effects)]
     return out
 
 
@@ -43,11 +54,11 @@ def _effects(d: DynamicDiagnosis) -> list[str]:
             if k.startswith("beta"):
                 continue
             flag = " (at its bound)" if p.at_bound else ""
-            out.append(f"| {e.label} | {k} | {p.value:.4g}{flag} | {p.low:.4g} .. {p.high:.4g} "
-                       f"| {p.unit} | {e.chi2_drop:.3g} |")
+            out.append(md_row(e.label, k, f"{p.value:.4g}{flag}", f"{p.low:.4g} .. {p.high:.4g}",
+                              p.unit, f"{e.chi2_drop:.3g}"))
         if e.name == "inertial":
-            out.append(f"| {e.label} | {len(e.params)} base combinations | see diagnosis.json "
-                       f"| | | {e.chi2_drop:.3g} |")
+            out.append(md_row(e.label, f"{len(e.params)} base combinations",
+                              "see diagnosis.json", "", "", f"{e.chi2_drop:.3g}"))
     return out
 
 
@@ -57,15 +68,14 @@ def _regimes(d: DynamicDiagnosis) -> list[str]:
            "|---|" + "---|" * n]
     for name, before in d.regimes["before"].items():
         after = d.regimes["after"][name]
-        out.append(f"| {name} | " + " | ".join(f"{_fmt(b)} / {_fmt(a)}"
-                                                for b, a in zip(before, after, strict=True))
-                   + " |")
+        out.append(md_row(name, *(f"{_fmt(b)} / {_fmt(a)}"
+                                   for b, a in zip(before, after, strict=True))))
     return out
 
 
 def _validation(v: Validation, joints: list[str]) -> list[str]:
-    out = [validation_words(v), "", "| joint | noise floor | model | corrected | ratio to noise |",
-           "|---|---|---|---|---|"]
+    out = [md_text(validation_words(v)), "",
+           "| joint | noise floor | model | corrected | ratio to noise |", "|---|---|---|---|---|"]
     out += [f"| {k + 1} | {v.noise_nm[k]:.3g} | {v.rms_before[k]:.3g} | {v.rms_after[k]:.3g} "
             f"| {v.rms_after[k] / v.noise_nm[k]:.2f} |" for k in range(len(joints))]
     out.append(f"| all | {v.overall_noise:.3g} | {v.overall_before:.3g} | "
@@ -78,12 +88,14 @@ def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
     """The report's text (``extra``: more sections, heading -> lines; ``validation``: the
     corrected model on a second log)."""
     n = len(d.joints)
-    lines = [f"# Dynamic gap: {d.arm}", "", "## Verdict", "", *_verdict(d, validation), "",
+    lines = [md_line("# Dynamic gap: {}", d.arm), "", "## Verdict", "", *_verdict(d, validation),
+             "",
              "## Torque residual per joint (N m RMS)", "",
              "| joint | name | noise floor | model | corrected (withheld) | ratio to noise |",
              "|---|---|---|---|---|---|"]
-    lines += [f"| {k + 1} | {d.joints[k]} | {d.noise_nm[k]:.3g} | {d.rms_before[k]:.3g} | "
-              f"{d.rms_after[k]:.3g} | {d.rms_after[k] / d.noise_nm[k]:.2f} |" for k in range(n)]
+    lines += [md_row(k + 1, d.joints[k], f"{d.noise_nm[k]:.3g}", f"{d.rms_before[k]:.3g}",
+                     f"{d.rms_after[k]:.3g}", f"{d.rms_after[k] / d.noise_nm[k]:.2f}")
+              for k in range(n)]
     lines.append(f"| all | | {overall_rms(d.noise_nm):.3g} | {overall_rms(d.rms_before):.3g} | "
                  f"{overall_rms(d.rms_after):.3g} | "
                  f"{overall_rms(d.rms_after) / overall_rms(d.noise_nm):.2f} |")
@@ -93,16 +105,17 @@ def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
     lines += ["", "## Effects found", ""]
     lines += _effects(d) if d.effects else ["None: the torques are explained to the noise."]
     lines += ["", "## Selection (withheld chi2: 1 is the noise floor)", "",
-              " -> ".join(f"{s.key} {s.chi2:.3g}" for s in d.steps), "",
+              " -> ".join(md_line("{} {}", s.key, f"{s.chi2:.3g}") for s in d.steps), "",
               "## Where: residual RMS per regime (N m; before / after)", ""]
     lines += _regimes(d)
     lines += ["", "## Cannot tell", ""]
-    lines += [f"- {c}" for c in d.cannot_tell] or ["- nothing: every joint effect is excited"]
+    lines += [md_line("- {}", c) for c in d.cannot_tell] or [
+        "- nothing: every joint effect is excited"]
     for heading, body in (extra or {}).items():
-        lines += ["", f"## {heading}", "", *body]
+        lines += ["", md_line("## {}", heading), "", *body]
     lines += ["", "## Residuals", "", *(f"![residual against {v[1]}]({name})"
                                         for name, v in FIGURES.items())]
-    lines += ["", "## Notes", "", *(f"- {s}" for s in d.notes)]
+    lines += ["", "## Notes", "", *(md_line("- {}", s) for s in d.notes)]
     return "\n".join(lines) + "\n"
 
 
@@ -193,7 +206,7 @@ def write_report(d: DynamicDiagnosis, folder: str | Path, *, overwrite: bool = F
             plt.close(fig)
         md = report_markdown(d, sections, validation)
         out.write_text("report.md", md)
-        out.write_text("report.html", report_html(md, svgs, f"Dynamic gap: {d.arm}"))
+        out.write_text("report.html", report_html(md, svgs, f"Dynamic gap: {one_line(d.arm)}"))
         out.write_json("diagnosis.json", diagnosis_json(
             d, {k: v for k, v in (extra or {}).items() if k != "sections"}, validation))
     return Path(folder)
@@ -202,10 +215,10 @@ def write_report(d: DynamicDiagnosis, folder: str | Path, *, overwrite: bool = F
 def _tracking_lines(track: Any, joints: int) -> list[str]:
     if track is None:
         return ["- the log has no commanded positions qc1..qcn: no re-simulation"]
-    lines = [f"Re-simulation of the logged command with {track.servo}; RMS of simulated minus "
-             "logged joint positions (rad):", "", "| joint | model | corrected model |",
-             "|---|---|---|"]
-    return lines + [f"| {k + 1} | {track.before_rad[k]:.3g} | {track.after_rad[k]:.3g} |"
+    lines = [md_line("Re-simulation of the logged command with {}; RMS of simulated minus "
+                     "logged joint positions (rad):", track.servo), "",
+             "| joint | model | corrected model |", "|---|---|---|"]
+    return lines + [md_row(k + 1, f"{track.before_rad[k]:.3g}", f"{track.after_rad[k]:.3g}")
                     for k in range(joints)]
 
 
@@ -214,7 +227,7 @@ def _extra(run: DynamicsRun) -> dict[str, Any]:
     sections: dict[str, list[str]] = {}
     data: dict[str, Any] = {}
     if run.corrected_model is not None:
-        sections["Corrected model"] = run.model_notes
+        sections["Corrected model"] = [md_text(s) for s in run.model_notes]
         sections["Tracking"] = _tracking_lines(run.tracking, n)
         if run.tracking is not None:
             data["tracking"] = {"before_rad": run.tracking.before_rad,

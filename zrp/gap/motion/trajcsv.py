@@ -33,6 +33,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 
 from zrp.errors import InputError
+from zrp.escape import csv_text, csv_uncell
 from zrp.gap.data.choices import MAX_ROWS
 from zrp.gap.motion.data import TIME_UNITS, Trajectory, check_rate
 from zrp.model.manipulator import Manipulator
@@ -93,7 +94,7 @@ def _rows(reader: Any, cols: dict[str, int], numeric: list[str], name: str,
                 for i, c in pairs:
                     _num(row[i], name, line, c)
             if points is not None:
-                points.append(row[ipoint].strip())  # type: ignore[index]
+                points.append(csv_uncell(row[ipoint].strip()))  # type: ignore[index]
             lines.append(line)
         line = reader.line_num + 1
     return vals, points, lines
@@ -214,12 +215,10 @@ def write_trajectory(traj: Trajectory, path: str | os.PathLike[str], *, deg: boo
         rev = ~np.asarray(model.prismatic)
         q[:, rev] = np.degrees(q[:, rev])
     n = traj.n_joints
-    with atomic_path(path, overwrite=overwrite) as tmp, tmp.open("w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(["t", "point", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z"])
-        for i in range(traj.n_samples):
-            qi = [repr(float(v)) for v in q[i]]
-            for j, lab in enumerate(traj.point_labels):
-                w.writerow([repr(float(traj.t[i])), lab, *qi,
-                            *(repr(float(v)) for v in traj.xyz[i, j])])
+    rows = ([repr(float(traj.t[i])), lab, *(repr(float(v)) for v in q[i]),
+             *(repr(float(v)) for v in traj.xyz[i, j])]
+            for i in range(traj.n_samples) for j, lab in enumerate(traj.point_labels))
+    text = csv_text(["t", "point", *[f"q{k}" for k in range(1, n + 1)], "x", "y", "z"], rows)
+    with atomic_path(path, overwrite=overwrite) as tmp:
+        tmp.write_text(text, encoding="utf-8", newline="")
     return Path(path)

@@ -4,6 +4,7 @@ values (:mod:`zrp.gap.fit.wellposed`), the values refused for leaving their phys
 
 from __future__ import annotations
 
+from zrp.escape import md_text
 from zrp.gap.results import Diagnosis
 
 __all__ = ["identification_markdown"]
@@ -31,7 +32,7 @@ def identification_markdown(diag: Diagnosis) -> list[str]:
         L.append("| held combination (tolerance units) | singular value | noise | seen at "
                  "all |")
         L.append("|---|---|---|---|")
-        L += [f"| {h.label} | {h.singular_value:.3g} {u} | {h.threshold:.3g} {u} | "
+        L += [f"| {md_text(h.label)} | {h.singular_value:.3g} {u} | {h.threshold:.3g} {u} | "
               f"{'no' if h.exact else 'weakly'} |" for h in held]
         L.append("")
     else:

@@ -4,7 +4,6 @@ same text with the figures embedded), through the one output policy (:mod:`zrp.o
 
 from __future__ import annotations
 
-import csv
 import io
 import os
 from pathlib import Path
@@ -12,7 +11,7 @@ from typing import Any
 
 import numpy as np
 
-from zrp.escape import csv_cell
+from zrp.escape import csv_text
 from zrp.gap.report.html import report_html
 from zrp.gap.report.markdown import report_markdown
 from zrp.gap.report.plots import DPI, PLOT_FILES, figures, withheld_rows
@@ -46,15 +45,12 @@ def residuals_csv(diag: Diagnosis) -> str:
     meas = diag.context.meas
     rb = diag.withheld_residual_before.reshape(-1, 3)
     ra = diag.withheld_residual_after.reshape(-1, 3)
-    buf = io.StringIO()
-    w = csv.writer(buf)
-    w.writerow(["line", "pose", "point", "before_x", "before_y", "before_z", "before_norm",
-                "after_x", "after_y", "after_z", "after_norm"])
-    for i, r in enumerate(withheld_rows(diag)):
-        w.writerow([int(meas.lines[r]), csv_cell(meas.pose[r]), csv_cell(meas.point[r]),
-                    *(f"{v:.6g}" for v in rb[i]), f"{np.linalg.norm(rb[i]):.6g}",
-                    *(f"{v:.6g}" for v in ra[i]), f"{np.linalg.norm(ra[i]):.6g}"])
-    return buf.getvalue()
+    rows = ([int(meas.lines[r]), meas.pose[r], meas.point[r],
+             *(f"{v:.6g}" for v in rb[i]), f"{np.linalg.norm(rb[i]):.6g}",
+             *(f"{v:.6g}" for v in ra[i]), f"{np.linalg.norm(ra[i]):.6g}"]
+            for i, r in enumerate(withheld_rows(diag)))
+    return csv_text(["line", "pose", "point", "before_x", "before_y", "before_z",
+                     "before_norm", "after_x", "after_y", "after_z", "after_norm"], rows)
 
 
 def _write(diag: Diagnosis, out: OutputDir, plots: bool) -> list[Path]:
