@@ -31,12 +31,12 @@ from zrp.arrays import F64
 from zrp.calibration.conditions import Conditions
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.errors import InputError
-from zrp.gap.analysis.determination import fit_determinations
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.model.context import Context
 from zrp.gap.model.problem import Problem
 from zrp.gap.results import Diagnosis
+from zrp.gap.search.determination import fit_determinations
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import skew
 
@@ -161,7 +161,7 @@ class CalibratedRobot:
             of its play (the diagnosis's profiled flank, eq. B1), or None (lagging everywhere).
         undetermined: the parameters the data did not determine, as
             ``name: held at nominal (...)`` / ``name: undetermined (...)``
-            (:mod:`zrp.gap.analysis.determination`): an undetermined tool or base direction is
+            (:mod:`zrp.gap.search.determination`): an undetermined tool or base direction is
             flagged so in the files a controller reads.
     """
 

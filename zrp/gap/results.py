@@ -25,7 +25,6 @@ from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.analysis.assessment import Assessment
 from zrp.gap.analysis.checks import GapWarning as GapWarning
-from zrp.gap.analysis.determination import Determination, determinations
 from zrp.gap.analysis.identifiability import EffectIdentifiability as EffectIdentifiability
 from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.data.noise import NoiseFloor
@@ -34,6 +33,7 @@ from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.fit.wellposed import HeldDirection
 from zrp.gap.model.context import Context
+from zrp.gap.search.determination import Determination, determinations
 from zrp.gap.search.posefit import FullPoseResult
 from zrp.gap.search.steps import Z95 as Z95
 from zrp.gap.search.steps import BacklashSwitch as BacklashSwitch
@@ -230,7 +230,7 @@ class Diagnosis(EffectsFound):
     def determination(self) -> dict[str, Determination]:
         """Parameter name -> what the data determine about it (registration and final model:
         held, undetermined with the direction it belongs to, or determined;
-        :mod:`zrp.gap.analysis.determination`)."""
+        :mod:`zrp.gap.search.determination`)."""
         a = self.assessment
         return determinations(self.final_fit, self.registration + self.final_parameters,
                               gap=self.nominal.rms, unit=self.length_unit,

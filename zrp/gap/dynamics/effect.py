@@ -11,7 +11,7 @@ from zrp.arrays import F64
 __all__ = ["Effect"]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # identity: its arrays have no one truth value
 class Effect:
     """One candidate effect: its regressor block and parameter bounds.
 

@@ -11,7 +11,6 @@ import math
 from collections.abc import Mapping, Sequence
 
 from zrp.escape import md_text as _t
-from zrp.gap.analysis.determination import Determination
 from zrp.gap.analysis.where import Region, WhereAnalysis
 from zrp.gap.report.backlash import backlash_flank_text
 from zrp.gap.report.fullpose import full_pose_markdown
@@ -23,6 +22,7 @@ from zrp.gap.report.verdict import (
     verdict_sections,
 )
 from zrp.gap.results import Candidate, Diagnosis, ParameterEstimate
+from zrp.gap.search.determination import Determination
 
 __all__ = ["decimals", "report_markdown", "value_ci"]
 
@@ -66,7 +66,7 @@ def _status(p: ParameterEstimate, det: Mapping[str, Determination], bad: bool) -
 def _parameter_table(params: Sequence[ParameterEstimate], *, flags: Sequence[str] = (),
                      det: Mapping[str, Determination] | None = None) -> list[str]:
     """One row per parameter: value, interval (none for a held one: the data did not move
-    it) and what the data say (:mod:`zrp.gap.analysis.determination`)."""
+    it) and what the data say (:mod:`zrp.gap.search.determination`)."""
     det = det or {}
     joint = any(p.ci95_effect is not None for p in params)
     out = (["| parameter | value | 95 % interval | 95 % for the whole effect | the data |",
