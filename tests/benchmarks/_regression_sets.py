@@ -1,7 +1,7 @@
 """The regression benchmark's data sets: small simulated sets that look like real ones.
 
 Each set is a function of a size factor only (seeded: the same call gives the same data), so
-the benchmark (``bench_regression.py``) and its check (tests/gap/test_regression_reference.py)
+the benchmark (``bench_regression.py``) and its check (tests/contracts/test_regression_benchmark.py)
 measure the same thing. The sets are the cases that slid back or are easy to lose:
 
 * ``payloads_compliance``: a 7-axis arm (KUKA iiwa 7 geometry) measured at three payloads

@@ -14,7 +14,7 @@ reference is written only with ``--write-reference`` (and ``--force`` over an ex
 after a change that is meant to move the numbers, and the commit says why.
 
 Run: python3 tests/benchmarks/bench_regression.py [--quick] [--check] [--write-reference]
-[--out FILE.md] [--force]  (writes renders/benchmarks/regression.md and .json; --quick: the
+[--out FILE.md] [--force]  (writes renders/benchmarks/bench_regression.md and .json; --quick: the
 sets at half size, for development: not comparable with the reference, so no --check).
 """
 
@@ -123,7 +123,7 @@ def main() -> None:
     ap.add_argument("--write-reference", action="store_true",
                     help="write tests/benchmarks/regression_reference.json (with --force "
                          "over an existing one)")
-    add_output_arguments(ap, "regression")
+    add_output_arguments(ap, "bench_regression")
     args = ap.parse_args()
     if args.quick and (args.check or args.write_reference):
         ap.error("--quick runs are not comparable with the reference")
@@ -139,7 +139,7 @@ def main() -> None:
         results.append(r)
         print(" | ".join(_row(r, None if args.quick else reference["sets"].get(name))),
               flush=True)
-    report = Report("regression", "final and baseline withheld errors of realistic "
+    report = Report("bench_regression", "final and baseline withheld errors of realistic "
                                   "simulated sets")
     report.table(f"Withheld RMS ({results[0]['unit']}), size {size:g}",
                  ["set", "what", "poses", "final", "baseline (plain)", "baseline (held)",
