@@ -11,7 +11,8 @@ residual: the whole candidate was refused ("no joint significant") although its
 cross-validated error was the best by far (issue 34: a 7-axis arm at three payloads).
 
 Here the fit is linearised at its solution, r(theta) ~ y + J theta with y = r1 - J theta1
-(the residual with every fitted parameter at zero), and a group g among the candidate's
+(the residual with every fitted parameter at zero; the columns of J normalised), and a group
+g among the candidate's
 remaining groups S is tested on what only it can explain: its columns projected off the
 span of the current model's and the other remaining groups' columns, keeping the directions
 whose projection retains at least :data:`IDENTIFIABLE_FRACTION` of the columns' norm (the
@@ -31,7 +32,7 @@ import numpy as np
 from scipy import special
 
 from zrp.arrays import F64
-from zrp.gap.fit.leastsq import FitResult, group_key, orthonormal_basis
+from zrp.gap.fit.leastsq import FitResult, group_key
 
 __all__ = ["IDENTIFIABLE_FRACTION", "identifiable_groups", "identifiable_pvalues"]
 
@@ -40,36 +41,52 @@ __all__ = ["IDENTIFIABLE_FRACTION", "identifiable_groups", "identifiable_pvalues
 IDENTIFIABLE_FRACTION = 1e-3
 
 
-def _normalised(a: F64) -> F64:
-    n = np.linalg.norm(a, axis=0)
-    return a / np.where(n > 0, n, 1.0)
-
-
-def _pvalue(y: F64, cols: F64, others: F64, s2: float) -> float:
-    """p-value of eq. G1 for the group with columns ``cols`` against ``others``."""
-    q = orthonormal_basis(_normalised(others)) if others.shape[1] else others
-    g = _normalised(cols)
-    g = g - q @ (q.T @ g)
-    u, s, _ = np.linalg.svd(g, full_matrices=False)
-    ok = s > IDENTIFIABLE_FRACTION
-    if not np.any(ok) or s2 <= 0:
+def _pvalue(A: F64, b: F64, g: list[int], o: list[int], s2: float) -> float:
+    """p-value of eq. G1 for the columns ``g`` against the columns ``o``, from the Gram
+    matrix ``A`` of the normalised Jacobian and ``b`` = its transpose times y: the projected
+    columns' Gram matrix is the Schur complement S = A_gg - A_go A_oo^+ A_og and their
+    products with y are c = b_g - A_go A_oo^+ b_o, so chi2 = sum_i (v_i^T c)^2 / w_i over the
+    eigenpairs of S with sqrt(w_i) > :data:`IDENTIFIABLE_FRACTION`."""
+    if s2 <= 0 or not g:
         return 1.0
-    chi2 = float(np.sum((u[:, ok].T @ y) ** 2)) / s2
+    agg, bg = A[np.ix_(g, g)], b[g]
+    if o:
+        ago = A[np.ix_(g, o)]
+        x = np.linalg.pinv(A[np.ix_(o, o)], rcond=1e-12, hermitian=True) @ np.column_stack(
+            [ago.T, b[o]])
+        agg = agg - ago @ x[:, :-1]
+        bg = bg - ago @ x[:, -1]
+    w, v = np.linalg.eigh(agg)
+    ok = w > IDENTIFIABLE_FRACTION ** 2
+    if not np.any(ok):
+        return 1.0
+    chi2 = float(np.sum((v[:, ok].T @ bg) ** 2 / w[ok])) / s2
     return float(special.chdtrc(int(ok.sum()), chi2))
 
 
-def identifiable_pvalues(f1: FitResult, nb: int, groups: list[str]) -> dict[str, float]:
+def _gram(f1: FitResult) -> tuple[F64, F64]:
+    """Gram matrix of the normalised Jacobian of ``f1`` and its products with
+    y = r1 - J theta1 (the residual with every fitted parameter at zero)."""
+    J = f1.jac
+    d = np.linalg.norm(J, axis=0)
+    d = np.where(d > 0, d, 1.0)
+    y = f1.residual - J @ f1.theta
+    Jn = J / d
+    return Jn.T @ Jn, Jn.T @ y
+
+
+def identifiable_pvalues(f1: FitResult, nb: int, groups: list[str],
+                         gram: tuple[F64, F64] | None = None) -> dict[str, float]:
     """p-value of eq. G1 per group in ``groups`` (the candidate's parameters of ``f1`` from
     index ``nb`` on; the first ``nb`` are the current model), each against the others."""
-    J = f1.jac
-    y = f1.residual - J @ f1.theta
+    A, b = _gram(f1) if gram is None else gram
     s2 = f1.rss / f1.dof
     key = [group_key(p) for p in f1.specs]
     idx = {g: [i for i in range(nb, len(key)) if key[i] == g] for g in groups}
     out: dict[str, float] = {}
     for g in groups:
         rest = list(range(nb)) + [i for h in groups if h != g for i in idx[h]]
-        out[g] = _pvalue(y, J[:, idx[g]], J[:, rest], s2)
+        out[g] = _pvalue(A, b, idx[g], rest, s2)
     return out
 
 
@@ -79,8 +96,9 @@ def identifiable_groups(f1: FitResult, nb: int, alpha: float) -> tuple[set[str],
     groups = list(dict.fromkeys(group_key(p) for p in f1.specs[nb:]))
     thr = alpha / max(len(groups), 1)
     pv: dict[str, float] = {}
+    gram = _gram(f1)
     while groups:
-        pv = identifiable_pvalues(f1, nb, groups)
+        pv = identifiable_pvalues(f1, nb, groups, gram)
         worst = max(groups, key=lambda g: pv[g])
         if pv[worst] < thr:
             break
