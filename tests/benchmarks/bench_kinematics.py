@@ -8,9 +8,7 @@ Prints, in one run:
 * the vectorised NumPy forward kinematics (``zrp.forward_kinematics``), the pre-compilation
   baseline;
 * batched Jacobians per second;
-* the 125 mm circle inverse kinematics with 1,000 steps;
-* the batch split across two threads (``zrp.kinematics._split``) against one thread, when
-  numba may use two (wall time is the figure; the CPU time shows the overhead).
+* the 125 mm circle inverse kinematics with 1,000 steps.
 
 Targets on the 2-core machine: >= 20 M poses/s (>= 10x the MuJoCo loop), >= 5 M Jacobians/s,
 circle IK of 1,000 steps <= 20 ms; the public call into a fresh array within 1.2x of its
@@ -38,13 +36,10 @@ from _timing import Timing, interleaved
 
 import zrp
 from zrp.kinematics import _kernels as K
-from zrp.kinematics import _split
 from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import _karrays
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "1")
-_TWO_CORES = _split.n_threads
-_split.n_threads = lambda: 1  # one core, whatever numba was told, except where stated
 
 
 def mujoco_loop(model: zrp.Manipulator, q: np.ndarray):
@@ -135,19 +130,6 @@ def main() -> None:
          f"{ik_t.wall * 1e3:.2f} ms; max error {res.position_error.max():.1e} mm)", "<= 20 ms")
     show("circle IK, 1,000 steps, bare ABM4", f"{t_ik_none * 1e3:.2f} ms CPU (Newton / bare "
          f"{t_ik / t_ik_none:.2f})")
-    if _TWO_CORES() >= 2 and n >= _split.SPLIT_MIN:
-        def two_threads():
-            _split.n_threads = lambda: 2
-            try:
-                zrp.end_effector_pose(model, q)
-            finally:
-                _split.n_threads = lambda: 1
-
-        one_t, two_t = interleaved(lambda: zrp.end_effector_pose(model, q), two_threads,
-                                   repeat=7)
-        show("end_effector_pose, batch split on 2 threads", rate(two_t, n))
-        show("ratio 2 threads / 1 thread, wall time", f"{two_t.wall / one_t.wall:.2f}x "
-             f"(CPU {two_t.cpu / one_t.cpu:.2f}x)")
     report = Report("bench_kinematics", "forward kinematics, Jacobians and the circle IK "
                     "on one core")
     report.table(f"PUMA, {n:,} random poses (best of several interleaved rounds, CPU time)",

@@ -260,7 +260,7 @@ def store_fence(typingctx):
     return sig, codegen
 
 
-@njit(cache=True, fastmath=_FM, nogil=True)  # nogil: _split runs slabs at once
+@njit(cache=True, fastmath=_FM)
 def fk_pose_batch(q, axes, bodies, prism, lim, out):
     """Batched :func:`fk_pose_one`: q (N, n) -> out (N, 7) (C-contiguous); returns True when every
     |q[:, k]| <= lim[k] (finite), False otherwise (out is then not to be used).

@@ -21,7 +21,6 @@ from zrp.arrays import F64, recycled_empty
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import all_in_range, joint_limits
-from zrp.kinematics._split import split_batch
 from zrp.model.manipulator import Manipulator, derived, hand_frame
 from zrp.rotations.rodrigues import (
     er_from_axis_angle,
@@ -224,7 +223,7 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
             return res[:3], res[3:]
     qf, batch = _flat(model, q)
     res = _out_buffer(out, (*batch, 7)).reshape(-1, 7)
-    if not split_batch(K.fk_pose_batch, qf, (*_karrays(model), joint_limits(model)), res):
+    if not K.fk_pose_batch(qf, *_karrays(model), joint_limits(model), res):
         _range_error(model, q)
     res = res.reshape(*batch, 7)
     return res[..., :3], res[..., 3:]
