@@ -32,9 +32,9 @@ def _quiet(*args, **kw):
 
 def _not_worse_than_baseline(d) -> None:
     a = d.assessment
-    assert d.final.rms <= a.baseline.withheld.rms
+    assert d.final.rms <= a.baseline.model_withheld.rms
     ch = a.choice
-    assert ch is not None and ch.baseline_rms == a.baseline.withheld.rms
+    assert ch is not None and ch.baseline_rms == a.baseline.model_withheld.rms
     candidates = [ch.search_rms, ch.baseline_rms] + (
         [] if ch.combined_rms is None else [ch.combined_rms])
     assert d.final.rms == ch.final_rms == min(candidates)
@@ -53,8 +53,8 @@ def test_falls_back_to_the_geometric_calibration_when_the_effects_do_not_beat_it
     d = _quiet(PUMA, m, seed=0, effects=("encoder_scale", "cyclic_error"))
     a = d.assessment
     assert a.choice.fell_back
-    assert a.choice.search_rms > 3 * a.baseline.withheld.rms  # the fallback matters here
-    assert d.final.rms == a.baseline.withheld.rms < 1.5 * d.noise_floor.rms
+    assert a.choice.search_rms > 3 * a.baseline.model_withheld.rms  # the fallback matters here
+    assert d.final.rms == a.baseline.model_withheld.rms < 1.5 * d.noise_floor.rms
     _not_worse_than_baseline(d)
     assert set(d.final_joints) <= {"joint_offset", "link_length", "axis_misalignment"}
     assert "does not beat a complete geometric calibration" in verdict_text(d)

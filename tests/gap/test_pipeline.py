@@ -227,7 +227,7 @@ def test_single_reflector_says_no_noise_floor():
     d = _quiet(PUMA, m, seed=0)
     assert d.noise_floor.rms is None and d.unexplained is None
     assert "No noise floor can be estimated" in verdict_text(d)
-    assert d.final.rms <= d.assessment.baseline.withheld.rms  # by construction (fallback.py)
+    assert d.final.rms <= d.assessment.baseline.model_withheld.rms  # by construction (fallback.py)
 
 
 SEVEN = """name = "7-axis test arm"
@@ -279,7 +279,7 @@ def test_seven_axis_arm_with_several_payloads(tmp_path):
     m = Measurements.from_arrays(m.pose, m.q, m.xyz, point=m.point, load=load)
     d = _quiet(arm, m, seed=0)
     assert {"joint_offset", "cyclic_error"} <= set(d.effects)
-    assert d.final.rms <= d.assessment.baseline.withheld.rms
+    assert d.final.rms <= d.assessment.baseline.model_withheld.rms
     assert d.final.rms < 1.5 * d.noise_floor.rms
 
 

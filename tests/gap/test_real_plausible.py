@@ -29,4 +29,4 @@ def test_no_fit_stopped_early_and_final_beats_the_geometric_calibration(irb120_r
     assert d.final_fit.converged and not d.solver_stops
     assert d.assessment.baseline.fit.converged
     assert not any("least squares" in str(w.message) for w in irb120_real.warnings)
-    assert d.final.rms <= d.assessment.baseline.withheld.rms
+    assert d.final.rms <= d.assessment.baseline.model_withheld.rms

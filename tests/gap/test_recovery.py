@@ -156,7 +156,7 @@ def test_no_effect_gives_none():
     # the final model is registration only, or the complete geometric calibration when that is
     # (here by chance, within the noise) lower on the withheld poses (zrp/gap/analysis/fallback.py)
     ch = d.assessment.choice
-    assert d.final.rms == min(d.nominal.rms, d.assessment.baseline.withheld.rms)
+    assert d.final.rms == min(d.nominal.rms, d.assessment.baseline.model_withheld.rms)
     if ch.fell_back:
         assert ch.within_noise and "within the noise" in verdict_text(d)
     assert "at the noise floor" in verdict_text(d)

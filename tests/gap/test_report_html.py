@@ -139,4 +139,4 @@ def test_report_html_real_irb120(irb120_real, tmp_path):
     # no cause is stated that conflicts with the IRB 120's specified repeatability
     assert "conflict with the specified repeatability" in verdict_text(d)
     # the final model is at or below the complete geometric calibration on withheld poses
-    assert d.final.rms <= a.baseline.withheld.rms
+    assert d.final.rms <= a.baseline.model_withheld.rms

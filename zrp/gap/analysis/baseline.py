@@ -12,6 +12,16 @@ used), every fit here identifies the parameters from positions and orientations 
 each weighted by its noise (``Context.orientation``, :func:`zrp.gap.fit.leastsq.fit`): a
 direction that positions alone cannot pin (a common tilt of parallel axes) is then
 estimated, not held at its nominal.
+
+Two baselines, named honestly (issue 34). The reference every comparison is made against
+("what the non-geometric effects add") is the plain complete geometric calibration: the
+unconstrained least-squares fit of the base set, what a calibration engineer (or FIGAROH)
+computes. The model the diagnosis may use as its final model is the physically held one:
+the same fit with the parameters whose values leave their physical domains
+(:mod:`zrp.gap.model.domains`, e.g. an axis tilt beyond ``max_tilt_rad``) taken out and the
+rest refitted (:func:`~zrp.gap.fit.constrained.within_domains`), so that no impossible value
+reaches an output file. When no parameter leaves its domain the two are the same fit; when
+they differ, both withheld errors are reported, with the parameters that left their domain.
 """
 
 from __future__ import annotations
@@ -44,15 +54,20 @@ class GeometricBaseline:
     Attributes:
         n_parameters: base-set size (identifiable geometric parameters, registration excluded).
         n_dropped: geometric parameters the reduction dropped (aliased).
-        withheld: withheld errors of the geometric calibration.
+        withheld: withheld errors of the plain (unconstrained) geometric calibration: the
+            reference.
         cv_rms: its cross-validated RMS on the fitting poses.
         non_geometric: the non-geometric effects of the search's model added on top (empty:
             none).
         n_non_geometric: their parameters identifiable on top of the base set.
-        combined: withheld errors of geometric + non-geometric, or None when the search's
-            model has no non-geometric effect.
-        fit: the geometric calibration's fit (registration + base set; the final model when
-            the search's model does not beat it on the withheld poses, see
+        combined: withheld errors of geometric + non-geometric (held in the physical
+            domains), or None when the search's model has no non-geometric effect.
+        held: withheld errors of the physically held geometric calibration, or None when
+            it is the plain one (no parameter left its domain).
+        outside: the plain fit's parameters outside their physical domains, in words
+            ("name = value outside ..."; empty when ``held`` is None).
+        fit: the physically held geometric calibration's fit (registration + base set; the
+            final model when the search's model does not beat it on the withheld poses, see
             :mod:`zrp.gap.analysis.fallback`).
         combined_fit: the fit of geometric + non-geometric (None with ``combined``; the final
             model when it clearly beats both others on the withheld poses, same module).
@@ -65,13 +80,21 @@ class GeometricBaseline:
     non_geometric: tuple[str, ...]
     n_non_geometric: int
     combined: Metrics | None
+    held: Metrics | None = None
+    outside: tuple[str, ...] = ()
     fit: FitResult | None = field(default=None, compare=False, repr=False)
     combined_fit: FitResult | None = field(default=None, compare=False, repr=False)
 
     @property
+    def model_withheld(self) -> Metrics:
+        """Withheld errors of the geometric calibration that may be a final model (``fit``):
+        the physically held one."""
+        return self.withheld if self.held is None else self.held
+
+    @property
     def increment(self) -> float | None:
-        """Share by which the non-geometric effects lower the baseline's withheld RMS (negative
-        when they make it worse), or None."""
+        """Share by which the non-geometric effects lower the plain baseline's withheld RMS
+        (negative when they make it worse), or None."""
         if self.combined is None or self.withheld.rms <= 0:
             return None
         return 1.0 - self.combined.rms / self.withheld.rms
@@ -82,7 +105,10 @@ class GeometricBaseline:
                 "cv_rms": self.cv_rms, "non_geometric": list(self.non_geometric),
                 "n_non_geometric": self.n_non_geometric,
                 "combined": None if self.combined is None else self.combined.to_dict(),
-                "increment": self.increment}
+                "increment": self.increment, "reference": "plain",
+                "physically_held": None if self.held is None else {
+                    "withheld": self.held.to_dict(), "rms": self.held.rms,
+                    "outside_domains": list(self.outside)}}
 
 
 def _withheld(ctx: Context, f: FitResult, withheld: NDArray[np.int64]) -> Metrics:
@@ -90,12 +116,15 @@ def _withheld(ctx: Context, f: FitResult, withheld: NDArray[np.int64]) -> Metric
 
 
 def _on_top(ctx: Context, base: FitResult, extra: list[ParamSpec], fitting: NDArray[np.int64],
-            rb0: F64) -> tuple[FitResult, int, int]:
+            rb0: F64) -> tuple[FitResult, FitResult, tuple[str, ...], int, int]:
+    """``extra`` fitted on top of ``base``: the plain fit, the fit held in the physical
+    domains (the same object when nothing left them), the reasons, the number kept and
+    dropped."""
     keep, _, start = identifiable_start(ctx, base, extra)
-    f = fit(ctx, list(base.specs) + keep, fitting,
-            np.concatenate([base.theta, np.zeros(len(keep))]), rb0, start=start)
-    f, _ = within_domains(ctx, f, n_registration(f.specs), fitting, rb0)
-    return f, len(keep), len(extra) - len(keep)
+    plain = fit(ctx, list(base.specs) + keep, fitting,
+                np.concatenate([base.theta, np.zeros(len(keep))]), rb0, start=start)
+    held, outside = within_domains(ctx, plain, n_registration(plain.specs), fitting, rb0)
+    return plain, held, outside, len(keep), len(extra) - len(keep)
 
 
 def geometric_specs(ctx: Context, reg: FitResult) -> list[ParamSpec]:
@@ -118,13 +147,15 @@ def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
     geo: list[ParamSpec] = []
     for e in KINEMATIC:
         geo += effect_parameters(ctx, e)[0]
-    base, n_geo, n_drop = _on_top(ctx, reg, geo, fitting, rb0)
+    plain, base, outside, n_geo, n_drop = _on_top(ctx, reg, geo, fitting, rb0)
     nreg = len(reg.specs)
     non_geo = [s for s in final.specs[nreg:] if s.effect not in KINEMATIC]
     effects = tuple(dict.fromkeys(s.effect for s in non_geo))
     combined, n_ng, both = None, 0, None
     if non_geo:
-        both, n_ng, _ = _on_top(ctx, base, non_geo, fitting, rb0)
+        _, both, _, n_ng, _ = _on_top(ctx, base, non_geo, fitting, rb0)
         combined = _withheld(ctx, both, withheld)
-    return GeometricBaseline(n_geo, n_drop, _withheld(ctx, base, withheld),
-                             cv_rms(ctx, base, folds), effects, n_ng, combined, base, both)
+    held = None if base is plain else _withheld(ctx, base, withheld)
+    return GeometricBaseline(n_geo, n_drop, _withheld(ctx, plain, withheld),
+                             cv_rms(ctx, plain, folds), effects, n_ng, combined, held,
+                             outside if held is not None else (), base, both)

@@ -269,7 +269,7 @@ def choose_final(ctx: Context, search_fit: FitResult, baseline: GeometricBaselin
                          "combination with the non-geometric effects")
     r_search = _residual(ctx, search_fit, withheld)
     s_rms = Metrics.of(r_search).rms
-    b_rms = baseline.withheld.rms
+    b_rms = baseline.model_withheld.rms  # the physically held one: a model may be final
     b = baseline.fit
     r_base = _residual(ctx, b, withheld)
     z = _paired_z(ctx, withheld, r_search, r_base)

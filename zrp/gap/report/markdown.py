@@ -19,6 +19,7 @@ from zrp.gap.report.identification import identification_markdown
 from zrp.gap.report.verdict import (
     baseline_text,
     final_effects_text,
+    held_names,
     verdict_sections,
 )
 from zrp.gap.results import Candidate, Diagnosis, ParameterEstimate
@@ -147,9 +148,13 @@ def _shrink(diag: Diagnosis, figures: bool = True) -> list[str]:
              f"{fin.rms:.4g} | {fin.p95:.4g} | {fin.max:.4g} | | | |")
     if a is not None:
         b = a.baseline
-        L.append(f"| baseline | complete geometric calibration ({b.n_parameters} parameters) "
-                 f"| all | {b.withheld.rms:.4g} | {b.withheld.p95:.4g} | {b.withheld.max:.4g} "
-                 f"| {b.cv_rms:.4g} | | |")
+        L.append(f"| baseline | complete geometric calibration, plain ({b.n_parameters} "
+                 f"parameters; the reference) | all | {b.withheld.rms:.4g} | "
+                 f"{b.withheld.p95:.4g} | {b.withheld.max:.4g} | {b.cv_rms:.4g} | | |")
+        if b.held is not None:
+            L.append(f"| baseline, held | the same held in the physical domains (left them: "
+                     f"{held_names(b)}) | all | {b.held.rms:.4g} | {b.held.p95:.4g} | "
+                     f"{b.held.max:.4g} | | | |")
         if b.combined is not None:
             L.append(f"| baseline + | geometric calibration + {', '.join(b.non_geometric)} | "
                      f"| {b.combined.rms:.4g} | {b.combined.p95:.4g} | {b.combined.max:.4g} "

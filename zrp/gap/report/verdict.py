@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from zrp.gap.analysis.baseline import GeometricBaseline
 from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.report.headline import headline_text, summary_terminal
 from zrp.gap.report.headline import ranges as _ranges
@@ -98,6 +99,11 @@ def _effects_found(diag: Diagnosis) -> list[str]:
     return parts
 
 
+def held_names(b: GeometricBaseline) -> str:
+    """The parameters of the plain geometric calibration outside their physical domains."""
+    return ", ".join(w.split(" = ")[0] for w in b.outside) or "none"
+
+
 def baseline_text(diag: Diagnosis) -> str:
     """One line: the complete geometric calibration and what the non-geometric effects add
     beyond it on the withheld poses."""
@@ -106,7 +112,10 @@ def baseline_text(diag: Diagnosis) -> str:
         return ""
     b, u = a.baseline, diag.length_unit
     txt = (f"A complete geometric calibration ({b.n_parameters} identifiable kinematic "
-           f"parameters) gives {b.withheld.rms:.4g} {u} withheld RMS")
+           f"parameters, plain least squares) gives {b.withheld.rms:.4g} {u} withheld RMS")
+    if b.held is not None:
+        txt += (f" (held in the physical domains, which {held_names(b)} left, "
+                f"{b.held.rms:.4g} {u})")
     if b.combined is None or b.increment is None:
         return txt + "; the final model adds no non-geometric effect to it."
     verb = "lower" if b.increment > 0 else "raise"
