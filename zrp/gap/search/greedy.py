@@ -38,7 +38,6 @@ from zrp.gap.fit.profiles import switch_bands, with_backlash_switch
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.model.problem import Problem
-from zrp.gap.search.groups import identifiable_groups
 from zrp.gap.search.lookalike import temperature_needed
 from zrp.gap.search.progress import progress_bar
 from zrp.gap.search.steps import BacklashSwitch, Candidate, Step, parameter_estimates
@@ -119,17 +118,14 @@ def _not_tried(effect: str, note: str, aliased: list[Aliased] | None = None) -> 
 
 def _significant(ctx: Context, current: FitResult, f1: FitResult, keep: list[ParamSpec],
                  s: SearchSettings) -> tuple[FitResult, list[ParamSpec]]:
-    """The candidate's parameters whose group is significant (refitted without the others
-    when some were pruned): those whose Wald group passes and, when some do not, those that
-    backward elimination on their identifiable parts keeps (:mod:`zrp.gap.search.groups`: a
-    group that fails only because a near-collinear partner shares its variance is not
-    lost)."""
+    """The candidate's parameters whose Wald group is significant (refitted without the
+    others when some were pruned). The backward elimination on identifiable parts
+    (:mod:`zrp.gap.search.groups`) is not applied here: it released the common tilt that
+    positions alone must hold (tests/gap/test_orientation_search.py)."""
     nb = len(current.specs)
     pv = wald_groups(f1, nb)
     thr = s.alpha / max(len(pv), 1)
     sig = {g for g, p in pv.items() if p < thr}
-    if len(sig) < len(pv):
-        sig |= identifiable_groups(f1, nb, s.alpha)[0]
     kept = [p for p in keep if group_key(p) in sig]
     if kept and len(kept) < len(keep):
         idx = [nb + i for i, p in enumerate(keep) if group_key(p) in sig]
