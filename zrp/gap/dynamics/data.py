@@ -196,6 +196,7 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
         if n_joints is not None and n_joints != m.n:
             raise InputError(f"{src} line 1: the log has {m.n} joints ({m.form} form), but "
                              f"the model has {n_joints}")
+        factor, bare = _factors(m, src)
         cols = sorted({m.time, *(c for g in m.groups.values() for c in g)}
                       | ({m.payload} if m.payload is not None else set()))
         _, raw = read_table(p, src, cols, max_rows)
@@ -204,7 +205,6 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
     if raw is None:
         raise InputError(f"{src}: no data rows after the header")
     at = {c: k for k, c in enumerate(cols)}
-    factor, bare = _factors(m, src)
     bare = ([m.names[m.time]] if m.units[m.time] is None else []) + bare
     t, said = clock(raw.values[:, at[m.time]], m.units[m.time], _default_time(m), m.names[m.time],
                     src)

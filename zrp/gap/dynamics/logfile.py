@@ -147,10 +147,7 @@ def read_table(path: Path, src: str, cols: list[int] | None, max_rows: int | Non
         raise InputError(f"{src}: more than max_rows = {max_rows} data rows; pass a larger "
                          "max_rows (or None) to read it")
     lines = np.asarray(reader.lines[: values.shape[0]], dtype=np.int64)
-    bad = np.argwhere(~np.isfinite(values))
-    if bad.size:
-        r, c = (int(x) for x in bad[0])
-        raise InputError(f"{src} line {lines[r]}: column {header[cols[c]].strip()} is "
-                         f"{values[r, c]!r}; expected a finite number")
+    if not np.all(np.isfinite(values)):
+        raise _locate(path, src, header, cols)
     return header, RawTable(header, values, lines, first_cells(path, src, len(header)),
                             reader.skipped)
