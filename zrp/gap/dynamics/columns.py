@@ -243,12 +243,24 @@ def _claimed(found: dict) -> set[int]:
     return {c for cols in found.values() for c in cols.values()}
 
 
+_BRACKET_INDEX = re.compile(r"(.+\[\d+\])(?:\s*\[([^\[\]]+)\])?")
+
+
+def _split(cell: str, src: str) -> tuple[str, str | None]:
+    """Name and unit of a header cell; ``q[0]`` is an index (libfranka), ``q[0] [rad]``
+    an index and a unit."""
+    m = _BRACKET_INDEX.fullmatch(cell)
+    if m:
+        return m.group(1).strip(), m.group(2)
+    return split_unit(cell, f"{src} line 1")
+
+
 def _checked_names(header: list[str], src: str) -> tuple[list[str], list[str | None]]:
     for i, h in enumerate(header):
         if len(h) > MAX_NAME:
             raise InputError(f"{src} line 1: column {i + 1}'s name has {len(h)} characters "
                              f"(more than {MAX_NAME}); not a torque log header")
-    parsed = [split_unit(h.strip(), f"{src} line 1") for h in header]
+    parsed = [_split(h.strip(), src) for h in header]
     names = [p[0] for p in parsed]
     dup = sorted({c for c in names if c and names.count(c) > 1})
     if dup:
