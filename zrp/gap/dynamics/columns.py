@@ -136,6 +136,9 @@ class Mapping:
         base = "" if self.index_base is None else f", {self.index_base}-based"
         text = (f"columns read as the {self.form} form ({self.n} joints{base}): time <- "
                 f"{self.names[self.time]}, {cols}")
+        if self.form != "zrp":
+            text += ("; undeclared units are the form's own (SI: rad, rad/s, N m, A; KUKA "
+                     "A1..A7 in deg)")
         if self.ignored:
             shown = ", ".join(self.ignored[:8]) + (" ..." if len(self.ignored) > 8 else "")
             text += f"; {len(self.ignored)} column(s) not used: {shown}"

@@ -132,8 +132,8 @@ def _factors(m: Mapping, src: str) -> tuple[dict[int, float], list[str]]:
         kinds[m.payload] = "mass"
     for c, kind in kinds.items():
         unit = m.units[c] or m.defaults.get(c)
-        if m.units[c] is None and c not in m.defaults:
-            bare.append(m.names[c])
+        if m.units[c] is None and c not in m.defaults and m.form == "zrp":
+            bare.append(m.names[c])  # a controller's form has its documented (SI) units
         out[c] = si_factor(kind, unit, f"{src} line 1: column {m.names[c]}")
     return out, bare
 
@@ -205,7 +205,7 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
     if raw is None:
         raise InputError(f"{src}: no data rows after the header")
     at = {c: k for k, c in enumerate(cols)}
-    bare = ([m.names[m.time]] if m.units[m.time] is None else []) + bare
+    bare = ([m.names[m.time]] if m.units[m.time] is None and m.form == "zrp" else []) + bare
     t, said = clock(raw.values[:, at[m.time]], m.units[m.time], _default_time(m), m.names[m.time],
                     src)
     kept, segments, rec = condition(t, raw.values, raw.lines, src)

@@ -175,8 +175,8 @@ def _drop_repeats(t: F64, values: np.ndarray, lines: np.ndarray, src: str
     back = np.flatnonzero(dt < 0.0)
     if back.size:
         i = int(back[0]) + 1
-        raise InputError(f"{src} line {lines[i]}: column t is {t[i]!r} s, earlier than the "
-                         f"previous row's {t[i - 1]!r} s; rows must be in time order")
+        raise InputError(f"{src} line {lines[i]}: column t is {float(t[i])!r} s, earlier "
+                         f"than the previous row's {float(t[i - 1])!r} s; rows must be in time order")
     same_t = np.concatenate([[False], dt == 0.0])
     same_v = np.concatenate([[False], np.all(values[1:] == values[:-1], axis=1)])
     rep, con = np.flatnonzero(same_t & same_v), np.flatnonzero(same_t & ~same_v)
