@@ -235,7 +235,7 @@ def test_rostopic_echo_export(tmp_path):
 def test_a_header_of_no_known_form_lists_the_forms(tmp_path):
     p = tmp_path / "x.csv"
     p.write_text("stamp_x,angle_a,angle_b,load_a,load_b\n0,0,0,0,0\n1,1,1,1,1\n")
-    with pytest.raises(InputError, match="accepted: zrp: .*libfranka.*UR RTDE.*KUKA.*ROS"):
+    with pytest.raises(InputError, match=r"accepted: zrp: .*libfranka.*UR RTDE.*KUKA.*ROS"):
         load_torque_log(p)
 
 

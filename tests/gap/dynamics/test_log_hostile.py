@@ -41,7 +41,8 @@ def _edit(rows, i, j, v):
 
 CASES = {
     "header cell over the csv field limit":
-        (("t," + "q" * 131_073 + ",tau1\n0,0,0\n").encode(), r"line 1: not a CSV header .*field limit"),
+        (("t," + "q" * 131_073 + ",tau1\n0,0,0\n").encode(),
+         r"line 1: not a CSV header .*field limit"),
     "a header cell of 2,000 characters":
         (("t,q1,tau1," + "x" * 2000 + "\n0,0,0,0\n").encode(), r"line 1: column 4's name"),
     "seconds under t [ms]":
@@ -56,7 +57,8 @@ CASES = {
     "a torque of inf":
         (_text(rows=_edit(_rows(), 50, 4, math.inf)).encode(),
          r"line 52: column tau2 \[Nm\] is 'inf'; expected a finite"),
-    "q of 1e6 rad": (_text(rows=_edit(_rows(), 7, 2, 1e6)).encode(), r"line 9: column q2 is 1e\+06"),
+    "q of 1e6 rad":
+        (_text(rows=_edit(_rows(), 7, 2, 1e6)).encode(), r"line 9: column q2 is 1e\+06"),
     "a 1e30 kg payload":
         (_text(HEAD + ",payload [kg]", [[*r, 1e30 if k == 3 else 0.0]
                                          for k, r in enumerate(_rows())]).encode(),
@@ -64,7 +66,8 @@ CASES = {
     "a time step of 1e-12 s": (_text(rows=_rows(step=1e-12)).encode(), r"implausible"),
     "non-UTF-8 bytes":
         (_text().encode().replace(b"\n0.002", b"\n\xff0.002", 1), r"line 4: not UTF-8"),
-    "a NUL byte": (_text().encode().replace(b"\n0.002", b"\n0.0\x0002", 1), r"line 4: column t"),
+    "a NUL byte":
+        (_text().encode().replace(b"\n0.002", b"\n0.0\x0002", 1), r"line 4: column t"),
     "no data rows": (HEAD.encode() + b"\n", r"0 data row"),
     "one data row": (_text(rows=_rows(1)).encode(), r"1 data row"),
     "an empty file": (b"", r"empty file"),

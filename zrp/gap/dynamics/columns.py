@@ -271,50 +271,67 @@ def _checked_names(header: list[str], src: str) -> tuple[list[str], list[str | N
     return names, [p[1] for p in parsed]
 
 
-def map_header(header: list[str], src: str) -> Mapping:
-    """The :class:`Mapping` of ``header`` (module docstring); an InputError naming what is
-    missing, or listing the accepted forms when nothing matches."""
-    names, units = _checked_names(header, src)
+def _choose(names: list[str], src: str) -> tuple[str, dict]:
+    """The form giving positions and torques that claims the most columns."""
     cands = _candidates(names)
     full = [(f, m) for f, m in cands if "tau" in m or "i" in m]
-    if not full:
-        if cands:
-            raise InputError(f"{src} line 1: no torques: the {cands[0][0]} form's positions "
-                             "are there, but no torques (tau1..taun, N m) or motor currents "
-                             "(i1..in, A, with a torque constant)")
-        raise InputError(f"{src} line 1: missing column(s) q1: no joint positions in a form "
-                         f"this reader knows; accepted: {accepted_forms()}")
-    form, found = max(full, key=lambda fm: len(_claimed(fm[1])))
+    if full:
+        return max(full, key=lambda fm: len(_claimed(fm[1])))
+    if cands:
+        raise InputError(f"{src} line 1: no torques: the {cands[0][0]} form's positions are "
+                         "there, but no torques (tau1..taun, N m) or motor currents (i1..in, "
+                         "A, with a torque constant)")
+    raise InputError(f"{src} line 1: missing column(s) q1: no joint positions in a form this "
+                     f"reader knows; accepted: {accepted_forms()}")
+
+
+def _unused(form: str, found: dict, names: list[str], src: str
+            ) -> tuple[int, int | None, tuple[str, ...]]:
+    """The time and payload columns, and the columns not used (an error in the zrp form)."""
     t = _time_column(names)
     if t is None:
         raise InputError(f"{src} line 1: missing column(s) t: no time column (accepted: "
                          "t, time, timestamp, field.header.stamp, __time, ZeitInSec, %time)")
-    used = _claimed(found) | {t}
     payload = next((i for i, c in enumerate(names) if c.lower() == "payload"), None)
-    if payload is not None:
-        used.add(payload)
+    used = _claimed(found) | {t, payload}
     ignored = tuple(names[i] for i in range(len(names)) if i not in used)
     if form == "zrp" and ignored:
         raise InputError(f"{src} line 1: unknown column {ignored[0]!r}; valid columns are t, "
                          "q1..qn, qd1..qdn, tau1..taun, i1..in, qc1..qcn, payload (or a "
                          f"controller's form: {accepted_forms()})")
+    return t, payload, ignored
+
+
+def _ros_name_cells(names: list[str], base: int, n: int) -> tuple[int, ...]:
+    cells = {int(m.group(1)): i for i, c in enumerate(names)
+             if (m := _ROS_NAME_CELL.fullmatch(c))}
+    out = tuple(cells[k] for k in range(base, base + n) if k in cells)
+    return out if len(out) == n else ()
+
+
+def _defaults(form: str, groups: dict[str, tuple[int, ...]], names: list[str]) -> dict[int, str]:
+    """Column -> the form's unit for an undeclared position column (KUKA's A1..A7: deg)."""
+    return {c: DEFAULT_UNITS[(form, b)] for c in groups["q"]
+            for b, pat in _PATTERNS.get(form, {}).get("q", [])
+            if (form, b) in DEFAULT_UNITS and pat.fullmatch(names[c])}
+
+
+def map_header(header: list[str], src: str) -> Mapping:
+    """The :class:`Mapping` of ``header`` (module docstring); an InputError naming what is
+    missing, or listing the accepted forms when nothing matches."""
+    names, units = _checked_names(header, src)
+    form, found = _choose(names, src)
+    t, payload, ignored = _unused(form, found, names, src)
     joint_names: tuple[str, ...] = ()
     name_cells: tuple[int, ...] = ()
-    base: int | None
+    base: int | None = None
     if form == "ROS joint_states":
         n, groups, joint_names = _order_named(found, names, src)
-        base = None
-    else:
-        if form.startswith("ROS"):
-            found = {g: {int(k): c for k, c in cols.items()} for g, cols in found.items()}
+    elif form.startswith("ROS"):
+        found = {g: {int(k): c for k, c in cols.items()} for g, cols in found.items()}
         n, base, groups = _order_indexed(found, names, src)
-        if form.startswith("ROS"):
-            cells = {int(m.group(1)): i for i, c in enumerate(names)
-                     if (m := _ROS_NAME_CELL.fullmatch(c))}
-            name_cells = tuple(cells[k] for k in range(base, base + n) if k in cells)
-            name_cells = name_cells if len(name_cells) == n else ()
-    defaults = {c: DEFAULT_UNITS[(form, b)] for g, cols in groups.items() if g == "q"
-                for c in cols for b, pat in _PATTERNS.get(form, {}).get("q", [])
-                if (form, b) in DEFAULT_UNITS and pat.fullmatch(names[c])}
-    return Mapping(form, n, t, groups, dict(enumerate(units)), defaults, dict(enumerate(names)),
-                   payload, joint_names, name_cells, base, ignored)
+        name_cells = _ros_name_cells(names, base, n)
+    else:
+        n, base, groups = _order_indexed(found, names, src)
+    return Mapping(form, n, t, groups, dict(enumerate(units)), _defaults(form, groups, names),
+                   dict(enumerate(names)), payload, joint_names, name_cells, base, ignored)

@@ -45,7 +45,7 @@ from zrp.errors import InputError
 from zrp.gap.data.measurements import DataWarning
 from zrp.gap.dynamics.columns import GROUP_KIND, Mapping, map_header
 from zrp.gap.dynamics.logcheck import check_log, unmeasured_joints
-from zrp.gap.dynamics.logfile import read_table
+from zrp.gap.dynamics.logfile import RawTable, read_table
 from zrp.gap.dynamics.timebase import Conditioning, clock, condition
 from zrp.output import atomic_path
 from zrp.units import SI_UNITS, si_factor
@@ -173,6 +173,28 @@ def _excluded(unmeasured: dict[int, str], names: tuple[str, ...]) -> tuple[str, 
                  "not used" for k, why in sorted(unmeasured.items()))
 
 
+def _read(p: Path, src: str, n_joints: int | None, max_rows: int | None
+          ) -> tuple[Mapping, dict[int, int], RawTable, dict[int, float], list[str]]:
+    """The mapping, column -> position in the numbers read, the numbers, the factors to SI
+    and the columns of no declared unit."""
+    try:
+        header, _ = read_table(p, src, None, max_rows)
+        m = map_header(header, src)
+        if n_joints is not None and n_joints != m.n:
+            raise InputError(f"{src} line 1: the log has {m.n} joints ({m.form} form), but "
+                             f"the model has {n_joints}")
+        factor, bare = _factors(m, src)
+        cols = sorted({m.time, *(c for g in m.groups.values() for c in g)}
+                      | ({m.payload} if m.payload is not None else set()))
+        _, raw = read_table(p, src, cols, max_rows)
+    except OSError as exc:
+        raise InputError(f"{src}: cannot read ({exc.strerror or exc})") from None
+    if raw is None:
+        raise InputError(f"{src}: no data rows after the header")
+    bare = ([m.names[m.time]] if m.units[m.time] is None and m.form == "zrp" else []) + bare
+    return m, {c: k for k, c in enumerate(cols)}, raw, factor, bare
+
+
 def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[float] | None = None,
                     n_joints: int | None = None, max_rows: int | None = MAX_ROWS) -> TorqueLog:
     """Read a torque log (format in the module docstring), converting to SI.
@@ -190,24 +212,9 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
     src = str(p.name)
     if not p.is_file():
         raise InputError(f"{path}: no such file")
-    try:
-        header, _ = read_table(p, src, None, max_rows)
-        m = map_header(header, src)
-        if n_joints is not None and n_joints != m.n:
-            raise InputError(f"{src} line 1: the log has {m.n} joints ({m.form} form), but "
-                             f"the model has {n_joints}")
-        factor, bare = _factors(m, src)
-        cols = sorted({m.time, *(c for g in m.groups.values() for c in g)}
-                      | ({m.payload} if m.payload is not None else set()))
-        _, raw = read_table(p, src, cols, max_rows)
-    except OSError as exc:
-        raise InputError(f"{src}: cannot read ({exc.strerror or exc})") from None
-    if raw is None:
-        raise InputError(f"{src}: no data rows after the header")
-    at = {c: k for k, c in enumerate(cols)}
-    bare = ([m.names[m.time]] if m.units[m.time] is None and m.form == "zrp" else []) + bare
-    t, said = clock(raw.values[:, at[m.time]], m.units[m.time], _default_time(m), m.names[m.time],
-                    src)
+    m, at, raw, factor, bare = _read(p, src, n_joints, max_rows)
+    t, said = clock(raw.values[:, at[m.time]], m.units[m.time], _default_time(m),
+                    m.names[m.time], src)
     kept, segments, rec = condition(t, raw.values, raw.lines, src)
     vals, lines, t = raw.values[kept], raw.lines[kept], t[kept]
     block = {g: vals[:, [at[c] for c in cs]] * np.array([factor[c] for c in cs])

@@ -23,6 +23,7 @@ segments, and the record of what was done (:class:`Conditioning`).
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -176,13 +177,29 @@ def _drop_repeats(t: F64, values: np.ndarray, lines: np.ndarray, src: str
     if back.size:
         i = int(back[0]) + 1
         raise InputError(f"{src} line {lines[i]}: column t is {float(t[i])!r} s, earlier "
-                         f"than the previous row's {float(t[i - 1])!r} s; rows must be in time order")
+                         f"than the previous row's {float(t[i - 1])!r} s; rows must be in "
+                         "time order")
     same_t = np.concatenate([[False], dt == 0.0])
     same_v = np.concatenate([[False], np.all(values[1:] == values[:-1], axis=1)])
     rep, con = np.flatnonzero(same_t & same_v), np.flatnonzero(same_t & ~same_v)
-    return ~same_t, {"repeats": int(rep.size), "repeat_lines": tuple(lines[rep[:_SHOWN]].tolist()),
+    return ~same_t, {"repeats": int(rep.size),
+                     "repeat_lines": tuple(lines[rep[:_SHOWN]].tolist()),
                      "conflicts": int(con.size),
                      "conflict_lines": tuple(lines[con[:_SHOWN]].tolist())}
+
+
+def _short_dropped(segs: list[tuple[int, int]], lk: np.ndarray, step: float, src: str
+                   ) -> tuple[list[tuple[int, int]], tuple[str, ...]]:
+    """The segments kept (all when one) and those dropped as too short, in words."""
+    if len(segs) == 1:
+        return segs, ()
+    short = [(a, b) for a, b in segs if b - a < MIN_ROWS]
+    kept = [s for s in segs if s not in short]
+    if not kept:
+        raise InputError(f"{src}: no stretch of {MIN_ROWS} rows without a gap (a step over "
+                         f"{GAP:g} x the median {step:g} s)")
+    return kept, tuple(f"lines {lk[a]}-{lk[b - 1]} ({b - a} row(s) between gaps, fewer than "
+                       f"{MIN_ROWS})" for a, b in short)
 
 
 def condition(t: F64, values: np.ndarray, lines: np.ndarray, src: str
@@ -196,16 +213,8 @@ def condition(t: F64, values: np.ndarray, lines: np.ndarray, src: str
     step = float(np.median(dt))
     cut = np.flatnonzero(dt > GAP * step) + 1
     rec["gaps"] = tuple(Gap(int(lk[i]), float(dt[i - 1]), float(dt[i - 1] / step)) for i in cut)
-    bounds = [0, *cut.tolist(), tk.size]
-    segs = [(a, b) for a, b in zip(bounds[:-1], bounds[1:], strict=True)]
-    if len(segs) > 1:
-        short = [(a, b) for a, b in segs if b - a < MIN_ROWS]
-        rec["dropped"] = tuple(f"lines {lk[a]}-{lk[b - 1]} ({b - a} row(s) between gaps, fewer "
-                               f"than {MIN_ROWS})" for a, b in short)
-        segs = [s for s in segs if s not in short]
-        if not segs:
-            raise InputError(f"{src}: no stretch of {MIN_ROWS} rows without a gap (a step over "
-                             f"{GAP:g} x the median {step:g} s)")
+    segs, rec["dropped"] = _short_dropped(list(itertools.pairwise([0, *cut.tolist(), tk.size])),
+                                          lk, step, src)
     rows = np.flatnonzero(keep)
     kept = np.concatenate([rows[a:b] for a, b in segs])
     starts = np.cumsum([0] + [b - a for a, b in segs])
