@@ -44,9 +44,7 @@ def _servo(arm: Arm, log: TorqueLog, kp: list[float] | None, kv: list[float] | N
 def _truncate(log: TorqueLog, seconds: float | None) -> TorqueLog:
     if seconds is None:
         return log
-    k = max(2, int(np.searchsorted(log.t - log.t[0], seconds)))
-    return TorqueLog(log.t[:k], log.q[:k], None if log.qd is None else log.qd[:k], log.tau[:k],
-                     log.qc[:k], None, log.lines[:k], log.source, log.torque_from)
+    return log.first(int(np.searchsorted(log.t - log.t[0], seconds)))
 
 
 def _tracking(arm: Arm, log: TorqueLog, model: mujoco.MjModel, args: argparse.Namespace

@@ -259,3 +259,11 @@ def test_unmeasured_joints_are_excluded_and_named(tmp_path):
     p = write_torque_log(TorqueLog(t, q, None, tau), tmp_path / "none.csv")
     with pytest.raises(InputError, match="no joint's torque is data"):
         load_torque_log(p)
+
+
+def test_first_keeps_segments_and_record(twins):
+    _, bad, _ = twins
+    k = bad.segments[2][0] + 10
+    part = bad.first(k)
+    assert part.n_samples == k and len(part.segments) == 3 and part.segments[-1] == (k - 10, k)
+    assert part.conditioning is bad.conditioning

@@ -116,6 +116,16 @@ class TorqueLog:
         """Per joint, whether its torque is data (not in :attr:`unmeasured`)."""
         return np.array([k not in self.unmeasured for k in range(self.n_joints)])
 
+    def first(self, k: int) -> TorqueLog:
+        """The first ``k`` samples (at least 2), segments and record kept."""
+        k = min(max(2, int(k)), self.n_samples)
+        cut = lambda a: None if a is None else a[:k]  # noqa: E731
+        segs = tuple((a, min(b, k)) for a, b in self.segments if a < k)
+        return TorqueLog(self.t[:k], self.q[:k], cut(self.qd), self.tau[:k], cut(self.qc),
+                         cut(self.payload), self.lines[:k] if self.lines.size else self.lines,
+                         self.source, self.torque_from, segs if len(segs) > 1 else (),
+                         dict(self.unmeasured), self.joint_names, self.conditioning)
+
     @property
     def dt(self) -> float:
         """The sampling step, s (median of the steps within segments)."""
