@@ -267,3 +267,27 @@ def test_first_keeps_segments_and_record(twins):
     part = bad.first(k)
     assert part.n_samples == k and len(part.segments) == 3 and part.segments[-1] == (k - 10, k)
     assert part.conditioning is bad.conditioning
+
+
+def test_the_real_time_axis_fit_is_savitzky_golay_and_exact_for_cubics():
+    """localpoly's general path: on a uniform grid it is scipy's savgol_filter (an independent
+    reference); on a jittered grid it reproduces a cubic and its derivatives exactly."""
+    from scipy.signal import savgol_filter
+
+    from zrp.gap.dynamics.localpoly import _chunk, local_fit
+
+    rng = np.random.default_rng(4)
+    t = np.arange(600) / 1000.0
+    y = rng.normal(size=(600, 2))
+    coef, _ = _chunk(t, y, np.arange(600), 51, 3, 0.025)
+    for d in (0, 1, 2):
+        ref = savgol_filter(y, 51, 3, deriv=d, delta=1e-3, axis=0, mode="interp")
+        np.testing.assert_allclose(coef[:, d, :] * math.factorial(d) / 0.025**d, ref,
+                                   atol=1e-9 * 10**(3 * d))
+    tj = np.cumsum(rng.uniform(0.8e-3, 1.6e-3, 600))
+    cubic = np.column_stack([1 - 2 * tj + 3 * tj**2 - 4 * tj**3])
+    (v, d1, d2), h0 = local_fit(tj, cubic, 51, 3, (0, 1, 2))
+    np.testing.assert_allclose(v, cubic, atol=1e-10)
+    np.testing.assert_allclose(d1[:, 0], -2 + 6 * tj - 12 * tj**2, atol=1e-7)
+    np.testing.assert_allclose(d2[:, 0], 6 - 24 * tj, atol=1e-4)
+    assert np.all((h0 > 0) & (h0 < 1))

@@ -117,12 +117,16 @@ def derive_states(log: TorqueLog, window_s: float = 0.1, polyorder: int = 3,
                            f"shorter than the {w}-sample window)")
             continue
         t = log.t[a:b]
+        # one local fit of every channel: positions (or velocities) and torques together
+        src = log.q[a:b] if log.qd is None else log.qd[a:b]
+        both = np.hstack([src, log.tau[a:b]] + ([log.q[a:b]] if log.qd is not None else []))
+        (f0, f1, f2), _ = local_fit(t, both, w, polyorder, (0, 1, 2))
+        n = log.n_joints
         if log.qd is not None:
-            (q,), _ = local_fit(t, log.q[a:b], w, polyorder)
-            (qd, qdd), _ = local_fit(t, log.qd[a:b], w, polyorder, (0, 1))
+            q, qd, qdd = f0[:, 2 * n:], f0[:, :n], f1[:, :n]
         else:
-            (q, qd, qdd), _ = local_fit(t, log.q[a:b], w, polyorder, (0, 1, 2))
-        tau = local_fit(t, log.tau[a:b], w, polyorder)[0][0] if filter_torque else log.tau[a:b]
+            q, qd, qdd = f0[:, :n], f1[:, :n], f2[:, :n]
+        tau = f0[:, n:2 * n] if filter_torque else log.tau[a:b]
         parts.append((t, q, qd, qdd, tau, log.tau[a:b]))
         segs.append(np.full(b - a, k))
         rows.append(np.arange(a, b))
