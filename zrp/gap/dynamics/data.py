@@ -221,7 +221,8 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
     p = Path(path)
     src = str(p.name)
     if not p.is_file():
-        raise InputError(f"{path}: no such file")
+        raise InputError(f"{path}: no such file" if not p.exists() else
+                         f"{path}: not a regular file")
     m, at, raw, factor, bare = _read(p, src, n_joints, max_rows)
     t, said = clock(raw.values[:, at[m.time]], m.units[m.time], _default_time(m),
                     m.names[m.time], src)
