@@ -291,3 +291,27 @@ def test_the_real_time_axis_fit_is_savitzky_golay_and_exact_for_cubics():
     np.testing.assert_allclose(d1[:, 0], -2 + 6 * tj - 12 * tj**2, atol=1e-7)
     np.testing.assert_allclose(d2[:, 0], 6 - 24 * tj, atol=1e-4)
     assert np.all((h0 > 0) & (h0 < 1))
+
+
+def test_libfranka_log_to_csv_as_written(tmp_path):
+    """The header ``franka::logToCSV`` writes (libfranka's src/logging/robot_state_log.cpp):
+    time in integer ms, ``state.q[i]`` .. and ``cmd.`` columns, separators with or without a
+    space; a lost packet (a 3 ms step) is a gap."""
+    t, q, qd, tau = _reference()
+    t_ms = np.round(t * 1e3)
+    t_ms[300:] += 2.0
+    arr = lambda name: [f"{name}[{k}]" for k in range(3)]  # noqa: E731
+    head = ["time", "success_rate", *arr("state.q"), *arr("state.q_d"), *arr("state.dq"),
+            *arr("state.dq_d"), *arr("state.tau_J"), *arr("state.tau_ext_hat_filtered"),
+            *arr("cmd.q_d"), *arr("cmd.tau_J_d")]
+    cols = [t_ms, 0 * t + 1, q, q, qd, qd, tau, 0 * tau, q, 0 * tau]
+    for sep in (",", ", "):
+        p = tmp_path / "franka.csv"
+        text = _table(head, cols).replace(",", sep)
+        p.write_text(text.replace(".0,", ",").replace(".0\n", "\n"))
+        log = load_torque_log(p)
+        assert "libfranka" in log.conditioning.columns and "read as ms" in log.conditioning.clock
+        assert "state.q[0]..state.q[2]" in log.conditioning.columns
+        assert len(log.segments) == 2 and log.conditioning.gaps[0].seconds == pytest.approx(3e-3)
+        np.testing.assert_allclose(log.tau, tau)
+        np.testing.assert_allclose(log.qc, q)

@@ -11,7 +11,9 @@ form              per-joint columns (group: base names; separators)
 ================  ==========================================================================
 zrp               q, qd, tau, i (currents), qc (command): ``q1``, ``tau1`` ...; ``payload``
 libfranka         q: ``q``; qd: ``dq``; tau: ``tau_J``; qc: ``q_d``; as ``q0``, ``q_0``,
-                  ``q[0]``, ``q.0``
+                  ``q[0]``, ``q.0``; and as ``franka::logToCSV`` writes them:
+                  ``state.q[0]``, ``state.dq[0]``, ``state.tau_J[0]``, ``state.q_d[0]``
+                  (or ``cmd.q_d[0]``), time ``time`` in ms
 UR RTDE           q: ``actual_q``; qd: ``actual_qd``; tau: ``actual_current_as_torque``;
                   i: ``actual_current`` (needs torque constants); qc: ``target_q``; as
                   ``actual_q_0``, ``actual_q[0]``, ``actual_q0``
@@ -60,7 +62,8 @@ _SEPS = {"zrp": ("",), "libfranka": ("", "_", "[]", "."), "UR RTDE": ("_", "[]",
 #: form -> group -> base names (lowercase).
 FORMS: dict[str, dict[str, tuple[str, ...]]] = {
     "zrp": {"q": ("q",), "qd": ("qd",), "tau": ("tau",), "i": ("i",), "qc": ("qc",)},
-    "libfranka": {"q": ("q",), "qd": ("dq",), "tau": ("tau_j",), "qc": ("q_d",)},
+    "libfranka": {"q": ("q", "state.q"), "qd": ("dq", "state.dq"),
+                  "tau": ("tau_j", "state.tau_j"), "qc": ("q_d", "state.q_d", "cmd.q_d")},
     "UR RTDE": {"q": ("actual_q",), "qd": ("actual_qd",), "tau": ("actual_current_as_torque",),
                 "i": ("actual_current",), "qc": ("target_q",)},
     "KUKA FRI/Sunrise": {
