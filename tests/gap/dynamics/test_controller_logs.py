@@ -315,3 +315,23 @@ def test_libfranka_log_to_csv_as_written(tmp_path):
         assert len(log.segments) == 2 and log.conditioning.gaps[0].seconds == pytest.approx(3e-3)
         np.testing.assert_allclose(log.tau, tau)
         np.testing.assert_allclose(log.qc, q)
+
+
+def test_ur_rtde_record_py_space_separated(tmp_path):
+    """UR's RTDE client ``record.py`` writes its CSV space-separated (its CSVWriter's
+    default delimiter); semicolons and tabs are read too."""
+    t, q, qd, tau = _reference()
+    head = ["timestamp", *(f"actual_q_{k}" for k in range(3)),
+            *(f"actual_qd_{k}" for k in range(3)), *(f"actual_current_{k}" for k in range(3)),
+            "runtime_state"]
+    for sep in (" ", ";", "\t"):
+        p = tmp_path / "robot_data.csv"
+        p.write_text(_table(head, [t + 20.0, q, qd, tau / 5.0, 0 * t + 2]).replace(",", sep))
+        log = load_torque_log(p, torque_constant=[5.0] * 3)
+        assert "UR RTDE" in log.conditioning.columns and log.torque_from == "current"
+        np.testing.assert_allclose(log.tau, tau)
+        np.testing.assert_allclose(log.t, t + 20.0)
+    text = _table(head, [t, q, qd, tau, 0 * t]).replace(",", " ")
+    p.write_text(text.replace("\n0.3", "\n0.3 7", 1))
+    with pytest.raises(InputError, match=r"line \d+: 12 fields, but the header has 11"):
+        load_torque_log(p, torque_constant=[5.0] * 3)

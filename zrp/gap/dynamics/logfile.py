@@ -1,4 +1,5 @@
-"""The torque log's text, read defensively: bounded lines, UTF-8 named by line, blank and
+"""The torque log's text, read defensively: the delimiter the header uses (comma, semicolon,
+tab, or whitespace as UR's RTDE ``record.py`` writes), bounded lines, UTF-8 named by line, blank and
 comment lines skipped, the numbers of the used columns parsed by NumPy's C reader.
 
 Every problem is an :class:`~zrp.errors.InputError` naming the file and line (and the
@@ -45,8 +46,8 @@ class RawTable:
 class _Lines:
     """The file's data lines, checked, with their line numbers (an iterator for loadtxt)."""
 
-    def __init__(self, path: Path, src: str, n_fields: int) -> None:
-        self.path, self.src, self.n_fields = path, src, n_fields
+    def __init__(self, path: Path, src: str, n_fields: int, delimiter: str | None = ",") -> None:
+        self.path, self.src, self.n_fields, self.delimiter = path, src, n_fields, delimiter
         self.lines: list[int] = []
         self.skipped = 0
 
@@ -77,31 +78,55 @@ class _Lines:
             if not s or s.startswith("#"):
                 self.skipped += 1
                 continue
-            if '"' not in text and text.count(",") + 1 != self.n_fields:
-                raise InputError(f"{self.src} line {k}: {text.count(',') + 1} fields, but the "
-                                 f"header has {self.n_fields}")
+            fields = _count(text, self.delimiter)
+            if fields and fields != self.n_fields:
+                raise InputError(f"{self.src} line {k}: {fields} fields, but the header has "
+                                 f"{self.n_fields}")
             self.lines.append(k)
             yield text
 
 
-def _header(src: str, reader: _Lines) -> list[str]:
+def _count(text: str, delimiter: str | None) -> int:
+    """The fields of a line (0: quoted, left to the parser)."""
+    if '"' in text:
+        return 0
+    return len(text.split()) if delimiter is None else text.count(delimiter) + 1
+
+
+def _delimiter(header: str) -> str | None:
+    """Comma, semicolon or tab, whichever the header has (in this order); else whitespace
+    (None), as UR's RTDE ``record.py`` writes."""
+    return next((d for d in ",;\t" if d in header), None)
+
+
+def _header(src: str, reader: _Lines) -> tuple[list[str], str | None]:
     first = next(reader.texts(), None)
     if first is None or not first[1].strip():
         raise InputError(f"{src}: empty file (or an empty first line); expected a header line "
                          "t, q1..qn, tau1..taun")
+    delimiter = _delimiter(first[1])
+    if delimiter is None:
+        return first[1].split(), None
     try:
-        return next(csv.reader(io.StringIO(first[1])))
+        return next(csv.reader(io.StringIO(first[1]), delimiter=delimiter)), delimiter
     except csv.Error as exc:
         raise InputError(f"{src} line 1: not a CSV header ({exc})") from None
 
 
-def _locate(path: Path, src: str, header: list[str], cols: list[int]) -> InputError:
+def _cells(text: str, delimiter: str | None) -> list[str]:
+    if delimiter is None:
+        return text.split()
+    return next(csv.reader(io.StringIO(text), delimiter=delimiter))
+
+
+def _locate(path: Path, src: str, header: list[str], cols: list[int], delimiter: str | None
+            ) -> InputError:
     """The error of the first bad cell (the rows read again one by one)."""
-    again = _Lines(path, src, len(header))
+    again = _Lines(path, src, len(header), delimiter)
     for text in again.data():
         line = again.lines[-1]
         try:
-            rec = next(csv.reader(io.StringIO(text)))
+            rec = _cells(text, delimiter)
         except (csv.Error, StopIteration) as exc:
             return InputError(f"{src} line {line}: not a CSV row ({exc})")
         if len(rec) != len(header):
@@ -112,14 +137,14 @@ def _locate(path: Path, src: str, header: list[str], cols: list[int]) -> InputEr
     return InputError(f"{src}: not a numeric CSV after its header")
 
 
-def first_cells(path: Path, src: str, n_fields: int) -> list[str]:
+def first_cells(path: Path, src: str, n_fields: int, delimiter: str | None) -> list[str]:
     """The cells of the first data row (for joint names logged as text)."""
-    lines = _Lines(path, src, n_fields)
+    lines = _Lines(path, src, n_fields, delimiter)
     text = next(lines.data(), None)
     if text is None:
         return []
     try:
-        return next(csv.reader(io.StringIO(text)))
+        return _cells(text, delimiter)
     except (csv.Error, StopIteration):
         return []
 
@@ -127,19 +152,18 @@ def first_cells(path: Path, src: str, n_fields: int) -> list[str]:
 def read_table(path: Path, src: str, cols: list[int] | None, max_rows: int | None
                ) -> tuple[list[str], RawTable | None]:
     """The header, and (when ``cols`` is given) the numbers of columns ``cols``."""
-    probe = _Lines(path, src, 0)
-    header = _header(src, probe)
+    header, delimiter = _header(src, _Lines(path, src, 0))
     if cols is None:
         return header, None
-    reader = _Lines(path, src, len(header))
+    reader = _Lines(path, src, len(header), delimiter)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # "input contained no data": said below
-            values = np.loadtxt(reader.data(), delimiter=",", usecols=cols, ndmin=2,
+            values = np.loadtxt(reader.data(), delimiter=delimiter, usecols=cols, ndmin=2,
                                 dtype=float, quotechar='"',
                                 max_rows=None if max_rows is None else max_rows + 1)
     except (ValueError, TypeError, OverflowError, IndexError):
-        raise _locate(path, src, header, cols) from None
+        raise _locate(path, src, header, cols, delimiter) from None
     if values.shape[0] < 2:
         raise InputError(f"{src}: {values.shape[0]} data row(s) after the header; a torque "
                          "log needs a time series")
@@ -148,6 +172,7 @@ def read_table(path: Path, src: str, cols: list[int] | None, max_rows: int | Non
                          "max_rows (or None) to read it")
     lines = np.asarray(reader.lines[: values.shape[0]], dtype=np.int64)
     if not np.all(np.isfinite(values)):
-        raise _locate(path, src, header, cols)
-    return header, RawTable(header, values, lines, first_cells(path, src, len(header)),
+        raise _locate(path, src, header, cols, delimiter)
+    return header, RawTable(header, values, lines,
+                            first_cells(path, src, len(header), delimiter),
                             reader.skipped)
