@@ -335,3 +335,23 @@ def test_ur_rtde_record_py_space_separated(tmp_path):
     p.write_text(text.replace("\n0.3", "\n0.3 7", 1))
     with pytest.raises(InputError, match=r"line \d+: 12 fields, but the header has 11"):
         load_torque_log(p, torque_constant=[5.0] * 3)
+
+
+def test_kuka_sunrise_trace(tmp_path):
+    """A Sunrise trace: a "%" header, whitespace-separated, ZeitInSec + ZeitInNanoSec, the
+    axes' measured and commanded positions in degrees, 0-based; torques named as FRI does."""
+    t, q, _, tau = _reference()
+    sec = np.floor(t + 100.0)
+    nsec = np.round((t + 100.0 - sec) * 1e9)
+    robot = "LBR_iiwa_7_R800_1"
+    head = ["ZeitInSec", "ZeitInNanoSec", *(f"axisQMsr_{robot}[{k}]" for k in range(3)),
+            *(f"axisQCmdT1m_{robot}[{k}]" for k in range(3)),
+            *(f"MeasuredTorque_{k + 1}" for k in range(3))]
+    p = tmp_path / "trace.log"
+    p.write_text("%" + _table(head, [sec, nsec, np.degrees(q), np.degrees(q), tau])
+                 .replace(",", " "))
+    log = load_torque_log(p)
+    assert "KUKA" in log.conditioning.columns
+    np.testing.assert_allclose(log.t, t, atol=1e-9)
+    np.testing.assert_allclose(log.q, q, atol=1e-12)
+    np.testing.assert_allclose(log.qc, q, atol=1e-12)

@@ -4,7 +4,8 @@ A header is matched against each *form* below (case-insensitive; a unit in brack
 ``q_0 [rad]``, is split off first by :func:`zrp.units.split_unit`); the form that gives
 positions and torques (or currents) and claims the most columns is used, and said
 (:attr:`Mapping.describe`). Per-joint columns are numbered 0- or 1-based (decided by the
-positions: ``0..n-1`` or ``1..n``, every group alike), with the separators listed.
+positions: ``0..n-1`` or ``1..n``; another group may count from the other), with the
+separators listed.
 
 ================  ==========================================================================
 form              per-joint columns (group: base names; separators)
@@ -17,11 +18,15 @@ libfranka         q: ``q``; qd: ``dq``; tau: ``tau_J``; qc: ``q_d``; as ``q0``, 
 UR RTDE           q: ``actual_q``; qd: ``actual_qd``; tau: ``actual_current_as_torque``;
                   i: ``actual_current`` (needs torque constants); qc: ``target_q``; as
                   ``actual_q_0``, ``actual_q[0]``, ``actual_q0``
-KUKA FRI/Sunrise  q: ``MeasuredJointPosition``, ``measured_joint_position``, and ``A1..A7``
-                  (degrees unless declared); tau: ``MeasuredTorque``, ``measured_torque``,
+KUKA FRI/Sunrise  q: ``MeasuredJointPosition``, ``measured_joint_position``, ``A1..A7``
+                  and a Sunrise trace's ``axisQMsr_<robot>[0]`` (these two in degrees unless
+                  declared); tau: ``MeasuredTorque``, ``measured_torque``,
                   ``MeasuredJointTorque``, ``measured_joint_torque``; qc:
-                  ``CommandedJointPosition``, ``commanded_joint_position``; as ``_1``, ``1``,
-                  ``[1]``, ``_a1``, ``a1``
+                  ``CommandedJointPosition``, ``commanded_joint_position``,
+                  ``axisQCmdT1m_<robot>[0]``, ``axisQCmdIPO_<robot>[0]`` (degrees); as ``_1``,
+                  ``1``, ``[1]``, ``_a1``, ``a1``; time ``ZeitInSec`` plus ``ZeitInNanoSec``
+                  when present. (A trace's torque columns are not in this table: their names
+                  were not confirmed; name them ``MeasuredTorque_1``.. or ``tau1``..)
 ROS joint_states  q/qd/tau: ``position``/``velocity``/``effort``, by joint name as
                   ``/joint_states/position/<joint>`` (any topic), ``position_<joint>``, or by
                   index as ``field.position0`` (rostopic echo -p, the names from the
@@ -67,10 +72,11 @@ FORMS: dict[str, dict[str, tuple[str, ...]]] = {
     "UR RTDE": {"q": ("actual_q",), "qd": ("actual_qd",), "tau": ("actual_current_as_torque",),
                 "i": ("actual_current",), "qc": ("target_q",)},
     "KUKA FRI/Sunrise": {
-        "q": ("measuredjointposition", "measured_joint_position", ""),
+        "q": ("measuredjointposition", "measured_joint_position", "", "axisqmsr_*"),
         "tau": ("measuredtorque", "measured_torque", "measuredjointtorque",
                 "measured_joint_torque"),
-        "qc": ("commandedjointposition", "commanded_joint_position")},
+        "qc": ("commandedjointposition", "commanded_joint_position", "axisqcmdt1m_*",
+               "axisqcmdipo_*")},
 }
 
 #: Time column names in order of preference (regular expressions, whole name).
@@ -84,7 +90,9 @@ _ROS_INDEXED = re.compile(r"field\.(position|velocity|effort)(0|[1-9]\d{0,3})", 
 _ROS_NAME_CELL = re.compile(r"field\.name(0|[1-9]\d{0,3})", re.I)
 
 #: Units assumed for an undeclared column of a base (KUKA's axis columns are degrees).
-DEFAULT_UNITS = {("KUKA FRI/Sunrise", ""): "deg"}
+DEFAULT_UNITS = {("KUKA FRI/Sunrise", ""): "deg", ("KUKA FRI/Sunrise", "axisqmsr_*"): "deg",
+                 ("KUKA FRI/Sunrise", "axisqcmdt1m_*"): "deg",
+                 ("KUKA FRI/Sunrise", "axisqcmdipo_*"): "deg"}
 
 
 def _indexed(base: str, seps: tuple[str, ...]) -> re.Pattern[str]:
@@ -93,7 +101,8 @@ def _indexed(base: str, seps: tuple[str, ...]) -> re.Pattern[str]:
         if not base and "a" not in s:
             continue
         idx = r"(0|[1-9]\d{0,3})"
-        alts.append(re.escape(base) + (r"\[" + idx + r"\]" if s == "[]" else re.escape(s) + idx))
+        head = re.escape(base[:-1]) + r"[^\[\]]+" if base.endswith("*") else re.escape(base)
+        alts.append(head + (r"\[" + idx + r"\]" if s == "[]" else re.escape(s) + idx))
     return re.compile("|".join(alts), re.I)
 
 
@@ -132,6 +141,7 @@ class Mapping:
     name_cells: tuple[int, ...] = ()
     index_base: int | None = 1
     ignored: tuple[str, ...] = ()
+    time_ns: int | None = None
 
     def describe(self) -> str:
         cols = ", ".join(f"{g} <- {self.names[c[0]]}..{self.names[c[-1]]}"
@@ -214,12 +224,15 @@ def _order_indexed(found: dict[str, dict[int, int]], names: list[str], src: str
                          f"({names[qs[min(qs)]]}..); missing column q{missing[0]}")
     out: dict[str, tuple[int, ...]] = {}
     for g, cols in found.items():
+        # each group 0- or 1-based on its own (a trace's axes [0].. beside MeasuredTorque_1..)
+        gb = base if g == "q" or len(cols) != n else (0 if 0 in cols else 1)
+        want = list(range(gb, gb + n))
         extra = sorted(set(cols) - set(want))
         if extra:
             raise InputError(f"{src} line 1: column(s) {', '.join(names[cols[k]] for k in extra)}"
                              f" beyond the {n} joints of the positions")
         if len(cols) != n:
-            raise InputError(f"{src} line 1: {g}{base}..{g}{base + n - 1} must all be given; "
+            raise InputError(f"{src} line 1: {g}{gb}..{g}{gb + n - 1} must all be given; "
                              f"got only {', '.join(names[cols[k]] for k in sorted(cols))}")
         out[g] = tuple(cols[k] for k in want)
     return n, base, out
@@ -296,13 +309,20 @@ def _unused(form: str, found: dict, names: list[str], src: str
         raise InputError(f"{src} line 1: missing column(s) t: no time column (accepted: "
                          "t, time, timestamp, field.header.stamp, __time, ZeitInSec, %time)")
     payload = next((i for i, c in enumerate(names) if c.lower() == "payload"), None)
-    used = _claimed(found) | {t, payload}
+    used = _claimed(found) | {t, payload, _nanoseconds(names, t)}
     ignored = tuple(names[i] for i in range(len(names)) if i not in used)
     if form == "zrp" and ignored:
         raise InputError(f"{src} line 1: unknown column {ignored[0]!r}; valid columns are t, "
                          "q1..qn, qd1..qdn, tau1..taun, i1..in, qc1..qcn, payload (or a "
                          f"controller's form: {accepted_forms()})")
     return t, payload, ignored
+
+
+def _nanoseconds(names: list[str], t: int) -> int | None:
+    """The ``ZeitInNanoSec`` column that completes a Sunrise ``ZeitInSec`` clock, if any."""
+    if names[t].lower() != "zeitinsec":
+        return None
+    return next((i for i, c in enumerate(names) if c.lower() == "zeitinnanosec"), None)
 
 
 def _ros_name_cells(names: list[str], base: int, n: int) -> tuple[int, ...]:
@@ -314,8 +334,8 @@ def _ros_name_cells(names: list[str], base: int, n: int) -> tuple[int, ...]:
 
 def _defaults(form: str, groups: dict[str, tuple[int, ...]], names: list[str]) -> dict[int, str]:
     """Column -> the form's unit for an undeclared position column (KUKA's A1..A7: deg)."""
-    return {c: DEFAULT_UNITS[(form, b)] for c in groups["q"]
-            for b, pat in _PATTERNS.get(form, {}).get("q", [])
+    return {c: DEFAULT_UNITS[(form, b)] for g in ("q", "qc") for c in groups.get(g, ())
+            for b, pat in _PATTERNS.get(form, {}).get(g, [])
             if (form, b) in DEFAULT_UNITS and pat.fullmatch(names[c])}
 
 
@@ -337,4 +357,5 @@ def map_header(header: list[str], src: str) -> Mapping:
     else:
         n, base, groups = _order_indexed(found, names, src)
     return Mapping(form, n, t, groups, dict(enumerate(units)), _defaults(form, groups, names),
-                   dict(enumerate(names)), payload, joint_names, name_cells, base, ignored)
+                   dict(enumerate(names)), payload, joint_names, name_cells, base, ignored,
+                   _nanoseconds(names, t))

@@ -195,7 +195,7 @@ def _read(p: Path, src: str, n_joints: int | None, max_rows: int | None
                              f"the model has {n_joints}")
         factor, bare = _factors(m, src)
         cols = sorted({m.time, *(c for g in m.groups.values() for c in g)}
-                      | ({m.payload} if m.payload is not None else set()))
+                      | {c for c in (m.payload, m.time_ns) if c is not None})
         _, raw = read_table(p, src, cols, max_rows)
     except OSError as exc:
         raise InputError(f"{src}: cannot read ({exc.strerror or exc})") from None
@@ -224,8 +224,10 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
         raise InputError(f"{path}: no such file" if not p.exists() else
                          f"{path}: not a regular file")
     m, at, raw, factor, bare = _read(p, src, n_joints, max_rows)
-    t, said = clock(raw.values[:, at[m.time]], m.units[m.time], _default_time(m),
-                    m.names[m.time], src)
+    t_raw = raw.values[:, at[m.time]]
+    if m.time_ns is not None:  # a Sunrise trace: ZeitInSec + ZeitInNanoSec
+        t_raw = (t_raw - t_raw[0]) + raw.values[:, at[m.time_ns]] * 1e-9
+    t, said = clock(t_raw, m.units[m.time], _default_time(m), m.names[m.time], src)
     kept, segments, rec = condition(t, raw.values, raw.lines, src)
     vals, lines, t = raw.values[kept], raw.lines[kept], t[kept]
     block = {g: vals[:, [at[c] for c in cs]] * np.array([factor[c] for c in cs])

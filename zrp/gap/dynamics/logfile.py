@@ -1,14 +1,14 @@
 """The torque log's text, read defensively: the delimiter the header uses (comma, semicolon,
-tab, or whitespace as UR's RTDE ``record.py`` writes), bounded lines, UTF-8 named by line, blank and
-comment lines skipped, the numbers of the used columns parsed by NumPy's C reader.
+tab, or whitespace as UR's RTDE ``record.py`` writes), bounded lines, UTF-8 named by line,
+blank and comment lines skipped, the numbers of the used columns parsed by NumPy's C reader.
 
 Every problem is an :class:`~zrp.errors.InputError` naming the file and line (and the
 column for a cell): a line longer than :data:`MAX_LINE` characters, bytes that are not
 UTF-8, a header that is not CSV, a row with another number of fields than the header, a
 cell that is not a finite number. Lines that are empty or whitespace only, and lines whose
-first non-blank character is ``#``, are skipped (counted). Cost: one pass over the lines in
-Python (about 1 s a million lines) feeding ``np.loadtxt``; only when that fails are the
-rows read again, one by one, to name the first bad cell.
+first non-blank character is ``#`` or ``%``, are skipped (counted). Cost: one pass over the
+lines in Python (about 1 s a million lines) feeding ``np.loadtxt``; only when that fails are
+the rows read again, one by one, to name the first bad cell.
 """
 
 from __future__ import annotations
@@ -75,7 +75,7 @@ class _Lines:
         next(it, None)
         for k, text in it:
             s = text.strip()
-            if not s or s.startswith("#"):
+            if not s or s.startswith(("#", "%")):
                 self.skipped += 1
                 continue
             fields = _count(text, self.delimiter)
@@ -104,11 +104,14 @@ def _header(src: str, reader: _Lines) -> tuple[list[str], str | None]:
     if first is None or not first[1].strip():
         raise InputError(f"{src}: empty file (or an empty first line); expected a header line "
                          "t, q1..qn, tau1..taun")
-    delimiter = _delimiter(first[1])
+    text = first[1].lstrip()
+    if text.startswith("%") and not text.lower().startswith("%time"):
+        text = text[1:]  # a KUKA Sunrise trace's header starts with "%" (rostopic: "%time")
+    delimiter = _delimiter(text)
     if delimiter is None:
-        return first[1].split(), None
+        return text.split(), None
     try:
-        return next(csv.reader(io.StringIO(first[1]), delimiter=delimiter)), delimiter
+        return next(csv.reader(io.StringIO(text), delimiter=delimiter)), delimiter
     except csv.Error as exc:
         raise InputError(f"{src} line 1: not a CSV header ({exc})") from None
 
