@@ -169,10 +169,7 @@ def _servo(arm: Arm, q0: F64, kp: F64 | None, kv: F64 | None) -> tuple[Servo, st
 def _first_seconds(log: TorqueLog, seconds: float | None) -> TorqueLog:
     if seconds is None:
         return log
-    k = max(2, int(np.searchsorted(log.t - log.t[0], seconds)))
-    return TorqueLog(log.t[:k], log.q[:k], None if log.qd is None else log.qd[:k], log.tau[:k],
-                     None if log.qc is None else log.qc[:k], None, log.lines[:k], log.source,
-                     log.torque_from)
+    return log.first(max(2, int(np.searchsorted(log.t - log.t[0], seconds))))
 
 
 def track_log(arm: Arm, corrected_xml: str, log: TorqueLog, *, kp: F64 | None = None,

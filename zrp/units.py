@@ -150,7 +150,7 @@ def split_unit(column: str, field: str = "column") -> tuple[str, str | None]:
 #: Per kind of time-series quantity, unit name (lower case) -> factor to SI (value * factor).
 #: Joint values are rad (hinges) or m (slides); efforts N m (hinges) or N (slides).
 QUANTITY_UNITS: dict[str, dict[str, float]] = {
-    "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6},
+    "time": {"s": 1.0, "ms": 1e-3, "us": 1e-6, "ns": 1e-9},
     "position": {**ANGLE_UNITS, **LENGTH_UNITS},
     "velocity": {"rad/s": 1.0, "deg/s": math.pi / 180.0, "m/s": 1.0, "mm/s": 1e-3},
     "effort": {"nm": 1.0, "n m": 1.0, "n.m": 1.0, "mnm": 1e-3, "n": 1.0},

@@ -52,7 +52,7 @@ def test_header_units_are_zrp_units(tmp_path):
     """One header syntax with every CSV of ZRP (zrp.units.split_unit): ``q1[deg]`` as
     ``q1 [deg]``; a slide's position in any length unit of zrp.units."""
     p = _write(tmp_path / "v.csv", "t[ms],q1[deg],q2[cm],tau1[Nm],tau2[N]",
-               [[0, 90, 5, 1, 1], [10, 45, 2, 1, 1], [20, 0, 0, 1, 1]])
+               [[0, 90, 5, 1, 1], [10, 45, 2, 2, 1], [20, 0, 0, 1, 2]])
     log = load_torque_log(p)
     assert log.t[1] == pytest.approx(0.01)
     np.testing.assert_allclose(log.q[0], [math.pi / 2, 0.05])
@@ -61,14 +61,14 @@ def test_header_units_are_zrp_units(tmp_path):
 
 
 def test_missing_units_warn(tmp_path):
-    p = _write(tmp_path / "s.csv", "t,q1,tau1", [[0, 0, 0], [1, 0, 0], [2, 0, 0]])
+    p = _write(tmp_path / "s.csv", "t,q1,tau1", [[0, 0, 0], [0.01, 1, 1], [0.02, 0, 0]])
     with pytest.warns(Warning, match="no unit declared for t, q1, tau1"):
         load_torque_log(p)
 
 
 def test_currents_need_torque_constant(tmp_path):
     p = _write(tmp_path / "i.csv", "t [s],q1 [rad],q2 [rad],i1 [A],i2 [mA]",
-               [[0, 0, 0, 1, 1000], [1, 0, 0, 2, 2000]])
+               [[0, 0, 0, 1, 1000], [0.01, 1, 1, 2, 2000]])
     with pytest.raises(InputError, match="torque_constant"):
         load_torque_log(p)
     log = load_torque_log(p, torque_constant=[10.0, 5.0])
@@ -84,13 +84,13 @@ def test_currents_need_torque_constant(tmp_path):
     ("t,q1,qd1", [[0, 0, 0]], "no torques"),
     ("t,q1,tau1,tau1", [[0, 0, 0, 0]], "more than once"),
     ("t,q1 [furlong],tau1", [[0, 0, 0]], r"q1 has unit \[furlong\]"),
+    ("t,q1,tau1", [[0, 0, 0]], "1 data row"),
     ("t,q1,tau1,q3", [[0, 0, 0, 0]], "missing column"),
     ("t,q1,tau1", [[0, 0, 0], [1, "x", 0]], "line 3: column q1 is 'x'"),
     ("t,q1,tau1", [[0, 0, 0], [1, 0, "nan"]], "line 3: column tau1 is 'nan'"),
     ("t,q1,tau1", [[0, 0, 0], [1, 0]], "line 3: 2 fields"),
     ("t,q1,tau1", [[0, 0, 0], [1, 0, 0], [0.5, 0, 0]], "line 4: column t"),
-    ("t,q1,tau1", [[0, 0, 0], [1, 0, 0], [3, 0, 0], [4, 0, 0]], "line 4: time step 2"),
-    ("t,q1,tau1,payload", [[0, 0, 0, 1], [1, 0, 0, -1]], "line 3: column payload"),
+    ("t,q1,tau1,payload", [[0, 0, 0, 1], [0.01, 1, 1, -1]], "line 3: column payload"),
 ])
 def test_named_errors(tmp_path, header, rows, match):
     p = _write(tmp_path / "bad.csv", header, rows)
@@ -101,7 +101,7 @@ def test_named_errors(tmp_path, header, rows, match):
 
 
 def test_comment_lines_keep_line_numbers(tmp_path):
-    p = _write(tmp_path / "c.csv", "t,q1,tau1", [["# note"], [0, 0, 0], [1, 0, 0], [2, 0, 0]])
+    p = _write(tmp_path / "c.csv", "t,q1,tau1", [["# note"], [0, 0, 0], [1, 1, 1], [2, 0, 0]])
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         log = load_torque_log(p)

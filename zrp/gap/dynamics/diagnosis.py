@@ -30,7 +30,6 @@ import itertools
 from dataclasses import dataclass, replace
 
 import numpy as np
-from scipy.signal import savgol_coeffs, savgol_filter
 
 from zrp.arrays import F64
 from zrp.blas import blas_threads
@@ -39,6 +38,7 @@ from zrp.gap.dynamics.arm import DynamicArm as Arm
 from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, payload_columns
 from zrp.gap.dynamics.fit import cross_validate, design, solve
+from zrp.gap.dynamics.localpoly import local_fit
 from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
 from zrp.gap.dynamics.resulting import BodyChange, ChangedArm, link_changes, resulting_bodies
@@ -70,13 +70,21 @@ class DynamicsOptions:
 
 
 def torque_noise(log: TorqueLog, window_s: float, polyorder: int = 3) -> F64:
-    """sigma_k of each joint's raw torque (eq. N1)."""
+    """sigma_k of each joint's raw torque (eq. N1), segment by segment on the real time axis
+    (never across a gap; the segments' ends left out when long enough)."""
     w = max(round(window_s / log.dt) | 1, polyorder + 2 | 1)
-    h0 = float(savgol_coeffs(w, polyorder)[w // 2])
-    smooth = savgol_filter(log.tau, w, polyorder, axis=0, mode="interp")
-    r = (log.tau - smooth)[w:-w] if log.n_samples > 3 * w else log.tau - smooth
-    sigma = np.sqrt(np.mean(r * r, axis=0) / (1.0 - h0))
-    return np.maximum(sigma, 1e-9)
+    parts = []
+    for a, b in log.segment_ranges:
+        ww = min(w, (b - a) - (1 - (b - a) % 2))
+        if ww <= polyorder:
+            continue
+        (smooth,), h0 = local_fit(log.t[a:b], log.tau[a:b], ww, polyorder)
+        r = (log.tau[a:b] - smooth) / np.sqrt(1.0 - h0)[:, None]
+        parts.append(r[ww:-ww] if b - a > 3 * ww else r)
+    if not parts:
+        raise InputError(f"{log.source}: no segment long enough to estimate the torque noise")
+    r = np.concatenate(parts)
+    return np.maximum(np.sqrt(np.mean(r * r, axis=0)), 1e-9)
 
 
 def decimated_states(log: TorqueLog, opt: DynamicsOptions) -> tuple[States, int]:
@@ -90,7 +98,7 @@ def model_torques(arm: Arm, log: TorqueLog, s: States, stride: int) -> F64:
     model)."""
     tau0 = arm.inverse_dynamics(s.q, s.qd, s.qdd)
     if log.payload is not None and np.any(log.payload > 0.0):
-        known = log.payload[::stride][:, None]
+        known = log.payload[s.index][:, None]
         tau0 = tau0 + payload_columns(arm, s.q, s.qd, s.qdd)[..., 0] * known
     return tau0
 
@@ -98,7 +106,7 @@ def model_torques(arm: Arm, log: TorqueLog, s: States, stride: int) -> F64:
 def _decimated(log: TorqueLog, opt: DynamicsOptions) -> tuple[States, int]:
     states = derive_states(log, opt.window_s)
     stride = max(1, round(1.0 / (opt.fit_rate_hz * log.dt)))
-    return states.take(np.arange(0, log.n_samples, stride)), stride
+    return states.every(stride), stride
 
 
 def _params(e: Effect, theta: F64, cov: F64, at_bound: np.ndarray) -> dict[str, Param]:
@@ -329,7 +337,9 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     masks = regime_masks(s.qd, arm.gravity_torques(s.q), guard)
     notes = [*getattr(arm, "notes", ()),
              f"accelerations by Savitzky-Golay, window {s.window_s:.3g} s; fit at "
-             f"{1.0 / (stride * log.dt):.4g} Hz", *gate_notes]
+             f"{1.0 / (stride * log.dt):.4g} Hz", *log.conditioning.describe(),
+             *(f"left out (shorter than the filter window): {d}" for d in s.dropped),
+             *gate_notes]
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
             "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
     inert, pred = fitted.inert, fitted.pred
