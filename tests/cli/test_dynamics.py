@@ -47,8 +47,8 @@ def test_diagnose_dynamics(puma_log, tmp_path, capsys):
 
 def test_diagnose_dynamics_named_errors(puma_log, tmp_path, capsys):
     bad = tmp_path / "bad.csv"
-    bad.write_text("t,q1,q2,tau1,tau2\n" + "".join(f"{0.001 * i},{0.01 * i},0,0,0\n"
-                                                    for i in range(400)))
+    bad.write_text("t,q1,q2,tau1,tau2\n" + "".join(
+        f"{0.001 * i},{0.01 * i},{0.02 * i},{np.sin(i)},{np.cos(i)}\n" for i in range(400)))
     code = main(["diagnose-dynamics", "--model", "puma", "--data", str(bad), "--out",
                  str(tmp_path / "o")])
     err = capsys.readouterr().err

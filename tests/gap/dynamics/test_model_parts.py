@@ -124,3 +124,27 @@ def test_a_body_change_that_leaves_a_link_non_physical_is_refused():
     assert not physical_body(phi + np.array([0, 0, 0, 1.0, 0, 0, 0, 0, 0, 0]))  # centre 1.1 m
     assert physical_body(np.zeros(10))  # nothing there
     assert not physical_body(np.full(10, np.nan))
+
+
+def test_a_joint_whose_torque_is_not_logged_is_left_out_and_named(panda, hand_logs, tmp_path):
+    """A controller that logs a constant zero for one joint: that joint is excluded from the
+    fit and from the overall figures, and the report says so; the rest is diagnosed as
+    usual."""
+    from zrp.gap.dynamics.data import TorqueLog, load_torque_log, write_torque_log
+    from zrp.gap.dynamics.report import diagnosis_json, report_markdown
+
+    _, (log, _), _ = hand_logs
+    tau = log.tau.copy()
+    tau[:, 6] = 0.0
+    path = write_torque_log(TorqueLog(log.t, log.q, log.qd, tau, log.qc, None, log.lines,
+                                      "dead joint 7", "tau"), tmp_path / "dead.csv")
+    dead = load_torque_log(path)
+    assert list(dead.unmeasured) == [6]
+    d = diagnose_dynamics(panda, dead, DynamicsOptions(inertial=False))
+    assert 6 in d.unmeasured and not d.measured[6]
+    assert (d.effects[0].name, d.effects[0].detail) == ("absent_part", "panda_hand")
+    assert not [e for e in d.effects if e.joint == 6]
+    assert "joint 7 is not measured" in report_markdown(d)
+    doc = diagnosis_json(d)
+    assert doc["unmeasured"] == {"7": d.unmeasured[6]}
+    assert np.isfinite(doc["overall_nm"]["after_withheld"])

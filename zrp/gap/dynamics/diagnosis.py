@@ -319,41 +319,83 @@ def _unphysical_links(arm: Arm, inert: InertialFit) -> list[str]:
     return out
 
 
-def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> DynamicDiagnosis:
-    opt = options or DynamicsOptions()
-    _check_inputs(arm, log)
-    sigma = torque_noise(log, opt.window_s)
+def _measured_only(e: Effect, measured: np.ndarray) -> Effect:
+    """``e`` with no torque on the joints whose torque is not data."""
+    cols = e.columns.copy()
+    cols[:, ~measured, :] = 0.0
+    full = None if e.full is None else e.full * measured[None, :, None]
+    return replace(e, columns=cols, full=full)
+
+
+@dataclass(frozen=True)
+class _Setup:
+    """Steps 1-3 and the candidates: the states, the residual torques (filtered and raw),
+    the noise estimate and the weights of the fit (1 on a joint that is not data)."""
+
+    s: States
+    stride: int
+    b: F64
+    b_raw: F64
+    noise: F64
+    sigma: F64
+    effects: list[Effect]
+
+
+def _setup(arm: Arm, log: TorqueLog, opt: DynamicsOptions) -> _Setup:
+    # a joint whose torque is not data (constant, zero) is left out: no residual, no column
+    if not np.any(log.measured):
+        raise InputError(f"{log.source}: no joint's torque is data ("
+                         + "; ".join(f"joint {k + 1}: {w}" for k, w in log.unmeasured.items())
+                         + ")")
+    noise = torque_noise(log, opt.window_s)
     s, stride = _decimated(log, opt)
     tau0 = model_torques(arm, log, s, stride)
     b, b_raw = s.tau - tau0, s.tau_raw - tau0
     effects = candidate_effects(arm, s.q, s.qd, s.qdd, tau0, inertial=opt.inertial)
+    m = log.measured
+    if not np.all(m):
+        b[:, ~m] = 0.0
+        b_raw[:, ~m] = 0.0
+        effects = [_measured_only(e, m) for e in effects if e.joint is None or m[e.joint]]
     if opt.effects is not None:
         effects = [e for e in effects if e.name in _known_effects(opt.effects)]
+    return _Setup(s, stride, b, b_raw, noise, np.where(m, noise, 1.0), effects)
+
+
+def _notes(arm: Arm, log: TorqueLog, su: _Setup, fitted: _Fitted, gate: list[str]
+           ) -> list[str]:
+    notes = [*getattr(arm, "notes", ()),
+             f"accelerations by Savitzky-Golay, window {su.s.window_s:.3g} s; fit at "
+             f"{1.0 / (su.stride * log.dt):.4g} Hz", *log.conditioning.describe(),
+             *(f"left out (shorter than the filter window): {d}" for d in su.s.dropped),
+             *gate, *_common_gain(fitted.found)]
+    if fitted.inert is not None:
+        notes += [fitted.inert.describe(), *_unphysical_links(arm, fitted.inert)]
+    return notes
+
+
+def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> DynamicDiagnosis:
+    opt = options or DynamicsOptions()
+    _check_inputs(arm, log)
+    su = _setup(arm, log, opt)
+    s, b, b_raw, sigma = su.s, su.b, su.b_raw, su.sigma
     guard = max(1, round(0.5 * opt.window_s * opt.fit_rate_hz))
-    chosen, steps, pred = forward_select(effects, b, b_raw, sigma, folds=opt.folds, guard=guard,
-                                         min_rel=opt.min_rel, min_abs=opt.min_abs,
+    chosen, steps, pred = forward_select(su.effects, b, b_raw, sigma, folds=opt.folds,
+                                         guard=guard, min_rel=opt.min_rel, min_abs=opt.min_abs,
                                          max_effects=opt.max_effects or 3 * arm.n + 4)
     chosen, fitted, gate_notes = _physical_gate(arm, chosen, steps, b, sigma, opt, guard, pred)
     masks = regime_masks(s.qd, arm.gravity_torques(s.q), guard)
-    notes = [*getattr(arm, "notes", ()),
-             f"accelerations by Savitzky-Golay, window {s.window_s:.3g} s; fit at "
-             f"{1.0 / (stride * log.dt):.4g} Hz", *log.conditioning.describe(),
-             *(f"left out (shorter than the filter window): {d}" for d in s.dropped),
-             *gate_notes]
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
             "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
     inert, pred = fitted.inert, fitted.pred
-    notes += _common_gain(fitted.found)
-    if inert is not None:
-        notes += [inert.describe(), *_unphysical_links(arm, inert)]
     bodies = {b: replace(c, torque_rms=np.sqrt(np.mean(
         (arm.regressor(s.q, s.qd, s.qdd, [b])[0] @ (c.phi - c.phi0)) ** 2, axis=0)))
         for b, c in fitted.bodies.items()}
     return DynamicDiagnosis(
-        arm.name, arm.joint_names, sigma, np.sqrt(np.mean(b_raw**2, 0)),
+        arm.name, arm.joint_names, su.noise, np.sqrt(np.mean(b_raw**2, 0)),
         np.sqrt(np.mean((b_raw - pred) ** 2, 0)), steps, fitted.found,
-        ties + _cannot_tell([e for e in effects if e.name in JOINT_EFFECTS], sigma,
+        ties + _cannot_tell([e for e in su.effects if e.name in JOINT_EFFECTS], sigma,
                             opt.collinear),
         {"before": regime_rms(b_raw, masks), "after": regime_rms(b_raw - pred, masks)},
-        inert, {} if inert is None else inert.phi, notes,
-        Samples(s.t, s.q, s.qd, b_raw, b_raw - pred), bodies)
+        inert, {} if inert is None else inert.phi, _notes(arm, log, su, fitted, gate_notes),
+        Samples(s.t, s.q, s.qd, b_raw, b_raw - pred), bodies, dict(log.unmeasured))

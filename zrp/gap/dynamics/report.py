@@ -95,10 +95,14 @@ def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
              "|---|---|---|---|---|---|"]
     lines += [md_row(k + 1, d.joints[k], f"{d.noise_nm[k]:.3g}", f"{d.rms_before[k]:.3g}",
                      f"{d.rms_after[k]:.3g}", f"{d.rms_after[k] / d.noise_nm[k]:.2f}")
+              if d.measured[k] else md_row(k + 1, d.joints[k], "-", "-", "-", "not measured")
               for k in range(n)]
-    lines.append(f"| all | | {overall_rms(d.noise_nm):.3g} | {overall_rms(d.rms_before):.3g} | "
-                 f"{overall_rms(d.rms_after):.3g} | "
-                 f"{overall_rms(d.rms_after) / overall_rms(d.noise_nm):.2f} |")
+    m = d.measured
+    lines.append(f"| all measured | | {overall_rms(d.noise_nm, m):.3g} | "
+                 f"{overall_rms(d.rms_before, m):.3g} | {overall_rms(d.rms_after, m):.3g} | "
+                 f"{overall_rms(d.rms_after, m) / overall_rms(d.noise_nm, m):.2f} |")
+    lines += [md_line("- joint {} is not measured ({}): left out of the fit and of the overall "
+                      "figures", k + 1, why) for k, why in sorted(d.unmeasured.items())]
     if validation is not None:
         lines += ["", "## Validation on another log (N m RMS)", "",
                   *_validation(validation, d.joints)]
@@ -179,8 +183,10 @@ def diagnosis_json(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
                    validation: Validation | None = None) -> dict:
     out = {"verdict": headline(d, validation), "arm": d.arm, "joints": d.joints,
            "noise_nm": d.noise_nm, "overall_nm": {
-               "noise": overall_rms(d.noise_nm), "before": overall_rms(d.rms_before),
-               "after_withheld": overall_rms(d.rms_after)},
+               "noise": overall_rms(d.noise_nm, d.measured),
+               "before": overall_rms(d.rms_before, d.measured),
+               "after_withheld": overall_rms(d.rms_after, d.measured)},
+           "unmeasured": {str(k + 1): why for k, why in sorted(d.unmeasured.items())},
            "rms_before_nm": d.rms_before, "rms_after_withheld_nm": d.rms_after,
            "validation": _validation_json(validation), "bodies": _bodies_json(d),
            "steps": [asdict(s) for s in d.steps],

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from zrp.arrays import F64
 from zrp.gap.dynamics.physical import InertialFit
 from zrp.gap.dynamics.resulting import BodyChange
@@ -78,6 +80,8 @@ class DynamicDiagnosis:
         bodies: every body the effects of the masses change (payload, absent part, link
             mass, link inertias), with its resulting phi, all physical
             (:mod:`zrp.gap.dynamics.resulting`).
+        unmeasured: joints whose torque is not data (constant, zero), excluded from the fit
+            and from every overall figure, with why.
     """
 
     arm: str
@@ -94,6 +98,12 @@ class DynamicDiagnosis:
     notes: list[str] = field(default_factory=list)
     samples: Samples | None = None
     bodies: dict[int, BodyChange] = field(default_factory=dict)
+    unmeasured: dict[int, str] = field(default_factory=dict)
+
+    @property
+    def measured(self) -> np.ndarray:
+        """Per joint, whether its torque is data (the others were excluded from the fit)."""
+        return np.array([k not in self.unmeasured for k in range(len(self.joints))])
 
     def effect(self, name: str, joint: int | None = None) -> FoundEffect | None:
         for e in self.effects:

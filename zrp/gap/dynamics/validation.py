@@ -48,18 +48,23 @@ class Validation:
     rms_before: F64
     rms_after: F64
     samples: int
+    measured: np.ndarray | None = None  # per joint: its torque is data (None: all)
+
+    def _overall(self, x: F64) -> float:
+        m = np.ones(x.size, dtype=bool) if self.measured is None else self.measured
+        return float(np.sqrt(np.mean(x[m] ** 2)))
 
     @property
     def overall_before(self) -> float:
-        return float(np.sqrt(np.mean(self.rms_before**2)))
+        return self._overall(self.rms_before)
 
     @property
     def overall_after(self) -> float:
-        return float(np.sqrt(np.mean(self.rms_after**2)))
+        return self._overall(self.rms_after)
 
     @property
     def overall_noise(self) -> float:
-        return float(np.sqrt(np.mean(self.noise_nm**2)))
+        return self._overall(self.noise_nm)
 
 
 def _prediction(arm: Arm, diag: DynamicDiagnosis, q: F64, qd: F64, qdd: F64, tau0: F64
@@ -100,4 +105,5 @@ def validate(arm: Arm, diag: DynamicDiagnosis, log: TorqueLog,
     pred = _prediction(arm, diag, s.q, s.qd, s.qdd, tau0)
     b_raw = s.tau_raw - tau0
     return Validation(log.source, sigma, np.sqrt(np.mean(b_raw**2, axis=0)),
-                      np.sqrt(np.mean((b_raw - pred) ** 2, axis=0)), int(b_raw.shape[0]))
+                      np.sqrt(np.mean((b_raw - pred) ** 2, axis=0)), int(b_raw.shape[0]),
+                      log.measured & diag.measured)

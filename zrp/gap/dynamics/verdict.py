@@ -27,9 +27,11 @@ _JOINT_WORDS = {"coulomb": "Coulomb friction", "viscous": "viscous friction",
                 "offset": "a torque-sensor offset", "gain": "a torque-sensor gain"}
 
 
-def overall_rms(per_joint: F64) -> float:
-    """The RMS over all joints of per-joint RMS values (equal samples per joint)."""
-    return float(np.sqrt(np.mean(np.asarray(per_joint, dtype=float) ** 2)))
+def overall_rms(per_joint: F64, measured: np.ndarray | None = None) -> float:
+    """The RMS over the (measured) joints of per-joint RMS values (equal samples per
+    joint)."""
+    x = np.asarray(per_joint, dtype=float)
+    return float(np.sqrt(np.mean((x if measured is None else x[measured]) ** 2)))
 
 
 def _joints(ks: Sequence[int]) -> str:
@@ -135,16 +137,17 @@ def headline(d: DynamicDiagnosis, validation: Validation | None = None) -> str:
 
 
 def _headline(d: DynamicDiagnosis) -> str:
-    before, after = overall_rms(d.rms_before), overall_rms(d.rms_after)
-    noise = overall_rms(d.noise_nm)
+    m = d.measured
+    before, after = overall_rms(d.rms_before, m), overall_rms(d.rms_after, m)
+    noise = overall_rms(d.noise_nm, m)
     removed = 1.0 - after / before if before > 0 else 0.0
     head = (f"Withheld torque error {before:.3g} -> {after:.3g} N m RMS over all joints "
             f"({removed:.0%} removed; noise floor {noise:.3g} N m). Largest misses: "
-            f"{_misses(d.rms_before, d.rms_after, d.noise_nm)}.")
+            f"{_misses(np.where(m, d.rms_before, 0.0), d.rms_after, d.noise_nm)}.")
     if not d.effects:
         return head.split(" Largest")[0] + (" The model's torques match the log down to the "
                                             "noise; no effect is needed.")
-    ratio = d.rms_after / d.noise_nm
+    ratio = np.where(m, d.rms_after / d.noise_nm, 0.0)
     left = [int(k) for k in np.argsort(-ratio) if ratio[k] > REMAINS]
     remains = ("What remains is at the noise floor." if not left else
                "What remains: " + ", ".join(f"joint {k + 1} at {ratio[k]:.1f}x its noise "
