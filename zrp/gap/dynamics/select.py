@@ -64,8 +64,15 @@ def _tag(e: Effect) -> str:
     return e.key if e.name in ("absent_part", "link_mass") else e.key.split("@")[0]
 
 
-def _rank(e: Effect, physical_near: bool) -> int:
-    return int(e.name == "gain" and physical_near)
+def _rank(e: Effect, near: set[str]) -> int:
+    """Among near-equal candidates, what gives way: a torque gain to any effect of the
+    masses, a link's mass to a payload or a part at the tool (a gripper is the likelier
+    story than a wrist link's mass where the log cannot tell them apart)."""
+    if e.name == "gain":
+        return int(bool(near & set(PHYSICAL)))
+    if e.name == "link_mass":
+        return int(bool(near & {"payload", "absent_part"}))
+    return 0
 
 
 def _parsimonious(scored: list[tuple[float, Effect, F64]], chi2: float, occam: float
@@ -82,8 +89,8 @@ def _parsimonious(scored: list[tuple[float, Effect, F64]], chi2: float, occam: f
         lumped = [s for s in scored if s[1].name in ("payload", "absent_part", "link_mass")
                   and chi2 - s[0] >= LUMPED * (chi2 - top)]
         near += lumped
-    physical = any(s[1].name in PHYSICAL for s in near)
-    best = min(near, key=lambda s: (_rank(s[1], physical), s[1].columns.shape[-1], s[0]))
+    names = {s[1].name for s in near}
+    best = min(near, key=lambda s: (_rank(s[1], names), s[1].columns.shape[-1], s[0]))
     others = {_tag(s[1]) for s in near if _family(s[1]) != _family(best[1])}
     return best, tuple(sorted(others))
 
