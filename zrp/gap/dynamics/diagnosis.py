@@ -49,6 +49,10 @@ from zrp.gap.dynamics.states import States, derive_states
 __all__ = ["EFFECT_NAMES", "DynamicDiagnosis", "DynamicsOptions", "FoundEffect", "decimated_states",
            "diagnose_dynamics", "model_torques", "torque_noise"]
 
+#: An effect whose torques stay under this share of the noise on every joint in the final fit
+#: is left out (another effect took them).
+IDLE = 0.05
+
 #: The effects that change a body of the model (their resulting bodies must be physical).
 BODY_CHANGES = ("payload", "absent_part", "link_mass")
 
@@ -286,6 +290,14 @@ def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, si
         notes.append(f"{key} left out: with it link {body.name} would not be physical (mass "
                      f"{body.phi[0]:.3g} kg, or a centre or inertia no body can have)")
         chosen = [e for e in chosen if e.key != key]
+        fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, None)
+    # an effect the final fit leaves at nothing (its torques taken by others) is no finding
+    idle = [f.key for f in fitted.found if f.rms_nm is not None
+            and np.all(f.rms_nm < IDLE * np.where(np.isfinite(sigma), sigma, np.inf))]
+    if idle:
+        notes.append(f"{', '.join(idle)} left out: the final fit leaves it at nothing (under "
+                     f"{IDLE:g} of the noise on every joint; other effects took its torques)")
+        chosen = [e for e in chosen if e.key not in idle]
         fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, None)
     return chosen, fitted, notes
 

@@ -151,6 +151,6 @@ def _headline(d: DynamicDiagnosis) -> str:
     left = [int(k) for k in np.argsort(-ratio) if ratio[k] > REMAINS]
     remains = ("What remains is at the noise floor." if not left else
                "What remains: " + ", ".join(f"joint {k + 1} at {ratio[k]:.1f}x its noise "
-                                            f"({d.rms_after[k]:.3g} N m)" for k in left[:3])
+                                            f"({d.rms_after[k]:.3g} N m)" for k in left[:2])
                + ".")
     return f"{head} Found: {_findings(d)}. {remains}"
