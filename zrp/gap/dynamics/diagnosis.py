@@ -224,9 +224,11 @@ def _fit_chosen(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma
                          drop.get(e.key, 0.0), _contribution(e, values[sl]))
              for e, sl in zip(chosen, d.slices, strict=True)]
     # findings in order of the torque they explain (N m over all joints): a hand of 0.76 kg
-    # on the big joints before a wrist's friction that is large only in its own noise units
+    # on the big joints before a wrist's friction that is large only in its own noise units;
+    # the model's physics before the sensors' offsets and gains
     found = sorted((_with_part_mass(arm, f) for f in found),
-                   key=lambda f: -float(np.sqrt(np.mean(f.rms_nm**2))))
+                   key=lambda f: (f.name in ("offset", "gain"),
+                                  -float(np.sqrt(np.mean(f.rms_nm**2)))))
     if named is not None and inert is not None:
         return _Fitted(found, inert, pred, link_changes(arm, inert.phi, named))
     bodies = resulting_bodies(

@@ -68,8 +68,9 @@ class DynamicDiagnosis:
         rms_after: RMS of measured minus corrected torques, each time segment predicted by
             the fit on the others (withheld).
         steps: the forward selection (nominal first) with the withheld chi2 after each.
-        effects: the chosen effects, in order of the torque they explain (RMS over all
-            joints, N m; ``steps`` has the order of choice).
+        effects: the chosen effects, the model's physics before the sensors' offsets and
+            gains, each in order of the torque it explains (RMS over all joints, N m;
+            ``steps`` has the order of choice).
         cannot_tell: what this log cannot separate, in words.
         regimes: {"before"|"after": {regime: [rms or None per joint]}}.
         inertial_fit: the physically consistent link inertia fit (None: no inertial effect
