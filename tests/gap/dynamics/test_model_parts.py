@@ -41,9 +41,10 @@ def test_absent_hand_named_first_with_its_mass_and_no_gain(panda, hand_logs, ine
     assert not [e for e in d.effects if e.name == "gain"]
     tool = d.bodies[panda.tool_body]
     assert tool.physical and tool.mass_change == pytest.approx(-HAND_KG, rel=0.1)
-    # friction named on the distal joints that have it, not on joint 2 (none there)
-    coulomb = {e.joint for e in d.effects if e.name == "coulomb"}
-    assert {4, 6} <= coulomb and 1 not in coulomb
+    # friction named on the distal joints that have it (Coulomb, or its shape as a Stribeck
+    # bump with viscous friction), not on joint 2 (none there)
+    friction = {e.joint for e in d.effects if e.name in ("coulomb", "stribeck", "viscous")}
+    assert {4, 5, 6} <= friction and 1 not in friction
     # the overall withheld error falls to near the noise
     assert np.sqrt(np.mean(d.rms_after**2)) < 1.3 * np.sqrt(np.mean(sigma**2))
 
