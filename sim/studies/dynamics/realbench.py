@@ -90,6 +90,11 @@ def read_log(path: str | Path, n: int) -> tuple[TorqueLog, str]:
     try:
         return load_torque_log(path, n_joints=n), "as is"
     except InputError as exc:
+        if "torque_constant" in str(exc):
+            # motor currents: the user passes the controller's stated constants
+            # (--torque-constant), as the log's comment line gives them
+            log = load_torque_log(path, n_joints=n, torque_constant=_torque_constant(n))
+            return log, "as is, with the controller's torque constants (--torque-constant)"
         log, done = prepare_by_hand(path)
         return log, f"refused ({str(exc)[:90]}); by hand: {'; '.join(done)}"
 
