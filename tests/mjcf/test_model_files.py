@@ -89,7 +89,9 @@ def test_a_urdf_fifo_mesh_is_refused(tmp_path):
 ])
 def test_commands_refuse_a_fifo_mesh_in_bounded_time(tmp_path, argv):
     p = _models(tmp_path)["mesh"]
-    (tmp_path / "log.csv").write_text("t [s],q1 [rad],tau1 [N m]\n0,0,0\n0.01,0,0\n")
+    # a log that reads (a moving joint, a torque that is data): the model is what is refused
+    (tmp_path / "log.csv").write_text("t [s],q1 [rad],tau1 [N m]\n" + "".join(
+        f"{0.001 * i:.3f},{0.01 * i:.4f},{(i * 37 % 11) * 0.1:.1f}\n" for i in range(300)))
     argv = [str(p) if a == "M" else a for a in argv]
     t0 = time.monotonic()
     res = subprocess.run([sys.executable, "-m", "zrp", *argv], cwd=tmp_path,

@@ -293,15 +293,19 @@ def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, si
                      f"{body.phi[0]:.3g} kg, or a centre or inertia no body can have)")
         chosen = [e for e in chosen if e.key != key]
         fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, None)
-    # an effect the final fit leaves at nothing (its torques taken by others) is no finding
-    idle = [f.key for f in fitted.found if f.rms_nm is not None
-            and np.all(f.rms_nm < IDLE * np.where(np.isfinite(sigma), sigma, np.inf))]
+    idle = _idle(fitted.found, sigma)
     if idle:
         notes.append(f"{', '.join(idle)} left out: the final fit leaves it at nothing (under "
                      f"{IDLE:g} of the noise on every joint; other effects took its torques)")
         chosen = [e for e in chosen if e.key not in idle]
         fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, None)
     return chosen, fitted, notes
+
+
+def _idle(found: list[FoundEffect], sigma: F64) -> list[str]:
+    """The effects the final fit leaves at nothing (their torques taken by others): no
+    findings."""
+    return [f.key for f in found if f.rms_nm is not None and np.all(f.rms_nm < IDLE * sigma)]
 
 
 def _common_gain(found: list[FoundEffect]) -> list[str]:
