@@ -3,9 +3,16 @@ one line naming the option or file, no traceback) or in correct behaviour."""
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
+import numpy as np
+import pytest
+
+import zrp
 from zrp.cli import main
+from zrp.gap import Injection, synthesize
+from zrp.kinematics import uniform_joint_values
 
 
 def _refused(capsys, argv: list[str], match: str) -> str:
@@ -26,3 +33,24 @@ def test_plan_with_fewer_candidates_than_poses_names_candidates(tmp_path: Path, 
     _refused(capsys, ["plan", "--model", "puma", "--poses", "10", "--effects", "joint_offset",
                       "--out", str(out), "--candidates", "1"], "--candidates: 1 candidate")
     assert not out.exists()
+
+
+@pytest.mark.parametrize("damage", ["truncated", "wrong type", "not an object"])
+def test_fleet_resume_over_a_damaged_diagnosis_names_the_file(tmp_path: Path, capsys, damage):
+    model = zrp.load_model("puma")
+    (tmp_path / "fleet").mkdir()
+    for i in range(2):
+        rng = np.random.default_rng(i)
+        synthesize(model, uniform_joint_values(model, 40, rng), Injection(joint_offset={2: 2e-3}),
+                   rng=rng, noise_sigma=0.02).to_csv(tmp_path / f"fleet/r{i}.csv")
+    argv = ["diagnose", "--model", "puma", "--data", str(tmp_path / "fleet/*.csv"),
+            "--no-plots", "--no-progress", "--tolerance", "0.5", "--out", str(tmp_path / "out")]
+    assert main(argv) == 0
+    capsys.readouterr()
+    path = tmp_path / "out/robots/r0/diagnosis.json"
+    text = path.read_text(encoding="utf-8")
+    doc = json.loads(text)
+    doc["nominal"]["rms"] = "x"
+    path.write_text({"truncated": text[:200], "wrong type": json.dumps(doc),
+                     "not an object": "[1]"}[damage], encoding="utf-8")
+    _refused(capsys, [*argv, "--resume"], f"--resume: {path}: not a diagnosis")
