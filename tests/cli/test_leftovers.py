@@ -54,3 +54,10 @@ def test_fleet_resume_over_a_damaged_diagnosis_names_the_file(tmp_path: Path, ca
     path.write_text({"truncated": text[:200], "wrong type": json.dumps(doc),
                      "not an object": "[1]"}[damage], encoding="utf-8")
     _refused(capsys, [*argv, "--resume"], f"--resume: {path}: not a diagnosis")
+
+
+@pytest.mark.parametrize("address", ["bogus", "tcp://host:notaport"])
+def test_tolerance_with_a_malformed_scheduler_address_names_scheduler(capsys, address):
+    pytest.importorskip("distributed")
+    _refused(capsys, ["tolerance", "--model", "puma", "--scheduler", address],
+             f"--scheduler: cannot reach a Dask scheduler at {address!r}")
