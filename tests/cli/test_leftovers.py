@@ -61,3 +61,10 @@ def test_tolerance_with_a_malformed_scheduler_address_names_scheduler(capsys, ad
     pytest.importorskip("distributed")
     _refused(capsys, ["tolerance", "--model", "puma", "--scheduler", address],
              f"--scheduler: cannot reach a Dask scheduler at {address!r}")
+
+
+def test_ik_target_er_without_target_is_refused(tmp_path: Path, capsys):
+    out = tmp_path / "joints.csv"
+    _refused(capsys, ["ik", "--target-er", "1", "0", "0", "0", "--out", str(out)],
+             "--target-er: only with --target")
+    assert not out.exists()
