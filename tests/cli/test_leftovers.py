@@ -13,6 +13,7 @@ import zrp
 from zrp.cli import main
 from zrp.gap import Injection, synthesize
 from zrp.kinematics import uniform_joint_values
+from zrp.units import LENGTH_UNITS
 
 
 def _refused(capsys, argv: list[str], match: str) -> str:
@@ -67,4 +68,21 @@ def test_ik_target_er_without_target_is_refused(tmp_path: Path, capsys):
     out = tmp_path / "joints.csv"
     _refused(capsys, ["ik", "--target-er", "1", "0", "0", "0", "--out", str(out)],
              "--target-er: only with --target")
+    assert not out.exists()
+
+
+@pytest.mark.parametrize("argv", [["mjcf", "--model", "puma"], ["mjcf", "--from", "arm.xml"],
+                                  ["import", "arm.xml"]])
+def test_an_unknown_length_unit_is_refused_listing_the_known_ones(tmp_path: Path, capsys, argv):
+    out = tmp_path / "out.xml"
+    err = _refused(capsys, [*argv, "--unit", "furlong", "--out", str(out)],
+                   "argument --unit: unknown length unit 'furlong'")
+    assert all(repr(u) in err for u in LENGTH_UNITS)
+    assert not out.exists()
+
+
+def test_mjcf_unit_without_from_is_refused(tmp_path: Path, capsys):
+    out = tmp_path / "puma.xml"
+    _refused(capsys, ["mjcf", "--model", "puma", "--unit", "m", "--out", str(out)],
+             "--unit: only with --from")
     assert not out.exists()
