@@ -13,7 +13,7 @@ import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from zrp.errors import InputError
+from zrp.errors import InputError, UnitError
 from zrp.limits import MAX_LENGTH, MAX_SEED
 
 if TYPE_CHECKING:
@@ -70,7 +70,6 @@ def whole(lo: int, hi: int | None = None) -> Callable[[str], int]:
 def LENGTH_UNIT(text: str) -> str:
     """A length unit of :data:`zrp.units.LENGTH_UNITS` or an alias, canonical ("metres" -> "m");
     an unknown one is refused listing the known units."""
-    from zrp.errors import UnitError
     from zrp.units import canonical_length_unit  # on use: keeps --help quick
 
     try:
