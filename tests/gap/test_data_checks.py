@@ -105,6 +105,21 @@ def test_measurements_from_arrays_bounded(meas):
         zrp.gap.Measurements.from_arrays(meas.pose, meas.q, xyz, point=meas.point)
 
 
+def test_degrees_passed_as_radians_are_refused_where_the_model_meets_them(meas):
+    """Issue 35, finding 11: from_arrays took degrees silently. It cannot tell a revolute column
+    from a prismatic one; the model can: a revolute value beyond one turn (or the joint's
+    limit) is refused as degrees, naming the row and joint; the same poses in rad pass."""
+    from zrp.errors import UnitError
+    from zrp.gap.model.context import Context
+
+    deg = zrp.gap.Measurements.from_arrays(meas.pose, np.degrees(meas.q), meas.xyz,
+                                           point=meas.point)
+    i, k = (int(v) for v in np.argwhere(np.abs(deg.q) > 2 * np.pi)[0])
+    with pytest.raises(UnitError, match=rf"row {i + 1}: joint {k + 1} .*looks like degrees"):
+        zrp.diagnose(PUMA, deg)
+    assert Context(PUMA, meas).n == PUMA.n
+
+
 # ---- diagnose arguments --------------------------------------------------------------------
 @pytest.mark.parametrize("kwargs, match", [
     ({"model": None}, "model: expected a zrp.Manipulator"),

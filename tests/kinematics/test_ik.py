@@ -174,6 +174,21 @@ def test_bad_ik_inputs(puma):
         zrp.track_trajectory(puma, tr, q0, gain=-1.0)
 
 
+@pytest.mark.parametrize("name", ["position_tol", "orientation_tol_rad"])
+@pytest.mark.parametrize("value", [0.0, -1e-9, float("nan"), float("inf"), "1e-9"])
+def test_a_tolerance_that_is_not_positive_and_finite_is_refused_by_name(puma, name, value):
+    """Issue 35, finding 11: a zero, negative or NaN Newton tolerance was taken silently."""
+    setup = zrp.puma_circle()
+    with pytest.raises(zrp.InputError, match=rf"^{name}: expected a (finite )?number"):
+        zrp.track_trajectory(puma, setup.trajectory, setup.q0, 8, **{name: value})
+
+
+def test_max_iter_below_one_is_refused(puma):
+    setup = zrp.puma_circle()
+    with pytest.raises(zrp.InputError, match="max_iter: expected a whole number >= 1"):
+        zrp.track_trajectory(puma, setup.trajectory, setup.q0, 8, max_iter=0)
+
+
 def test_bad_trajectory_inputs():
     with pytest.raises(zrp.InputError, match="normal: is a zero vector"):
         zrp.Circle([0, 0, 0], [0, 0, 0], [1, 0, 0])

@@ -90,7 +90,11 @@ class Plan:
 
 
 def _candidates(model: Manipulator, count: int, rng: np.random.Generator, limits: F64,
-                tool: F64, floor_z: float | None) -> F64:
+                tool: F64, floor_z: float | None, n_poses: int) -> F64:
+    if count < n_poses:
+        raise InputError(f"candidates: {count} candidate poses cannot give {n_poses} distinct "
+                         f"poses; draw at least {n_poses}, or many more (default 1000) for a "
+                         "good plan")
     q = uniform_joint_values(model, count, rng, limits)
     if floor_z is None:
         return q
@@ -102,6 +106,10 @@ def _candidates(model: Manipulator, count: int, rng: np.random.Generator, limits
     if keep.sum() < 2 * model.n:
         raise InputError(f"floor_z: only {int(keep.sum())} of {count} candidate poses keep "
                          f"the arm above z = {floor_z}")
+    if keep.sum() < n_poses:
+        raise InputError(f"floor_z: only {int(keep.sum())} of {count} candidate poses keep "
+                         f"the arm above z = {floor_z}, fewer than the {n_poses} poses asked; "
+                         "draw more candidates")
     return q[keep]
 
 
@@ -223,7 +231,7 @@ def plan_poses(model: Manipulator, n_poses: int, effects: Sequence[str], *,
     """
     tool = np.atleast_2d(np.asarray(tool_points, dtype=float))
     lim = _within_model(model, limits)
-    q = _candidates(model, candidates, rng, lim, tool, floor_z)
+    q = _candidates(model, candidates, rng, lim, tool, floor_z, n_poses)
     d = rng.choice([-1.0, 1.0], size=q.shape)
     if direction_fn is not None:
         imposed = np.asarray(direction_fn(q), dtype=float)  # type: ignore[operator]

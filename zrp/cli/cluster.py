@@ -149,7 +149,7 @@ def executor(workers: int | None = None, scheduler: str | None = None, *,
 
             try:
                 client = stack.enter_context(Client(scheduler, timeout="10s"))
-            except (OSError, TimeoutError) as exc:
+            except (OSError, TimeoutError, ValueError) as exc:  # ValueError: not an address
                 raise InputError(f"{field}: cannot reach a Dask scheduler at {scheduler!r} "
                                  f"({exc}); expected e.g. tcp://host:8786") from exc
         else:

@@ -13,7 +13,7 @@ import math
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from zrp.errors import InputError
+from zrp.errors import InputError, UnitError
 from zrp.limits import MAX_LENGTH, MAX_SEED
 
 if TYPE_CHECKING:
@@ -26,6 +26,7 @@ __all__ = [
     "FINITE",
     "FRACTION",
     "LENGTH",
+    "LENGTH_UNIT",
     "MAX_FPS",
     "MAX_HEIGHT",
     "MAX_SECONDS",
@@ -64,6 +65,20 @@ def whole(lo: int, hi: int | None = None) -> Callable[[str], int]:
 
     convert.__name__ = "whole number"
     return convert
+
+
+def LENGTH_UNIT(text: str) -> str:
+    """A length unit of :data:`zrp.units.LENGTH_UNITS` or an alias, canonical ("metres" -> "m");
+    an unknown one is refused listing the known units."""
+    from zrp.units import canonical_length_unit  # on use: keeps --help quick
+
+    try:
+        return canonical_length_unit(text, field="unit")
+    except UnitError as exc:
+        raise argparse.ArgumentTypeError(str(exc).removeprefix("unit: ")) from None
+
+
+LENGTH_UNIT.__name__ = "length unit"
 
 
 def real(lo: float = -math.inf, hi: float = math.inf, *, open_lo: bool = False,

@@ -20,6 +20,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from zrp.arguments import check_float, check_int
 from zrp.arrays import F64
 from zrp.errors import (
     IKError,
@@ -317,12 +318,21 @@ def track_trajectory(
         IKError: the integration diverged.
         SingularityError: a point within reach that the arm cannot follow at a singularity.
         JointLimitError: with ``limits="error"``, the path needs a joint beyond its limits.
+        InputError: an invalid argument, e.g. a tolerance that is not a positive finite number
+            (naming it).
     """
     q0, n_steps, task, gain = _check_options(model, trajectory, q0, steps, task, correction,
                                              gain)
     length = model.characteristic_length
     if position_tol is None:
         position_tol = 1e-14 * length
+    # a zero, negative or NaN tolerance would iterate to max_iter everywhere (or never stop
+    # correcting): refused by name, as every other option
+    position_tol = check_float(position_tol, "position_tol", 0.0, open_lo=True,
+                               unit=model.length_unit)
+    orientation_tol_rad = check_float(orientation_tol_rad, "orientation_tol_rad", 0.0,
+                                      open_lo=True, unit="rad")
+    max_iter = check_int(max_iter, "max_iter", 1)
 
     h = trajectory.duration / n_steps
     t = np.linspace(0.0, trajectory.duration, n_steps + 1)

@@ -133,6 +133,14 @@ def _fk(args: argparse.Namespace) -> int:
     return 0
 
 
+def _refuse_lone_target_er(args: argparse.Namespace) -> None:
+    """``--target-er`` without ``--target`` would be ignored (a trajectory is followed)."""
+    if args.target_er is not None and args.target is None:
+        raise InputError("--target-er: only with --target (the hand rotation of a single-pose "
+                         "IK); without --target a trajectory is followed and the rotation "
+                         "would be ignored: add --target X Y Z, or drop --target-er")
+
+
 def _ik(args: argparse.Namespace) -> int:
     import numpy as np  # on use: keeps --help quick
 
@@ -143,6 +151,7 @@ def _ik(args: argparse.Namespace) -> int:
     from zrp.model.files import load_model  # on use: keeps --help quick
     from zrp.paper.scenario import is_paper_model  # on use: keeps --help quick
 
+    _refuse_lone_target_er(args)
     model = load_model(args.model)
     if args.q0 is None:
         if not is_paper_model(model):

@@ -7,7 +7,7 @@ import re
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.cli.options import real
+from zrp.cli.options import LENGTH_UNIT, real
 from zrp.errors import InputError
 from zrp.model.builtin import builtin_models
 from zrp.output import safe_name
@@ -48,7 +48,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="import: MJCF or URDF file to read (writes a model TOML)")
     p.add_argument("--site", default=None, help="import: end-effector site name")
     p.add_argument("--body", default=None, help="import: end body name (if no site)")
-    p.add_argument("--unit", default="mm", help="import: length unit of the TOML (default mm)")
+    p.add_argument("--unit", type=LENGTH_UNIT, default=None,
+                   help="import: length unit of the TOML (default mm; only with --from)")
     p.add_argument("--out", default=None, metavar="FILE",
                    help="output (default renders/<model>.xml, or renders/<name>.toml with "
                         "--from); an existing file, the default one too, needs --force")
@@ -68,9 +69,12 @@ def _run(args: argparse.Namespace) -> int:
     from zrp.manufacturing.perturb import Perturbation  # on use: keeps --help quick
     from zrp.model.files import load_model, save_model  # on use: keeps --help quick
 
+    if args.unit is not None and not args.source:
+        raise InputError("--unit: only with --from (the length unit of the imported TOML); "
+                         "the MJCF written is in metres whatever the model's unit")
     if args.source:
         model = mjcf.from_mjcf(args.source, site=args.site, body=args.body,
-                               length_unit=args.unit)
+                               length_unit=args.unit or "mm")
         out = Path(args.out or f"renders/{_slug(Path(args.source).stem)}.toml")
         save_model(model, out, overwrite=args.force)
         emit(args, {"written": str(out), "joints": model.n, "types": model.joint_types,

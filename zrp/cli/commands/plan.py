@@ -62,6 +62,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run, api_names={"n_poses": "--poses", "floor_z": "--floor",
                                          "limits": "--limits", "effects": "--effects",
                                          "noise_sigma": "--noise",
+                                         "candidates": "--candidates",
                                          "gravity_torque_fn": "--mjcf"})
 
 

@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from zrp.cli.app import emit
+from zrp.cli.options import LENGTH_UNIT
 from zrp.errors import InputError, ModelFileError
 
 if TYPE_CHECKING:
@@ -31,7 +32,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--base", default=None, metavar="LINK",
                    help="URDF: base link (default the root; e.g. the arm's base on a mobile "
                         "robot)")
-    p.add_argument("--unit", default="mm", help="length unit of the model (default mm)")
+    p.add_argument("--unit", type=LENGTH_UNIT, default="mm",
+                   help="length unit of the model (default mm)")
     p.add_argument("--name", default=None, help="model name (default: the robot's)")
     p.add_argument("--out", default=None, metavar="TOML",
                    help="model file to write (default renders/<source name>.toml)")

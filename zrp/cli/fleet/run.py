@@ -86,10 +86,34 @@ def _previous(tasks: list[RobotTask]) -> dict[str, dict[str, Any]]:
 
     done = {}
     for t in tasks:
-        if (t.out / DONE_MARKER).exists() and (t.out / "diagnosis.json").exists():
-            d = json.loads((t.out / "diagnosis.json").read_text(encoding="utf-8"))
-            done[t.name] = robot_row(t.name, str(t.data), d)
+        path = t.out / "diagnosis.json"
+        if (t.out / DONE_MARKER).exists() and path.exists():
+            try:
+                done[t.name] = _checked_row(robot_row(t.name, str(t.data), json.loads(
+                    path.read_text(encoding="utf-8"))))
+            except (ValueError, KeyError, TypeError, AttributeError, IndexError,
+                    RecursionError) as exc:  # JSONDecodeError, UnicodeDecodeError are ValueErrors
+                raise InputError(f"--resume: {path}: not a diagnosis this toolkit wrote "
+                                 f"(damaged: {type(exc).__name__}: {exc}); delete {t.out} to "
+                                 "diagnose that robot again, or run with --force") from None
     return done
+
+
+_ROW_NUMBERS = ("points", "error_rms", "error_p95", "error_max", "corrected_rms",
+                "corrected_max", "shrink")
+
+
+def _checked_row(row: dict[str, Any]) -> dict[str, Any]:
+    """``row`` if its numbers are numbers (or null: a NaN written) and its lists lists
+    (TypeError naming the field)."""
+    for key in _ROW_NUMBERS:
+        v = row[key]
+        if v is not None and (not isinstance(v, (int, float)) or isinstance(v, bool)):
+            raise TypeError(f"{key}: expected a number, got {v!r:.40}")
+    for key in ("top_joints", "effects"):
+        if not isinstance(row[key], list):
+            raise TypeError(f"{key}: expected a list, got {row[key]!r:.40}")
+    return row
 
 
 def _diagnose_all(args: argparse.Namespace, todo: list[RobotTask]

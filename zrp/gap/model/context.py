@@ -15,14 +15,14 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.arrays import F64
-from zrp.errors import InputError
+from zrp.errors import InputError, UnitError
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.model.choices import EFFECTS, REGISTRATION
 from zrp.gap.model.domains import DEFAULT_MAX_TILT_RAD
 from zrp.kinematics.forward import forward_kinematics
 from zrp.kinematics.identification import axis_tangents
 from zrp.model.manipulator import Manipulator
-from zrp.units import G_STANDARD, metres_per_unit
+from zrp.units import G_STANDARD, angle_bounds, metres_per_unit
 
 __all__ = [
     "EFFECTS",
@@ -159,6 +159,7 @@ class Context:
         if self.meas.n_joints != self.model.n:
             raise InputError(f"measurements have {self.meas.n_joints} joint columns but the model "
                              f"{self.model.name!r} has {self.model.n} joints")
+        self._check_radians()
         g = np.asarray(self.gravity_dir, dtype=float)
         if g.shape != (3,) or not np.isclose(np.linalg.norm(g), 1.0):
             raise InputError(f"gravity_dir: expected a unit 3-vector, got {self.gravity_dir}")
@@ -171,6 +172,22 @@ class Context:
         if self.backlash_lead is not None and len(self.backlash_lead) != self.model.n:
             raise InputError(f"backlash_lead: expected {self.model.n} flags (one per joint), "
                              f"got {len(self.backlash_lead)}")
+
+    def _check_radians(self) -> None:
+        """Degrees passed as rad (``Measurements.from_arrays`` takes rad): a revolute joint
+        value beyond one turn, or beyond the joint's limit where that reaches further, cannot
+        be an angle in rad (the rule of the CSV reader, :func:`zrp.units.joint_values_to_rad`).
+        """
+        rev = ~np.asarray(self.model.prismatic, dtype=bool)
+        bound = np.maximum(angle_bounds(self.model.lower, self.model.upper), 2.0 * np.pi)
+        big = rev[None, :] & (np.abs(self.meas.q) > bound[None, :] + 1e-9)
+        if big.any():
+            i, k = (int(v) for v in np.argwhere(big)[0])
+            raise UnitError(f"{self.meas.source} row {i + 1}: joint {k + 1} "
+                            f"({self.model.joint_names[k]}) is {self.meas.q[i, k]:g}, beyond "
+                            f"{bound[k]:.4g} rad (one turn, or the joint's limit): it cannot be "
+                            "an angle in rad and looks like degrees; the measurements take q "
+                            "in rad (convert with np.radians)")
 
     @property
     def n(self) -> int:
