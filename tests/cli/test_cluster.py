@@ -231,8 +231,11 @@ def test_a_stopped_local_cluster_run_keeps_its_checkpoint_and_prints_no_tracebac
     ck = tmp_path / "mc.npz"
     cmd = [sys.executable, "-m", "zrp", "tolerance", "-n", "20000000", "--workers", "2",
            "--checkpoint", str(ck), "--no-progress"]
+    # SIGINT at its default, as a terminal's shell starts a command: an ignored SIGINT is
+    # inherited, and the whole suite's process may have it ignored by then
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
-                            start_new_session=True, cwd=Path(__file__).resolve().parents[2])
+                            start_new_session=True, cwd=Path(__file__).resolve().parents[2],
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     try:
         deadline = time.monotonic() + 120
         while time.monotonic() < deadline and proc.poll() is None:
