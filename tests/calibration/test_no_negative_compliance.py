@@ -47,5 +47,5 @@ def test_negative_lumped_compliance_never_written(tmp_path):
     assert "TAKEN OUT as non-physical" in (tmp_path / "calibrated.toml").read_text()
     bad = dataclasses.replace(result.robot, terms=(
         Term("q2.w_ee", "joint_compliance", 2, "rad/mm", -1.5e-6),))
-    with pytest.raises(ImplausibleValueError, match="q2.w_ee"):
+    with pytest.raises(ImplausibleValueError, match=r"q2\.w_ee"):
         write_calibration(bad, tmp_path / "b" / "c.toml", tmp_path / "b" / "c.json")
