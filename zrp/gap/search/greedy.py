@@ -24,6 +24,7 @@ from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.identifiability import GEOMETRIC, geometric_overlap
 from zrp.gap.fit.aliasing import Aliased
 from zrp.gap.fit.constrained import n_registration, within_domains
+from zrp.gap.fit.heldwald import group_pvalues
 from zrp.gap.fit.leastsq import (
     FitResult,
     cv_rms,
@@ -31,7 +32,6 @@ from zrp.gap.fit.leastsq import (
     fit,
     group_key,
     identifiable_start,
-    wald_groups,
 )
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.fit.profiles import switch_bands, with_backlash_switch
@@ -118,12 +118,12 @@ def _not_tried(effect: str, note: str, aliased: list[Aliased] | None = None) -> 
 
 def _significant(ctx: Context, current: FitResult, f1: FitResult, keep: list[ParamSpec],
                  s: SearchSettings) -> tuple[FitResult, list[ParamSpec]]:
-    """The candidate's parameters whose Wald group is significant (refitted without the
-    others when some were pruned). The backward elimination on identifiable parts
-    (:mod:`zrp.gap.search.groups`) is not applied here: it released the common tilt that
-    positions alone must hold (tests/gap/test_orientation_search.py)."""
+    """The candidate's parameters whose group is significant (:mod:`zrp.gap.fit.heldwald`,
+    eq. H2: near-collinear groups that a held combination spans, each needed by the data, are
+    not lost to the prior variance that combination gives them), refitted without the others
+    when some were pruned."""
     nb = len(current.specs)
-    pv = wald_groups(f1, nb)
+    pv = group_pvalues(f1, nb, s.alpha)
     thr = s.alpha / max(len(pv), 1)
     sig = {g for g, p in pv.items() if p < thr}
     kept = [p for p in keep if group_key(p) in sig]
@@ -300,7 +300,9 @@ def backward_pass(ctx: Context, current: FitResult, nreg: int, s: SearchSettings
     the final model no longer needs them (Wald test at alpha / groups); returns the refitted
     model and the groups dropped.
 
-    Backward elimination one group at a time: the least significant group goes, the model is
+    The groups are tested as in the forward steps (eq. H2 of :mod:`zrp.gap.fit.heldwald`).
+    Backward elimination one group at
+    a time: the least significant group goes, the model is
     refitted and the tests are redone. Dropping every group above the threshold at once
     removed groups that are each insignificant only because they stand in for one another
     (a joint's offset and its encoder scale over a narrow range of that joint, an axis tilt and
@@ -308,7 +310,7 @@ def backward_pass(ctx: Context, current: FitResult, nreg: int, s: SearchSettings
     residual sum of squares grew 240-fold."""
     pruned: list[str] = []
     while len(current.specs) > nreg:
-        pv = wald_groups(current, nreg)
+        pv = group_pvalues(current, nreg, s.alpha)
         thr = s.alpha / max(len(pv), 1)
         worst = max(pv, key=lambda g: pv[g]) if pv else None
         if worst is None or pv[worst] < thr:
