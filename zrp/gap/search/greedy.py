@@ -32,6 +32,7 @@ from zrp.gap.fit.leastsq import (
     fit,
     group_key,
     identifiable_start,
+    wald_groups,
 )
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.fit.profiles import switch_bands, with_backlash_switch
@@ -300,8 +301,9 @@ def backward_pass(ctx: Context, current: FitResult, nreg: int, s: SearchSettings
     the final model no longer needs them (Wald test at alpha / groups); returns the refitted
     model and the groups dropped.
 
-    The groups are tested as in the forward steps (eq. H2 of :mod:`zrp.gap.fit.heldwald`).
-    Backward elimination one group at
+    The plain Wald test, not eq. H2 of the forward steps (:mod:`zrp.gap.fit.heldwald`): of
+    near-collinear groups that a step took in together, held together, one is dropped here
+    and the refit estimates the other. Backward elimination one group at
     a time: the least significant group goes, the model is
     refitted and the tests are redone. Dropping every group above the threshold at once
     removed groups that are each insignificant only because they stand in for one another
@@ -310,7 +312,7 @@ def backward_pass(ctx: Context, current: FitResult, nreg: int, s: SearchSettings
     residual sum of squares grew 240-fold."""
     pruned: list[str] = []
     while len(current.specs) > nreg:
-        pv = group_pvalues(current, nreg, s.alpha)
+        pv = wald_groups(current, nreg)
         thr = s.alpha / max(len(pv), 1)
         worst = max(pv, key=lambda g: pv[g]) if pv else None
         if worst is None or pv[worst] < thr:
