@@ -20,7 +20,8 @@ measure the same thing. The sets are the cases that slid back or are easy to los
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -60,12 +61,16 @@ def ur10_dh() -> zrp.Manipulator:
 
 def payload_compliance_set(n_per_payload: int = 200, seed: int = 1, sigma: float = 0.1,
                            compliance: float = 2e-5,
-                           payloads: tuple[float, ...] = (0.0, 1.25, 2.5)
+                           payloads: tuple[float, ...] = (0.0, 1.25, 2.5),
+                           hidden: Mapping[str, Any] | None = None
                            ) -> tuple[zrp.Manipulator, Measurements]:
     """The iiwa at each payload: commanded q uniform within the limits (0.1 rad inside), the
     link angles q + offset - c tau(link angles) (the static deflection of a servo of
     stiffness 1/c, three fixed-point passes), the tool points of the MuJoCo arm's true
-    geometry with ``sigma`` mm noise, in an instrument frame; a ``load`` column in kg."""
+    geometry with ``sigma`` mm noise, in an instrument frame; a ``load`` column in kg.
+    ``compliance``: joint 2's (rad/(N m)); ``hidden``: more :class:`sim.robot.effects.
+    HiddenEffects` (its ``joint_compliance`` adds other joints'; default: joint 3's offset
+    of 0.5 mrad only)."""
     from sim.robot.effects import HiddenEffects
     from sim.robot.real import RealRobot
 
@@ -73,14 +78,16 @@ def payload_compliance_set(n_per_payload: int = 200, seed: int = 1, sigma: float
     rng = np.random.default_rng(seed)
     lo, hi = np.array(IIWA_LIMITS).T
     rb, tb = matrix_from_rotvec([0.02, -0.01, 0.8]), np.array([1500.0, -300.0, 200.0])
+    effects = dict(hidden) if hidden is not None else {"joint_offset": {3: 5e-4}}
+    effects["joint_compliance"] = {**effects.get("joint_compliance", {}), 2: compliance}
     c = np.zeros(arm.n)
-    c[1] = compliance
+    for k, v in effects["joint_compliance"].items():
+        c[k - 1] = v
     parts = []
     for i, w in enumerate(payloads):
         with warnings.catch_warnings():  # the announced fallback inertias (rods)
             warnings.simplefilter("ignore")
-            robot = RealRobot(arm, HiddenEffects(joint_compliance={2: compliance}, payload=w,
-                                                 joint_offset={3: 5e-4}))
+            robot = RealRobot(arm, HiddenEffects(**effects, payload=w))
         q = rng.uniform(lo + 0.1, hi - 0.1, size=(n_per_payload, arm.n))
         qm = robot.motor_target(q)
         ql = qm.copy()
