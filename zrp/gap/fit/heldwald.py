@@ -36,6 +36,10 @@ still held; :func:`group_pvalues`):
 (G: the number of groups tested; the members of a held combination: the parameters its
 reported direction names, weight at least 0.1 in tolerance units, at most six,
 :class:`zrp.gap.fit.wellposed.HeldDirection`).
+
+The search (:func:`zrp.gap.search.greedy.greedy_search`) tests a candidate's groups by (H2);
+its backward pass keeps the plain test, so of a near-collinear pair that entered together one
+is dropped there and the refit estimates the other (tests/gap/test_backward_pass.py).
 """
 
 from __future__ import annotations
