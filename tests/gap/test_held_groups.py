@@ -5,12 +5,18 @@ combination its prior's variance, which then lands on every group it spans."""
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
+import zrp
+from zrp.gap import diagnose
+from zrp.gap.data.synthetic import Injection, synthesize
 from zrp.gap.fit.heldwald import group_pvalues, wald_groups_given_held
 from zrp.gap.fit.leastsq import FitResult, wald_groups
 from zrp.gap.fit.wellposed import HeldDirection, solve
 from zrp.gap.model.context import ParamSpec
+from zrp.kinematics import uniform_joint_values
 
 ALPHA = 1e-3
 
@@ -110,13 +116,6 @@ def test_a_body_error_lost_to_its_collinear_neighbour_is_found():
     plain Wald test refused both, so the search (0.5.0) fitted joint offsets, axis tilts and
     backlash in their place. With eq. H2 the body error is the first step, clearly best on
     cross-validation, and the backward pass keeps one of the collinear pair."""
-    import warnings
-
-    import zrp
-    from zrp.gap import diagnose
-    from zrp.gap.data.synthetic import Injection, synthesize
-    from zrp.kinematics import uniform_joint_values
-
     puma = zrp.load_model("puma")
     rng = np.random.default_rng(0)
     limits = np.array([[-2.0, 2.0]] * 6)
