@@ -115,8 +115,9 @@ def one_line_warnings(prog: str) -> Iterator[None]:
         yield
 
 
-#: options naming files the command writes (or reads and rewrites, as a checkpoint)
-_WRITTEN = frozenset({"out", "video", "checkpoint", "workdir"})
+#: options naming files the command writes (or reads and rewrites, as a checkpoint); a
+#: command adds its own with ``set_defaults(writes=(dest, ...))``
+_WRITTEN = frozenset({"out", "video", "checkpoint", "workdir", "hist", "writes"})
 
 
 def _inputs(parser: argparse.ArgumentParser, args: argparse.Namespace
@@ -128,8 +129,9 @@ def _inputs(parser: argparse.ArgumentParser, args: argparse.Namespace
     cmd = sub.choices.get(args.command) if sub is not None else None
     names = {a.dest: (a.option_strings[-1] if a.option_strings else str(a.metavar or a.dest))
              for a in (cmd._actions if cmd is not None else ())}
+    written = _WRITTEN | set(getattr(args, "writes", ()))
     for dest, value in vars(args).items():
-        if dest in _WRITTEN:
+        if dest in written:
             continue
         for v in value if isinstance(value, (list, tuple)) else (value,):
             if isinstance(v, str) and v:
