@@ -36,6 +36,7 @@ MAX_XML_MARKUP = 1_000_000
 #: One item of the text before the root element: white space, the XML declaration or
 #: another processing instruction, a comment, a document type declaration.
 _PROLOG_ITEM = re.compile(r"\s+|<\?.*?\?>|<!--.*?-->|<!DOCTYPE(?:[^\[>]|\[.*?\])*>", re.S)
+_LEADING_PIS = re.compile(r"(?:\s*<\?.*?\?>)*", re.S)
 _ENCODING = re.compile(r"""(\bencoding\s*=\s*)(["'])[^"']*\2""")
 
 
@@ -50,15 +51,15 @@ class XMLDocument:
 
     def text(self, note: str = "") -> str:
         """The document as UTF-8 text, the XML comment ``note`` (if any) after the
-        declaration; a declared encoding is written as UTF-8 (the file's bytes are)."""
-        prolog, decl = self.prolog, ""
-        if prolog.startswith("<?xml") and prolog[5:6].isspace():
-            end = prolog.index("?>") + 2
-            decl = _ENCODING.sub(r"\1\2UTF-8\2", prolog[:end]) + "\n"
-            prolog = prolog[end:].lstrip("\r\n")
+        processing instructions the file opens with (MuJoCo's parser accepts them only
+        first); a declared encoding is written as UTF-8 (the file's bytes are)."""
+        head = _LEADING_PIS.match(self.prolog)
+        end = head.end() if head else 0
+        first = _ENCODING.sub(r"\1\2UTF-8\2", self.prolog[:end]).rstrip()
         comment = f"<!-- {note} -->\n" if note else ""
         body = ET.tostring(self.root, encoding="unicode")
-        return decl + comment + prolog + body + self.epilog.rstrip() + "\n"
+        return ((first + "\n" if first else "") + comment + self.prolog[end:].lstrip("\r\n")
+                + body + self.epilog.rstrip() + "\n")
 
 
 def _check_size(text: str, label: str, error: type[ZRPError]) -> None:
