@@ -19,7 +19,6 @@ from zrp.output.atomic import (
     write_json,
     write_text,
 )
-from zrp.output.inputs import is_input
 from zrp.output.lock import LOCK_WAIT_S, acquire, release
 from zrp.output.paths import as_path, check_regular, check_writable, make_folder
 
@@ -87,7 +86,7 @@ class OutputDir:
         mine = set(self.written)
         for name in self.names:
             p = self.root / name
-            if p not in mine and check_regular(p) and is_input(p) is None:
+            if p not in mine and check_regular(p):
                 try:
                     p.unlink()
                 except OSError as exc:

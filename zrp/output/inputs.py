@@ -5,8 +5,8 @@ line registers the files a command reads (:func:`reading`, from its options); ev
 through :func:`~zrp.output.check_writable`, which calls :func:`check_not_input`: a target that
 is one of those files (the same file: compared by device and inode, so another spelling, a
 link or a hard link is caught) is refused with :class:`~zrp.errors.OutputIsInputError`
-naming the option. A file the run does not write is not removed either
-(:class:`~zrp.output.OutputDir`'s pruning skips it).
+naming the option; an :class:`~zrp.output.OutputDir` whose declared names include an input is
+refused before any work (so its pruning never reaches one).
 """
 
 from __future__ import annotations
