@@ -79,7 +79,7 @@ def export_urdf(cal: CalibratedRobot, source: str | Path, urdf_path: str | Path,
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{source}: cannot read the URDF ({exc})") from exc
     urdf = patch_urdf(text, cal.model, base_link=base_link, end_link=end_link,
-                      rotations=cal.fold_rotations())
+                      rotations=cal.fold_rotations(), label=str(source))
     side = side_document(cal, Path(urdf_path).name, text, base_link, end_link)
     u = write_text(urdf_path, urdf, overwrite=overwrite)
     s = write_text(side_path, dumps(side), overwrite=overwrite)

@@ -27,7 +27,7 @@ from zrp.calibration.validation import validate_calibration
 from zrp.errors import InputError, ZRPError
 from zrp.escape import one_line
 from zrp.gap.fit.fullpose import FullPoseFit
-from zrp.jsonio import dumps, to_jsonable
+from zrp.jsonio import dumps, to_jsonable, version_field
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
@@ -229,11 +229,9 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
     doc = loads_bounded(read_text(comp_path, label=src), src)
     if not isinstance(doc, dict):
         raise InputError(f"{src}: expected a JSON object")
-    version = doc.get("schema_version")
-    if isinstance(version, bool) or version not in READABLE_VERSIONS:
-        raise InputError(f"{src}: schema_version {doc.get('schema_version')!r}, expected one "
-                         f"of {', '.join(map(str, READABLE_VERSIONS))} (a file from a newer "
-                         f"zrp-accuracy? zrp_version {doc.get('zrp_version')!r})")
+    version_field(doc, "schema_version", READABLE_VERSIONS, src=src,
+                  hint=f" (a file from a newer zrp-accuracy? zrp_version "
+                       f"{doc.get('zrp_version')!r})")
     bl = doc.get("backlash")
     if doc.get("schema_version") == 1 and isinstance(bl, dict) and "lead" in bl:
         raise InputError(f"{src}: backlash.lead in a schema_version 1 file (version 1 has "
