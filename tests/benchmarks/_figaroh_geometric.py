@@ -116,9 +116,10 @@ def _limited(model: zrp.Manipulator) -> zrp.Manipulator:
 
 def _calibration_class(sigma_position: float, sigma_orientation: float) -> type:
     from figaroh.calibration.base_calibration import BaseCalibration
-    from figaroh.calibration.calibration_tools import calc_updated_fkm
-
-    from figaroh.calibration.calibration_tools import estimate_frames_closed_form
+    from figaroh.calibration.calibration_tools import (
+        calc_updated_fkm,
+        estimate_frames_closed_form,
+    )
 
     class Calibration(BaseCalibration):  # type: ignore[misc]
         """FIGAROH's documented cost: updated FK, SE(3) log-map residuals (world-frame

@@ -51,9 +51,9 @@ from _timing import interleaved
 README = ROOT / "zrp" / "gap" / "README.md"
 #: (label, regression set, size factor): the sets at their reference size, then two at the
 #: sizes of the issue's slow real sets.
-CASES = tuple((name, name, 1.0) for name in SETS) + (
-    ("probe_6d, 630 poses", "probe_6d", 3.15),
-    ("parallel_axes, 1,500 poses", "parallel_axes", 7.5))
+CASES = (*((name, name, 1.0) for name in SETS),
+         ("probe_6d, 630 poses", "probe_6d", 3.15),
+         ("parallel_axes, 1,500 poses", "parallel_axes", 7.5))
 COLUMNS = ["set", "poses", "orientation", "zrp diagnose (CPU s)", "zrp diagnose (wall s)",
            "with plots (CPU s)", "FIGAROH (CPU s)", "FIGAROH (wall s)", "zrp / FIGAROH (CPU)",
            "goal", "load", "zrp final (withheld RMS)", "FIGAROH fit RMS (all poses)"]
