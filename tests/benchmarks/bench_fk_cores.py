@@ -5,9 +5,10 @@ On N random PUMA poses (1e6; --quick 1e5) the calls below are timed in turn with
 (interleaved, ``_timing.interleaved``: the best of the rounds; CPU time of this process, all
 threads, the wall time and the 1-minute load average beside it):
 
-* ``zrp.end_effector_pose(model, q, threads=1)`` and ``threads=2`` (zrp/kinematics/parallel.py:
-  the batch cut in two, each half run by the same compiled kernel in its own thread; the
-  result is the one-thread result to the bit), and the same for ``zrp.jacobian``;
+* five batches in a row of ``zrp.end_effector_pose(model, q, threads=1)`` and
+  ``threads=2`` (zrp/kinematics/parallel.py: the batch cut in two, each half run by the
+  same compiled kernel in its own thread; the result is the one-thread result to the bit),
+  and the same for ``zrp.jacobian``;
 * a Python loop of MuJoCo's ``mj_kinematics`` on the equivalent MJCF, and of Pinocchio's
   ``forwardKinematics`` + ``updateFramePlacements`` on the equivalent model (Pinocchio has no
   batched forward kinematics; the loop is how a batch is computed with it), both on a subset of
@@ -40,6 +41,10 @@ from _timing import Timing, interleaved
 
 import zrp
 from zrp.kinematics.parallel import usable_cores
+
+#: batches computed one after the other per timed call (a batch loop: a second core that was
+#: idle takes a while to wake on a shared virtual machine, and one batch is over in ~15 ms)
+BATCHES = 5
 
 
 def _mujoco_loop(model: zrp.Manipulator, q: np.ndarray):
@@ -113,12 +118,14 @@ def main() -> None:
 
     def fk(threads: int):
         def run() -> None:  # the usual loop: the previous result held while the next is made
-            held[f"fk{threads}"] = zrp.end_effector_pose(model, q, threads=threads)
+            for _ in range(BATCHES):
+                held[f"fk{threads}"] = zrp.end_effector_pose(model, q, threads=threads)
         return run
 
     def jac(threads: int):
         def run() -> None:
-            held[f"jac{threads}"] = zrp.jacobian(model, q, threads=threads)
+            for _ in range(BATCHES):
+                held[f"jac{threads}"] = zrp.jacobian(model, q, threads=threads)
         return run
 
     print(f"PUMA, N = {n:,} poses; {cores} usable cores")
@@ -148,10 +155,10 @@ def main() -> None:
                      f"{t.load[0]:.1f}-{t.load[1]:.1f}"])
         print(" | ".join(rows[-1]), flush=True)
 
-    add("zrp end_effector_pose, 1 thread", fk1, n)
-    add(f"zrp end_effector_pose, {two} threads", fk2, n, fk1)
-    add("zrp jacobian, 1 thread", j1, n)
-    add(f"zrp jacobian, {two} threads", j2, n, j1)
+    add("zrp end_effector_pose, 1 thread", fk1, BATCHES * n)
+    add(f"zrp end_effector_pose, {two} threads", fk2, BATCHES * n, fk1)
+    add("zrp jacobian, 1 thread", j1, BATCHES * n)
+    add(f"zrp jacobian, {two} threads", j2, BATCHES * n, j1)
     add("MuJoCo mj_kinematics, Python loop", mj, n_loop)
     add("Pinocchio forwardKinematics + frames, Python loop", pl, n_loop)
     per = [f"{t.cpu / calls * 1e6:.2f}" for t in single]
@@ -168,8 +175,9 @@ def main() -> None:
                  f"{two}-thread result identical to 1 thread: {same}",
                  ["call", "M poses/s (CPU)", "M poses/s (wall)", "vs MuJoCo loop (CPU)",
                   "vs Pinocchio loop (CPU)", "gain over 1 thread", "load"], rows,
-                 note="CPU: process time of the call, all threads (a split costs no CPU time: "
-                      "the same work); wall: elapsed time, where a free second core shows. "
+                 note=f"Each timed call: {BATCHES} batches one after the other. CPU: process "
+                      "time of the call, all threads (a split costs no CPU time: the same "
+                      "work); wall: elapsed time, where a free second core shows. "
                       f"The loops run on {n_loop:,} of the poses. Load: 1-minute load average "
                       "at the start and end of the rounds (2 cores).")
     report.table(f"One call from Python (CPU us per call, best of {args.repeat} rounds of "
