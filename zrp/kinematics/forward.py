@@ -206,7 +206,8 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
             batches costs as much as a fifth of the kinematics (the OS zero-fills new pages).
         threads: threads the batch is split over (:mod:`zrp.kinematics.parallel`; the same
             result to the bit); None: every usable core from
-            :data:`~zrp.kinematics.parallel.MIN_FK_POSES` poses on, one below.
+            :data:`~zrp.kinematics.parallel.MIN_FK_POSES` poses on, one below (a single pose
+            always runs on the calling thread).
 
     Returns:
         position p, shape (..., 3), and Euler-Rodrigues parameters of R_n, shape (..., 4)
