@@ -97,14 +97,14 @@ def _raw_value(ctx: Context, rows: NDArray[np.int64], name: str) -> F64:
     return _column(ctx, rows, name)[:, 0]
 
 
-def pose_inputs(ctx: Context, rows: NDArray[np.int64]) -> Inputs:
+def pose_inputs(ctx: Context, rows: NDArray[np.int64], *, logged: bool = True) -> Inputs:
     """The inputs set on the poses of ``rows`` (one row per pose): joints that move at least
-    the excitation threshold, and the logged columns that vary."""
+    the excitation threshold, and (with ``logged``) the logged columns that vary."""
     meas = ctx.meas
     names = [f"q{k + 1}" for k in range(ctx.n)
              if ctx.excited[k] and np.ptp(ctx.q[meas.pose_index[rows], k]) >= MIN_EXCITATION_RAD]
     names += [n for n, a in (("time", meas.t), ("temperature", meas.temp), ("load", meas.load))
-              if a is not None and np.ptp(a[rows]) > 0]
+              if logged and a is not None and np.ptp(a[rows]) > 0]
     center, scale, widths = [], [], []
     for n in names:
         f = _column(ctx, rows, n)
