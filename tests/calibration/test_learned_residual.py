@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 
 from zrp.calibration import CalibrationOptions, calibrate, compensate, read_calibration
+from zrp.calibration.calibrated import rotation_about
 from zrp.calibration.filecheck import FieldDomainError
 from zrp.calibration.guards import UnmeasuredTargetError
 from zrp.gap import Injection, Measurements, synthesize
@@ -80,8 +81,11 @@ def test_kept_term_is_in_the_files_and_evaluates_as_the_diagnosis_kernel(sag):
     # the file's plain-NumPy evaluation against scikit-learn's kernel in the diagnosis
     ctx = res.diagnosis.context
     rows = np.flatnonzero(ctx.meas.point_index == 0)[:50]
-    want = rm.kernel.predict(rm.scaling(ctx, rows)).reshape(len(rows), -1, 3)
-    got = cal.learned.evaluate(ctx.q[ctx.meas.pose_index[rows]])
+    q = ctx.q[ctx.meas.pose_index[rows]]
+    g = rm.kernel.predict(rm.scaling(ctx, rows)).reshape(len(rows), -1, 3)  # the arm's frame
+    turn = np.stack([rm.frame @ rotation_about(np.asarray(IRB120.axes[0]), a) for a in q[:, 0]])
+    want = np.einsum("pij,pmj->pmi", turn, g)
+    got = cal.learned.evaluate(q)
     np.testing.assert_allclose(got, want, rtol=0, atol=1e-9)
 
 
@@ -131,6 +135,8 @@ def test_targets_outside_the_training_ranges_are_refused_or_flagged(sag):
     (lambda e: e.update(coef=e["coef"][:-1]), "coef"),
     (lambda e: e.update(gamma=-0.5), "gamma"),
     (lambda e: e.update(ard=[0.0] * len(e["ard"])), "ard"),
+    (lambda e: e.update(turn_axis=[0.0, 0.0, 2.0]), "turn_axis"),
+    (lambda e: e.update(frame=[[1, 0, 0], [0, 1, 0], [0, 0, -1]]), "frame"),
 ])
 def test_a_learned_field_outside_its_domain_is_refused_on_read(sag, tmp_path, edit, field):
     _, folder, _ = sag

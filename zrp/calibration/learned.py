@@ -11,11 +11,15 @@ Evaluation (eq. L1), for commanded joint values q (T, n):
 
     z_c   = (sin q_k, cos q_k) per revolute input joint k, q_k per prismatic one   (D columns)
     x     = (z - center) / scale * ard                                              (D,)
-    f(q)  = mean + sum_i coef_i exp(-gamma |x - train_i|^2)                         (3M,)
+    g(q)  = mean + sum_i coef_i exp(-gamma |x - train_i|^2)                         (3M,)
+    f_j(q) = frame R(turn_axis, q_1) g_j(q)                                         (per point)
 
 ``f`` is, per measured point j (``points`` order), the physical model's predicted minus
 measured position (x, y, z; the calibration's ``frame``, length unit): the point is
-**predicted at p_j(q) - f_j(q)**. ``train`` (N, D) are the training poses' inputs already
+**predicted at p_j(q) - f_j(q)**. ``g`` is learned in the arm's frame: the data's frame turned
+with joint 1 (``frame``, data-from-base rotation, times the rotation by q_1 about joint 1's
+nominal axis ``turn_axis`` in the base frame; no turn when ``turn_axis`` is null: a prismatic
+joint 1; :mod:`zrp.gap.analysis.residual`). ``train`` (N, D) are the training poses' inputs already
 scaled and multiplied by ``ard`` (1 / the per-column length scales), ``coef`` (N, 3M) the dual
 coefficients of the ridge.
 
@@ -43,15 +47,16 @@ from numpy.typing import ArrayLike, NDArray
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.rotations.matrices import skew
-from zrp.rotations.rodrigues import er_from_rotvec, matrix_from_er
+from zrp.rotations.rodrigues import er_from_axis_angle, er_from_rotvec, matrix_from_er
 
 __all__ = ["LearnedTerm", "correct_hand", "hand_correction", "learned_outside"]
 
 #: what the term is, in the file (``learned_residual.kind``).
 KIND = "kernel ridge regression (Gaussian RBF kernel) on (sin q, cos q) of the joint angles"
 EVALUATE = ("x = (z - center) / scale * ard with z = (sin q_k, cos q_k) per revolute input "
-            "joint (q_k if prismatic); f = mean + sum_i coef_i exp(-gamma |x - train_i|^2); "
-            "point j (points order, x, y, z in frame) is predicted at p_j(q) - f_j")
+            "joint (q_k if prismatic); g = mean + sum_i coef_i exp(-gamma |x - train_i|^2); "
+            "f_j = frame R(turn_axis, q1) g_j (rotation by q1 about turn_axis; none if null); "
+            "point j (points order, x, y, z in the data's frame) is predicted at p_j(q) - f_j")
 
 
 @dataclass(frozen=True, eq=False)
@@ -68,6 +73,8 @@ class LearnedTerm:
         withheld_rms_physical, withheld_rms_hybrid: the diagnosis's withheld RMS of the
             physical model alone and with the term (length unit); paired_z: their paired z.
         n_poses: training poses (N).
+        frame: data-from-base rotation (3, 3); turn_axis: joint 1's nominal axis (3,), or
+            None (no turn): the arm's frame g is learned in (eq. L1).
     """
 
     inputs: tuple[str, ...]
@@ -85,6 +92,8 @@ class LearnedTerm:
     withheld_rms_hybrid: float
     paired_z: float
     n_poses: int
+    frame: F64
+    turn_axis: F64 | None
 
     def __post_init__(self) -> None:
         bad = _problems(self)
@@ -102,7 +111,8 @@ class LearnedTerm:
                    np.asarray(k.Xtr, float), np.asarray(k.coef, float),
                    np.asarray(k.mean, float), tuple(rm.points), tuple(s.ranges),
                    float(rm.withheld_rms_physical), float(rm.withheld_rms_hybrid),
-                   float(rm.paired_z), int(rm.n_poses))
+                   float(rm.paired_z), int(rm.n_poses), np.asarray(rm.frame, float),
+                   None if rm.turn_axis is None else np.asarray(rm.turn_axis, float))
 
     @property
     def joints(self) -> list[int]:
@@ -120,8 +130,11 @@ class LearnedTerm:
         x = (np.column_stack(cols) - self.center) / self.scale * self.ard
         d2 = (np.sum(x**2, axis=1)[:, None] + np.sum(self.train**2, axis=1)[None, :]
               - 2.0 * x @ self.train.T)
-        f = self.mean + np.exp(-self.gamma * np.maximum(d2, 0.0)) @ self.coef
-        return f.reshape(len(q), len(self.points), 3)
+        g = self.mean + np.exp(-self.gamma * np.maximum(d2, 0.0)) @ self.coef
+        rot = np.asarray(self.frame) if self.turn_axis is None else (
+            np.asarray(self.frame) @ matrix_from_er(er_from_axis_angle(self.turn_axis, q[:, 0])))
+        return np.einsum("ij,tmj->tmi" if rot.ndim == 2 else "tij,tmj->tmi", rot,
+                         g.reshape(len(q), len(self.points), 3))
 
     def to_dict(self) -> dict[str, Any]:
         """The ``learned_residual`` entry of compensation.json."""
@@ -134,7 +147,9 @@ class LearnedTerm:
                     self.inputs, self.training_ranges, strict=True)},
                 "withheld_rms_physical": self.withheld_rms_physical,
                 "withheld_rms_hybrid": self.withheld_rms_hybrid,
-                "paired_z": self.paired_z, "n_poses": self.n_poses}
+                "paired_z": self.paired_z, "n_poses": self.n_poses,
+                "frame": np.asarray(self.frame).tolist(),
+                "turn_axis": None if self.turn_axis is None else self.turn_axis.tolist()}
 
     @classmethod
     def from_dict(cls, d: Mapping[str, Any], src: str) -> LearnedTerm:
@@ -158,7 +173,9 @@ class LearnedTerm:
                                    for v in ranges[n]) for n in inputs),
                        *(_number(d[k], f"{where}.{k}") for k in (
                            "withheld_rms_physical", "withheld_rms_hybrid", "paired_z")),
-                       _whole(d["n_poses"], where))
+                       _whole(d["n_poses"], where), _array(d["frame"], f"{where}.frame"),
+                       None if d["turn_axis"] is None
+                       else _array(d["turn_axis"], f"{where}.turn_axis"))
         except (KeyError, TypeError) as exc:
             raise InputError(f"{where}: missing or malformed field ({exc})") from None
         except InputError as exc:
@@ -223,6 +240,13 @@ def _problems(t: LearnedTerm) -> list[str]:
     if not all(math.isfinite(v) and v >= 0 for v in (t.withheld_rms_physical,
                                                      t.withheld_rms_hybrid)):
         out.append("withheld_rms_physical, withheld_rms_hybrid: expected finite values >= 0")
+    fr = np.asarray(t.frame)
+    if fr.shape != (3, 3) or not (np.allclose(fr @ fr.T, np.eye(3), atol=1e-6)
+                                  and np.linalg.det(fr) > 0):
+        out.append("frame: expected a 3x3 rotation")
+    ax = None if t.turn_axis is None else np.asarray(t.turn_axis)
+    if ax is not None and (ax.shape != (3,) or not abs(np.linalg.norm(ax) - 1.0) <= 1e-6):
+        out.append("turn_axis: expected null or a unit vector of 3 values")
     if t.n_poses != N:
         out.append(f"n_poses: {t.n_poses}; the training inputs have {N} rows")
     return out
