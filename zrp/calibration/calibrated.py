@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike
 from zrp.arrays import F64
 from zrp.calibration.conditions import Conditions
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
-from zrp.calibration.learned import LearnedTerm, correct_hand
+from zrp.calibration.learned import LearnedTerm, check_learned, correct_hand
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.fit.leastsq import FitResult
@@ -213,9 +213,7 @@ class CalibratedRobot:
                              f"entries for {n} joints")
         if self.backlash_lead is not None and len(self.backlash_lead) != n:
             raise InputError(f"backlash_lead: {len(self.backlash_lead)} flags for {n} joints")
-        if self.learned is not None and (self.learned.points != tuple(self.tool_labels) or
-                                         max(self.learned.joints) >= n):
-            raise InputError("learned: its points or joints are not this robot's")
+        check_learned(self.learned, tuple(self.tool_labels), n)
         bad = [t.name for t in self.terms if not 1 <= t.joint <= n]
         if bad:
             raise InputError(f"terms {bad}: joint outside 1..{n}")

@@ -49,7 +49,7 @@ from zrp.errors import InputError
 from zrp.rotations.matrices import skew
 from zrp.rotations.rodrigues import er_from_axis_angle, er_from_rotvec, matrix_from_er
 
-__all__ = ["LearnedTerm", "correct_hand", "hand_correction", "learned_outside"]
+__all__ = ["LearnedTerm", "check_learned", "correct_hand", "hand_correction", "learned_outside"]
 
 #: what the term is, in the file (``learned_residual.kind``).
 KIND = "kernel ridge regression (Gaussian RBF kernel) on (sin q, cos q) of the joint angles"
@@ -213,43 +213,84 @@ def _array(v: object, where: str) -> F64:
 
 def _problems(t: LearnedTerm) -> list[str]:
     """Every field outside its domain (shapes, finite, ordered ranges)."""
-    D, M = sum(t.widths), len(t.points)
+    return _name_problems(t) + _shape_problems(t) + _value_problems(t) + _frame_problems(t)
+
+
+def _joint_name(n: str) -> bool:
+    return n.startswith("q") and n[1:].isdigit() and int(n[1:]) >= 1
+
+
+def _name_problems(t: LearnedTerm) -> list[str]:
     out = []
-    if not t.inputs or len(t.widths) != len(t.inputs) or any(
-            not (n.startswith("q") and n[1:].isdigit() and int(n[1:]) >= 1) for n in t.inputs):
+    if not t.inputs or len(t.widths) != len(t.inputs) or not all(map(_joint_name, t.inputs)):
         out.append(f"inputs: {list(t.inputs)[:8]}; expected joint names q1.. (one width each)")
     if any(w not in (1, 2) for w in t.widths):
         out.append(f"widths: {list(t.widths)}; expected 1 (prismatic) or 2 (revolute)")
+    if not t.points or len(set(t.points)) != len(t.points):
+        out.append(f"points: {list(t.points)[:8]}; expected distinct labels")
+    return out
+
+
+def _shape_problems(t: LearnedTerm) -> list[str]:
+    D, M = sum(t.widths), len(t.points)
     N = np.shape(t.train)[0] if np.ndim(t.train) == 2 else -1
     shapes = {"center": (D,), "scale": (D,), "ard": (D,), "train": (N, D), "coef": (N, 3 * M),
               "mean": (3 * M,)}
-    for name, want in shapes.items():
-        a = np.asarray(getattr(t, name))
-        if a.shape != want or N < 1 or not np.all(np.isfinite(a)):
-            out.append(f"{name}: shape {a.shape}; expected {want} finite values")
+    out = [f"{name}: shape {np.shape(getattr(t, name))}; expected {want} finite values"
+           for name, want in shapes.items() if not _finite_shape(getattr(t, name), want)]
+    if N < 1 or t.n_poses != N:
+        out.append(f"n_poses: {t.n_poses}; the training inputs have {N} rows")
+    return out
+
+
+def _finite_shape(a: object, shape: tuple[int, ...]) -> bool:
+    arr = np.asarray(a)
+    return arr.shape == shape and bool(np.all(np.isfinite(arr)))
+
+
+def _ordered(r: tuple[float, ...]) -> bool:
+    return len(r) == 2 and all(math.isfinite(v) for v in r) and r[0] <= r[1]
+
+
+def _value_problems(t: LearnedTerm) -> list[str]:
+    out = []
     if not (np.all(np.asarray(t.scale) > 0) and np.all(np.asarray(t.ard) > 0)):
         out.append("scale, ard: expected positive values")
     if not (math.isfinite(t.gamma) and t.gamma > 0):
         out.append(f"gamma: {t.gamma!r}; expected a finite value > 0")
-    if M < 1 or len(set(t.points)) != M:
-        out.append(f"points: {list(t.points)[:8]}; expected distinct labels")
-    if len(t.training_ranges) != len(t.inputs) or not all(
-            len(r) == 2 and all(math.isfinite(v) for v in r) and r[0] <= r[1]
-            for r in t.training_ranges):
+    if len(t.training_ranges) != len(t.inputs) or not all(map(_ordered, t.training_ranges)):
         out.append("training_ranges: expected per input a finite, ordered [low, high]")
-    if not all(math.isfinite(v) and v >= 0 for v in (t.withheld_rms_physical,
-                                                     t.withheld_rms_hybrid)):
+    rms = (t.withheld_rms_physical, t.withheld_rms_hybrid)
+    if not all(math.isfinite(v) and v >= 0 for v in rms):
         out.append("withheld_rms_physical, withheld_rms_hybrid: expected finite values >= 0")
-    fr = np.asarray(t.frame)
-    if fr.shape != (3, 3) or not (np.allclose(fr @ fr.T, np.eye(3), atol=1e-6)
-                                  and np.linalg.det(fr) > 0):
-        out.append("frame: expected a 3x3 rotation")
-    ax = None if t.turn_axis is None else np.asarray(t.turn_axis)
-    if ax is not None and (ax.shape != (3,) or not abs(np.linalg.norm(ax) - 1.0) <= 1e-6):
-        out.append("turn_axis: expected null or a unit vector of 3 values")
-    if t.n_poses != N:
-        out.append(f"n_poses: {t.n_poses}; the training inputs have {N} rows")
     return out
+
+
+def _frame_problems(t: LearnedTerm) -> list[str]:
+    out = []
+    fr = np.asarray(t.frame)
+    if not (_finite_shape(fr, (3, 3)) and np.allclose(fr @ fr.T, np.eye(3), atol=1e-6)
+            and np.linalg.det(fr) > 0):
+        out.append("frame: expected a 3x3 rotation")
+    if t.turn_axis is not None and not (_finite_shape(t.turn_axis, (3,)) and abs(
+            float(np.linalg.norm(t.turn_axis)) - 1.0) <= 1e-6):
+        out.append("turn_axis: expected null or a unit vector of 3 values")
+    return out
+
+
+def check_learned(term: LearnedTerm | None, tool_labels: tuple[str, ...], n: int) -> None:
+    """Refuse a term (None: nothing to check) whose points are not the robot's tool points
+    (in order) or whose input joints it lacks (``n`` joints).
+
+    Raises:
+        InputError: naming the mismatch.
+    """
+    if term is None:
+        return
+    if term.points != tool_labels or max(term.joints) >= n:
+        raise InputError(f"learned: its points {list(term.points)} and joints "
+                         f"{list(term.inputs)} are not this robot's (tool points "
+                         f"{list(tool_labels)}, {n} joints)")
 
 
 def learned_outside(term: LearnedTerm, q: F64, share: float) -> NDArray[np.bool_]:
