@@ -51,9 +51,7 @@ def main() -> None:
                   f"kept with a withheld RMS <= {WITHIN_NOISE:g} x the noise RMS sqrt(3) sigma; "
                   "effect-free and scatter-only give no structure and no term. 'structure "
                   "recovered': the share of the withheld mean square above the noise that the "
-                  "learned term removes. q1 is named with the arm's joints because the "
-                  "diagnosis tests the residual in the instrument frame, which turns with "
-                  "joint 1."))
+                  "learned term removes."))
     report.write(out_md, args)
 
 
