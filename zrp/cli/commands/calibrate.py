@@ -65,7 +65,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "seed": "--seed",
                                          "effects": "--effects", "max_steps": "--max-steps",
                                          "gravity_torque": "--mjcf",
-                                         "orientation_sigma": "--orientation-sigma"})
+                                         "orientation_sigma": "--orientation-sigma",
+                                         "residual_model": "--residual-model"})
 
 
 def _widen(items: list[str]) -> dict[str, float] | None:
