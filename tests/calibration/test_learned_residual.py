@@ -157,3 +157,16 @@ def test_scatter_only_keeps_no_term_and_writes_none(tmp_path):
     res.write(tmp_path / "calibrated.toml", tmp_path / "compensation.json")
     assert json.loads((tmp_path / "compensation.json").read_text())["learned_residual"] is None
     assert "LEARNED" not in (tmp_path / "calibrated.toml").read_text()
+
+
+def test_full_pose_refit_leaves_a_kept_term_out_and_says_why():
+    """The term was trained on the position-only final model's residual: a calibration that
+    is the full-pose refit does not carry it, and the note says so."""
+    from types import SimpleNamespace
+
+    from zrp.calibration.recipe import _learned
+    diag = SimpleNamespace(assessment=SimpleNamespace(residual_model=SimpleNamespace(kept=True)))
+    term, note = _learned(diag, full=object())
+    assert term is None and "full-pose refit" in note and "--no-orientation" in note
+    diag.assessment.residual_model.kept = False
+    assert _learned(diag, full=object()) == (None, None)
