@@ -22,6 +22,7 @@ from numpy.typing import ArrayLike
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.conditions import Conditions
 from zrp.calibration.fullpose import FullPoseCalibration, full_pose_calibration
+from zrp.calibration.learned import LearnedTerm
 from zrp.calibration.storage import write_calibration
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
@@ -54,6 +55,11 @@ class CalibrationOptions:
         data_angle_unit: "rad" or "deg", as the data file gives the joint values.
         instrument: the measuring instrument (recorded in the conditions).
         progress: show the diagnosis's progress on stderr.
+        residual_model: also train the learned residual term on the joint angles
+            (``zrp diagnose --residual-model``); when the diagnosis keeps it (it lowers the
+            withheld error clearly) the calibrated robot carries it (``learned``,
+            :mod:`zrp.calibration.learned`), unless the calibration is a full-pose refit
+            (the term was trained on the position-only final model's residual).
     """
 
     gravity_torque: ArrayLike | None = None
@@ -68,6 +74,7 @@ class CalibrationOptions:
     data_angle_unit: str = "rad"
     instrument: str | None = None
     progress: bool = False
+    residual_model: bool = False
 
     @property
     def max_tilt_rad(self) -> float:
@@ -83,11 +90,14 @@ class Calibration:
         robot: the calibrated robot (the full-pose refit's when ``full_pose``), with the data's
             conditions and the widened domains.
         full_pose: the full-pose calibration (measured orientations), or None.
+        learned_note: why a kept learned residual term is not in the calibrated robot, or
+            None.
     """
 
     diagnosis: Diagnosis
     robot: CalibratedRobot
     full_pose: FullPoseCalibration | None = None
+    learned_note: str | None = None
 
     def write(self, model_path: str | Path, comp_path: str | Path, *,
               overwrite: bool = False) -> list[Path]:
@@ -120,7 +130,8 @@ def calibrate(model: Manipulator, measurements: Measurements, *,
                              max_steps=opt.max_steps, noise_sigma=opt.noise_sigma,
                              use_orientation=opt.use_orientation,
                              orientation_sigma=opt.orientation_sigma,
-                             max_tilt_rad=opt.max_tilt_rad, progress=opt.progress)
+                             max_tilt_rad=opt.max_tilt_rad, progress=opt.progress,
+                             residual_model=opt.residual_model)
     elif diagnosis.context.meas is not measurements and (
             diagnosis.context.meas.source != measurements.source):
         raise InputError(f"diagnosis: it diagnosed {diagnosis.context.meas.source}, not "
@@ -134,4 +145,21 @@ def calibrate(model: Manipulator, measurements: Measurements, *,
         measurements, model, data_path=opt.data_path, data_angle_unit=opt.data_angle_unit,
         instrument=opt.instrument)
     widen = None if opt.widen is None else dict(opt.widen)
-    return Calibration(diagnosis, dataclasses.replace(cal, widen=widen, conditions=cond), full)
+    learned, note = _learned(diagnosis, full)
+    return Calibration(diagnosis, dataclasses.replace(cal, widen=widen, conditions=cond,
+                                                      learned=learned), full, note)
+
+
+def _learned(diag: Diagnosis, full: FullPoseCalibration | None
+             ) -> tuple[LearnedTerm | None, str | None]:
+    """The diagnosis's learned residual term when it was kept, and a note when it was kept
+    but cannot be used."""
+    rm = diag.assessment.residual_model if diag.assessment is not None else None
+    if rm is None or not rm.kept:
+        return None, None
+    if full is not None:
+        return None, ("the learned residual term was kept by the diagnosis but is not in the "
+                      "calibration: it was trained on the position-only model's residual, and "
+                      "the calibration is the full-pose refit (use --no-orientation to "
+                      "calibrate on positions with it)")
+    return LearnedTerm.from_residual_model(rm), None

@@ -7,8 +7,9 @@ read with a warning that the pair cannot be checked; version 1, written by 0.3.0
 has no ``backlash.lead``, so every joint lags behind its approach) holds everything the
 model file cannot: the nominal model, the instrument-from-base transform, the tool points in
 full, the folded offsets, the joint map, thermal expansion, the backlash flank model and,
-after a full-pose fit, the probe rotation and noise weights; its keys are documented in
-zrp/calibration/README.md.
+after a full-pose fit, the probe rotation and noise weights, and the learned residual term
+(``learned_residual``, :mod:`zrp.calibration.learned`: plain arrays, null without one); its
+keys are documented in zrp/calibration/README.md.
 """
 
 from __future__ import annotations
@@ -21,8 +22,15 @@ from numpy.typing import ArrayLike
 
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.conditions import Conditions
-from zrp.calibration.filecheck import bind_pair, check_fields, check_pair, loads_bounded
+from zrp.calibration.filecheck import (
+    FieldDomainError,
+    bind_pair,
+    check_fields,
+    check_pair,
+    loads_bounded,
+)
 from zrp.calibration.jointmap import Term
+from zrp.calibration.learned import LearnedTerm
 from zrp.calibration.validation import validate_calibration
 from zrp.errors import InputError, ZRPError
 from zrp.escape import one_line
@@ -99,9 +107,11 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "conditions": None if cal.conditions is None else cal.conditions.to_dict(),
         "domains_widened": cal.widen,
         "undetermined": list(cal.undetermined),
+        "learned_residual": None if cal.learned is None else cal.learned.to_dict(),
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
                   "= R_b (p'(x) + R'_n(x) t'_j) + t_b with p', R'_n the forward kinematics of "
-                  "model_file, bodies scaled by 1 + kappa (temp - t_ref)"),
+                  "model_file, bodies scaled by 1 + kappa (temp - t_ref); with learned_residual, "
+                  "the hand then moves by its rigid fit to -f(q) (learned_residual.evaluate)"),
     }
 
 
@@ -139,6 +149,13 @@ def _toml_header(cal: CalibratedRobot, comp_name: str) -> str:
                   f"#   instrument = {one_line(c.instrument)}; data_file = "
                   f"{one_line(c.data_file)}; "
                   f"data_sha256 = {c.data_sha256}"]
+    if cal.learned is not None:
+        t = cal.learned
+        lines += ["# LEARNED RESIDUAL TERM (compensation.json 'learned_residual'): kernel ridge "
+                  f"on (sin q, cos q) of {', '.join(t.inputs)};",
+                  f"#   withheld RMS {t.withheld_rms_physical:.4g} (physical model) -> "
+                  f"{t.withheld_rms_hybrid:.4g} {cal.model.length_unit} with it; valid within "
+                  "its training ranges only"]
     if cal.undetermined:
         lines.append("# NOT DETERMINED by the data (kept at nominal or known only loosely; "
                      "compensation.json 'undetermined'):")
@@ -286,7 +303,19 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
         else np.array(doc["gravity_side_weights"], dtype=float),
         None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
         None if widen is None else {str(k): float(v) for k, v in dict(widen).items()},
-        _lead(bl.get("lead"), src), tuple(str(u) for u in doc.get("undetermined") or ()))
+        _lead(bl.get("lead"), src), tuple(str(u) for u in doc.get("undetermined") or ()),
+        _learned(doc.get("learned_residual"), src))
+
+
+def _learned(value: Any, src: str) -> LearnedTerm | None:
+    """learned_residual: null (none; every file before 0.5.0) or the term, each field in its
+    domain (finite, shapes, ordered ranges)."""
+    if value is None:
+        return None
+    try:
+        return LearnedTerm.from_dict(value, src)
+    except InputError as exc:
+        raise FieldDomainError(f"{exc}; refused") from None
 
 
 def _lead(value: Any, src: str) -> tuple[bool, ...] | None:

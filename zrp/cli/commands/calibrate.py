@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
+    from zrp.calibration import Calibration
     from zrp.calibration.fullpose import FullPoseCalibration
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
@@ -52,6 +53,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="raise a physical domain's upper bound (zrp/gap/model/domains.py: "
                    f"{', '.join(DOMAINS)}), e.g. --widen axis_tilt=0.02, for an arm known "
                    "to need it; repeatable")
+    p.add_argument("--residual-model", action="store_true",
+                   help="also train a learned residual term on the joint angles (as zrp "
+                   "diagnose --residual-model); kept only when it lowers the withheld error "
+                   "clearly, it is then written into compensation.json (learned_residual) and "
+                   "applied by zrp compensate within its training ranges")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
                    help="show the diagnosis's progress on stderr (default on; --no-progress: "
                         "silent)")
@@ -59,7 +65,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "seed": "--seed",
                                          "effects": "--effects", "max_steps": "--max-steps",
                                          "gravity_torque": "--mjcf",
-                                         "orientation_sigma": "--orientation-sigma"})
+                                         "orientation_sigma": "--orientation-sigma",
+                                         "residual_model": "--residual-model"})
 
 
 def _widen(items: list[str]) -> dict[str, float] | None:
@@ -99,7 +106,7 @@ def _run(args: argparse.Namespace) -> int:
         noise_sigma=args.noise, use_orientation=not args.no_orientation,
         orientation_sigma=args.orientation_sigma, widen=widen, data_path=args.data,
         data_angle_unit="deg" if args.deg else "rad", instrument=args.instrument,
-        progress=args.progress)
+        progress=args.progress, residual_model=args.residual_model)
     out_dir = Path(args.out)
     created = not out_dir.exists()
     try:
@@ -125,10 +132,21 @@ def _run(args: argparse.Namespace) -> int:
     text = (f"withheld RMS {diag.nominal.rms:.4g} -> {diag.final.rms:.4g} "
             f"{model.length_unit} (effects: {', '.join(diag.effects)})\n"
             + ("" if full is None else _full_pose_line(full, model.length_unit))
+            + _learned_line(result, model.length_unit)
             + "\n".join(f"wrote {f}" for f in files))
     emit(args, calibration_document(result.robot, FILES[0], None if full is None else
                                     full.fit), text)
     return 0
+
+
+def _learned_line(result: Calibration, unit: str) -> str:
+    """What the learned residual term adds (or why it is not in the files), one line."""
+    rm = result.diagnosis.assessment.residual_model if result.diagnosis.assessment else None
+    if result.robot.learned is not None:
+        return f"with the {result.robot.learned.words(unit)} (in compensation.json)\n"
+    if result.learned_note is not None:
+        return f"note: {result.learned_note}\n"
+    return "" if rm is None else rm.words(unit) + "\n"
 
 
 def _full_pose_line(full: FullPoseCalibration, unit: str) -> str:
