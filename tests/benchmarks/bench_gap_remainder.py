@@ -3,7 +3,8 @@ errors at the 3rd and 4th harmonic), effect-free and scatter-only, each simulate
 robot, diagnosed blind with the learned residual term and scored against the truth afterwards
 (sim/studies/benchmark/remainder.py), at two pose counts.
 
-    python3 tests/benchmarks/bench_gap_remainder.py [--poses 800 1600] [--out FILE.md] [--force]
+    python3 tests/benchmarks/bench_gap_remainder.py [--poses 800 1600] [--quick]
+        [--out FILE.md] [--force]
 
 Writes renders/benchmarks/bench_gap_remainder.md (and .json): generated output, replaced.
 The 50-scenario run of bench_gap_benchmark.py is separate (10 minutes on a free machine).
@@ -29,12 +30,14 @@ from sim.studies.benchmark.remainder import (
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--poses", type=int, nargs="+", default=[800, 1600])
+    ap.add_argument("--quick", action="store_true",
+                    help="one size only (800 poses per scenario): a smoke run")
     add_output_arguments(ap, "bench_gap_remainder")
     args = ap.parse_args()
     out_md = output_path(args)
     model = zrp.load_model("puma")
     report = Report("bench_gap_remainder", "what remains: the blind remainder scenarios")
-    for poses in args.poses:
+    for poses in [800] if args.quick else args.poses:
         t0 = time.perf_counter()
         with tempfile.TemporaryDirectory() as work:
             scores = run_remainder_benchmark(model, Path(work), poses=poses)
