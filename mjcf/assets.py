@@ -22,6 +22,7 @@ from pathlib import Path
 
 from mjcf.errors import MJCFImportError
 from zrp.textio import read_text
+from zrp.xmlio import parse_xml
 
 __all__ = ["MAX_ASSET_BYTES", "MAX_INCLUDE_DEPTH", "check_asset_file", "check_model_files"]
 
@@ -63,13 +64,11 @@ def check_asset_file(p: Path, what: str, max_bytes: int = MAX_ASSET_BYTES) -> bo
     return True
 
 
-def _parse(text: str) -> ET.Element | None:
+def _parse(text: str, label: str) -> ET.Element | None:
     """The XML's root; None when it is not well-formed (MuJoCo refuses it then, by name,
-    before it opens any file it names)."""
-    try:
-        return ET.fromstring(text)
-    except ET.ParseError:
-        return None
+    before it opens any file it names). More markup than :data:`zrp.xmlio.MAX_XML_MARKUP`
+    is refused by name (it bounds MuJoCo's parse too)."""
+    return parse_xml(text, label=label, error=MJCFImportError, strict=False)
 
 
 def _dirs(root: ET.Element, base: Path) -> list[Path]:
@@ -99,7 +98,7 @@ def _walk(root: ET.Element, base: Path, dirs: list[Path], label: str, depth: int
                     raise MJCFImportError(f"{what}: more than {MAX_INCLUDE_DEPTH} nested "
                                           "<include> files")
                 inc = found[0]
-                sub = _parse(read_text(inc, label=str(inc), error=MJCFImportError))
+                sub = _parse(read_text(inc, label=str(inc), error=MJCFImportError), str(inc))
                 if sub is not None:
                     _walk(sub, base, dirs, str(inc), depth + 1, max_bytes)
 
@@ -119,6 +118,6 @@ def check_model_files(path: str | os.PathLike[str] | None, *, text: str | None =
         if path is None:
             raise MJCFImportError("source: give a model file or its XML text")
         text = read_text(path, label=label, error=MJCFImportError)
-    root = _parse(text)
+    root = _parse(text, label)
     if root is not None:
         _walk(root, base, _dirs(root, base), label, 0, max_bytes)

@@ -21,6 +21,7 @@ import mujoco
 import numpy as np
 
 from mjcf.arm import Arm
+from mjcf.inverse import principal_inertia
 from mjcf.tracking import TrackingGap, track_log
 from zrp.arrays import F64
 from zrp.errors import InputError
@@ -90,15 +91,8 @@ def _body_name(m: mujoco.MjModel, b: int) -> str:
 def _set_inertial(body: mujoco.MjsBody, phi: F64) -> None:
     """Write phi_b (eq. R1) as mass, centre, principal inertias and their frame."""
     mass = max(float(phi[0]), MIN_MASS_KG)  # a link emptied of its mass stays compilable
-    c = phi[1:4] / mass
-    io = np.array([[phi[4], phi[7], phi[8]], [phi[7], phi[5], phi[9]],
-                   [phi[8], phi[9], phi[6]]])
-    w, v = np.linalg.eigh(io - mass * (float(c @ c) * np.eye(3) - np.outer(c, c)))
+    c, quat, w = principal_inertia(phi, mass)
     w = np.maximum(w, 0.0)  # rounding of a physical body (eq. R5) never below zero
-    if np.linalg.det(v) < 0:
-        v[:, 0] = -v[:, 0]
-    quat = np.empty(4)
-    mujoco.mju_mat2Quat(quat, v.ravel())
     body.explicitinertial = True
     body.mass = mass
     body.ipos = c

@@ -16,8 +16,8 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.gap.dynamics.inertia import PARAM_NAMES, V_EPS, inertia_matrix, skew2
 
-__all__ = ["body_params", "gravity_torques", "inverse_dynamics", "regressor",
-           "set_body_params"]
+__all__ = ["body_params", "gravity_torques", "inverse_dynamics", "principal_inertia",
+           "regressor", "set_body_params"]
 
 
 def body_params(m: mujoco.MjModel, b: int) -> F64:
@@ -32,17 +32,23 @@ def body_params(m: mujoco.MjModel, b: int) -> F64:
                      io[1, 2]])
 
 
-def set_body_params(m: mujoco.MjModel, b: int, phi: F64) -> None:
-    """Write phi_b into the model's body fields (mass, ipos, iquat, diagonal inertia); any
-    values, physical or not (``mj_inverse`` is linear in them)."""
-    mass = float(phi[0])
+def principal_inertia(phi: F64, mass: float) -> tuple[F64, F64, F64]:
+    """Body frame of phi_b (eq. R1) taken with ``mass``: the centre c (3,), the quaternion of
+    the principal axes (4,, a proper rotation) and the principal inertias about c (3,)."""
     c = phi[1:4] / mass if mass != 0.0 else np.zeros(3)
-    ic = inertia_matrix(phi) - mass * skew2(c)
-    w, v = np.linalg.eigh(ic)
+    w, v = np.linalg.eigh(inertia_matrix(phi) - mass * skew2(c))
     if np.linalg.det(v) < 0:
         v[:, 0] = -v[:, 0]
     q = np.empty(4)
     mujoco.mju_mat2Quat(q, v.ravel())
+    return c, q, w
+
+
+def set_body_params(m: mujoco.MjModel, b: int, phi: F64) -> None:
+    """Write phi_b into the model's body fields (mass, ipos, iquat, diagonal inertia); any
+    values, physical or not (``mj_inverse`` is linear in them)."""
+    mass = float(phi[0])
+    c, q, w = principal_inertia(phi, mass)
     m.body_sameframe[b] = 0  # else MuJoCo ignores ipos/iquat of a body compiled "same frame"
     m.body_mass[b] = mass
     m.body_ipos[b] = c

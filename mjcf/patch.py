@@ -41,6 +41,7 @@ from zrp.model.manipulator import Manipulator, hand_frame
 from zrp.output import check_writable, write_text
 from zrp.textio import read_text
 from zrp.units import metres_per_unit
+from zrp.xmlio import XMLDocument, xml_document
 
 __all__ = ["export_mjcf", "patch_mjcf", "relocate_assets"]
 
@@ -127,10 +128,15 @@ class _Chain:
     sid: int
     joints: list[int]
     names: list[str]
-    root: ET.Element
+    doc: XMLDocument
     pts: F64            # p'_1..p'_n and the end point, (n + 1, 3)
     end: F64            # the end frame, 4x4
     rot: F64 | None
+
+    @property
+    def root(self) -> ET.Element:
+        """The file's root element (rewritten in place)."""
+        return self.doc.root
 
     def bodies(self) -> list[int]:
         """Bodies from the first below the world down to the end body."""
@@ -151,11 +157,8 @@ def _load(path: str | os.PathLike[str], model: Manipulator, site: str | None,
     if model.n != len(joints) or list(model.joint_names) != names:
         raise ModelError(f"{src}: the model's joints {list(model.joint_names)} are not the "
                          f"chain's joints {names}; patch the file the model was imported from")
-    try:
-        root = ET.parse(path).getroot()
-    except (ET.ParseError, OSError) as exc:
-        raise MJCFImportError(f"{src}: cannot read ({exc})") from exc
-    _check_file(root, src)
+    doc = xml_document(path, label=src, error=MJCFImportError)  # comments, PIs kept
+    _check_file(doc.root, src)
     rot = None if rotations is None else np.asarray(rotations, dtype=float)
     if rot is not None and rot.shape != (model.n, 3, 3):
         raise ModelError(f"rotations: expected shape ({model.n}, 3, 3), got {rot.shape}")
@@ -165,7 +168,7 @@ def _load(path: str | os.PathLike[str], model: Manipulator, site: str | None,
     pts = np.cumsum(np.asarray(model.bodies), axis=0) * metres_per_unit(model.length_unit)
     ee = model.end_effector
     end = _pose(hand_frame(ee.axial, ee.transverse), pts[-1])
-    return _Chain(src, m, d, bid, sid, joints, names, root, pts, end, rot)
+    return _Chain(src, m, d, bid, sid, joints, names, doc, pts, end, rot)
 
 
 def _rewrite(c: _Chain, model: Manipulator) -> F64:
@@ -224,8 +227,8 @@ def patch_mjcf(path: str | os.PathLike[str], model: Manipulator, *, site: str | 
     if out_dir is not None:
         relocate_assets(c.root, Path(path).resolve().parent, Path(out_dir).resolve())
     ET.indent(c.root, space="  ")
-    return ("<!-- patched by zrp-accuracy: the calibrated chain (body poses, joint axes, end "
-            "frame) -->\n" + ET.tostring(c.root, encoding="unicode") + "\n")
+    return c.doc.text("patched by zrp-accuracy: the calibrated chain (body poses, joint axes, "
+                      "end frame)")
 
 
 def export_mjcf(cal: CalibratedRobot, source: str | os.PathLike[str], xml_path: str | Path,

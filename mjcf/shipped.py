@@ -26,6 +26,7 @@ from mjcf.assets import check_asset_file, check_model_files
 from mjcf.errors import MJCFImportError
 from zrp.errors import InputError
 from zrp.textio import read_text
+from zrp.xmlio import read_xml
 
 __all__ = ["MESH_SUFFIXES", "example_robot_data_root", "load_shipped", "load_shipped_spec",
            "resolve_mesh", "shipped_urdf_xml"]
@@ -76,10 +77,7 @@ def shipped_urdf_xml(path: str | os.PathLike[str]) -> tuple[str, list[str]]:
     / ``<collision>`` of unresolvable or unreadable meshes dropped, MuJoCo's compiler
     settings (module docstring) added. Returns (text, the mesh URIs dropped)."""
     p = Path(path)
-    try:
-        root = ET.parse(p).getroot()
-    except (OSError, ET.ParseError) as exc:
-        raise MJCFImportError(f"source {str(p)!r}: cannot read it as URDF XML: {exc}") from exc
+    root = read_xml(p, label=f"source {str(p)!r}", error=MJCFImportError)  # bounded, linear
     if root.tag != "robot":
         raise MJCFImportError(f"source {str(p)!r}: the root element is <{root.tag}>, not "
                               "<robot>; not a URDF")

@@ -76,8 +76,10 @@ class Run:
 
 def run_servo(plant: mujoco.MjModel, nominal: mujoco.MjModel, servo: Servo, command: Command,
               duration_s: float, rate_hz: float = 1000.0, substeps: int = 4,
-              stribeck: tuple[F64, float] | None = None) -> Run:
-    """Drive ``plant`` along ``command`` with ``servo`` (feed-forward from ``nominal``)."""
+              stribeck: tuple[F64, float] | None = None, moving_start: bool = False) -> Run:
+    """Drive ``plant`` along ``command`` with ``servo`` (feed-forward from ``nominal``),
+    starting at the command's first position, at rest (or at its velocity: ``moving_start``,
+    for a stretch of a log that starts in motion)."""
     dt = 1.0 / (rate_hz * substeps)
     p = _plant(plant, dt)
     d = mujoco.MjData(p)
@@ -87,6 +89,8 @@ def run_servo(plant: mujoco.MjModel, nominal: mujoco.MjModel, servo: Servo, comm
     tf = np.arange(steps * substeps) * dt
     qc, qcd, qcdd = command.evaluate(tf)
     d.qpos[:] = qc[0]
+    if moving_start:
+        d.qvel[:] = qcd[0]
     fl = np.asarray(nominal.dof_frictionloss)
     n = p.nv
     out_q, out_qd, out_tau = (np.empty((steps, n)) for _ in range(3))
@@ -128,19 +132,45 @@ class SampledCommand:
         return sp(t), sp(t, 1), sp(t, 2)
 
 
+def _simulated_at(model: mujoco.MjModel, nominal: mujoco.MjModel, servo: Servo,
+                  command: Command, t: F64, rate_hz: float) -> F64:
+    """Positions (len(t), n) of ``model`` driven along ``command`` (which starts at t[0]),
+    read at the real sample times ``t`` (a jittered clock is not a uniform grid)."""
+    span = float(t[-1] - t[0])
+    run = run_servo(copy.deepcopy(model), nominal, servo, command, span + 1.0 / rate_hz,
+                    rate_hz, moving_start=True)
+    return np.column_stack([np.interp(t - t[0], run.t, run.q[:, j])
+                            for j in range(run.q.shape[1])])
+
+
 def tracking_gap(model: mujoco.MjModel, nominal: mujoco.MjModel, log: TorqueLog, servo: Servo,
                  command: Command | None = None) -> F64:
     """RMS of (re-simulated minus logged) joint positions per joint (n,), ``model`` driven by
     ``servo`` (feed-forward from ``nominal``, as the real controller) along the log's
-    commanded positions (or ``command``, an object with ``evaluate(t)``)."""
-    if command is None:
-        if log.qc is None:
-            raise InputError(f"{log.source}: no commanded positions qc1..qcn; the "
-                             "re-simulation drives them")
-        command = SampledCommand(log.t, log.qc)
-    run = run_servo(copy.deepcopy(model), nominal, servo, command,
-                    log.n_samples / (1.0 / log.dt), 1.0 / log.dt)
-    return np.sqrt(np.mean((run.q - log.q) ** 2, axis=0))
+    commanded positions (or ``command``, an object with ``evaluate(t)``).
+
+    The simulation is read at the log's own sample times, and a log split at gaps is
+    re-simulated one segment at a time, each from its own start (a gap is time the log does
+    not show, not time the servo ran through)."""
+    rate = 1.0 / log.dt
+    if command is not None:
+        return np.sqrt(np.mean((_simulated_at(model, nominal, servo, command, log.t, rate)
+                                - log.q) ** 2, axis=0))
+    if log.qc is None:
+        raise InputError(f"{log.source}: no commanded positions qc1..qcn; the "
+                         "re-simulation drives them")
+    sq, count = np.zeros(log.n_joints), 0
+    for a, b in log.segment_ranges:
+        if b - a < 4:
+            continue
+        seg = SampledCommand(log.t[a:b], log.qc[a:b])
+        q = _simulated_at(model, nominal, servo, seg, log.t[a:b], rate)
+        sq += np.sum((q - log.q[a:b]) ** 2, axis=0)
+        count += b - a
+    if count == 0:
+        raise InputError(f"{log.source}: no stretch of at least 4 samples without a gap to "
+                         "re-simulate")
+    return np.sqrt(sq / count)
 
 
 @dataclass(frozen=True)

@@ -21,6 +21,7 @@ from mjcf.errors import MJCFOutputError
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
+from zrp.xmlio import parse_xml
 
 __all__ = ["mjcf_xml", "save_mjcf"]
 
@@ -42,7 +43,8 @@ def mjcf_xml(arm: BuiltArm | Manipulator, options: MJCFOptions | None = None) ->
         raise InputError(f"arm: expected a mjcf.BuiltArm or a zrp.Manipulator, got "
                          f"{type(arm).__name__}")
     text = arm.spec.to_xml()
-    root = ET.fromstring(text)
+    root = parse_xml(text, label="the built arm's MJCF", error=MJCFOutputError)
+    assert root is not None
     model = arm.manipulator
     pre = arm.options.prefix
     bodies_m = np.asarray(model.bodies) * arm.scale

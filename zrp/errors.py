@@ -15,6 +15,7 @@ __all__ = [
     "ModelFileError",
     "OutputBusyError",
     "OutputExistsError",
+    "OutputIsInputError",
     "OutputKindError",
     "SingularityError",
     "SingularityWarning",
@@ -70,6 +71,10 @@ class OutputExistsError(ZRPError, FileExistsError):
 
     def __str__(self) -> str:
         return self.message(getattr(self, "option", "overwrite=True"))
+
+
+class OutputIsInputError(InputError):
+    """An output path is a file the same command reads (refused even with ``--force``)."""
 
 
 class OutputBusyError(ZRPError, RuntimeError):

@@ -8,6 +8,9 @@ type, not a silent ``str()``.
 
 :func:`dict_from_dataclass` is the one way a result dataclass writes its ``to_dict()``: its
 fields in declaration order, renamed or left out where the JSON schema says so.
+
+:func:`version_field` is the one way a reader checks a file's format version: an integer
+among the known ones (``true`` is not version 1, though Python's ``True == 1``).
 """
 
 from __future__ import annotations
@@ -21,7 +24,9 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["dict_from_dataclass", "dumps", "to_jsonable"]
+from zrp.errors import InputError, ZRPError
+
+__all__ = ["dict_from_dataclass", "dumps", "to_jsonable", "version_field"]
 
 
 def to_jsonable(obj: Any) -> Any:
@@ -106,3 +111,23 @@ def dict_from_dataclass(obj: Any, *, exclude: Collection[str] = (),
         else:
             out[keys.get(f.name, f.name)] = _field_value(v)
     return out
+
+
+def version_field(doc: Mapping[str, Any], key: str, accepted: Collection[int], *, src: str,
+                  error: type[ZRPError] = InputError, hint: str = "") -> int:
+    """``doc[key]`` when it is an integer (not a boolean, not a float) among ``accepted``.
+
+    Raises:
+        error: naming ``src``, the field, its value and the accepted versions (``hint``
+            appended: what to do).
+    """
+    v = doc.get(key)
+    if type(v) is int and v in accepted:
+        return v
+    want = ", ".join(map(str, accepted))
+    raise error(f"{src}: {key} {json.dumps(v) if _plain(v) else repr(v)}, expected "
+                f"{'one of ' if len(accepted) > 1 else ''}{want} (an integer){hint}")
+
+
+def _plain(v: Any) -> bool:
+    return v is None or isinstance(v, (bool, int, float, str))

@@ -8,6 +8,11 @@ measure the same thing. The sets are the cases that slid back or are easy to los
   (0, 1.25, 2.5 kg) with a compliant joint 2: the deflection is the MuJoCo arm's own static
   gravity torque (distributed link inertias, :meth:`sim.robot.real.RealRobot.static_torque`,
   not the diagnosis's lumped masses) times the compliance (issue 34).
+* ``payloads_lookalikes``: the same arm at the same payloads with what made the real case
+  hard (issue 34): joint 2's compliance smaller (a few tenths of a mm at the tool), smaller
+  ones on joints 4 and 6 (near-collinear compliance terms), a cyclic error of joint 2 (a
+  look-alike of its gravity torque), an encoder scale, joint offsets, body errors and a tilt,
+  a tracker's 0.05 mm noise.
 * ``probe_6d``: a PUMA with a 6-D probe (positions and orientations) and an axis tilt that
   positions alone see weakly, plus a joint offset.
 * ``near_collinear``: the Panda over a narrow range around a home pose (offset, encoder scale
@@ -20,7 +25,8 @@ measure the same thing. The sets are the cases that slid back or are easy to los
 from __future__ import annotations
 
 import warnings
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -32,7 +38,7 @@ from zrp.kinematics import uniform_joint_values
 from zrp.rotations import matrix_from_rotvec
 from zrp.testing import panda_mdh
 
-__all__ = ["IIWA_LIMITS", "SETS", "iiwa_mdh", "payload_compliance_set", "ur10_dh"]
+__all__ = ["IIWA_LIMITS", "LOOKALIKES", "SETS", "iiwa_mdh", "payload_compliance_set", "ur10_dh"]
 
 #: KUKA LBR iiwa 7 R800 joint limits (deg in the datasheet), rad.
 IIWA_LIMITS = tuple((-lim, lim) for lim in np.radians([170, 120, 170, 120, 170, 120, 175]))
@@ -60,12 +66,16 @@ def ur10_dh() -> zrp.Manipulator:
 
 def payload_compliance_set(n_per_payload: int = 200, seed: int = 1, sigma: float = 0.1,
                            compliance: float = 2e-5,
-                           payloads: tuple[float, ...] = (0.0, 1.25, 2.5)
+                           payloads: tuple[float, ...] = (0.0, 1.25, 2.5),
+                           hidden: Mapping[str, Any] | None = None
                            ) -> tuple[zrp.Manipulator, Measurements]:
     """The iiwa at each payload: commanded q uniform within the limits (0.1 rad inside), the
     link angles q + offset - c tau(link angles) (the static deflection of a servo of
     stiffness 1/c, three fixed-point passes), the tool points of the MuJoCo arm's true
-    geometry with ``sigma`` mm noise, in an instrument frame; a ``load`` column in kg."""
+    geometry with ``sigma`` mm noise, in an instrument frame; a ``load`` column in kg.
+    ``compliance``: joint 2's (rad/(N m)); ``hidden``: more :class:`sim.robot.effects.
+    HiddenEffects` (its ``joint_compliance`` adds other joints'; default: joint 3's offset
+    of 0.5 mrad only)."""
     from sim.robot.effects import HiddenEffects
     from sim.robot.real import RealRobot
 
@@ -73,14 +83,16 @@ def payload_compliance_set(n_per_payload: int = 200, seed: int = 1, sigma: float
     rng = np.random.default_rng(seed)
     lo, hi = np.array(IIWA_LIMITS).T
     rb, tb = matrix_from_rotvec([0.02, -0.01, 0.8]), np.array([1500.0, -300.0, 200.0])
+    effects = dict(hidden) if hidden is not None else {"joint_offset": {3: 5e-4}}
+    effects["joint_compliance"] = {**effects.get("joint_compliance", {}), 2: compliance}
     c = np.zeros(arm.n)
-    c[1] = compliance
+    for k, v in effects["joint_compliance"].items():
+        c[k - 1] = v
     parts = []
     for i, w in enumerate(payloads):
         with warnings.catch_warnings():  # the announced fallback inertias (rods)
             warnings.simplefilter("ignore")
-            robot = RealRobot(arm, HiddenEffects(joint_compliance={2: compliance}, payload=w,
-                                                 joint_offset={3: 5e-4}))
+            robot = RealRobot(arm, HiddenEffects(**effects, payload=w))
         q = rng.uniform(lo + 0.1, hi - 0.1, size=(n_per_payload, arm.n))
         qm = robot.motor_target(q)
         ql = qm.copy()
@@ -99,6 +111,22 @@ def payload_compliance_set(n_per_payload: int = 200, seed: int = 1, sigma: float
 
 def _payloads(size: float) -> tuple[zrp.Manipulator, Measurements]:
     return payload_compliance_set(max(int(200 * size), 40))
+
+
+#: the hidden effects of ``payloads_lookalikes`` besides joint 2's compliance (1e-5 rad/(N m)).
+LOOKALIKES: dict[str, Any] = {
+    "joint_compliance": {4: 4e-6, 6: 2e-6},
+    "joint_offset": {2: 3e-4, 3: 5e-4, 5: -4e-4},
+    "encoder_scale": {4: 5e-4},
+    "cyclic_error": {2: (1, 2e-4, 1e-4)},
+    "link_length": {3: (0.1, -0.05, 0.08), 5: (-0.06, 0.1, 0.0)},
+    "axis_misalignment": {4: (2e-4, -1e-4)},
+}
+
+
+def _payloads_lookalikes(size: float) -> tuple[zrp.Manipulator, Measurements]:
+    return payload_compliance_set(max(int(200 * size), 40), seed=2, sigma=0.05,
+                                  compliance=1e-5, hidden=LOOKALIKES)
 
 
 def _probe_6d(size: float) -> tuple[zrp.Manipulator, Measurements]:
@@ -142,6 +170,8 @@ def _few_poses(size: float) -> tuple[zrp.Manipulator, Measurements]:
 SETS: dict[str, tuple[str, Callable[[float], tuple[zrp.Manipulator, Measurements]]]] = {
     "payloads_compliance": ("iiwa 7, 3 payloads, compliant joint 2 (MuJoCo torques)",
                             _payloads),
+    "payloads_lookalikes": ("iiwa 7, 3 payloads, compliant joints 2/4/6, cyclic/scale "
+                            "look-alikes, geometry", _payloads_lookalikes),
     "probe_6d": ("PUMA, 6-D probe, weakly seen axis tilt + offset", _probe_6d),
     "near_collinear": ("Panda, narrow range: offset/scale/cyclic near-collinear",
                        _near_collinear),

@@ -8,7 +8,9 @@ prints figures and ratios measured in the same run.
   worse. Before issue 26: 1e6 rows took 434 s and 5.3 GB.
 * URDF import (``zrp.import_urdf``) of chains of 5,000 and 20,000 joints (CPU time; a ratio of
   about 4 is linear: it was quadratic, 109 s for 20,000 joints) and of a 20 MB file that is
-  mostly comments (it took 46 s).
+  mostly comments (it took 46 s), and of files of 4e5 and 9e5 short comments on lines of their
+  own (a ratio of about 2.25 is linear; 2e6 took 50 s, quadratic, and is now refused by
+  ``zrp.xmlio.MAX_XML_MARKUP``).
 
 * With ``--baseline REF``: each trajectory file also runs through the code of git commit REF
   (extracted by ``git archive`` into a temporary folder) in the same run, and the table gives
@@ -131,6 +133,16 @@ def _urdf_rows(folder: Path) -> list[tuple[str, ...]]:
     cpu = _cpu(import_urdf, path)
     rows.append(("2,000 joints, mostly comments", f"{path.stat().st_size / 1e6:.1f}",
                  f"{cpu:.2f}", "(was 46 s)"))
+    base = None
+    for n in (400_000, 900_000):  # short comments on lines of their own (issue 35, #11)
+        path = folder / f"short{n}.urdf"
+        text = _urdf(10)
+        path.write_text(text.replace("</robot>", "<!--a-->\n" * n + "</robot>"))
+        cpu = _cpu(import_urdf, path)
+        base = base or cpu
+        rows.append((f"{n:,} short comment lines", f"{path.stat().st_size / 1e6:.1f}",
+                     f"{cpu:.2f}", f"{cpu / base:.2f}" + (" (linear: about 2.25)"
+                                                          if n == 900_000 else "")))
     for r in rows:
         print("URDF " + ", ".join(r))
     return rows

@@ -94,7 +94,7 @@ def test_a_field_outside_its_domain_is_refused_by_name(pair, name, edit, match):
     ("[" * 100_000 + "]" * 100_000, r"nested 100000 deep; .* at most 32"),
     ('{"schema_version": NaN}', r"NaN is not a JSON number"),
     ('{"schema_version": Infinity}', r"Infinity is not a JSON number"),
-    ('{"schema_version": true}', r"schema_version True, expected one of 1, 2, 3"),
+    ('{"schema_version": true}', r"schema_version true, expected one of 1, 2, 3 \(an integer\)"),
 ])
 def test_json_nesting_constants_and_version(pair, text, match):
     _, c = pair

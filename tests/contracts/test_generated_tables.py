@@ -16,10 +16,11 @@ ROOT = Path(__file__).resolve().parents[2]
 BENCH = ROOT / "tests" / "benchmarks"
 BLOCKS = (("bench_arms", ROOT / "sim" / "README.md"),
           ("bench_dynamics", ROOT / "zrp" / "gap" / "dynamics" / "README.md"),
-          ("bench_dynamics_reallogs", ROOT / "sim" / "README.md"))
+          ("bench_dynamics_reallogs", ROOT / "sim" / "README.md"),
+          ("bench_figaroh", ROOT / "zrp" / "gap" / "README.md"))
 #: The benchmarks whose --quick runs leave the README as it is (the others write it, saying
 #: the size they ran at in the block's heading).
-QUICK_SKIPS_README = {"bench_arms", "bench_dynamics_reallogs"}
+QUICK_SKIPS_README = {"bench_arms", "bench_dynamics_reallogs", "bench_figaroh"}
 
 
 def _block_module():

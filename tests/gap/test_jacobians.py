@@ -99,3 +99,35 @@ def test_geometric_columns_agree_with_identification_module():
     _, J = prob.residual_and_jacobian(np.zeros(len(specs)))
     ref = parameter_jacobian(model, meas.q_pose, joint_offsets=True)[:, 3:6, :]
     np.testing.assert_allclose(J.reshape(5, 3, -1), ref, atol=1e-9)
+
+
+def test_the_chain_is_kept_for_its_theta_only_and_read_only():
+    """A Problem hands out its last chain again for the same theta (the full-pose fit asks
+    twice), a new one for any other theta, and the kept arrays cannot be written."""
+    model = zrp.load_model("puma")
+    ctx = Context(model, _data(model, np.random.default_rng(3)))
+    specs = registration_parameters(ctx) + effect_parameters(ctx, "joint_offset")[0]
+    prob = Problem(ctx, specs, np.arange(12))
+    theta = np.random.default_rng(4).normal(size=len(specs)) * 1e-3
+    ch = prob._chain(theta)
+    assert prob._chain(theta.copy()) is ch
+    other = theta.copy()
+    other[-1] += 1e-12
+    assert prob._chain(other) is not ch
+    with pytest.raises(ValueError, match="read-only"):
+        ch.pos[0, 0] = 1.0
+    r1, _ = prob.residual_and_jacobian(theta)
+    prob._last = None  # the same values computed afresh
+    assert np.array_equal(r1, prob.residual_and_jacobian(theta)[0])
+
+
+def test_the_moment_arms_are_computed_once_per_context():
+    model = zrp.load_model("puma")
+    ctx = Context(model, _data(model, np.random.default_rng(5)))
+    labels, h = ctx.moment_arms()
+    labels2, h2 = ctx.moment_arms()
+    assert h2 is h and labels2 == labels
+    labels2.append("x")  # the caller's list, not the cache's
+    assert ctx.moment_arms()[0] == labels
+    with pytest.raises(ValueError, match="read-only"):
+        h[0, 0, 0] = 1.0

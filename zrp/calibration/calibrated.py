@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike
 from zrp.arrays import F64
 from zrp.calibration.conditions import Conditions
 from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
+from zrp.calibration.learned import LearnedTerm, check_learned, correct_hand
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.finalrecord import FinalModelRecord, final_model_record
@@ -160,6 +161,8 @@ class CalibratedRobot:
         backlash_switch_weights: per joint, the plausible switching torques and their
             weights of the diagnosis's flank model (the loaded-flank share of a pose is their
             weighted vote), or None (``backlash_switch`` alone decides).
+        learned: the learned residual term on the joint angles (:mod:`.learned`; its points
+            are ``tool_labels``), or None (the physical model alone).
     """
 
     model: Manipulator
@@ -186,6 +189,7 @@ class CalibratedRobot:
     undetermined: tuple[str, ...] = ()
     taken_out: tuple[str, ...] = ()
     backlash_switch_weights: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None = None
+    learned: LearnedTerm | None = None
 
     def __post_init__(self) -> None:
         n = self.model.n
@@ -208,6 +212,7 @@ class CalibratedRobot:
                              f"entries for {n} joints")
         if self.backlash_lead is not None and len(self.backlash_lead) != n:
             raise InputError(f"backlash_lead: {len(self.backlash_lead)} flags for {n} joints")
+        check_learned(self.learned, tuple(self.tool_labels), n)
         bad = [t.name for t in self.terms if not 1 <= t.joint <= n]
         if bad:
             raise InputError(f"terms {bad}: joint outside 1..{n}")
@@ -330,7 +335,9 @@ class CalibratedRobot:
         cond = cond or PoseConditions()
         x = self.actual_joint_values(q, cond)
         pos, rn, _, _ = chain(self.model, x, self.body_scale(len(x), cond.temp))
-        y = pos + rn @ self.tool_offset(point)
+        tool = self.tool_offset(point)
+        y, _ = correct_hand(self.learned, self.base_rotation, self.tool_points,
+                            np.atleast_2d(np.asarray(q, dtype=float)), pos + rn @ tool, rn, tool)
         return self.to_frame(y, frame)
 
     def predict_rotation(self, q: ArrayLike, cond: PoseConditions | None = None,
@@ -338,7 +345,9 @@ class CalibratedRobot:
         """Predicted hand rotation R'_n(x) when q (P, n) is commanded, shape (P, 3, 3), in the
         instrument frame (R_b R'_n) or ``frame="base"``."""
         x = self.actual_joint_values(q, cond or PoseConditions())
-        _, rn, _, _ = chain(self.model, x)
+        pos, rn, _, _ = chain(self.model, x)
+        _, rn = correct_hand(self.learned, self.base_rotation, self.tool_points,
+                             np.atleast_2d(np.asarray(q, dtype=float)), pos, rn, np.zeros(3))
         if frame == "base":
             return rn
         if frame != "instrument":

@@ -36,6 +36,7 @@ from zrp.calibration.conditions import (
     payload_separated,
 )
 from zrp.calibration.guards import guard, reference_poses
+from zrp.calibration.learned import correct_hand
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
 from zrp.model.manipulator import hand_frame
@@ -65,8 +66,9 @@ class Compensation:
             :mod:`zrp.calibration.guards`), shape (T,).
         near_limit: a joint within the margin of its limit, shape (T,) (False without limits).
         converged: the solve met its tolerance, shape (T,).
-        outside_measured: a command outside the joint ranges the calibration measured,
-            shape (T,) (compensated only with ``accept_flagged``).
+        outside_measured: a command outside the joint ranges the calibration measured (or
+            the training ranges of its learned residual term), shape (T,) (compensated only
+            with ``accept_flagged``).
     """
 
     target_ids: tuple[str, ...]
@@ -150,6 +152,7 @@ def _errors(cal: CalibratedRobot, q: F64, cond: PoseConditions, tg: _Targets
     """Error vector (T, 3 or 6), Jacobian (T, 3 or 6, n) and the 6-row scaled Jacobian."""
     x = cal.actual_joint_values(q, cond)
     y, rn, jv, jw = _kinematics(cal, x, tg.tool, cal.body_scale(len(x), cond.temp))
+    y, rn = correct_hand(cal.learned, cal.base_rotation, cal.tool_points, q, y, rn, tg.tool)
     L = cal.model.characteristic_length
     full = np.concatenate([jw, jv / L], axis=2).transpose(0, 2, 1)      # (T, 6, n)
     e = y - tg.y
@@ -348,7 +351,8 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
     near_limit = _check_limits(q, lim, limit_margin, ids)
     smin = np.linalg.svd(full, compute_uv=False)[:, -1]
     outside, near = guard(ids, q, smin, cal.conditions, lambda: _reference_sigma(cal, tg),
-                          accept_flagged=accept_flagged, singular_tol=singular_tol)
+                          accept_flagged=accept_flagged, singular_tol=singular_tol,
+                          learned=cal.learned)
     L = cal.model.characteristic_length
     return Compensation(ids, q, q0, y + e[:, :3], np.linalg.norm(e[:, :3], axis=1),
                         None if rot is None else np.linalg.norm(e[:, 3:], axis=1) / L,

@@ -8,7 +8,8 @@ names, joint types, limits, inertias, meshes and fixed frames stay) with the fol
 turning each link's frame by its folded offsets (so meshes follow their link), and writes the
 terms a URDF cannot hold to a side file (JSON, keys in zrp/calibration/README.md): the joint
 map (encoder scale, cyclic error, compliance, backlash), thermal expansion, the
-instrument-from-base transform, the tool points, the folded offsets and the conditions.
+instrument-from-base transform, the tool points, the folded offsets, the conditions and the
+learned residual term (:mod:`zrp.calibration.learned`; null without one).
 """
 
 from __future__ import annotations
@@ -34,7 +35,8 @@ SIDE_KIND = "zrp calibration side file (the terms a URDF cannot hold)"
 _SIDE_KEYS = ("schema_version", "zrp_version", "length_unit", "frame", "base_rotation",
               "base_rotvec", "base_translation", "tool_points", "joint_offsets_folded",
               "joint_map", "thermal", "backlash", "gravity_dir", "harmonics",
-              "compliance_model", "gravity_side_weights", "conditions", "domains_widened")
+              "compliance_model", "gravity_side_weights", "conditions", "domains_widened",
+              "learned_residual")
 
 
 def side_document(cal: CalibratedRobot, urdf_file: str, source_text: str, base_link: str | None,
@@ -52,7 +54,8 @@ def side_document(cal: CalibratedRobot, urdf_file: str, source_text: str, base_l
                     "revolute offsets joint_offsets_folded are folded into the origins, so "
                     "commands stay the robot's own joint values); x = q + sum(value * basis) "
                     "per joint-map term (zrp/calibration/README.md), bodies scaled by 1 + kappa "
-                    "(temp - t_ref), measured points m = R_b (p(x) + R_n(x) t_j) + t_b")
+                    "(temp - t_ref), measured points m = R_b (p(x) + R_n(x) t_j) + t_b; with "
+                    "learned_residual, point j is then moved by -f_j(q) (its evaluate key)")
     return out
 
 
@@ -79,7 +82,7 @@ def export_urdf(cal: CalibratedRobot, source: str | Path, urdf_path: str | Path,
     except (OSError, UnicodeDecodeError) as exc:
         raise InputError(f"{source}: cannot read the URDF ({exc})") from exc
     urdf = patch_urdf(text, cal.model, base_link=base_link, end_link=end_link,
-                      rotations=cal.fold_rotations())
+                      rotations=cal.fold_rotations(), label=str(source))
     side = side_document(cal, Path(urdf_path).name, text, base_link, end_link)
     u = write_text(urdf_path, urdf, overwrite=overwrite)
     s = write_text(side_path, dumps(side), overwrite=overwrite)

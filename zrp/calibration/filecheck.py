@@ -257,7 +257,7 @@ def check_pair(doc: dict[str, Any], src: str, model_path: Path, model_bytes: byt
     Raises:
         TamperedPairError: naming the file that was changed.
     """
-    if doc.get("schema_version") in (1, 2):
+    if type(doc.get("schema_version")) is int and doc["schema_version"] in (1, 2):
         warnings.warn(f"{src}: written before schema_version 3, it does not name its model "
                       f"file's SHA-256: a changed {model_path.name} cannot be detected "
                       "(calibrate again to bind the pair)", PairWarning, stacklevel=3)

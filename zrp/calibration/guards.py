@@ -16,6 +16,10 @@ measured joint ranges (the model's limits, else +-pi, for a joint without a reco
 
     near singular:  sigma_min(command) < NEAR_SINGULAR_SHARE * median_k sigma_min(q_k)
 
+* a command **outside the training ranges of the learned residual term** (when the
+  calibration carries one, :mod:`zrp.calibration.learned`; by the same share of its ranges):
+  the learned term is extrapolated there.
+
 With ``accept_flagged`` every target is compensated and these rows are flagged in the result
 (``outside_measured``, ``near_singular``) and in the commands CSV.
 """
@@ -30,6 +34,7 @@ from numpy.typing import NDArray
 
 from zrp.arrays import F64
 from zrp.calibration.conditions import Conditions
+from zrp.calibration.learned import LearnedTerm, learned_outside
 from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 
@@ -95,18 +100,22 @@ def _outside(q: F64, conditions: Conditions | None) -> NDArray[np.bool_]:
 
 def guard(ids: tuple[str, ...], q: F64, sigma_min: F64, conditions: Conditions | None,
           reference: Callable[[], float], *, accept_flagged: bool,
-          singular_tol: float | None = None) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
-    """(outside the measured ranges, near-singular) per target, shape (T,) each.
+          singular_tol: float | None = None, learned: LearnedTerm | None = None
+          ) -> tuple[NDArray[np.bool_], NDArray[np.bool_]]:
+    """(outside the measured ranges or the learned term's training ranges, near-singular)
+    per target, shape (T,) each.
 
     Args:
         ids: target labels; q: the commands (T, n); sigma_min: their sigma_min (T,).
         reference: the median sigma_min of eq. G1 (called only without ``singular_tol``).
         accept_flagged: compensate and flag instead of refusing.
         singular_tol: an absolute sigma_min threshold instead of eq. G1.
+        learned: the calibration's learned residual term, or None.
 
     Raises:
-        UnmeasuredTargetError: a command outside a measured range (naming the target, the
-            joint, its value and the range), unless ``accept_flagged``.
+        UnmeasuredTargetError: a command outside a measured range or the learned term's
+            training range (naming the target, the joint, its value and the range), unless
+            ``accept_flagged``.
         NearSingularTargetError: a near-singular command, unless ``accept_flagged``.
     """
     out = _outside(q, conditions)
@@ -120,6 +129,8 @@ def guard(ids: tuple[str, ...], q: F64, sigma_min: F64, conditions: Conditions |
             f"range the calibration measured [{lo:.6g}, {hi:.6g}] "
             f"({int(out.any(axis=1).sum())} target(s) outside): the model is extrapolated "
             f"there; measure poses there, or pass {ACCEPT} to compensate them flagged")
+    out_learned = (np.zeros(q.shape[0], dtype=bool) if learned is None
+                   else _refuse_learned(ids, q, learned, accept_flagged))
     if not accept_flagged and near.any():
         i = int(np.argmax(near))
         why = ("the given singular_tol" if singular_tol is not None else
@@ -129,4 +140,21 @@ def guard(ids: tuple[str, ...], q: F64, sigma_min: F64, conditions: Conditions |
             f"{sigma_min[i]:.3g} < {tol:.3g}, {why}; {int(near.sum())} target(s)): a small "
             f"correction needs a large joint motion there; move the target, or pass {ACCEPT} "
             "to compensate them flagged")
-    return out.any(axis=1), near
+    return out.any(axis=1) | out_learned, near
+
+
+def _refuse_learned(ids: tuple[str, ...], q: F64, learned: LearnedTerm,
+                    accept_flagged: bool) -> NDArray[np.bool_]:
+    """Per target, outside the learned term's training ranges (refused unless accepted)."""
+    out = learned_outside(learned, q, RANGE_SHARE)
+    if not accept_flagged and out.any():
+        i, j = map(int, np.argwhere(out)[0])
+        k = learned.joints[j]
+        lo, hi = learned.training_ranges[j]
+        raise UnmeasuredTargetError(
+            f"target {ids[i]}: the command of joint {k + 1} is {q[i, k]:.6g}, outside the "
+            f"range the learned residual term was trained on [{lo:.6g}, {hi:.6g}] "
+            f"({int(out.any(axis=1).sum())} target(s) outside): the learned term is "
+            f"extrapolated there; measure poses there, or pass {ACCEPT} to compensate them "
+            "flagged")
+    return out.any(axis=1)

@@ -12,6 +12,7 @@ call it, so the same data build the same calibrated robot everywhere.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,6 +25,7 @@ from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.conditions import Conditions
 from zrp.calibration.filecheck import loads_bounded
 from zrp.calibration.fullpose import FullPoseCalibration, full_pose_calibration
+from zrp.calibration.learned import LearnedTerm
 from zrp.calibration.storage import write_calibration
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
@@ -58,6 +60,11 @@ class CalibrationOptions:
         data_angle_unit: "rad" or "deg", as the data file gives the joint values.
         instrument: the measuring instrument (recorded in the conditions).
         progress: show the diagnosis's progress on stderr.
+        residual_model: also train the learned residual term on the joint angles
+            (``zrp diagnose --residual-model``); when the diagnosis keeps it (it lowers the
+            withheld error clearly) the calibrated robot carries it (``learned``,
+            :mod:`zrp.calibration.learned`), unless the calibration is a full-pose refit
+            (the term was trained on the position-only final model's residual).
     """
 
     gravity_torque: ArrayLike | None = None
@@ -72,6 +79,7 @@ class CalibrationOptions:
     data_angle_unit: str = "rad"
     instrument: str | None = None
     progress: bool = False
+    residual_model: bool = False
 
     @property
     def max_tilt_rad(self) -> float:
@@ -90,12 +98,15 @@ class Calibration:
         full_pose: the full-pose calibration (measured orientations; its summary), or None
             (none, or a stored diagnosis).
         record: what the robot was built from (:class:`zrp.gap.FinalModelRecord`).
+        learned_note: why a kept learned residual term is not in the calibrated robot, or
+            None.
     """
 
     diagnosis: Diagnosis | None
     robot: CalibratedRobot
     full_pose: FullPoseCalibration | None = None
     record: FinalModelRecord | None = None
+    learned_note: str | None = None
 
     def write(self, model_path: str | Path, comp_path: str | Path, *,
               overwrite: bool = False) -> list[Path]:
@@ -109,7 +120,7 @@ class Calibration:
 
 #: the options that shape a diagnosis: a stored or given diagnosis has its own
 _DIAGNOSIS_FIELDS = ("gravity_torque", "effects", "seed", "max_steps", "noise_sigma",
-                     "use_orientation", "orientation_sigma")
+                     "use_orientation", "orientation_sigma", "residual_model")
 
 
 def _differs(value: Any, default: Any) -> bool:
@@ -135,6 +146,11 @@ def stored_record(source: str | Path | Mapping[str, Any]) -> FinalModelRecord:
             1, written before 0.5.0), naming the file and saying to re-run ``zrp diagnose``.
         InputError: unreadable or malformed.
     """
+    doc, src = _stored_document(source)
+    return FinalModelRecord.from_dict(doc["final_model_record"], f"{src}: final_model_record")
+
+
+def _stored_document(source: str | Path | Mapping[str, Any]) -> tuple[Mapping[str, Any], str]:
     src = "diagnosis" if isinstance(source, Mapping) else str(source)
     doc = source if isinstance(source, Mapping) else loads_bounded(read_text(
         source, label=src), src)
@@ -150,7 +166,7 @@ def stored_record(source: str | Path | Mapping[str, Any]) -> FinalModelRecord:
     if version != SCHEMA_VERSION:
         raise StaleDiagnosisError(f"{src}: schema_version {version!r}, expected "
                                   f"{SCHEMA_VERSION}; re-run zrp diagnose with this version")
-    return FinalModelRecord.from_dict(doc["final_model_record"], f"{src}: final_model_record")
+    return doc, src
 
 
 def calibrate(model: Manipulator, measurements: Measurements, *,
@@ -173,37 +189,77 @@ def calibrate(model: Manipulator, measurements: Measurements, *,
     opt = CalibrationOptions() if options is None else options
     if not isinstance(opt, CalibrationOptions):
         raise InputError(f"options: expected CalibrationOptions, got {type(opt).__name__}")
-    full = None
     if diagnosis is not None:
         _refuse_diagnosis_options(opt)
-    if diagnosis is None or isinstance(diagnosis, Diagnosis):
-        if diagnosis is None:
-            diagnosis = diagnose(model, measurements, gravity_torque=opt.gravity_torque,
-                                 effects=tuple(opt.effects), seed=opt.seed,
-                                 max_steps=opt.max_steps, noise_sigma=opt.noise_sigma,
-                                 use_orientation=opt.use_orientation,
-                                 orientation_sigma=opt.orientation_sigma,
-                                 max_tilt_rad=opt.max_tilt_rad, progress=opt.progress)
-        elif diagnosis.context.meas is not measurements and (
-                diagnosis.context.meas.source != measurements.source):
-            raise StaleDiagnosisError(f"diagnosis: it diagnosed "
-                                      f"{diagnosis.context.meas.source}, not "
-                                      f"{measurements.source}")
-        src, meas_check = "diagnosis", diagnosis.context.meas is not measurements
-        # the record in its JSON form, exactly as diagnosis.json stores it
-        record = FinalModelRecord.from_dict(diagnosis.calibration_record.to_dict(), src)
-        if diagnosis.full_pose is not None:
-            full = full_pose_calibration(diagnosis, diagnosis.settings.get(
-                "orientation_sigma_rad"))
-    else:
-        src, meas_check = ("diagnosis" if isinstance(diagnosis, Mapping)
-                           else str(diagnosis)), True
-        record = stored_record(diagnosis)
-        diagnosis = None
+    src, stored_kept = _source(diagnosis)
+    diagnosis, record, full, meas_check = _final_record(model, measurements, opt, diagnosis)
     record.check(model, measurements if meas_check else None, src)
     cond = Conditions.from_measurements(
         measurements, model, data_path=opt.data_path, data_angle_unit=opt.data_angle_unit,
         instrument=opt.instrument)
     widen = None if opt.widen is None else dict(opt.widen)
     robot = CalibratedRobot.from_record(record, model, cond, widen)
-    return Calibration(diagnosis, robot, full, record)
+    learned, note = _learned(diagnosis, full, stored=stored_kept)
+    if learned is not None:
+        robot = dataclasses.replace(robot, learned=learned)
+    return Calibration(diagnosis, robot, full, record, note)
+
+
+def _source(diagnosis: Diagnosis | str | Path | Mapping[str, Any] | None) -> tuple[str, bool]:
+    """How errors name the diagnosis, and whether it is a stored one that kept a learned
+    residual term (diagnosis.json says so, without the term itself)."""
+    if diagnosis is None or isinstance(diagnosis, Diagnosis):
+        return "diagnosis", False
+    if isinstance(diagnosis, Mapping):
+        doc, src = diagnosis, "diagnosis"
+    else:
+        doc, src = _stored_document(diagnosis)
+    rm = doc.get("residual_model")
+    return src, isinstance(rm, Mapping) and rm.get("kept") is True
+
+
+def _final_record(model: Manipulator, measurements: Measurements, opt: CalibrationOptions,
+                  diagnosis: Diagnosis | str | Path | Mapping[str, Any] | None
+                  ) -> tuple[Diagnosis | None, FinalModelRecord,
+                             FullPoseCalibration | None, bool]:
+    """The diagnosis (None for a stored one), its final model's record in the JSON form
+    diagnosis.json stores, its full-pose calibration, and whether the record's measurements
+    must be checked against ``measurements``."""
+    if diagnosis is not None and not isinstance(diagnosis, Diagnosis):
+        return None, stored_record(diagnosis), None, True
+    if diagnosis is None:
+        diagnosis = diagnose(model, measurements, gravity_torque=opt.gravity_torque,
+                             effects=tuple(opt.effects), seed=opt.seed,
+                             max_steps=opt.max_steps, noise_sigma=opt.noise_sigma,
+                             use_orientation=opt.use_orientation,
+                             orientation_sigma=opt.orientation_sigma,
+                             max_tilt_rad=opt.max_tilt_rad, progress=opt.progress,
+                             residual_model=opt.residual_model)
+    elif diagnosis.context.meas is not measurements and (
+            diagnosis.context.meas.source != measurements.source):
+        raise StaleDiagnosisError(f"diagnosis: it diagnosed {diagnosis.context.meas.source}, "
+                                  f"not {measurements.source}")
+    # the record in its JSON form, exactly as diagnosis.json stores it
+    record = FinalModelRecord.from_dict(diagnosis.calibration_record.to_dict(), "diagnosis")
+    full = None if diagnosis.full_pose is None else full_pose_calibration(
+        diagnosis, diagnosis.settings.get("orientation_sigma_rad"))
+    return diagnosis, record, full, diagnosis.context.meas is not measurements
+
+
+def _learned(diag: Diagnosis | None, full: FullPoseCalibration | None, *, stored: bool
+             ) -> tuple[LearnedTerm | None, str | None]:
+    """The diagnosis's learned residual term when it was kept, and a note when it was kept
+    but cannot be used."""
+    if stored:
+        return None, ("the stored diagnosis kept a learned residual term, but diagnosis.json "
+                      "does not hold it: the calibration is the physical model alone "
+                      "(calibrate with --residual-model, without --diagnosis, to include it)")
+    rm = None if diag is None or diag.assessment is None else diag.assessment.residual_model
+    if rm is None or not rm.kept:
+        return None, None
+    if full is not None:
+        return None, ("the learned residual term was kept by the diagnosis but is not in the "
+                      "calibration: it was trained on the position-only model's residual, and "
+                      "the calibration is the full-pose refit (use --no-orientation to "
+                      "calibrate on positions with it)")
+    return LearnedTerm.from_residual_model(rm), None

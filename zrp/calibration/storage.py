@@ -7,8 +7,9 @@ read with a warning that the pair cannot be checked; version 1, written by 0.3.0
 has no ``backlash.lead``, so every joint lags behind its approach) holds everything the
 model file cannot: the nominal model, the instrument-from-base transform, the tool points in
 full, the folded offsets, the joint map, thermal expansion, the backlash flank model and,
-after a full-pose fit, the probe rotation and noise weights; its keys are documented in
-zrp/calibration/README.md.
+after a full-pose fit, the probe rotation and noise weights, and the learned residual term
+(``learned_residual``, :mod:`zrp.calibration.learned`: plain arrays, null without one); its
+keys are documented in zrp/calibration/README.md.
 """
 
 from __future__ import annotations
@@ -21,14 +22,21 @@ from numpy.typing import ArrayLike
 
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.conditions import Conditions
-from zrp.calibration.filecheck import bind_pair, check_fields, check_pair, loads_bounded
+from zrp.calibration.filecheck import (
+    FieldDomainError,
+    bind_pair,
+    check_fields,
+    check_pair,
+    loads_bounded,
+)
 from zrp.calibration.jointmap import Term
+from zrp.calibration.learned import LearnedTerm
 from zrp.calibration.validation import validate_calibration
 from zrp.errors import InputError, ZRPError
 from zrp.escape import one_line
 from zrp.gap.finalrecord import ProbeRecord, switch_weights
 from zrp.gap.fit.fullpose import FullPoseFit
-from zrp.jsonio import dumps, to_jsonable
+from zrp.jsonio import dumps, to_jsonable, version_field
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
@@ -102,9 +110,11 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "domains_widened": cal.widen,
         "undetermined": list(cal.undetermined),
         "taken_out_non_physical": list(cal.taken_out),
+        "learned_residual": None if cal.learned is None else cal.learned.to_dict(),
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
                   "= R_b (p'(x) + R'_n(x) t'_j) + t_b with p', R'_n the forward kinematics of "
-                  "model_file, bodies scaled by 1 + kappa (temp - t_ref)"),
+                  "model_file, bodies scaled by 1 + kappa (temp - t_ref); with learned_residual, "
+                  "the hand then moves by its rigid fit to -f(q) (learned_residual.evaluate)"),
     }
 
 
@@ -142,6 +152,13 @@ def _toml_header(cal: CalibratedRobot, comp_name: str) -> str:
                   f"#   instrument = {one_line(c.instrument)}; data_file = "
                   f"{one_line(c.data_file)}; "
                   f"data_sha256 = {c.data_sha256}"]
+    if cal.learned is not None:
+        t = cal.learned
+        lines += ["# LEARNED RESIDUAL TERM (compensation.json 'learned_residual'): kernel ridge "
+                  f"on (sin q, cos q) of {', '.join(t.inputs)};",
+                  f"#   withheld RMS {t.withheld_rms_physical:.4g} (physical model) -> "
+                  f"{t.withheld_rms_hybrid:.4g} {cal.model.length_unit} with it; valid within "
+                  "its training ranges only"]
     if cal.undetermined:
         lines.append("# NOT DETERMINED by the data (kept at nominal or known only loosely; "
                      "compensation.json 'undetermined'):")
@@ -237,11 +254,9 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
     doc = loads_bounded(read_text(comp_path, label=src), src)
     if not isinstance(doc, dict):
         raise InputError(f"{src}: expected a JSON object")
-    version = doc.get("schema_version")
-    if isinstance(version, bool) or version not in READABLE_VERSIONS:
-        raise InputError(f"{src}: schema_version {doc.get('schema_version')!r}, expected one "
-                         f"of {', '.join(map(str, READABLE_VERSIONS))} (a file from a newer "
-                         f"zrp-accuracy? zrp_version {doc.get('zrp_version')!r})")
+    version_field(doc, "schema_version", READABLE_VERSIONS, src=src,
+                  hint=f" (a file from a newer zrp-accuracy? zrp_version "
+                       f"{doc.get('zrp_version')!r})")
     bl = doc.get("backlash")
     if doc.get("schema_version") == 1 and isinstance(bl, dict) and "lead" in bl:
         raise InputError(f"{src}: backlash.lead in a schema_version 1 file (version 1 has "
@@ -274,8 +289,6 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
     tools = _get(doc, "tool_points", src)
     bl = _get(doc, "backlash", src)
     th = _get(doc, "thermal", src)
-    cond = doc.get("conditions")
-    widen = doc.get("domains_widened")
     return CalibratedRobot(
         model, loads_model(str(_get(doc, "nominal_model", src)), f"{src}: nominal_model"),
         np.array(_get(doc, "base_rotation", src), dtype=float),
@@ -291,14 +304,35 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
         tuple(float(v) for v in _get(doc, "gravity_dir", src)),
         tuple(int(h) for h in _get(doc, "harmonics", src)),
         str(_get(doc, "frame", src)), str(_get(doc, "compliance_model", src)),
-        None if doc.get("withheld_rms") is None else float(doc["withheld_rms"]),
-        None if doc.get("gravity_side_weights") is None
-        else np.array(doc["gravity_side_weights"], dtype=float),
-        None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
-        None if widen is None else {str(k): float(v) for k, v in dict(widen).items()},
-        _lead(bl.get("lead"), src), tuple(str(u) for u in doc.get("undetermined") or ()),
-        tuple(str(u) for u in doc.get("taken_out_non_physical") or ()),
-        switch_weights(bl.get("switch_weights")))
+        **_optional_fields(doc, bl, src))
+
+
+def _optional_fields(doc: dict[str, Any], bl: dict[str, Any], src: str) -> dict[str, Any]:
+    """The fields a compensation.json may leave out or set to null (older versions)."""
+    cond = doc.get("conditions")
+    widen = doc.get("domains_widened")
+    gsw = doc.get("gravity_side_weights")
+    return {
+        "withheld_rms": None if doc.get("withheld_rms") is None else float(doc["withheld_rms"]),
+        "gravity_side_weights": None if gsw is None else np.array(gsw, dtype=float),
+        "conditions": None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
+        "widen": None if widen is None else {str(k): float(v) for k, v in dict(widen).items()},
+        "backlash_lead": _lead(bl.get("lead"), src),
+        "undetermined": tuple(str(u) for u in doc.get("undetermined") or ()),
+        "taken_out": tuple(str(u) for u in doc.get("taken_out_non_physical") or ()),
+        "backlash_switch_weights": switch_weights(bl.get("switch_weights")),
+        "learned": _learned(doc.get("learned_residual"), src)}
+
+
+def _learned(value: Any, src: str) -> LearnedTerm | None:
+    """learned_residual: null (none; every file before 0.5.0) or the term, each field in its
+    domain (finite, shapes, ordered ranges)."""
+    if value is None:
+        return None
+    try:
+        return LearnedTerm.from_dict(value, src)
+    except InputError as exc:
+        raise FieldDomainError(f"{exc}; refused") from None
 
 
 def _lead(value: Any, src: str) -> tuple[bool, ...] | None:

@@ -31,6 +31,7 @@ from zrp.cli import commands
 from zrp.cli.signals import handling
 from zrp.cli.streams import CLOSED_EXIT, closed_output, device_error
 from zrp.errors import OutputExistsError, ZRPError
+from zrp.output.inputs import reading
 from zrp.packages import PackageShadowedError, check_own_packages
 
 __all__ = ["API_TO_CLI", "build_parser", "cli_message", "emit", "main", "one_line_warnings"]
@@ -114,6 +115,29 @@ def one_line_warnings(prog: str) -> Iterator[None]:
         yield
 
 
+#: options naming files the command writes (or reads and rewrites, as a checkpoint); a
+#: command adds its own with ``set_defaults(writes=(dest, ...))``
+_WRITTEN = frozenset({"out", "video", "checkpoint", "workdir", "hist", "writes"})
+
+
+def _inputs(parser: argparse.ArgumentParser, args: argparse.Namespace
+            ) -> Iterator[tuple[str, str]]:
+    """(how given, value) of every other option's string values: the existing regular files
+    among them are the command's inputs, which no output may replace
+    (:func:`zrp.output.reading`)."""
+    sub = next((a for a in parser._actions if isinstance(a, argparse._SubParsersAction)), None)
+    cmd = sub.choices.get(args.command) if sub is not None else None
+    names = {a.dest: (a.option_strings[-1] if a.option_strings else str(a.metavar or a.dest))
+             for a in (cmd._actions if cmd is not None else ())}
+    written = _WRITTEN | set(getattr(args, "writes", ()))
+    for dest, value in vars(args).items():
+        if dest in written:
+            continue
+        for v in value if isinstance(value, (list, tuple)) else (value,):
+            if isinstance(v, str) and v:
+                yield f"{names.get(dest, dest)} {v}", v
+
+
 def _interrupt(signum: int, frame: object) -> None:
     raise KeyboardInterrupt
 
@@ -155,7 +179,8 @@ def _run(argv: Sequence[str] | None) -> int:
     try:
         # SIGTERM (a batch scheduler's time limit, `kill`) stops a command like Ctrl-C: it
         # closes its cluster and keeps what it saves when stopped (a Monte Carlo checkpoint)
-        with handling(signal.SIGTERM, _interrupt), one_line_warnings(f"zrp {args.command}"):
+        with handling(signal.SIGTERM, _interrupt), one_line_warnings(f"zrp {args.command}"), \
+                reading(_inputs(parser, args)):
             code = int(args.func(args) or 0)
             _flush_output()
             return code

@@ -24,7 +24,7 @@ import hashlib
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -40,8 +40,23 @@ from zrp.jsonio import to_jsonable
 from zrp.model.files import dumps_model
 from zrp.model.manipulator import Manipulator
 
-if TYPE_CHECKING:
-    from zrp.gap.results import Diagnosis
+
+class Diagnosis(Protocol):
+    """What :func:`final_model_record` reads of a :class:`zrp.gap.Diagnosis` (named here,
+    not imported: the diagnosis's results sit above this module and store its record)."""
+
+    context: Context
+    settings: dict[str, Any]
+    fitting_poses: Any
+    full_pose: Any
+    nominal_fit: FitResult
+    final_fit: FitResult
+    nominal: Any
+    final: Any
+    where: Any
+    determination: dict[str, Any]
+    length_unit: str
+    outside_domain: tuple[tuple[str, str], ...]
 
 __all__ = ["RECORD_VERSION", "FinalModelRecord", "ProbeRecord", "StaleDiagnosisError",
            "final_model_record", "full_pose_fit_result", "model_sha256", "switch_weights"]
@@ -187,7 +202,7 @@ class FinalModelRecord:
 
 
 def _from_dict(cls: type[FinalModelRecord], d: Mapping[str, Any]) -> FinalModelRecord:
-    bl, p, tools = d["backlash"], d["probe"], d["tool_points"]
+    tools = d["tool_points"]
     arr = (lambda k: np.array(d[k], dtype=float))  # noqa: E731
     return cls(
         str(d["model_sha256"]), str(d["measurements_sha256"]), str(d["source"]), arr("axes"),
@@ -199,19 +214,28 @@ def _from_dict(cls: type[FinalModelRecord], d: Mapping[str, Any]) -> FinalModelR
                              _num(q["stderr"])) for q in d["parameters"]),
         float(d["t_ref_degC"]), tuple(float(v) for v in d["gravity_dir"]),  # type: ignore[arg-type]
         tuple(int(h) for h in d["harmonics"]), str(d["frame"]), str(d["compliance_model"]),
-        _num(d["withheld_rms"]),
-        None if bl["switch"] is None else tuple(None if v is None else float(v)
-                                                for v in bl["switch"]),
-        float(bl["payload_kg"]),
-        None if bl["lead"] is None else tuple(bool(v) for v in bl["lead"]),
-        switch_weights(bl["switch_weights"]),
-        None if d["gravity_side_weights"] is None else arr("gravity_side_weights"),
-        tuple(str(u) for u in d["undetermined"]),
-        tuple(str(u) for u in d["taken_out_non_physical"]),
-        None if p is None else ProbeRecord(
-            np.array(p["probe_rotation"], dtype=float), _num(p["sigma_orientation_rad"]),
-            bool(p["sigma_orientation_given"]), _num(p["sigma_position"]),
-            _num(p["orientation_rms_rad"])))
+        _num(d["withheld_rms"]), **_backlash_from_dict(d["backlash"]),
+        gravity_side_weights=(None if d["gravity_side_weights"] is None
+                              else arr("gravity_side_weights")),
+        undetermined=tuple(str(u) for u in d["undetermined"]),
+        taken_out=tuple(str(u) for u in d["taken_out_non_physical"]),
+        probe=_probe_from_dict(d["probe"]))
+
+
+def _backlash_from_dict(bl: Mapping[str, Any]) -> dict[str, Any]:
+    return {"backlash_switch": None if bl["switch"] is None else tuple(
+                None if v is None else float(v) for v in bl["switch"]),
+            "payload_kg": float(bl["payload_kg"]),
+            "backlash_lead": None if bl["lead"] is None else tuple(bool(v) for v in bl["lead"]),
+            "backlash_switch_weights": switch_weights(bl["switch_weights"])}
+
+
+def _probe_from_dict(p: Mapping[str, Any] | None) -> ProbeRecord | None:
+    if p is None:
+        return None
+    return ProbeRecord(np.array(p["probe_rotation"], dtype=float),
+                       _num(p["sigma_orientation_rad"]), bool(p["sigma_orientation_given"]),
+                       _num(p["sigma_position"]), _num(p["orientation_rms_rad"]))
 
 
 def switch_weights(value: Any) -> tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None:
@@ -271,16 +295,7 @@ def final_model_record(diag: Diagnosis, *, registration_only: bool = False,
     """The record of what a calibration takes from ``diag``: its full-pose refit when it has
     one, else its final model; with ``registration_only``, the nominal model with the
     registration alone; with ``fit``, another estimate of the final model's parameters."""
-    probe = None
-    source = "registration" if registration_only else "final_fit"
-    if fit is None and not registration_only and diag.full_pose is not None:
-        fit, fp, source = full_pose_fit_result(diag), diag.full_pose.fit, "full_pose"
-        if fp.orientation:
-            probe = ProbeRecord(np.asarray(fp.probe_rotation, dtype=float),
-                                float(fp.sigma_orientation), bool(fp.sigma_orientation_given),
-                                float(fp.sigma_position), float(fp.orientation_rms))
-    if fit is None:
-        fit = diag.nominal_fit if registration_only else diag.final_fit
+    fit, probe, source = _chosen_fit(diag, registration_only, fit)
     ctx = diag.context
     prob = Problem(ctx, fit.specs, diag.fitting_poses[:1], fit.base_rotation)
     u, _, bodies = prob.geometry(fit.theta)
@@ -289,7 +304,6 @@ def final_model_record(diag: Diagnosis, *, registration_only: bool = False,
                                   float(se))
                    for s, v, se in zip(fit.specs, fit.theta, fit.stderr, strict=True)
                    if s.kind in _JOINT_KINDS)
-    bl = None if registration_only else diag.where.backlash
     return FinalModelRecord(
         model_sha256(ctx.model),
         diag.settings.get("measurements_sha256") or measurements_sha256(ctx.meas), source,
@@ -300,9 +314,34 @@ def final_model_record(diag: Diagnosis, *, registration_only: bool = False,
         tuple(int(h) for h in ctx.harmonics), ctx.meas.frame,
         "mjcf" if ctx.gravity_torque is not None else "lumped_masses",
         float(diag.nominal.rms if registration_only else diag.final.rms),
-        None if bl is None else tuple(None if v is None else float(v) for v in bl.switch),
-        0.0 if bl is None else float(bl.payload_kg),
-        None if bl is None or not bl.lead else tuple(bool(v) for v in bl.lead),
-        None if bl is None else switch_weights(bl.weights),
-        _side_weights(ctx), _undetermined(diag, fit),
-        () if registration_only else _taken_out(diag), probe)
+        **_backlash_fields(None if registration_only else diag.where.backlash),
+        gravity_side_weights=_side_weights(ctx), undetermined=_undetermined(diag, fit),
+        taken_out=() if registration_only else _taken_out(diag), probe=probe)
+
+
+def _chosen_fit(diag: Diagnosis, registration_only: bool, fit: FitResult | None
+                ) -> tuple[FitResult, ProbeRecord | None, str]:
+    """The fit a record is made of, the probe of a full-pose refit, and which it is."""
+    if fit is not None:
+        return fit, None, "registration" if registration_only else "final_fit"
+    if registration_only:
+        return diag.nominal_fit, None, "registration"
+    if diag.full_pose is None:
+        return diag.final_fit, None, "final_fit"
+    fp = diag.full_pose.fit
+    probe = None if not fp.orientation else ProbeRecord(
+        np.asarray(fp.probe_rotation, dtype=float), float(fp.sigma_orientation),
+        bool(fp.sigma_orientation_given), float(fp.sigma_position), float(fp.orientation_rms))
+    chosen = full_pose_fit_result(diag)
+    assert chosen is not None  # a full-pose refit exists
+    return chosen, probe, "full_pose"
+
+
+def _backlash_fields(bl: Any) -> dict[str, Any]:
+    """The backlash flank model's fields of a record (none without backlash)."""
+    if bl is None:
+        return {}
+    return {"backlash_switch": tuple(None if v is None else float(v) for v in bl.switch),
+            "payload_kg": float(bl.payload_kg),
+            "backlash_lead": tuple(bool(v) for v in bl.lead) if bl.lead else None,
+            "backlash_switch_weights": switch_weights(bl.weights)}

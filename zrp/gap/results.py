@@ -44,6 +44,7 @@ from zrp.gap.search.steps import EffectsFound
 from zrp.gap.search.steps import ParameterEstimate as ParameterEstimate
 from zrp.gap.search.steps import Step as Step
 from zrp.gap.search.steps import parameter_estimates as parameter_estimates
+from zrp.jsonio import version_field
 
 __all__ = [
     "SCHEMA_VERSION",
@@ -388,6 +389,9 @@ def load_diagnosis(source: str | os.PathLike[str] | Mapping[str, Any]) -> Diagno
     """
     doc = (source if isinstance(source, Mapping)
            else json.loads(Path(source).read_text(encoding="utf-8")))
+    if "schema_version" in doc:  # the in-memory documents and refusals may omit it
+        version_field(doc, "schema_version", (SCHEMA_VERSION,), src=str(
+            "the diagnosis" if isinstance(source, Mapping) else source))
     final = doc["final"]
     return DiagnosisRecord(tuple(_step(s) for s in doc.get("steps", ())),
                            _number(doc["nominal"]["rms"]), _number(final["rms"]),

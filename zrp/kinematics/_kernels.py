@@ -260,7 +260,7 @@ def store_fence(typingctx):
     return sig, codegen
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, nogil=True)  # nogil: zrp.kinematics.parallel
 def fk_pose_batch(q, axes, bodies, prism, lim, out):
     """Batched :func:`fk_pose_one`: q (N, n) -> out (N, 7) (C-contiguous); returns True when every
     |q[:, k]| <= lim[k] (finite), False otherwise (out is then not to be used).
@@ -428,7 +428,7 @@ def _jac_column(prismatic, wx, wy, wz, rx, ry, rz, col):
         col[5] = wx * ry - wy * rx
 
 
-@njit(cache=True, fastmath=_FM)
+@njit(cache=True, fastmath=_FM, nogil=True)  # nogil: zrp.kinematics.parallel
 def jac_batch(q, axes, bodies, prism, lim, pose, jac):
     """Batched :func:`fk_jac_one`: q (N, n) -> pose (N, 7) (or shape (0, 7) to skip), jac
     (N, 6, n); returns True when every |q[:, k]| <= lim[k] (as :func:`fk_pose_batch`).

@@ -21,6 +21,7 @@ from zrp.arrays import F64, recycled_empty
 from zrp.errors import InputError
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import all_in_range, joint_limits
+from zrp.kinematics.parallel import MIN_FK_POSES, MIN_JAC_POSES, run_split, thread_count
 from zrp.model.manipulator import Manipulator, derived, hand_frame
 from zrp.rotations.rodrigues import (
     er_from_axis_angle,
@@ -190,8 +191,8 @@ def _q_in_model_unit(model: Manipulator, q: ArrayLike, s: float) -> ArrayLike:
 
 
 def end_effector_pose(model: Manipulator, q: ArrayLike, *,
-                      out: F64 | None = None, length_unit: str | None = None
-                      ) -> tuple[F64, F64]:
+                      out: F64 | None = None, length_unit: str | None = None,
+                      threads: int | None = None) -> tuple[F64, F64]:
     """Fast forward kinematics of the end effector only.
 
     Args:
@@ -203,6 +204,10 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
             batch shape of ``q`` (position, then Euler-Rodrigues parameters). Reusing one
             buffer over many calls spares the allocation of a fresh result, which for large
             batches costs as much as a fifth of the kinematics (the OS zero-fills new pages).
+        threads: threads the batch is split over (:mod:`zrp.kinematics.parallel`; the same
+            result to the bit); None: every usable core from
+            :data:`~zrp.kinematics.parallel.MIN_FK_POSES` poses on, one below (a single pose
+            always runs on the calling thread).
 
     Returns:
         position p, shape (..., 3), and Euler-Rodrigues parameters of R_n, shape (..., 4)
@@ -214,7 +219,8 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
     """
     if length_unit is not None:
         s = _length_scale(model, length_unit)
-        p, er = end_effector_pose(model, _q_in_model_unit(model, q, s), out=out)
+        p, er = end_effector_pose(model, _q_in_model_unit(model, q, s), out=out,
+                                  threads=threads)
         p *= s
         return p, er
     if out is None and _one(q):  # one pose: ~1 us per call (one kernel call, three arguments)
@@ -223,7 +229,8 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
             return res[:3], res[3:]
     qf, batch = _flat(model, q)
     res = _out_buffer(out, (*batch, 7)).reshape(-1, 7)
-    if not K.fk_pose_batch(qf, *_karrays(model), joint_limits(model), res):
+    t = thread_count(qf.shape[0], MIN_FK_POSES, threads)
+    if not run_split(K.fk_pose_batch, qf, (*_karrays(model), joint_limits(model)), (res,), t):
         _range_error(model, q)
     res = res.reshape(*batch, 7)
     return res[..., :3], res[..., 3:]
@@ -243,7 +250,7 @@ def _out_buffer(out: object, shape: tuple[int, ...]) -> F64:
 
 
 def jacobian(model: Manipulator, q: ArrayLike, *, rows: str = "wv",
-             length_unit: str | None = None) -> F64:
+             length_unit: str | None = None, threads: int | None = None) -> F64:
     """Eq (7): J with J qdot = [omega_h; V_p], shape (..., 6, n).
 
     Revolute column k: [u_k; u_k x (p - p_k)]; prismatic column k: [0; u_k]. Rows 0-2 are in
@@ -252,14 +259,15 @@ def jacobian(model: Manipulator, q: ArrayLike, *, rows: str = "wv",
     Options for the conventions other libraries use (the same kernel, its result reordered
     and scaled): ``rows="vw"`` gives [V_p; omega_h], the row order of Pinocchio's
     ``getFrameJacobian(..., LOCAL_WORLD_ALIGNED)`` and the Robotics Toolbox's ``jacob0``;
-    ``length_unit="m"`` gives V_p in m/rad (prismatic joint values in m).
+    ``length_unit="m"`` gives V_p in m/rad (prismatic joint values in m). ``threads``: as in
+    :func:`end_effector_pose` (from :data:`~zrp.kinematics.parallel.MIN_JAC_POSES` poses on).
     """
     if rows not in ("wv", "vw"):
         raise InputError(f"rows: expected 'wv' ([omega; v], eq 7) or 'vw' ([v; omega], "
                          f"Pinocchio/RTB), got {rows!r}")
     if rows == "vw" or length_unit is not None:
         s = _length_scale(model, length_unit)
-        jac = jacobian(model, _q_in_model_unit(model, q, s))
+        jac = jacobian(model, _q_in_model_unit(model, q, s), threads=threads)
         jac[..., 3:, :] *= np.where(model.prismatic, 1.0, s)  # m/m stays for a slide
         return np.concatenate([jac[..., 3:, :], jac[..., :3, :]], axis=-2) if rows == "vw" \
             else jac
@@ -269,6 +277,8 @@ def jacobian(model: Manipulator, q: ArrayLike, *, rows: str = "wv",
             return jac
     qf, batch = _flat(model, q)
     jac = recycled_empty((qf.shape[0], 6, model.n))
-    if not K.jac_batch(qf, *_karrays(model), joint_limits(model), np.empty((0, 7)), jac):
+    t = thread_count(qf.shape[0], MIN_JAC_POSES, threads)
+    if not run_split(K.jac_batch, qf, (*_karrays(model), joint_limits(model)),
+                     (np.empty((0, 7)), jac), t):
         _range_error(model, q)
     return jac.reshape(*batch, 6, model.n)

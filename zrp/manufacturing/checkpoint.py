@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from zrp.errors import InputError, OutputExistsError
+from zrp.jsonio import version_field
 from zrp.manufacturing.chunks import ChunkResult, ChunkTask
 from zrp.manufacturing.histogram import Histogram
 from zrp.output import write_bytes
@@ -159,9 +160,9 @@ def _read(p: Path) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
         head = json.loads(head_text)
     except ValueError as exc:
         raise InputError(f"checkpoint {p}: its header is not JSON ({exc}); {fix}") from None
-    if not isinstance(head, dict) or head.get("version") != VERSION:
-        version = head.get("version") if isinstance(head, dict) else None
-        raise InputError(f"checkpoint {p}: format version {version!r}, expected {VERSION}; {fix}")
+    if not isinstance(head, dict):
+        raise InputError(f"checkpoint {p}: its header is not a JSON object; {fix}")
+    version_field(head, "version", (VERSION,), src=f"checkpoint {p}", hint=f"; {fix}")
     return head, data
 
 

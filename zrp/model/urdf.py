@@ -30,6 +30,7 @@ from zrp.errors import ModelFileError
 from zrp.model.manipulator import Manipulator
 from zrp.textio import read_text
 from zrp.units import metres_per_unit
+from zrp.xmlio import parse_xml
 
 __all__ = ["URDFImport", "URDFJoint", "URDFTree", "from_urdf", "import_urdf", "read_urdf"]
 
@@ -188,22 +189,22 @@ def _joint(el: ET.Element, source: str) -> URDFJoint:
                      vel, mimic.get("joint") if mimic is not None else None)
 
 
-def _parse(source: str | Path) -> tuple[ET.Element, str]:
+def _parse(source: str | Path, label: str | None = None) -> tuple[ET.Element, str]:
     """The root element and a label: a path is read with :func:`zrp.textio.read_text` (a
-    regular file, size checked, UTF-8 or UTF-16 decoded); text starting with ``<`` is XML."""
+    regular file, size checked, UTF-8 or UTF-16 decoded); text starting with ``<`` is XML,
+    named ``label`` (the file it came from) in errors."""
     text_given = isinstance(source, str) and source.lstrip("\ufeff \t\r\n").startswith("<")
     if text_given:
-        label, text = "<urdf string>", str(source)
+        label, text = label or "<urdf string>", str(source)
     else:
         if not isinstance(source, (str, os.PathLike)):
             raise ModelFileError(f"source: expected a URDF file path or XML text, got "
                                  f"{type(source).__name__}")
         label = str(source)
         text = read_text(source, label=label, error=ModelFileError)
-    try:
-        return ET.fromstring(text.lstrip("\ufeff")), label
-    except ET.ParseError as exc:
-        raise ModelFileError(f"{label}, line {exc.position[0]}: not valid XML: {exc}") from exc
+    root = parse_xml(text, label=label, error=ModelFileError)  # bounded, linear (zrp.xmlio)
+    assert root is not None
+    return root, label
 
 
 def _check_links(label: str, links: tuple[str, ...], joints: dict[str, URDFJoint],
@@ -240,8 +241,9 @@ def _check_links(label: str, links: tuple[str, ...], joints: dict[str, URDFJoint
                          "none)")
 
 
-def read_urdf(source: str | Path) -> URDFTree:
-    """Parse a URDF file path (or URDF XML text) into its kinematic tree.
+def read_urdf(source: str | Path, *, label: str | None = None) -> URDFTree:
+    """Parse a URDF file path (or URDF XML text, named ``label`` in errors) into its
+    kinematic tree.
 
     Raises:
         ModelFileError: unreadable file (not a regular file, too large, not UTF-8/UTF-16),
@@ -249,7 +251,7 @@ def read_urdf(source: str | Path) -> URDFTree:
             type, a limit that is not a number, several roots, a link with two parents, a
             joint naming an undeclared link, or joints forming a cycle.
     """
-    root_el, label = _parse(source)
+    root_el, label = _parse(source, label)
     if root_el.tag != "robot":
         raise ModelFileError(f"{label}: the root element is <{root_el.tag}>; expected <robot>")
     links = tuple(el.get("name", "") for el in root_el.findall("link"))
@@ -371,7 +373,7 @@ def _moving_joints(chain: list[URDFJoint], scale: float) -> tuple[F64, _Joints]:
 
 def import_urdf(source: str | Path, *, end_link: str | None = None,
                 base_link: str | None = None, length_unit: str = "mm",
-                name: str | None = None) -> URDFImport:
+                name: str | None = None, label: str | None = None) -> URDFImport:
     """Import the serial chain base_link -> end_link of a URDF (see the module docstring).
 
     Args:
@@ -382,12 +384,13 @@ def import_urdf(source: str | Path, *, end_link: str | None = None,
         base_link: the link whose frame is the base frame (default: the root link).
         length_unit: unit of the model (URDF is in metres).
         name: model name (default: the robot's name).
+        label: the name of XML text ``source`` in errors (the file it was read from).
 
     Raises:
         ModelFileError: an unknown link, a branching tree without ``end_link``, a floating or
             planar joint or a mimic joint on the chain, no moving joint.
     """
-    tree = read_urdf(source)
+    tree = read_urdf(source, label=label)
     base, end = _chain_ends(tree, base_link, end_link)
     chain = tree.path(base, end)
     _check_chain(tree, chain, base)

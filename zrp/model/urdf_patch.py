@@ -36,6 +36,7 @@ from zrp.errors import ModelError, ModelFileError
 from zrp.model.manipulator import Manipulator, hand_frame
 from zrp.model.urdf import URDFJoint, import_urdf, read_urdf, rpy_matrix
 from zrp.units import metres_per_unit
+from zrp.xmlio import XMLDocument, xml_document
 
 __all__ = ["patch_urdf"]
 
@@ -99,7 +100,8 @@ def _check_same_chain(model: Manipulator, names: tuple[str, ...], src: str) -> N
 
 
 def patch_urdf(source: str | Path, model: Manipulator, *, base_link: str | None = None,
-               end_link: str | None = None, rotations: ArrayLike | None = None) -> str:
+               end_link: str | None = None, rotations: ArrayLike | None = None,
+               label: str | None = None) -> str:
     """The URDF ``source`` with the geometry of ``model`` (a calibrated version of the chain
     base_link -> end_link imported from it, same joint names).
 
@@ -109,22 +111,21 @@ def patch_urdf(source: str | Path, model: Manipulator, *, base_link: str | None 
         base_link, end_link: the chain, as given to :func:`zrp.model.urdf.import_urdf`.
         rotations: per moving joint, the rotation (3, 3) that turns its frame (and the link
             after it) from the nominal orientation, shape (n, 3, 3), or None (none).
+        label: the name of XML text ``source`` in errors (the file it was read from).
+
+    The file's comments, processing instructions and XML declaration are kept
+    (:func:`zrp.xmlio.xml_document`).
 
     Raises:
         ModelError: the model is not that chain, or the end frame cannot be carried (see the
             module doc).
         ModelFileError: the URDF cannot be read.
     """
-    imp = import_urdf(source, base_link=base_link, end_link=end_link)
-    tree = read_urdf(source)
+    imp = import_urdf(source, base_link=base_link, end_link=end_link, label=label)
+    tree = read_urdf(source, label=label)
     _check_same_chain(model, imp.joints, tree.source)
-    text_given = isinstance(source, str) and source.lstrip().startswith("<")
-    parser = ET.XMLParser(target=ET.TreeBuilder(insert_comments=True))
-    try:
-        root = (ET.fromstring(str(source), parser=parser) if text_given
-                else ET.parse(source, parser=parser).getroot())
-    except (ET.ParseError, OSError) as exc:  # read_urdf succeeded: should not happen
-        raise ModelFileError(f"{tree.source}: cannot re-read ({exc})") from exc
+    doc = xml_document(source, label=tree.source, error=ModelFileError)
+    root = doc.root
     chain = tree.path(imp.base_link, imp.end_link)
     rot = None if rotations is None else np.asarray(rotations, dtype=float)
     if rot is not None and rot.shape != (model.n, 3, 3):
@@ -141,9 +142,11 @@ def patch_urdf(source: str | Path, model: Manipulator, *, base_link: str | None 
     elements = {el.get("name", ""): el for el in root.findall("joint")}
     _patch_chain(chain, elements, targets, end, model, scale)
     ET.indent(root, space="  ")
-    return ('<?xml version="1.0"?>\n<!-- patched by zrp-accuracy: the calibrated origins and '
-            'axes of the chain ' + f"{imp.base_link} -> {imp.end_link} -->\n"
-            + ET.tostring(root, encoding="unicode") + "\n")
+    note = ("patched by zrp-accuracy: the calibrated origins and axes of the chain "
+            f"{imp.base_link} -> {imp.end_link}")
+    if not doc.prolog.startswith("<?xml"):
+        doc = XMLDocument(root, '<?xml version="1.0"?>\n' + doc.prolog, doc.epilog)
+    return doc.text(note)
 
 
 def _patch_chain(chain: list[URDFJoint], elements: dict[str, ET.Element],

@@ -33,9 +33,13 @@ Typical use::
   named ``...csv`` cannot write into the folder above), and a command's default folder is
   replaced without ``--force`` only when :func:`claim_generated` says it is generated output.
 
-The policy lives in five modules: :mod:`zrp.output.paths` (names and file kinds, the refusal to
+* A command's input is never its output, even with ``--force``: the command line registers
+  the files it reads (:func:`reading`) and every write refuses them (:func:`check_not_input`).
+
+The policy lives in six modules: :mod:`zrp.output.paths` (names and file kinds, the refusal to
 replace), :mod:`zrp.output.atomic` (the atomic writes, the default folders' mark),
 :mod:`zrp.output.names` (default names from inputs, no links on the way),
+:mod:`zrp.output.inputs` (inputs are not outputs),
 :mod:`zrp.output.lock` (one run a folder) and :mod:`zrp.output.folder` (:class:`OutputDir`);
 import the names from here.
 """
@@ -52,6 +56,7 @@ from zrp.output.atomic import (
     write_text,
 )
 from zrp.output.folder import OutputDir
+from zrp.output.inputs import check_not_input, reading
 from zrp.output.lock import LOCK_NAME, LOCK_WAIT_S
 from zrp.output.names import check_no_links, safe_name
 from zrp.output.paths import NAME_MAX_BYTES, check_regular, check_writable
@@ -64,10 +69,12 @@ __all__ = [
     "OutputDir",
     "atomic_path",
     "check_no_links",
+    "check_not_input",
     "check_regular",
     "check_writable",
     "claim_generated",
     "default_overwrite",
+    "reading",
     "safe_name",
     "write_bytes",
     "write_json",

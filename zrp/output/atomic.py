@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import Any
 
 from zrp.errors import InputError, OutputExistsError
+from zrp.output.inputs import check_not_input
 from zrp.output.lock import pid_alive
 from zrp.output.paths import as_path, check_regular, check_writable, make_folder
 
@@ -91,6 +92,7 @@ def atomic_path(path: str | os.PathLike[str], *, overwrite: bool = False,
         # checked again: a link or a device may have appeared while we were writing
         if check_regular(p) and not overwrite:
             raise OutputExistsError([p])
+        check_not_input(p)
         os.replace(tmp, p)
     except OSError as exc:
         if isinstance(exc, OutputExistsError):

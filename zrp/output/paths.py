@@ -10,6 +10,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 from zrp.errors import InputError, OutputExistsError, OutputKindError
+from zrp.output.inputs import check_not_input
 
 __all__ = ["NAME_MAX_BYTES", "as_path", "check_regular", "check_writable", "make_folder"]
 
@@ -97,6 +98,7 @@ def check_writable(paths: Iterable[str | os.PathLike[str]], overwrite: bool) -> 
                 raise InputError(f"{p}: cannot write under {parent}, which is a file, not a "
                                  "folder")
         if check_regular(p):
+            check_not_input(p)
             existing.append(p)
     if existing and not overwrite:
         raise OutputExistsError(existing)

@@ -16,10 +16,11 @@ __all__ = ["left_jacobian", "matrix_from_rotvec", "rotation_angle", "skew"]
 def skew(v: ArrayLike) -> F64:
     """Cross-product matrices, shape (..., 3) -> (..., 3, 3)."""
     v = np.asarray(v, dtype=float)
-    z = np.zeros(v.shape[:-1])
-    return np.stack([np.stack([z, -v[..., 2], v[..., 1]], -1),
-                     np.stack([v[..., 2], z, -v[..., 0]], -1),
-                     np.stack([-v[..., 1], v[..., 0], z], -1)], -2)
+    k = np.zeros((*v.shape[:-1], 3, 3))
+    k[..., 0, 1], k[..., 0, 2] = -v[..., 2], v[..., 1]
+    k[..., 1, 0], k[..., 1, 2] = v[..., 2], -v[..., 0]
+    k[..., 2, 0], k[..., 2, 1] = -v[..., 1], v[..., 0]
+    return k
 
 
 def matrix_from_rotvec(rotvec: ArrayLike) -> F64:
@@ -33,13 +34,18 @@ def matrix_from_rotvec(rotvec: ArrayLike) -> F64:
 
 
 def left_jacobian(rotvec: ArrayLike) -> F64:
-    """Left Jacobian of SO(3): d exp(phi) = [J_l(phi) dphi]_x exp(phi), shape (3, 3)."""
+    """Left Jacobian of SO(3): d exp(phi) = [J_l(phi) dphi]_x exp(phi), shape (..., 3) ->
+    (..., 3, 3) (a batch at once: one NumPy pass, no loop over the rotations)."""
     phi = np.asarray(rotvec, dtype=float)
-    th = float(np.linalg.norm(phi))
+    th = np.linalg.norm(phi, axis=-1)[..., None, None]
     k = skew(phi)
-    if th < 1e-6:
-        return np.eye(3) + 0.5 * k + k @ k / 6.0
-    return (np.eye(3) + (1.0 - np.cos(th)) / th**2 * k + (th - np.sin(th)) / th**3 * k @ k)
+    kk = k @ k
+    small = th < 1e-6
+    safe = np.where(small, 1.0, th)
+    big = np.eye(3) + (1.0 - np.cos(safe)) / safe**2 * k + (safe - np.sin(safe)) / safe**3 * kk
+    if not small.any():
+        return big
+    return np.where(small, np.eye(3) + 0.5 * k + kk / 6.0, big)
 
 
 def rotation_angle(a: ArrayLike, b: ArrayLike) -> F64:

@@ -66,12 +66,15 @@ def diagnose_blind(csv_path: str | Path, model: Manipulator, *, mjcf_path: str |
 
 
 def diagnose_blind_result(csv_path: str | Path, model: Manipulator, *,
-                          mjcf_path: str | Path | None, seed: int = 0) -> Diagnosis:
+                          mjcf_path: str | Path | None, seed: int = 0,
+                          residual_model: bool = False) -> Diagnosis:
     """:func:`diagnose_blind`, returning the :class:`zrp.gap.Diagnosis` itself (the
-    compensated column takes the calibrated robot out of it)."""
+    compensated column takes the calibrated robot out of it); ``residual_model``: also train
+    the learned residual term (the remainder scenarios, :mod:`.remainder`)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         meas = load_measurements(csv_path, model)
         tau = None if mjcf_path is None else gravity_torques(
             mjcf_path, meas.q_pose, joint_names=[j.name for j in model.joints])
-        return diagnose(model, meas, gravity_torque=tau, seed=seed)
+        return diagnose(model, meas, gravity_torque=tau, seed=seed,
+                        residual_model=residual_model)

@@ -355,3 +355,34 @@ def test_kuka_sunrise_trace(tmp_path):
     np.testing.assert_allclose(log.t, t, atol=1e-9)
     np.testing.assert_allclose(log.q, q, atol=1e-12)
     np.testing.assert_allclose(log.qc, q, atol=1e-12)
+
+
+def test_kuka_fri_pyfri_collect_data(tmp_path):
+    """lbr-stack/pyfri's ``collect_data`` CSV as its C++ writes it: ``index,time,
+    record_time_nsec,tsec,tnsec,mp1..,ip1..,mt1..,et1..,dt``, every number through a default
+    ``std::ostream`` (6 significant digits). Its ``time`` column is a sum of nominal steps
+    that stalls at 6 digits (1000.00 s repeats for 10 rows): the FRI clock tsec + tnsec is the
+    time read, jitter and all."""
+    t, q, _, tau = _reference()
+    rng = np.random.default_rng(4)
+    clock = 1.7e9 + 1000.0 + t + rng.uniform(-5e-5, 5e-5, t.size)  # the controller's clock
+    sec = np.floor(clock)
+    nsec = np.round((clock - sec) * 1e9)
+    g6 = lambda v: f"{float(v):.6g}"  # noqa: E731 (std::ostream's default)
+    j = range(1, 4)
+    head = ["index", "time", "record_time_nsec", "tsec", "tnsec", *(f"mp{k}" for k in j),
+            *(f"ip{k}" for k in j), *(f"mt{k}" for k in j), *(f"et{k}" for k in j), "dt"]
+    rows = [",".join([str(i), g6(1000.0 + t[i]), str(int(1.7e18) + i * 1000000),
+                      str(int(sec[i])), str(int(nsec[i])), *map(g6, q[i]), *map(g6, q[i]),
+                      *map(g6, tau[i]), *map(g6, 0 * tau[i]), "0.001"])
+            for i in range(t.size)]
+    p = tmp_path / "lbr_data.csv"
+    p.write_text(",".join(head) + "\n" + "\n".join(rows) + "\n")
+    log = load_torque_log(p)
+    assert "KUKA FRI pyfri" in log.conditioning.columns
+    assert "tsec" in log.conditioning.columns and "et1" in log.conditioning.columns  # not used
+    assert log.n_samples == t.size and log.segments == ()  # no repeats, no gap: tsec + tnsec
+    np.testing.assert_allclose(log.t - log.t[0], clock - clock[0], atol=1e-9)
+    np.testing.assert_allclose(log.q, q, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(log.qc, q, rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(log.tau, tau, rtol=1e-5, atol=1e-5)

@@ -61,6 +61,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="raise a physical domain's upper bound (zrp/gap/model/domains.py: "
                    f"{', '.join(DOMAINS)}), e.g. --widen axis_tilt=0.02, for an arm known "
                    "to need it; repeatable")
+    p.add_argument("--residual-model", action="store_true",
+                   help="also train a learned residual term on the joint angles (as zrp "
+                   "diagnose --residual-model); kept only when it lowers the withheld error "
+                   "clearly, it is then written into compensation.json (learned_residual) and "
+                   "applied by zrp compensate within its training ranges")
     p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
                    help="show the diagnosis's progress on stderr (default on; --no-progress: "
                         "silent)")
@@ -68,7 +73,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "seed": "--seed",
                                          "effects": "--effects", "max_steps": "--max-steps",
                                          "gravity_torque": "--mjcf",
-                                         "orientation_sigma": "--orientation-sigma"})
+                                         "orientation_sigma": "--orientation-sigma",
+                                         "residual_model": "--residual-model"})
 
 
 def _widen(items: list[str]) -> dict[str, float] | None:
@@ -91,7 +97,8 @@ def _widen(items: list[str]) -> dict[str, float] | None:
 #: options that shape a diagnosis (refused with --diagnosis: it has its own)
 _SHAPING = (("mjcf", "--mjcf"), ("seed", "--seed"), ("effects", "--effects"),
             ("max_steps", "--max-steps"), ("noise", "--noise"),
-            ("orientation_sigma", "--orientation-sigma"), ("no_orientation", "--no-orientation"))
+            ("orientation_sigma", "--orientation-sigma"), ("no_orientation", "--no-orientation"),
+            ("residual_model", "--residual-model"))
 
 
 def _refuse_shaping(args: argparse.Namespace) -> None:
@@ -110,7 +117,7 @@ def _options(args: argparse.Namespace, tau: object) -> CalibrationOptions:
         "seed": 0 if args.seed is None else args.seed,
         "max_steps": 4 if args.max_steps is None else args.max_steps,
         "noise_sigma": args.noise, "use_orientation": not args.no_orientation,
-        "orientation_sigma": args.orientation_sigma}
+        "orientation_sigma": args.orientation_sigma, "residual_model": args.residual_model}
     return CalibrationOptions(
         **shaping, widen=_widen(args.widen), data_path=args.data,
         data_angle_unit="deg" if args.deg else "rad", instrument=args.instrument,
@@ -181,7 +188,19 @@ def _summary(result: Calibration, unit: str) -> str:
                 f"from the stored diagnosis: final withheld RMS {rec.withheld_rms:.4g} {unit}\n")
     return (f"withheld RMS {diag.nominal.rms:.4g} -> {diag.final.rms:.4g} "
             f"{unit} (effects: {', '.join(diag.effects)})\n"
-            + ("" if full is None else _full_pose_line(full, unit)))
+            + ("" if full is None else _full_pose_line(full, unit))
+            + _learned_line(result, unit))
+
+
+def _learned_line(result: Calibration, unit: str) -> str:
+    """What the learned residual term adds (or why it is not in the files), one line."""
+    assessment = result.diagnosis.assessment if result.diagnosis is not None else None
+    rm = assessment.residual_model if assessment is not None else None
+    if result.robot.learned is not None:
+        return f"with the {result.robot.learned.words(unit)} (in compensation.json)\n"
+    if result.learned_note is not None:
+        return f"note: {result.learned_note}\n"
+    return "" if rm is None else rm.words(unit) + "\n"
 
 
 def _full_pose_line(full: FullPoseCalibration, unit: str) -> str:

@@ -92,8 +92,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "anything is simulated)")
     p.add_argument("--progress", action="store_true", help="show a progress bar")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
-    p.set_defaults(func=_run, api_names={"count": "--poses", "specs": "--effect",
-                                         "rate_hz": "--stream"})
+    p.set_defaults(func=_run, writes=("truth",),
+                   api_names={"count": "--poses", "specs": "--effect", "rate_hz": "--stream"})
 
 
 _COUNT = whole(1, 100_000)

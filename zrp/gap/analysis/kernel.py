@@ -27,9 +27,10 @@ from numpy.typing import NDArray
 
 from zrp.arrays import F64
 from zrp.gap.model.context import MIN_EXCITATION_RAD, Context
+from zrp.rotations.rodrigues import er_from_axis_angle, matrix_from_er
 
-__all__ = ["Inputs", "KernelModel", "fit_kernel_ridge", "length_scales", "pose_inputs",
-           "pose_targets"]
+__all__ = ["Inputs", "KernelModel", "arm_frames", "fit_kernel_ridge", "length_scales",
+           "pose_inputs", "pose_targets"]
 
 #: most poses the Gaussian process that sets the length scales sees.
 ARD_POSES = 200
@@ -97,14 +98,14 @@ def _raw_value(ctx: Context, rows: NDArray[np.int64], name: str) -> F64:
     return _column(ctx, rows, name)[:, 0]
 
 
-def pose_inputs(ctx: Context, rows: NDArray[np.int64]) -> Inputs:
+def pose_inputs(ctx: Context, rows: NDArray[np.int64], *, logged: bool = True) -> Inputs:
     """The inputs set on the poses of ``rows`` (one row per pose): joints that move at least
-    the excitation threshold, and the logged columns that vary."""
+    the excitation threshold, and (with ``logged``) the logged columns that vary."""
     meas = ctx.meas
     names = [f"q{k + 1}" for k in range(ctx.n)
              if ctx.excited[k] and np.ptp(ctx.q[meas.pose_index[rows], k]) >= MIN_EXCITATION_RAD]
     names += [n for n, a in (("time", meas.t), ("temperature", meas.temp), ("load", meas.load))
-              if a is not None and np.ptp(a[rows]) > 0]
+              if logged and a is not None and np.ptp(a[rows]) > 0]
     center, scale, widths = [], [], []
     for n in names:
         f = _column(ctx, rows, n)
@@ -136,6 +137,16 @@ def pose_targets(ctx: Context, poses: NDArray[np.int64], residual: F64
     first[inv[::-1]] = rows[::-1]
     full = np.all(np.isfinite(Y.reshape(up.size, -1)), axis=1)
     return Y[full].reshape(int(full.sum()), -1), first[full]
+
+
+def arm_frames(frame: F64, turn_axis: F64 | None, q1: F64) -> F64:
+    """Per pose the frame F = frame R(turn_axis, q1), shape (P, 3, 3): the data's frame
+    (``frame``: data-from-base rotation) turned with joint 1 about its axis (base frame;
+    None: a prismatic joint 1, no turn). A residual y is expressed in it as F^T y."""
+    q1 = np.asarray(q1, dtype=float)
+    if turn_axis is None:
+        return np.broadcast_to(np.asarray(frame, dtype=float), (q1.size, 3, 3)).copy()
+    return np.asarray(frame, dtype=float) @ matrix_from_er(er_from_axis_angle(turn_axis, q1))
 
 
 def length_scales(X: F64, Y: F64, rng: np.random.Generator) -> F64:

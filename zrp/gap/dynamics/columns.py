@@ -27,13 +27,19 @@ KUKA FRI/Sunrise  q: ``MeasuredJointPosition``, ``measured_joint_position``, ``A
                   ``1``, ``[1]``, ``_a1``, ``a1``; time ``ZeitInSec`` plus ``ZeitInNanoSec``
                   when present. (A trace's torque columns are not in this table: their names
                   were not confirmed; name them ``MeasuredTorque_1``.. or ``tau1``..)
+KUKA FRI pyfri    q: ``mp``; tau: ``mt`` (measured torque); qc: ``ip`` (the interpolator's
+                  position), 1-based (``mp1..mp7``), as lbr-stack/pyfri's
+                  ``collect_data`` writes them; time ``tsec`` plus ``tnsec`` (the FRI
+                  controller's clock), not its ``time`` (a sum of nominal sample times
+                  printed to 6 significant digits); ``et1..`` (external torque) not used
 ROS joint_states  q/qd/tau: ``position``/``velocity``/``effort``, by joint name as
                   ``/joint_states/position/<joint>`` (any topic), ``position_<joint>``, or by
                   index as ``field.position0`` (rostopic echo -p, the names from the
                   ``field.name0..`` cells of the first data row)
 ================  ==========================================================================
 
-Time (any form; the first present in this order is used): ``t``, ``time``, ``timestamp``,
+Time (any form; the first present in this order is used): ``t``, ``tsec`` (with ``tnsec``),
+``time``, ``timestamp``,
 ``time_stamp``, ``field.header.stamp``, ``header.stamp``, ``<topic>/header/stamp``,
 ``__time`` (PlotJuggler), ``ZeitInSec`` (Sunrise), ``%time`` (rostopic receive time). Its unit
 is the declared one, else inferred from the step (:mod:`zrp.gap.dynamics.timebase`).
@@ -62,7 +68,7 @@ GROUP_KIND = {"q": "position", "qd": "velocity", "tau": "effort", "i": "current"
 MAX_NAME = 1000
 
 _SEPS = {"zrp": ("",), "libfranka": ("", "_", "[]", "."), "UR RTDE": ("_", "[]", ""),
-         "KUKA FRI/Sunrise": ("_a", "a", "_", "[]", "")}
+         "KUKA FRI/Sunrise": ("_a", "a", "_", "[]", ""), "KUKA FRI pyfri": ("",)}
 
 #: form -> group -> base names (lowercase).
 FORMS: dict[str, dict[str, tuple[str, ...]]] = {
@@ -77,10 +83,11 @@ FORMS: dict[str, dict[str, tuple[str, ...]]] = {
                 "measured_joint_torque"),
         "qc": ("commandedjointposition", "commanded_joint_position", "axisqcmdt1m_*",
                "axisqcmdipo_*")},
+    "KUKA FRI pyfri": {"q": ("mp",), "tau": ("mt",), "qc": ("ip",)},
 }
 
 #: Time column names in order of preference (regular expressions, whole name).
-TIME = ("t", "time", "timestamp", "time_stamp", r"field\.header\.stamp", r"header\.stamp",
+TIME = ("t", "tsec", "time", "timestamp", "time_stamp", r"field\.header\.stamp", r"header\.stamp",
         r"(?:/[^/]+)+/header/stamp", "__time", "zeitinsec", "%time")
 
 _ROS_GROUP = {"position": "q", "velocity": "qd", "effort": "tau"}
@@ -165,7 +172,7 @@ def accepted_forms() -> str:
              for form, groups in FORMS.items()]
     parts.append("ROS joint_states: /joint_states/position/<joint>, position_<joint>, "
                  "field.position<k> (and velocity, effort)")
-    return ("; ".join(parts) + "; time: t, time, timestamp, field.header.stamp, __time, "
+    return ("; ".join(parts) + "; time: t, tsec, time, timestamp, field.header.stamp, __time, "
             "ZeitInSec, %time")
 
 
@@ -307,7 +314,7 @@ def _unused(form: str, found: dict, names: list[str], src: str
     t = _time_column(names)
     if t is None:
         raise InputError(f"{src} line 1: missing column(s) t: no time column (accepted: "
-                         "t, time, timestamp, field.header.stamp, __time, ZeitInSec, %time)")
+                         "t, tsec, time, timestamp, field.header.stamp, __time, ZeitInSec, %time)")
     payload = next((i for i, c in enumerate(names) if c.lower() == "payload"), None)
     used = _claimed(found) | {t, payload, _nanoseconds(names, t)}
     ignored = tuple(names[i] for i in range(len(names)) if i not in used)
@@ -319,10 +326,12 @@ def _unused(form: str, found: dict, names: list[str], src: str
 
 
 def _nanoseconds(names: list[str], t: int) -> int | None:
-    """The ``ZeitInNanoSec`` column that completes a Sunrise ``ZeitInSec`` clock, if any."""
-    if names[t].lower() != "zeitinsec":
+    """The nanoseconds column that completes a seconds clock, if any (Sunrise's
+    ``ZeitInSec`` + ``ZeitInNanoSec``; FRI's ``tsec`` + ``tnsec``)."""
+    nanos = {"zeitinsec": "zeitinnanosec", "tsec": "tnsec"}.get(names[t].lower())
+    if nanos is None:
         return None
-    return next((i for i, c in enumerate(names) if c.lower() == "zeitinnanosec"), None)
+    return next((i for i, c in enumerate(names) if c.lower() == nanos), None)
 
 
 def _ros_name_cells(names: list[str], base: int, n: int) -> tuple[int, ...]:

@@ -70,6 +70,8 @@ class FitResult:
         probe_rotation: R_t identified with the orientations (3, 3), or None when the fit
             used positions only. ``residual``, ``jac`` and the statistics built on them are
             the positions' in both cases; ``cov`` is the fit's (with orientations: of both).
+        held_cov: the held directions' share of ``cov`` (their prior's, eq. W3), shape
+            (p, p), or None when not known (then ``cov`` is taken as all estimated).
     """
 
     specs: tuple[ParamSpec, ...]
@@ -84,6 +86,7 @@ class FitResult:
     stop_reason: str = ""
     iterations: int = 0
     probe_rotation: F64 | None = None
+    held_cov: F64 | None = None
 
     def __post_init__(self) -> None:
         p = len(self.specs)
@@ -240,7 +243,8 @@ def fit(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, theta0: Arra
                       stacklevel=2)
     return FitResult(tuple(specs), sol.theta, sol.cov, sol.residual, sol.jac,
                      np.asarray(base_rotation), np.asarray(poses, dtype=np.int64),
-                     sol.converged, sol.held, sol.reason, sol.iterations)
+                     sol.converged, sol.held, sol.reason, sol.iterations,
+                     held_cov=sol.held_cov)
 
 
 def _fit_with_orientation(ctx: Context, prob: Problem, theta0: F64, scales: F64) -> FitResult:
@@ -253,7 +257,8 @@ def _fit_with_orientation(ctx: Context, prob: Problem, theta0: F64, scales: F64)
     p = prob.size
     r, J = prob.residual_and_jacobian(sol.theta[:p])
     return FitResult(prob.specs, sol.theta[:p], sol.cov[:p, :p], r, J, prob.base_rotation,
-                     prob.poses, sol.converged, sol.held, sol.reason, sol.iterations, rt)
+                     prob.poses, sol.converged, sol.held, sol.reason, sol.iterations, rt,
+                     None if sol.held_cov is None else sol.held_cov[:p, :p])
 
 
 def check_identifiable(ctx: Context, base: FitResult, candidates: Sequence[ParamSpec],

@@ -38,10 +38,6 @@ def pose_rotations(ctx: Context) -> F64:
     return Rotation.from_quat(q[:, [1, 2, 3, 0]]).as_matrix()
 
 
-def _left_jacobians(e: F64) -> F64:
-    return np.stack([left_jacobian(v) for v in e])
-
-
 def orientation_residual(prob: Problem, theta: ArrayLike, psi: ArrayLike, rt0: ArrayLike,
                          measured: ArrayLike) -> tuple[F64, F64]:
     """Orientation residuals (O1) and their Jacobian (O2) on the poses of ``prob``.
@@ -83,7 +79,7 @@ def orientation_residual(prob: Problem, theta: ArrayLike, psi: ArrayLike, rt0: A
                + (1.0 - np.cos(ch.q[:, k]))[:, None] * np.cross(uk, du))
         cols[:, :, i] = np.einsum("ij,sjk,sk->si", rb, ch.rprev[:, k], loc)
     cols[:, :, prob.size:] = rb @ rn @ left_jacobian(psi)
-    jinv = np.linalg.inv(_left_jacobians(e))
+    jinv = np.linalg.inv(left_jacobian(e))
     return e, jinv @ cols
 
 

@@ -127,6 +127,8 @@ class Solution:
         residual, jac: at the solution.
         cov: covariance (eq. W3), shape (p, p).
         held: the held directions at the solution.
+        held_cov: the held directions' share of ``cov`` (the second term of eq. W3: their
+            prior's), shape (p, p); zero when none is held.
         converged: the stop test was met (False: ``reason`` says why not).
         iterations: Gauss-Newton iterations.
         reason: why the solver stopped, in words.
@@ -140,6 +142,7 @@ class Solution:
     converged: bool
     iterations: int
     reason: str
+    held_cov: F64 | None = None
 
 
 def parameter_scales(ctx: Context, specs: Sequence[ParamSpec], jac: F64) -> F64:
@@ -194,14 +197,16 @@ def _decompose(r: F64, J: F64, scales: F64, tau_fixed: float | None = None
     return g, U, s, Vt, sigma, (tau if tau_fixed is None else tau_fixed)
 
 
-def _covariance(r: F64, s: F64, Vt: F64, keep: NDArray[np.bool_], scales: F64) -> F64:
-    """Eq. W3."""
+def _covariance(r: F64, s: F64, Vt: F64, keep: NDArray[np.bool_], scales: F64
+                ) -> tuple[F64, F64]:
+    """Eq. W3, and its second term alone (the held directions' prior)."""
     k = int(keep.sum())
     dof = max(r.size - k, 1)
     s2 = float(r @ r) / dof
     vk, vh = Vt[keep], Vt[~keep]
-    c = (vk.T / s[keep] ** 2) @ vk * s2 + vh.T @ vh
-    return c * np.outer(scales, scales)
+    d2 = np.outer(scales, scales)
+    held = (vh.T @ vh) * d2
+    return ((vk.T / s[keep] ** 2) @ vk * s2) * d2 + held, held
 
 
 def _map_step(g: F64, U: F64, s: F64, Vt: F64, x: F64, keep: NDArray[np.bool_], s2: float
@@ -287,5 +292,5 @@ def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], 
         keep = s > tau
     held = _held(Vt, s, keep, names, tau, RANK_RTOL * float(s[0]) if s.size else 0.0,
                  reading)
-    return Solution(theta, r, J, _covariance(r, s, Vt, keep, scales), held, converged, it,
-                    reason)
+    cov, held_cov = _covariance(r, s, Vt, keep, scales)
+    return Solution(theta, r, J, cov, held, converged, it, reason, held_cov)

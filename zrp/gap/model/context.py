@@ -294,8 +294,14 @@ class Context:
 
         Mass points P_j: the points on joints 2..n and the end effector (points that coincide
         at q = 0 are merged). Returns the point labels (J,) and h, shape (P, n, J); entries of
-        points not beyond joint k are 0.
+        points not beyond joint k are 0. Computed once per context (every candidate effect and
+        step asks for them): h is read-only.
         """
+        labels, h = self._lumped_arms
+        return list(labels), h
+
+    @cached_property
+    def _lumped_arms(self) -> tuple[tuple[str, ...], F64]:
         fk = self.nominal_fk
         n = self.n
         g = np.asarray(self.gravity_dir, dtype=float)
@@ -319,4 +325,5 @@ class Context:
                     continue
                 arm = np.cross(pt - fk.points[:, k], g)
                 h[:, k, jj] = np.einsum("pi,pi->p", fk.axes[:, k], arm)
-        return labels, h
+        h.setflags(write=False)
+        return tuple(labels), h

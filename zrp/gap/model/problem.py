@@ -22,7 +22,7 @@ tests:
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -108,6 +108,9 @@ class Problem:
         self.dT = (None if ctx.dtemp is None else ctx.dtemp[self.poses])
         self.scale_basis = self._scale_basis()
         self.q = ctx.q_of(self.poses)
+        #: the last chain computed, by its theta: a full-pose fit asks for the chain of the
+        #: same theta twice (positions, then orientations), so the second is a look-up
+        self._last: tuple[bytes, _Chain] | None = None
 
     def _scale_basis(self) -> F64:
         """Body scale per pose and unit parameter of each ``thermal`` spec, shape (S, k):
@@ -165,7 +168,18 @@ class Problem:
 
     # ---- evaluation -----------------------------------------------------------------------
     def _chain(self, theta: F64) -> _Chain:
-        """The corrected kinematic chain at ``theta`` on the problem's poses."""
+        """The corrected kinematic chain at ``theta`` on the problem's poses (read-only
+        arrays: the last one is kept and handed out again for the same theta)."""
+        key = np.asarray(theta, dtype=float).tobytes()
+        if self._last is not None and self._last[0] == key:
+            return self._last[1]
+        ch = self._new_chain(theta)
+        for f in fields(ch):
+            getattr(ch, f.name).setflags(write=False)
+        self._last = (key, ch)
+        return ch
+
+    def _new_chain(self, theta: F64) -> _Chain:
         model = self.ctx.model
         n = model.n
         S = self.poses.size

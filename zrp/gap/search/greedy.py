@@ -24,6 +24,7 @@ from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.identifiability import GEOMETRIC, geometric_overlap
 from zrp.gap.fit.aliasing import Aliased
 from zrp.gap.fit.constrained import n_registration, within_domains
+from zrp.gap.fit.heldwald import group_pvalues
 from zrp.gap.fit.leastsq import (
     FitResult,
     cv_rms,
@@ -118,12 +119,12 @@ def _not_tried(effect: str, note: str, aliased: list[Aliased] | None = None) -> 
 
 def _significant(ctx: Context, current: FitResult, f1: FitResult, keep: list[ParamSpec],
                  s: SearchSettings) -> tuple[FitResult, list[ParamSpec]]:
-    """The candidate's parameters whose Wald group is significant (refitted without the
-    others when some were pruned). The backward elimination on identifiable parts
-    (:mod:`zrp.gap.search.groups`) is not applied here: it released the common tilt that
-    positions alone must hold (tests/gap/test_orientation_search.py)."""
+    """The candidate's parameters whose group is significant (:mod:`zrp.gap.fit.heldwald`,
+    eq. H2: near-collinear groups that a held combination spans, each needed by the data, are
+    not lost to the prior variance that combination gives them), refitted without the others
+    when some were pruned."""
     nb = len(current.specs)
-    pv = wald_groups(f1, nb)
+    pv = group_pvalues(f1, nb, s.alpha)
     thr = s.alpha / max(len(pv), 1)
     sig = {g for g, p in pv.items() if p < thr}
     kept = [p for p in keep if group_key(p) in sig]
@@ -301,7 +302,10 @@ def backward_pass(ctx: Context, current: FitResult, nreg: int, s: SearchSettings
     the final model no longer needs them (Wald test at alpha / groups); returns the refitted
     model and the groups dropped.
 
-    Backward elimination one group at a time: the least significant group goes, the model is
+    The plain Wald test, not eq. H2 of the forward steps (:mod:`zrp.gap.fit.heldwald`): of
+    near-collinear groups that a step took in together, held together, one is dropped here
+    and the refit estimates the other. Backward elimination one group at
+    a time: the least significant group goes, the model is
     refitted and the tests are redone. Dropping every group above the threshold at once
     removed groups that are each insignificant only because they stand in for one another
     (a joint's offset and its encoder scale over a narrow range of that joint, an axis tilt and
