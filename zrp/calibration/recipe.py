@@ -246,7 +246,7 @@ def _final_record(model: Manipulator, measurements: Measurements, opt: Calibrati
     return diagnosis, record, full, diagnosis.context.meas is not measurements
 
 
-def _learned(diag: Diagnosis | None, full: FullPoseCalibration | None, *, stored: bool
+def _learned(diag: Diagnosis | None, full: FullPoseCalibration | None, *, stored: bool = False
              ) -> tuple[LearnedTerm | None, str | None]:
     """The diagnosis's learned residual term when it was kept, and a note when it was kept
     but cannot be used."""

@@ -185,7 +185,8 @@ def _summary(result: Calibration, unit: str) -> str:
     if diag is None:
         rec = result.record
         return ("" if rec is None else
-                f"from the stored diagnosis: final withheld RMS {rec.withheld_rms:.4g} {unit}\n")
+                f"from the stored diagnosis: final withheld RMS {rec.withheld_rms:.4g} {unit}\n"
+                ) + _learned_line(result, unit)
     return (f"withheld RMS {diag.nominal.rms:.4g} -> {diag.final.rms:.4g} "
             f"{unit} (effects: {', '.join(diag.effects)})\n"
             + ("" if full is None else _full_pose_line(full, unit))
