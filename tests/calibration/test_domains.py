@@ -14,8 +14,8 @@ from zrp.gap.model.domains import DOMAINS, domain_key, parameter_bounds, violati
     ("q3.backlash", "backlash", "backlash"),
     ("q2.compliance", "joint_compliance", "compliance"),
     ("q2.compliance_payload", "joint_compliance", "compliance"),
-    ("q2.w_p3", "joint_compliance", None),
-    ("q2.w_load", "joint_compliance", None),
+    ("q2.w_p3", "joint_compliance", "compliance"),
+    ("q2.w_load", "joint_compliance", "compliance"),
     ("q6.sin2", "cyclic_error", "cyclic_amplitude"),
     ("q1.scale", "encoder_scale", "encoder_scale"),
     ("u4.t1", "axis_misalignment", "axis_tilt"),
@@ -35,6 +35,10 @@ def test_bounds_and_units():
     # compliance_payload (rad/kg) keeps the lower bound only
     assert parameter_bounds("q2.compliance_payload", "joint_compliance", "rad/kg") == (
         0.0, math.inf)
+    # the lumped weights (c m g on a moment arm): the lower bound only, as compliance_payload
+    assert parameter_bounds("q2.w_ee", "joint_compliance", "rad/mm") == (0.0, math.inf)
+    assert "q2.w_ee = -7e-06 rad/mm is outside" in violation("compliance", "q2.w_ee", -7e-6,
+                                                             "rad/mm")
     # each member of a grouped domain is bounded on both sides by the group's bound
     assert parameter_bounds("u2.t1", "axis_misalignment") == (-0.005, 0.005)
     assert parameter_bounds("u2.t1", "axis_misalignment", widen={"axis_tilt": 0.02}) == (

@@ -79,3 +79,23 @@ def test_compensate_refuses_outside_the_training_ranges(calibrated, tmp_path, ca
     rc = main([*argv, "--accept-flagged", "--json"])
     out = json.loads(capsys.readouterr().out)
     assert rc == 0 and out["outside_measured"] == 2
+
+
+def test_calibrate_from_the_stored_diagnosis_says_the_term_is_not_there(calibrated, capsys):
+    """diagnosis.json records that a learned term was kept but not the term: a calibration
+    reusing it is the physical model alone, equal to the fresh one's physical part, and the
+    summary says so instead of dropping the term silently."""
+    out = calibrated / "reused"
+    rc = main(["calibrate", "--model", str(calibrated / "irb120.toml"), "--data",
+               str(calibrated / "data.csv"), "--out", str(out), "--no-progress",
+               "--diagnosis", str(calibrated / "cal" / "diagnosis.json")])
+    assert rc == 0
+    said = capsys.readouterr().out
+    assert "note: the stored diagnosis kept a learned residual term" in said
+    assert "diagnosis.json does not hold it" in said
+    fresh = json.loads((calibrated / "cal" / "compensation.json").read_text())
+    reused = json.loads((out / "compensation.json").read_text())
+    assert reused["learned_residual"] is None and fresh["learned_residual"] is not None
+    for key in ("joint_map", "base_rotation", "base_translation", "tool_points",
+                "joint_offsets_folded", "withheld_rms"):
+        assert reused[key] == fresh[key], key

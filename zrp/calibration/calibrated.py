@@ -33,11 +33,10 @@ from zrp.calibration.jointmap import NON_GEOMETRIC, Term, joint_correction
 from zrp.calibration.learned import LearnedTerm, check_learned, correct_hand
 from zrp.errors import InputError
 from zrp.gap.data.measurements import Measurements
+from zrp.gap.finalrecord import FinalModelRecord, final_model_record
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.model.context import Context
-from zrp.gap.model.problem import Problem
 from zrp.gap.results import Diagnosis
-from zrp.gap.search.determination import fit_determinations
 from zrp.model.manipulator import Manipulator
 from zrp.rotations import skew
 
@@ -83,18 +82,20 @@ def chain(model: Manipulator, x: F64, scale: F64 | None = None) -> tuple[F64, F6
     return pos, np.array(r), pts, axes
 
 
-def _joint_terms(fit: FitResult, model: Manipulator) -> tuple[F64, list[Term], float]:
-    """The revolute offsets to fold (n,), the joint-map terms and kappa of a fit."""
+def _joint_terms(rec: FinalModelRecord, model: Manipulator
+                 ) -> tuple[F64, list[Term], float]:
+    """The revolute offsets to fold (n,), the joint-map terms and kappa of a record."""
     delta = np.zeros(model.n)
     terms: list[Term] = []
     kappa = 0.0
-    for s, v, se in zip(fit.specs, fit.theta, fit.stderr, strict=True):
+    for s in rec.parameters:
         if s.kind == "thermal":
-            kappa = float(v)
+            kappa = float(s.value)
         elif s.kind == "dq" and s.effect == "joint_offset" and not model.prismatic[s.joint - 1]:
-            delta[s.joint - 1] = float(v)
+            delta[s.joint - 1] = float(s.value)
         elif s.kind == "dq" and s.effect in NON_GEOMETRIC:
-            terms.append(Term(s.name, s.effect, s.joint, s.unit, float(v), float(se)))
+            terms.append(Term(s.name, s.effect, s.joint, s.unit, float(s.value),
+                              float(s.stderr)))
     return delta, terms, kappa
 
 
@@ -115,15 +116,6 @@ class PoseConditions:
     gravity_torque: ArrayLike | None = None
     temp: ArrayLike | None = None
     load: ArrayLike | None = None
-
-
-def _undetermined(diag: Diagnosis, fit: FitResult) -> tuple[str, ...]:
-    """``name: what the data say`` of the parameters of ``fit`` the data did not determine
-    (the diagnosis's robust story for its final fit; the fit's own intervals otherwise)."""
-    det = (diag.determination if fit is diag.final_fit else fit_determinations(
-        fit, gap=diag.nominal.rms, unit=diag.length_unit,
-        max_tilt_rad=diag.context.max_tilt_rad))
-    return tuple(f"{d.name}: {d.describe()}" for d in det.values() if not d.determined)
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,6 +156,11 @@ class CalibratedRobot:
             ``name: held at nominal (...)`` / ``name: undetermined (...)``
             (:mod:`zrp.gap.search.determination`): an undetermined tool or base direction is
             flagged so in the files a controller reads.
+        taken_out: the effects' values the diagnosis took out as non-physical (outside
+            their physical domains, e.g. a negative compliance), in words: held at nominal.
+        backlash_switch_weights: per joint, the plausible switching torques and their
+            weights of the diagnosis's flank model (the loaded-flank share of a pose is their
+            weighted vote), or None (``backlash_switch`` alone decides).
         learned: the learned residual term on the joint angles (:mod:`.learned`; its points
             are ``tool_labels``), or None (the physical model alone).
     """
@@ -190,6 +187,8 @@ class CalibratedRobot:
     widen: dict[str, float] | None = None
     backlash_lead: tuple[bool, ...] | None = None
     undetermined: tuple[str, ...] = ()
+    taken_out: tuple[str, ...] = ()
+    backlash_switch_weights: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None = None
     learned: LearnedTerm | None = None
 
     def __post_init__(self) -> None:
@@ -233,30 +232,31 @@ class CalibratedRobot:
         of :func:`zrp.calibration.fullpose.full_pose_calibration`)."""
         if fit is None:
             fit = diag.nominal_fit if registration_only else diag.final_fit
-        ctx = diag.context
-        prob = Problem(ctx, fit.specs, diag.fitting_poses[:1], fit.base_rotation)
-        theta = fit.theta
-        u, _, bodies = prob.geometry(theta)
-        tools = prob.tool_offsets(theta)
-        rb, tb = prob.base(theta)
-        delta, terms, kappa = _joint_terms(fit, ctx.model)
-        folded, tools_f = _fold(ctx.model, u, bodies, delta, tools)
-        bl = None if registration_only else diag.where.backlash
+        rec = final_model_record(diag, registration_only=registration_only, fit=fit)
+        return cls.from_record(rec, diag.context.model, Conditions.from_measurements(
+            diag.context.meas, diag.context.model))
+
+    @classmethod
+    def from_record(cls, rec: FinalModelRecord, nominal: Manipulator,
+                    conditions: Conditions | None = None, widen: dict[str, float] | None = None
+                    ) -> CalibratedRobot:
+        """The calibrated robot of a diagnosis's final-model record
+        (:class:`zrp.gap.FinalModelRecord`, stored in diagnosis.json): its revolute offsets
+        folded into its geometry (module doc), on the ``nominal`` model the diagnosis started
+        from, with the data's ``conditions`` and the widened domains."""
+        delta, terms, kappa = _joint_terms(rec, nominal)
+        folded, tools_f = _fold(nominal, rec.axes, rec.bodies, delta, rec.tool_offsets)
         return cls(
-            model=folded, nominal=ctx.model, base_rotation=rb, base_translation=tb,
-            tool_labels=tuple(ctx.meas.point_labels), tool_points=tools_f,
-            joint_offsets=delta, terms=tuple(terms), kappa=kappa,
-            t_ref=float(ctx.t_ref_degC),
-            backlash_switch=None if bl is None else tuple(bl.switch),
-            payload_kg=0.0 if bl is None else float(bl.payload_kg),
-            gravity_dir=tuple(ctx.gravity_dir), harmonics=tuple(ctx.harmonics),
-            frame=ctx.meas.frame,
-            compliance_model="mjcf" if ctx.gravity_torque is not None else "lumped_masses",
-            withheld_rms=float(diag.nominal.rms if registration_only else diag.final.rms),
-            gravity_side_weights=_side_weights(ctx),
-            conditions=Conditions.from_measurements(ctx.meas, ctx.model), widen=None,
-            backlash_lead=None if bl is None or not bl.lead else tuple(bl.lead),
-            undetermined=_undetermined(diag, fit))
+            model=folded, nominal=nominal, base_rotation=rec.base_rotation,
+            base_translation=rec.base_translation, tool_labels=rec.tool_labels,
+            tool_points=tools_f, joint_offsets=delta, terms=tuple(terms), kappa=kappa,
+            t_ref=rec.t_ref_degC, backlash_switch=rec.backlash_switch,
+            payload_kg=rec.payload_kg, gravity_dir=rec.gravity_dir, harmonics=rec.harmonics,
+            frame=rec.frame, compliance_model=rec.compliance_model,
+            withheld_rms=rec.withheld_rms, gravity_side_weights=rec.gravity_side_weights,
+            conditions=conditions, widen=widen, backlash_lead=rec.backlash_lead,
+            undetermined=rec.undetermined, taken_out=rec.taken_out,
+            backlash_switch_weights=rec.backlash_switch_weights)
 
     @classmethod
     def from_corrections(cls, nominal: Manipulator, joint_offsets: ArrayLike,
@@ -308,7 +308,8 @@ class CalibratedRobot:
                                                                   dtype=float)
         ctx = Context(self.nominal, meas, tau, self.gravity_dir, self.harmonics, self.t_ref,
                       backlash_switch=sw, payload_kg=self.payload_kg,
-                      backlash_lead=self.backlash_lead)
+                      backlash_lead=self.backlash_lead,
+                      backlash_switch_weights=self.backlash_switch_weights)
         if tau is None and self.gravity_side_weights is not None:
             _, h = ctx.moment_arms()
             side = np.einsum("pkj,kj->pk", h, np.asarray(self.gravity_side_weights))
@@ -369,19 +370,6 @@ class CalibratedRobot:
         if frame != "instrument":
             raise InputError(f"frame: expected 'instrument' or 'base', got {frame!r}")
         return y @ np.asarray(self.base_rotation).T + np.asarray(self.base_translation)
-
-
-def _side_weights(ctx: Context) -> F64 | None:
-    """The lumped masses behind the diagnosis's ``gravity_side`` torques, shape (n, J): per
-    joint, the least-squares combination of the moment-arm columns (exact: the diagnosis built
-    them as such a combination), or None with MJCF torques or without a gravity side."""
-    if ctx.gravity_torque is not None or ctx.gravity_side is None:
-        return None
-    _, h = ctx.moment_arms()
-    w = np.zeros((ctx.n, h.shape[2]))
-    for k in range(ctx.n):
-        w[k] = np.linalg.lstsq(h[:, k, :], ctx.gravity_side[:, k], rcond=None)[0]
-    return w
 
 
 def _fold(model: Manipulator, u: F64, bodies: F64, delta: F64, tools: F64

@@ -16,6 +16,7 @@ import numpy as np
 
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.errors import InputError
+from zrp.gap.finalrecord import full_pose_fit_result
 from zrp.gap.fit.fullpose import FullPoseFit, fit_full_pose, orientation_residual, pose_rotations
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.model.problem import Problem
@@ -83,8 +84,9 @@ def full_pose_calibration(diag: Diagnosis, orientation_sigma: float | None = Non
                              orientation_sigma=orientation_sigma))
     specs = fp.specs  # with the groups the orientations revealed (zrp.gap.search.posesearch)
     rb0 = fp.position.base_rotation
-    fit = FitResult(tuple(specs), fp.theta, np.diag(fp.stderr ** 2), fp.position.residual,
-                    fp.position.jac, rb0, np.asarray(diag.fitting_poses), True)
+    fit = (full_pose_fit_result(diag) if same else
+           FitResult(tuple(specs), fp.theta, np.diag(fp.stderr ** 2), fp.position.residual,
+                     fp.position.jac, rb0, np.asarray(diag.fitting_poses), True))
     robot = CalibratedRobot.from_diagnosis(diag, fit=fit)
     first = len(diag.registration)
     ratio = {s.name: float(fp.stderr[i] / fp.position.stderr[i])

@@ -34,6 +34,7 @@ from zrp.calibration.learned import LearnedTerm
 from zrp.calibration.validation import validate_calibration
 from zrp.errors import InputError, ZRPError
 from zrp.escape import one_line
+from zrp.gap.finalrecord import ProbeRecord, switch_weights
 from zrp.gap.fit.fullpose import FullPoseFit
 from zrp.jsonio import dumps, to_jsonable, version_field
 from zrp.model.files import dumps_model, load_model, loads_model
@@ -51,7 +52,7 @@ SCHEMA_VERSION = 3
 READABLE_VERSIONS = (1, 2, 3)
 
 
-def full_pose_document(fp: FullPoseFit | None,
+def full_pose_document(fp: FullPoseFit | ProbeRecord | None,
                        fold: ArrayLike | None = None) -> dict[str, Any] | None:
     """The ``full_pose`` entry: the probe rotation R_t (probe frame in the calibrated model's
     hand frame) and the noise weights of a full-pose fit (:mod:`zrp.gap.fit.fullpose`); None
@@ -75,7 +76,7 @@ def full_pose_document(fp: FullPoseFit | None,
 
 
 def calibration_document(cal: CalibratedRobot, model_file: str,
-                         full_pose: FullPoseFit | None = None) -> dict[str, Any]:
+                         full_pose: FullPoseFit | ProbeRecord | None = None) -> dict[str, Any]:
     """The compensation file's JSON document (see the module doc); ``full_pose``: the
     full-pose fit the calibration came from (its probe rotation and noise are recorded)."""
     return {
@@ -96,7 +97,8 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "thermal": {"kappa": cal.kappa, "t_ref_degC": cal.t_ref},
         "backlash": {"switch": None if cal.backlash_switch is None else list(
             cal.backlash_switch), "payload_kg": cal.payload_kg,
-                     "lead": None if cal.backlash_lead is None else list(cal.backlash_lead)},
+                     "lead": None if cal.backlash_lead is None else list(cal.backlash_lead),
+                     "switch_weights": cal.backlash_switch_weights},
         "gravity_dir": list(cal.gravity_dir),
         "harmonics": list(cal.harmonics),
         "compliance_model": cal.compliance_model,
@@ -107,6 +109,7 @@ def calibration_document(cal: CalibratedRobot, model_file: str,
         "conditions": None if cal.conditions is None else cal.conditions.to_dict(),
         "domains_widened": cal.widen,
         "undetermined": list(cal.undetermined),
+        "taken_out_non_physical": list(cal.taken_out),
         "learned_residual": None if cal.learned is None else cal.learned.to_dict(),
         "apply": ("x = q + sum(value * basis) per joint-map term; position of tool point j "
                   "= R_b (p'(x) + R'_n(x) t'_j) + t_b with p', R'_n the forward kinematics of "
@@ -160,11 +163,16 @@ def _toml_header(cal: CalibratedRobot, comp_name: str) -> str:
         lines.append("# NOT DETERMINED by the data (kept at nominal or known only loosely; "
                      "compensation.json 'undetermined'):")
         lines += [f"#   {' '.join(u.split())}" for u in cal.undetermined]
+    if cal.taken_out:
+        lines.append("# TAKEN OUT as non-physical (outside their physical domains, held at "
+                     "nominal; compensation.json 'taken_out_non_physical'):")
+        lines += [f"#   {one_line(' '.join(u.split()))}" for u in cal.taken_out]
     return "\n".join(lines) + "\n"
 
 
 def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: str | Path, *,
-                      overwrite: bool = False, full_pose: FullPoseFit | None = None
+                      overwrite: bool = False,
+                      full_pose: FullPoseFit | ProbeRecord | None = None
                       ) -> tuple[Path, Path]:
     """Write the calibrated model (TOML) and the compensation file (JSON), atomically; both
     names are checked before either is written. ``full_pose``: the full-pose fit of ``cal``
@@ -281,8 +289,6 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
     tools = _get(doc, "tool_points", src)
     bl = _get(doc, "backlash", src)
     th = _get(doc, "thermal", src)
-    cond = doc.get("conditions")
-    widen = doc.get("domains_widened")
     return CalibratedRobot(
         model, loads_model(str(_get(doc, "nominal_model", src)), f"{src}: nominal_model"),
         np.array(_get(doc, "base_rotation", src), dtype=float),
@@ -298,13 +304,24 @@ def _robot(doc: dict[str, Any], model: Manipulator, src: str) -> CalibratedRobot
         tuple(float(v) for v in _get(doc, "gravity_dir", src)),
         tuple(int(h) for h in _get(doc, "harmonics", src)),
         str(_get(doc, "frame", src)), str(_get(doc, "compliance_model", src)),
-        None if doc.get("withheld_rms") is None else float(doc["withheld_rms"]),
-        None if doc.get("gravity_side_weights") is None
-        else np.array(doc["gravity_side_weights"], dtype=float),
-        None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
-        None if widen is None else {str(k): float(v) for k, v in dict(widen).items()},
-        _lead(bl.get("lead"), src), tuple(str(u) for u in doc.get("undetermined") or ()),
-        _learned(doc.get("learned_residual"), src))
+        **_optional_fields(doc, bl, src))
+
+
+def _optional_fields(doc: dict[str, Any], bl: dict[str, Any], src: str) -> dict[str, Any]:
+    """The fields a compensation.json may leave out or set to null (older versions)."""
+    cond = doc.get("conditions")
+    widen = doc.get("domains_widened")
+    gsw = doc.get("gravity_side_weights")
+    return {
+        "withheld_rms": None if doc.get("withheld_rms") is None else float(doc["withheld_rms"]),
+        "gravity_side_weights": None if gsw is None else np.array(gsw, dtype=float),
+        "conditions": None if cond is None else Conditions.from_dict(cond, f"{src}: conditions"),
+        "widen": None if widen is None else {str(k): float(v) for k, v in dict(widen).items()},
+        "backlash_lead": _lead(bl.get("lead"), src),
+        "undetermined": tuple(str(u) for u in doc.get("undetermined") or ()),
+        "taken_out": tuple(str(u) for u in doc.get("taken_out_non_physical") or ()),
+        "backlash_switch_weights": switch_weights(bl.get("switch_weights")),
+        "learned": _learned(doc.get("learned_residual"), src)}
 
 
 def _learned(value: Any, src: str) -> LearnedTerm | None:

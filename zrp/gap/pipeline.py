@@ -40,6 +40,7 @@ from zrp.gap.analysis.fallback import FinalChoice, choose_final
 from zrp.gap.analysis.identifiability import ReferencePoses, registration_identifiable, survey
 from zrp.gap.analysis.residual import fit_residual_model
 from zrp.gap.analysis.where import WhereAnalysis, where_analysis
+from zrp.gap.data.digest import measurements_sha256
 from zrp.gap.data.measurements import Measurements
 from zrp.gap.data.noise import noise_floor
 from zrp.gap.data.split import split_poses
@@ -148,6 +149,7 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
     with warnings.catch_warnings(record=True) as wlist:
         warnings.simplefilter("always")
         n_poses = len(measurements.pose_ids)
+        digest = measurements_sha256(measurements)  # of the data given, before any subsample
         measurements, kept = subsample_poses(measurements, max_points, seed)
         if kept is not None and gravity_torque is not None:
             gravity_torque = _kept_rows(gravity_torque, kept, n_poses)
@@ -162,7 +164,8 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
         warnings.warn_explicit(w.message, w.category, caller.f_code.co_filename,
                                caller.f_lineno)
     caught = tuple(dict.fromkeys(str(w.message) for w in wlist))
-    return dataclasses.replace(result, warnings=caught)
+    return dataclasses.replace(result, warnings=caught,
+                               settings={**result.settings, "measurements_sha256": digest})
 
 
 def _check_orientation(meas: Measurements, use: object, sigma: object) -> None:

@@ -15,6 +15,7 @@ import math
 import os
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,7 @@ from zrp.gap.analysis.checks import GapWarning as GapWarning
 from zrp.gap.analysis.identifiability import EffectIdentifiability as EffectIdentifiability
 from zrp.gap.analysis.where import WhereAnalysis
 from zrp.gap.data.noise import NoiseFloor
+from zrp.gap.finalrecord import FinalModelRecord, final_model_record
 from zrp.gap.fit.aliasing import Aliased
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.fit.metrics import Metrics
@@ -61,7 +63,9 @@ __all__ = [
     "parameter_estimates",
 ]
 
-SCHEMA_VERSION = 1
+#: 2 (0.5.0): ``final_model_record`` (:mod:`zrp.gap.finalrecord`); ``joint`` null, not 0, for
+#: parameters of no joint (registration, kappa): joints count from 1 in every file
+SCHEMA_VERSION = 2
 #: final withheld RMS above this multiple of the noise-floor RMS counts as unexplained.
 UNEXPLAINED_RATIO = 1.5
 
@@ -260,6 +264,12 @@ class Diagnosis(EffectsFound):
         return tuple(dict.fromkeys((c.effect, c.note) for c in cands
                                    if "physical domain" in c.note))
 
+    @cached_property
+    def calibration_record(self) -> FinalModelRecord:
+        """What a calibration takes from this diagnosis (its full-pose refit when it has one,
+        else its final model; :mod:`zrp.gap.finalrecord`), as diagnosis.json stores it."""
+        return final_model_record(self)
+
     def identification(self) -> dict[str, Any]:
         """The well-posedness record of diagnosis.json's ``identification``."""
         f = self.final_fit
@@ -304,6 +314,7 @@ class Diagnosis(EffectsFound):
             "warnings": list(self.warnings),
             **({} if self.assessment is None else self.assessment.to_dict()),
             "full_pose": None if self.full_pose is None else self.full_pose.to_dict(),
+            "final_model_record": self.calibration_record.to_dict(),
         }
 
 
@@ -354,7 +365,7 @@ def _candidate(c: Mapping[str, Any]) -> Candidate:
 
 def _parameter(p: Mapping[str, Any]) -> ParameterEstimate:
     ci = p.get("ci95_effect")
-    return ParameterEstimate(p["name"], p["effect"], int(p["joint"]), p["unit"],
+    return ParameterEstimate(p["name"], p["effect"], int(p["joint"] or 0), p["unit"],
                              float(p["value"]), float(p["stderr"]),
                              (_number(p["ci95"][0]), _number(p["ci95"][1])),
                              None if ci is None else (_number(ci[0]), _number(ci[1])))

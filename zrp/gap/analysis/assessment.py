@@ -129,7 +129,7 @@ class Remainder:
     def to_dict(self) -> dict[str, Any]:
         return {**dict_from_dataclass(self, exclude=("joint_r2", "exceeds_spec", "structure")),
                 "structure": None if self.structure is None else self.structure.to_dict(),
-                "joint_r2": {"joint": self.joint_r2[0], "r2": self.joint_r2[1]},
+                "joint_r2": {"joint": self.joint_r2[0] or None, "r2": self.joint_r2[1]},
                 "exceeds_typical_repeatability": self.exceeds_spec,
                 "findings": [{"explanation": e, "status": s, "evidence": v}
                              for e, s, v in self.findings()]}

@@ -12,7 +12,9 @@ domain (key)           parameters                    domain (hard: outside it, n
                                                      (prismatic: 1 mm)
 ``backlash``           ``q{k}.backlash``             0 <= b <= 20 mrad (prismatic: 1 mm)
 ``compliance``         ``q{k}.compliance``,          0 <= c <= 0.01 rad/(N m)
-                       ``.compliance_payload``       (in rad/kg: c >= 0 only)
+                       ``.compliance_payload``,      (in rad/kg, and the lumped weights
+                       ``.w_{p}``, ``.w_load``       in rad/length, rad/(length kg):
+                                                     c >= 0 only)
 ``axis_tilt``          ``u{k}.t1``, ``u{k}.t2``      each and sqrt(t1^2 + t2^2) <=
                                                      ``max_tilt_rad`` (5 mrad)
 ``link_length``        ``b{k}.x/y/z``                abs <= 20 mm
@@ -30,9 +32,12 @@ load; a machined joint axis is square to its seat to a fraction of a mrad, so a 
 than a few mrad is a wrong model (a different kinematic convention, a missing joint) rather than
 a calibration. An arm known to need more passes ``widen`` (key -> a larger upper bound;
 ``max_tilt_rad`` of the diagnosis is the same thing for ``axis_tilt``): a domain can only be
-widened. Registration parameters (base frame, tool points) and the lumped-mass compliance
-weights ``q{k}.w_{p}``, ``w_load`` (products of unknown masses and compliances, with no sign of
-their own) have no domain.
+widened. Registration parameters (base frame, tool points) have no domain. The lumped-mass
+compliance weights ``q{k}.w_{p}``, ``w_load`` are products c_k m_p g of a compliance and a mass
+on the gravity moment arm of :meth:`zrp.gap.model.context.Context.moment_arms` (the same sign
+as the MJCF gravity torque of ``q{k}.compliance``): neither factor is negative, so a negative
+weight is a joint deflecting against its load and leaves the ``compliance`` domain exactly as
+its MJCF counterpart does (taken out by the search, refused by the writers).
 
 The tolerances scale the parameters of the well-posed identification
 (:mod:`zrp.gap.fit.wellposed`): one unit of scaled parameter is one typical manufacturing or
@@ -168,7 +173,8 @@ def domain_key(name: str, effect: str) -> str | None:
     what = name.split(".", 1)[-1]
     if effect in _BY_EFFECT:
         return _BY_EFFECT[effect]
-    if effect == "joint_compliance" and what in ("compliance", "compliance_payload"):
+    if effect == "joint_compliance" and (what in ("compliance", "compliance_payload")
+                                         or what.startswith("w_")):
         return "compliance"
     if effect == "cyclic_error" and _CYCLIC.match(what):
         return "cyclic_amplitude"

@@ -211,7 +211,8 @@ def _try_backlash(ctx: Context, current: FitResult, current_cv: float,
     switch = ctx_b.backlash_switch or ()
     flank = BacklashSwitch(tuple(None if not np.isfinite(v) else v for v in switch),
                            tuple(switch_bands(ctx_b.backlash_switch_weights)),
-                           ctx_b.payload_kg, tuple(ctx_b.backlash_lead or ()))
+                           ctx_b.payload_kg, tuple(ctx_b.backlash_lead or ()),
+                           ctx_b.backlash_switch_weights)
     trial = _try_effect(ctx, current, current_cv, "backlash", specs, why, s)
     return _Trial(trial.candidate, trial.fit, trial.aliased, flank)
 

@@ -55,7 +55,11 @@ class ParameterEstimate:
             raise InputError(f"ParameterEstimate {self.name}: stderr {self.stderr} < 0")
 
     def to_dict(self) -> dict[str, Any]:
-        return dict_from_dataclass(self, exclude=() if self.ci95_effect else ("ci95_effect",))
+        """The JSON form; ``joint`` 1-based, null for a parameter of no joint (registration,
+        kappa)."""
+        d = dict_from_dataclass(self, exclude=() if self.ci95_effect else ("ci95_effect",))
+        d["joint"] = self.joint or None
+        return d
 
 
 def parameter_estimates(result: FitResult, first: int, last: int | None = None,
@@ -184,15 +188,19 @@ class BacklashSwitch:
         payload_kg: the unknown payload at the tool profiled with MJCF torques, kg.
         lead: per joint, whether the approach leaves the load on the leading flank of its play
             (its inertia carries it over as the motor stops) rather than lagging behind.
+        weights: per joint, the plausible switching torques and their weights the fit used
+            (:attr:`zrp.gap.model.context.Context.backlash_switch_weights`), or None.
     """
 
     switch: tuple[float | None, ...]
     band: tuple[list[float] | None, ...]
     payload_kg: float
     lead: tuple[bool, ...] = ()
+    weights: tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None = None
 
     def to_dict(self) -> dict[str, Any]:
-        return dict_from_dataclass(self, rename={"switch": "backlash_switch",
+        return dict_from_dataclass(self, exclude=("weights",),
+                                   rename={"switch": "backlash_switch",
                                                  "band": "backlash_switch_band",
                                                  "payload_kg": "backlash_payload_kg",
                                                  "lead": "backlash_lead"})

@@ -1,0 +1,51 @@
+"""No negative compliance reaches a file (issue 33): data whose unconstrained lumped-mass fit
+wants q2.w_ee < 0 (a joint deflecting against its load) give a calibration without it, with
+the reason noted in compensation.json; the writer refuses one built by hand."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import warnings
+
+import numpy as np
+import pytest
+
+import zrp
+from zrp.calibration import CalibrationOptions, calibrate, write_calibration
+from zrp.calibration.jointmap import Term
+from zrp.gap import Injection, synthesize
+from zrp.gap.fit.leastsq import fit
+from zrp.gap.model.domains import ImplausibleValueError
+from zrp.gap.model.effects import effect_parameters
+from zrp.kinematics import uniform_joint_values
+
+PUMA = zrp.load_model("puma")
+
+
+def test_negative_lumped_compliance_never_written(tmp_path):
+    rng = np.random.default_rng(7)
+    meas = synthesize(PUMA, uniform_joint_values(PUMA, 150, rng),
+                      Injection(compliance={2: -4e-5}, masses={"ee": 5.0}), rng=rng,
+                      noise_sigma=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = calibrate(PUMA, meas, options=CalibrationOptions(
+            effects=("joint_compliance", "joint_offset")))
+    d = result.diagnosis
+    ctx, reg = d.context, d.nominal_fit
+    specs, _ = effect_parameters(ctx, "joint_compliance")
+    free = fit(ctx, list(reg.specs) + specs, d.fitting_poses,
+               np.concatenate([reg.theta, np.zeros(len(specs))]), reg.base_rotation)
+    wants = dict(zip([s.name for s in free.specs], free.theta, strict=True))
+    assert wants["q2.w_ee"] < -1e-6  # the unconstrained fit wants a negative compliance
+    result.write(tmp_path / "calibrated.toml", tmp_path / "compensation.json")
+    doc = json.loads((tmp_path / "compensation.json").read_text(encoding="utf-8"))
+    comp = [t for t in doc["joint_map"] if t["effect"] == "joint_compliance"]
+    assert all(t["value"] >= 0 for t in comp)
+    assert any("q2.w_ee" in n for n in doc["taken_out_non_physical"])
+    assert "TAKEN OUT as non-physical" in (tmp_path / "calibrated.toml").read_text()
+    bad = dataclasses.replace(result.robot, terms=(
+        Term("q2.w_ee", "joint_compliance", 2, "rad/mm", -1.5e-6),))
+    with pytest.raises(ImplausibleValueError, match=r"q2\.w_ee"):
+        write_calibration(bad, tmp_path / "b" / "c.toml", tmp_path / "b" / "c.json")
