@@ -35,10 +35,16 @@ def ranges(joints: Sequence[int]) -> str:
     return ", ".join(f"{a}" if a == b else f"{a}-{b}" for a, b in runs) or "-"
 
 
-def _effect(name: str, joints: Sequence[int], with_joints: bool) -> str:
-    if not (with_joints and joints):
+def effect_joints(name: str, joints: Sequence[int]) -> str:
+    """"backlash", (2,) -> "backlash (joint 2)"; (2, 3) -> "backlash (joints 2-3)"; no
+    joints: the name alone. Joints counted from 1, as everywhere a user reads."""
+    if not joints:
         return name
     return f"{name} ({'joint' if len(joints) == 1 else 'joints'} {ranges(joints)})"
+
+
+def _effect(name: str, joints: Sequence[int], with_joints: bool) -> str:
+    return effect_joints(name, joints) if with_joints else name
 
 
 def _matters(diag: Diagnosis, level: int) -> str:

@@ -14,7 +14,7 @@ from zrp.escape import md_text as _t
 from zrp.gap.analysis.where import Region, WhereAnalysis
 from zrp.gap.report.backlash import backlash_flank_text
 from zrp.gap.report.fullpose import full_pose_markdown
-from zrp.gap.report.headline import headline_text, summary_markdown
+from zrp.gap.report.headline import effect_joints, headline_text, summary_markdown
 from zrp.gap.report.identification import identification_markdown
 from zrp.gap.report.verdict import (
     baseline_text,
@@ -199,7 +199,7 @@ def _parameters(diag: Diagnosis) -> list[str]:
     for p in diag.final_parameters:
         by_eff.setdefault(p.effect, []).append(p)
     for eff, params in by_eff.items():
-        L.append(f"### {eff} (joints {_joints(diag.final_joints.get(eff, ()))})\n")
+        L.append(f"### {effect_joints(eff, diag.final_joints.get(eff, ()))}\n")
         L += _parameter_table(params, flags=flags, det=det)
         L.append("")
         if eff == "backlash" and backlash_flank_text(diag):

@@ -7,7 +7,7 @@ import numpy as np
 
 from zrp.gap.analysis.baseline import GeometricBaseline
 from zrp.gap.analysis.where import WhereAnalysis
-from zrp.gap.report.headline import headline_text, summary_terminal
+from zrp.gap.report.headline import effect_joints, headline_text, summary_terminal
 from zrp.gap.report.headline import ranges as _ranges
 from zrp.gap.results import Diagnosis
 
@@ -75,7 +75,7 @@ def remains_text(w: WhereAnalysis, unit: str) -> str:
 def final_effects_text(diag: Diagnosis) -> str:
     """The effects of the final model (after the backward pass) with their joints."""
     fj = diag.final_joints
-    return ", ".join(f"{e} (joints {_ranges(j)})" if j else e for e, j in fj.items())
+    return ", ".join(effect_joints(e, j) for e, j in fj.items())
 
 
 def _effects_found(diag: Diagnosis) -> list[str]:
