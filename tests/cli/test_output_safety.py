@@ -12,6 +12,7 @@ import stat
 import subprocess
 import sys
 import time
+import warnings
 from pathlib import Path
 
 import pytest
@@ -161,3 +162,25 @@ def test_diagnose_force_no_plots_leaves_no_stale_plot(tmp_path, measured_csv):
     assert main([*argv, "--force", "--no-plots"]) == 0
     assert not list(out.glob("*.png"))
     assert ".png" not in (out / "report.md").read_text()
+
+
+@pytest.mark.parametrize("make", [
+    lambda tmp: tmp / ("8" * 400),                       # over the file system's name limit
+    lambda tmp: tmp / "a-file" / "out",                  # a file where a folder must be
+])
+def test_an_output_folder_the_file_system_refuses_is_one_named_line(tmp_path, capsys, make):
+    """OSError of a file name the user gave (ENAMETOOLONG, ENOTDIR, ...): exit 2 and one line
+    naming the file, never a traceback (found by the hostile-input pass, issue 35)."""
+    (tmp_path / "a-file").write_text("x")
+    out = make(tmp_path)
+    data = tmp_path / "d.csv"
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        assert main(["measure", "--out", str(data), "--poses", "30", "--seed", "1"]) == 0
+        capsys.readouterr()
+        rc = main(["diagnose", "--model", "puma", "--data", str(data), "--out", str(out),
+                   "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "Traceback" not in err
+    assert err.startswith("zrp diagnose: error: ") and len(err.strip().splitlines()) == 1
+    assert str(out)[:40] in err

@@ -65,3 +65,12 @@ def test_model_file_line_lookup_is_linear_in_the_joints():
         loads_model(text, "big.toml")
     line = int(str(exc.value).split("line ")[1].split(":")[0])
     assert text.splitlines()[line - 1].startswith("axis = [0, 0, 0]")
+
+
+def test_a_model_name_over_the_file_system_limit_is_a_named_error(tmp_path):
+    """Path.exists raises ENAMETOOLONG for a 400-character name (found by the 5,000-case
+    compensation fuzz: a model_file field of 400 digits)."""
+    from zrp.model.files import ModelFileError, load_model
+
+    with pytest.raises(ModelFileError, match="not a usable file name"):
+        load_model(tmp_path / ("9" * 400 + ".toml"))

@@ -29,7 +29,7 @@ from typing import Any, TextIO
 from zrp import __version__
 from zrp.cli import commands
 from zrp.cli.signals import handling
-from zrp.cli.streams import CLOSED_EXIT, closed_output, device_error
+from zrp.cli.streams import CLOSED_EXIT, closed_output, device_error, path_error
 from zrp.errors import OutputExistsError, ZRPError
 from zrp.output.inputs import reading
 from zrp.packages import PackageShadowedError, check_own_packages
@@ -188,8 +188,8 @@ def _run(argv: Sequence[str] | None) -> int:
         msg = cli_message(exc, getattr(args, "api_names", None))
         print(f"zrp {args.command}: error: {msg}", file=sys.stderr)
         return 2
-    except OSError as exc:  # a full disk under stdout (`> /dev/full`): one line, not a traceback
-        msg = device_error(exc)
+    except OSError as exc:  # a full disk (`> /dev/full`), a bad file name: one line, no traceback
+        msg = device_error(exc) or path_error(exc)
         if msg is None:
             raise
         print(f"zrp {args.command}: error: {msg}", file=sys.stderr)

@@ -26,7 +26,8 @@ import signal
 import sys
 from typing import TextIO
 
-__all__ = ["CLOSED_EXIT", "DEVICE_ERRORS", "closed_output", "device_error"]
+__all__ = ["CLOSED_EXIT", "DEVICE_ERRORS", "PATH_ERRORS", "closed_output", "device_error",
+           "path_error"]
 
 #: The exit status of a command whose output was closed early (128 + SIGPIPE, as a shell shows
 #: a program that SIGPIPE ended; 141 on Linux and macOS).
@@ -36,6 +37,10 @@ CLOSED_EXIT = 128 + int(getattr(signal, "SIGPIPE", 13))
 #: The errors of a device or file system (no space, quota, file too large, I/O): the
 #: environment's, said in one line, never a sign of a bug in the command.
 DEVICE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO})
+#: Errors of a file name the user gave (too long, not allowed, a file where a folder must be):
+#: one line naming the file, as any other bad input.
+PATH_ERRORS = frozenset({errno.ENAMETOOLONG, errno.EACCES, errno.EPERM, errno.EROFS,
+                         errno.ENOTDIR, errno.EISDIR, errno.ELOOP})
 
 
 def device_error(exc: OSError) -> str | None:
@@ -55,6 +60,16 @@ def device_error(exc: OSError) -> str | None:
     why = exc.strerror or str(exc)
     return (f"{exc.filename}: cannot write ({why})" if exc.filename
             else f"cannot write the output ({why})")
+
+
+def path_error(exc: OSError) -> str | None:
+    """The one-line message of ``exc`` when it is one of :data:`PATH_ERRORS` and names its
+    file (shortened to 120 characters), else None."""
+    if exc.errno not in PATH_ERRORS or not exc.filename:
+        return None
+    name = str(exc.filename)
+    name = name if len(name) <= 120 else name[:117] + "..."
+    return f"{name}: {exc.strerror or exc}"
 
 
 def _to_devnull(fd: int) -> None:

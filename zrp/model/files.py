@@ -98,7 +98,12 @@ def load_model(path: str | Path) -> Manipulator:
         raise ModelFileError(f"path: expected a model file name or a built-in model "
                              f"{sorted(builtin_models())}, got {path!r}")
     p = Path(path)
-    if not p.exists():
+    try:
+        present = p.exists()
+    except OSError as exc:  # e.g. a name over the file system's limit (ENAMETOOLONG)
+        raise ModelFileError(f"{str(path)[:80]}{'...' if len(str(path)) > 80 else ''}: not a "
+                             f"usable file name ({exc.strerror or exc})") from None
+    if not present:
         builtins = builtin_models()
         if str(path) in builtins:
             p = builtins[str(path)]
