@@ -14,7 +14,8 @@ from zrp.gap.model.domains import DOMAINS, domain_key, parameter_bounds, violati
     ("q3.backlash", "backlash", "backlash"),
     ("q2.compliance", "joint_compliance", "compliance"),
     ("q2.compliance_payload", "joint_compliance", "compliance"),
-    ("q2.w_p3", "joint_compliance", "compliance"),
+    ("q2.w_p3", "joint_compliance", "lumped_compliance"),
+    ("q2.w_ee", "joint_compliance", "lumped_compliance"),
     ("q2.w_load", "joint_compliance", "compliance"),
     ("q6.sin2", "cyclic_error", "cyclic_amplitude"),
     ("q1.scale", "encoder_scale", "encoder_scale"),
@@ -35,10 +36,12 @@ def test_bounds_and_units():
     # compliance_payload (rad/kg) keeps the lower bound only
     assert parameter_bounds("q2.compliance_payload", "joint_compliance", "rad/kg") == (
         0.0, math.inf)
-    # the lumped weights (c m g on a moment arm): the lower bound only, as compliance_payload
-    assert parameter_bounds("q2.w_ee", "joint_compliance", "rad/mm") == (0.0, math.inf)
-    assert "q2.w_ee = -7e-06 rad/mm is outside" in violation("compliance", "q2.w_ee", -7e-6,
-                                                             "rad/mm")
+    # a lumped weight alone has no bound (a mass behind the joint); w_load (a known payload
+    # at the tool) has the compliance's lower bound; the sum of a joint's weights is >= 0
+    assert parameter_bounds("q2.w_ee", "joint_compliance", "rad/mm") == (-math.inf, math.inf)
+    assert parameter_bounds("q2.w_load", "joint_compliance", "rad/(mm kg)") == (0.0, math.inf)
+    assert "q2.w_* = -7e-06 rad/mm is outside" in violation("lumped_compliance", "q2.w_*",
+                                                            -7e-6, "rad/mm")
     # each member of a grouped domain is bounded on both sides by the group's bound
     assert parameter_bounds("u2.t1", "axis_misalignment") == (-0.005, 0.005)
     assert parameter_bounds("u2.t1", "axis_misalignment", widen={"axis_tilt": 0.02}) == (
@@ -53,3 +56,20 @@ def test_bounds_and_units():
     assert violation("thermal_expansion", "kappa", math.nan, "1/degC") is not None
     with pytest.raises(InputError, match="only be widened"):
         violation("axis_tilt", "u1.tilt", 0.0, widen={"axis_tilt": 1e-4})
+
+
+def test_the_lumped_weights_of_a_joint_are_bounded_by_their_sum():
+    """One weight may be negative (a centre of mass behind the joint, lumped on points ahead
+    of it); the weights of a joint sum to its compliance times the mass it carries, >= 0."""
+    from zrp.gap.model.domains import domain_violations
+
+    names = ["q2.w_p3", "q2.w_p4", "q2.w_ee", "q3.w_p4", "q3.w_ee", "q3.w_load"]
+    eff, units = ["joint_compliance"] * 6, ["rad/mm"] * 5 + ["rad/(mm kg)"]
+    # q2: one negative weight, sum +6e-6: inside; q3: sum -1e-6: every q3 weight flagged
+    bad = domain_violations(names, eff, units, [1e-5, -6e-6, 2e-6, 1e-6, -2e-6, 0.0])
+    assert sorted(i for i, _ in bad) == [3, 4]
+    assert all("the lumped weights of q3 sum to -1e-06" in why for _, why in bad)
+    assert bad[0][1].startswith("q3.w_p4 = 1e-06 rad/mm")  # the search parses 'name = '
+    # a negative payload weight is out by itself
+    bad = domain_violations(names, eff, units, [1e-5, -6e-6, 2e-6, 1e-6, 2e-6, -1e-7])
+    assert [i for i, _ in bad] == [5]

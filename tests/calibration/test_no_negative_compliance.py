@@ -49,3 +49,25 @@ def test_negative_lumped_compliance_never_written(tmp_path):
         Term("q2.w_ee", "joint_compliance", 2, "rad/mm", -1.5e-6),))
     with pytest.raises(ImplausibleValueError, match=r"q2\.w_ee"):
         write_calibration(bad, tmp_path / "b" / "c.toml", tmp_path / "b" / "c.json")
+
+
+def test_one_negative_weight_with_a_positive_sum_is_written(tmp_path):
+    """A centre of mass behind a joint is lumped with a negative weight on a point ahead of
+    it: the file keeps it (the joint's weights sum to its compliance times a positive mass)."""
+    rng = np.random.default_rng(3)
+    meas = synthesize(PUMA, uniform_joint_values(PUMA, 60, rng), Injection(), rng=rng,
+                      noise_sigma=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        result = calibrate(PUMA, meas, options=CalibrationOptions(effects=("joint_offset",)))
+    ok = dataclasses.replace(result.robot, terms=(
+        Term("q2.w_p3", "joint_compliance", 2, "rad/mm", 1e-5),
+        Term("q2.w_ee", "joint_compliance", 2, "rad/mm", -2e-6)))
+    write_calibration(ok, tmp_path / "c.toml", tmp_path / "c.json")
+    doc = json.loads((tmp_path / "c.json").read_text(encoding="utf-8"))
+    assert [t["value"] for t in doc["joint_map"]] == [1e-5, -2e-6]
+    bad = dataclasses.replace(ok, terms=(
+        Term("q2.w_p3", "joint_compliance", 2, "rad/mm", 1e-6),
+        Term("q2.w_ee", "joint_compliance", 2, "rad/mm", -2e-6)))
+    with pytest.raises(ImplausibleValueError, match=r"sum of joint 2's lumped weights"):
+        write_calibration(bad, tmp_path / "b" / "c.toml", tmp_path / "b" / "c.json")

@@ -15,12 +15,14 @@ identified axes are u_k = R_{k-1}(delta)^T u'_k, R_k(delta) = R_{k-1}(delta) Rot
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 
 import numpy as np
 
 from zrp.arrays import F64
 from zrp.calibration.calibrated import CalibratedRobot
+from zrp.calibration.jointmap import Term
 from zrp.gap.model.domains import DOMAINS, ImplausibleValueError, domain_key, violation
 
 __all__ = ["axis_tilts", "implausible_values", "validate_calibration"]
@@ -41,15 +43,24 @@ def axis_tilts(cal: CalibratedRobot) -> F64:
 def _term_problems(cal: CalibratedRobot, widen: Mapping[str, float] | None) -> list[str]:
     out = []
     cyclic: dict[tuple[int, str], float] = {}
+    lumped: dict[int, list[Term]] = {}
     for t in cal.terms:
         key = domain_key(t.name, t.effect)
-        if key == "cyclic_amplitude":
+        if key == "lumped_compliance":
+            lumped.setdefault(t.joint, []).append(t)
+        elif key == "cyclic_amplitude":
             h = t.what[3:]
             cyclic[(t.joint, h)] = cyclic.get((t.joint, h), 0.0) + t.value ** 2
         elif key is not None:
             msg = violation(key, t.name, t.value, t.unit, widen)
             if msg:
                 out.append(msg)
+    for k, terms in sorted(lumped.items()):
+        msg = violation("lumped_compliance", " + ".join(t.name for t in terms)
+                        + f" (the sum of joint {k}'s lumped weights)",
+                        math.fsum(t.value for t in terms), terms[0].unit, widen)
+        if msg:
+            out.append(msg)
     for (k, h), a2 in sorted(cyclic.items()):
         msg = violation("cyclic_amplitude", f"q{k}.amplitude{h} (sqrt(sin{h}^2 + cos{h}^2))",
                         float(np.sqrt(a2)), "rad", widen)

@@ -196,7 +196,9 @@ def compliance_units(ctx: Context) -> dict[str, Any]:
             "note": f"no MJCF supplied the masses, so compliance cannot be given in rad/(N m): "
                     f"each q{{k}}.w_{{p}} is the compliance times the weight of an unknown "
                     f"mass lumped at point p, in rad/{u} of moment arm (q{{k}}.w_load: per kg "
-                    f"of the load column, rad/({u} kg)); give the MJCF (--mjcf) for rad/(N m)"}
+                    f"of the load column, rad/({u} kg)); one weight may be negative (a mass "
+                    f"behind the joint), the weights of a joint sum to >= 0 (it deflects with "
+                    f"its load in total); give the MJCF (--mjcf) for rad/(N m)"}
 
 
 @dataclass(frozen=True, eq=False)

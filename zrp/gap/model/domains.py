@@ -32,12 +32,19 @@ load; a machined joint axis is square to its seat to a fraction of a mrad, so a 
 than a few mrad is a wrong model (a different kinematic convention, a missing joint) rather than
 a calibration. An arm known to need more passes ``widen`` (key -> a larger upper bound;
 ``max_tilt_rad`` of the diagnosis is the same thing for ``axis_tilt``): a domain can only be
-widened. Registration parameters (base frame, tool points) have no domain. The lumped-mass
-compliance weights ``q{k}.w_{p}``, ``w_load`` are products c_k m_p g of a compliance and a mass
-on the gravity moment arm of :meth:`zrp.gap.model.context.Context.moment_arms` (the same sign
-as the MJCF gravity torque of ``q{k}.compliance``): neither factor is negative, so a negative
-weight is a joint deflecting against its load and leaves the ``compliance`` domain exactly as
-its MJCF counterpart does (taken out by the search, refused by the writers).
+widened. Registration parameters (base frame, tool points) have no domain.
+
+The lumped-mass compliance weights ``q{k}.w_{p}`` are products c_k m_p g of joint k's
+compliance and a mass lumped at point p on the gravity moment arm of
+:meth:`zrp.gap.model.context.Context.moment_arms` (the same sign as the MJCF gravity torque of
+``q{k}.compliance``). The points are the ones the chain offers (joint origins, the flange), so
+the arm's real masses are represented by weights that sum to the mass they stand for, and one
+weight alone may be negative: a centre of mass behind a joint or a counterweight lumped on the
+points ahead of it. What physics fixes is their sum per joint, c_k times the mass joint k
+carries (domain ``lumped_compliance``: >= 0, a joint deflects with its load in total); a
+negative sum leaves the domain as a negative ``q{k}.compliance`` does (every weight of that
+joint taken out by the search, refused by the writers). ``q{k}.w_load`` is a known mass (per
+kg of payload at the tool) and has the ``compliance`` domain itself (>= 0).
 
 The tolerances scale the parameters of the well-posed identification
 (:mod:`zrp.gap.fit.wellposed`): one unit of scaled parameter is one typical manufacturing or
@@ -56,7 +63,8 @@ from dataclasses import dataclass
 
 from zrp.errors import InputError
 
-__all__ = ["DEFAULT_MAX_TILT_RAD", "DOMAINS", "GROUPED", "Domain", "ImplausibleValueError",
+__all__ = ["DEFAULT_MAX_TILT_RAD", "DOMAINS", "GROUPED", "SUMMED", "Domain",
+           "ImplausibleValueError",
            "domain_key", "domain_violations", "parameter_bounds", "parameter_domain",
            "tolerance", "violation"]
 
@@ -140,6 +148,10 @@ DOMAINS: dict[str, Domain] = {d.key: d for d in (
            "a play is never negative and a gear train keeps it below 20 mrad", MAX_PLAY_M),
     Domain("compliance", 0.0, 0.01, "rad/(N m)",
            "a joint deflects with its load, not against it"),
+    Domain("lumped_compliance", 0.0, math.inf, "rad/length",
+           "the lumped weights of one joint sum to its compliance times the mass it carries: "
+           "a joint deflects with its load in total (one weight alone may be negative, a mass "
+           "behind the joint)"),
     Domain("axis_tilt", 0.0, DEFAULT_MAX_TILT_RAD, "rad",
            "total tilt sqrt(t1^2 + t2^2) of a machined axis from its nominal: square to its "
            "seat within a few mrad"),
@@ -151,6 +163,8 @@ DOMAINS: dict[str, Domain] = {d.key: d for d in (
 
 #: domains bounding the norm of a group of parameters (each member is bounded alike).
 GROUPED = ("cyclic_amplitude", "axis_tilt")
+#: domains bounding the sum of a joint's parameters (a member alone has no bound).
+SUMMED = ("lumped_compliance",)
 
 _CYCLIC = re.compile(r"(sin|cos)\d+$")
 _BY_EFFECT = {"joint_offset": "joint_offset", "encoder_scale": "encoder_scale",
@@ -173,9 +187,10 @@ def domain_key(name: str, effect: str) -> str | None:
     what = name.split(".", 1)[-1]
     if effect in _BY_EFFECT:
         return _BY_EFFECT[effect]
-    if effect == "joint_compliance" and (what in ("compliance", "compliance_payload")
-                                         or what.startswith("w_")):
+    if effect == "joint_compliance" and what in ("compliance", "compliance_payload", "w_load"):
         return "compliance"
+    if effect == "joint_compliance" and what.startswith("w_"):
+        return "lumped_compliance"
     if effect == "cyclic_error" and _CYCLIC.match(what):
         return "cyclic_amplitude"
     if effect == "link_length" and name.startswith("b"):
@@ -207,7 +222,7 @@ def parameter_bounds(name: str, effect: str, unit: str = "rad",
     bounded by the group's bound on either side; the group itself is checked by
     :func:`violation` on its norm); (-inf, inf) without a domain."""
     key = domain_key(name, effect)
-    if key is None:
+    if key is None or key in SUMMED:
         return -math.inf, math.inf
     lo, hi = _bounds(DOMAINS[key], unit, widen)
     return (-hi, hi) if key in GROUPED else (lo, hi)
@@ -225,7 +240,7 @@ def parameter_domain(name: str, effect: str, unit: str, *,
         max_tilt_rad: the largest axis tilt accepted (widen for a part known to be tilted).
     """
     key = domain_key(name, effect)
-    if key is None:
+    if key is None or key in SUMMED:  # the sum of the joint's weights has the domain
         return None
     d = DOMAINS[key]
     if key == "axis_tilt":
@@ -241,8 +256,9 @@ def violation(key: str, name: str, value: float, unit: str = "rad",
     d = DOMAINS[key]
     lo, hi = _bounds(d, unit, widen)
     if not (math.isfinite(value) and lo <= value <= hi):
+        shown = unit if lo == 0.0 and hi == math.inf else d.unit  # no bound to convert
         return (f"{name} = {value:.6g} {unit} is outside its physical domain "
-                f"{Domain(key, lo, hi, d.unit, d.why).text()}")
+                f"{Domain(key, lo, hi, shown, d.why).text()}")
     return None
 
 
@@ -285,6 +301,7 @@ def domain_violations(names: Sequence[str], effects: Sequence[str], units: Seque
         if d.key in GROUPED:
             groups.setdefault((d.key, _group(n, d.key)), []).append(i)
     flagged = {i for i, _ in out}
+    out += _sum_violations(names, effects, units, values)
     for (key, group), idx in groups.items():
         bound = parameter_domain(names[idx[0]], effects[idx[0]], units[idx[0]],
                                  max_tilt_rad=max_tilt_rad)
@@ -294,4 +311,21 @@ def domain_violations(names: Sequence[str], effects: Sequence[str], units: Seque
             out += [(i, f"{group} {'tilt' if key == 'axis_tilt' else 'amplitude'} {norm:.3g} "
                      f"{units[i]} above {bound.upper:g} {units[i]}: {DOMAINS[key].why}")
                     for i in idx]
+    return out
+
+
+def _sum_violations(names: Sequence[str], effects: Sequence[str], units: Sequence[str],
+                    values: Sequence[float]) -> list[tuple[int, str]]:
+    """Every member of a joint's :data:`SUMMED` group whose sum leaves its domain."""
+    sums: dict[str, list[int]] = {}
+    for i, (n, e) in enumerate(zip(names, effects, strict=True)):
+        if domain_key(n, e) in SUMMED:
+            sums.setdefault(n.split(".", 1)[0], []).append(i)
+    out: list[tuple[int, str]] = []
+    for joint, idx in sums.items():
+        total = math.fsum(float(values[i]) for i in idx)
+        if not total >= DOMAINS["lumped_compliance"].lower:
+            out += [(i, f"{names[i]} = {float(values[i]):.3g} {units[i]} (the lumped weights "
+                     f"of {joint} sum to {total:.3g}) outside 0 <= sum: a joint deflects with "
+                     "its load in total") for i in idx]
     return out
