@@ -32,7 +32,8 @@ def test_a_diagnosis_json_with_version_true_is_refused(tmp_path):
            "final": {"rms": 1.0}, "unexplained": None}
     f = tmp_path / "diagnosis.json"
     f.write_text(json.dumps(doc))
-    with pytest.raises(InputError, match=r"diagnosis\.json: schema_version true, expected 2 \(an integer\)"):
+    with pytest.raises(InputError,
+                       match=r"diagnosis\.json: schema_version true, expected 2 \(an integer\)"):
         load_diagnosis(f)
     doc["schema_version"] = 1
     f.write_text(json.dumps(doc))
