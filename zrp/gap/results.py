@@ -390,7 +390,8 @@ def load_diagnosis(source: str | os.PathLike[str] | Mapping[str, Any]) -> Diagno
     doc = (source if isinstance(source, Mapping)
            else json.loads(Path(source).read_text(encoding="utf-8")))
     if "schema_version" in doc:  # the in-memory documents and refusals may omit it
-        version_field(doc, "schema_version", (SCHEMA_VERSION,), src=str(
+        # schema 1 (0.4.0) holds every field read here; schema 2 adds the final model's record
+        version_field(doc, "schema_version", (1, SCHEMA_VERSION), src=str(
             "the diagnosis" if isinstance(source, Mapping) else source))
     final = doc["final"]
     return DiagnosisRecord(tuple(_step(s) for s in doc.get("steps", ())),
