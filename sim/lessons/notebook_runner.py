@@ -24,7 +24,8 @@ from zrp.errors import InputError, ZRPError
 from zrp.output import OutputDir
 
 __all__ = ["NOTEBOOKS", "NOTEBOOK_DIR", "NotebookError", "NotebookRun", "execute_notebook",
-           "mediapy_outputs", "notebook_file_names", "notebook_source", "run_notebooks"]
+           "kernel_transport", "mediapy_outputs", "notebook_file_names", "notebook_source",
+           "run_notebooks"]
 
 NOTEBOOK_DIR = Path(__file__).with_name("notebooks")
 
@@ -130,6 +131,23 @@ def _require() -> None:
                             "'zrp-accuracy[notebooks]'")
 
 
+def kernel_transport(folder: str | Path) -> Any:
+    """The kernel manager's configuration (traitlets): the kernel talks to this process over
+    local (IPC) sockets in ``folder``, not over unencrypted TCP on localhost, so ipykernel
+    has no reason to warn "Kernel is running over TCP without encryption"; TCP (jupyter's
+    default) where ZeroMQ has no IPC transport (Windows)."""
+    import zmq
+    from traitlets.config import Config
+
+    config = Config()
+    if zmq.has("ipc"):
+        config.KernelManager.transport = "ipc"
+        # absolute: jupyter's default ("kernel-ipc") is relative to each process's own working
+        # folder, and the kernel's (the notebook's temporary folder) is not this one's
+        config.KernelManager.ip = str(Path(folder).resolve() / "kernel")
+    return config
+
+
 def execute_notebook(source: str | Path, timeout_s: float = DEFAULT_TIMEOUT_S,
                      kernel: str = "python3") -> tuple[Any, float]:
     """Execute the jupytext percent-format file ``source`` top to bottom in a fresh kernel
@@ -157,9 +175,11 @@ def execute_notebook(source: str | Path, timeout_s: float = DEFAULT_TIMEOUT_S,
     def left_s(cell: Any) -> int:   # the time limit is the whole notebook's
         return max(1, math.ceil(timeout_s - (time.perf_counter() - t0)))
 
-    with tempfile.TemporaryDirectory() as work:   # a notebook's own files stay out of the way
+    # a notebook's own files stay out of the way; the kernel's sockets get their own folder
+    with tempfile.TemporaryDirectory() as work, tempfile.TemporaryDirectory() as sockets:
         client = NotebookClient(nb, timeout_func=left_s, kernel_name=kernel,
-                                resources={"metadata": {"path": work}})
+                                resources={"metadata": {"path": work}},
+                                config=kernel_transport(sockets))
         try:
             client.execute()
         except CellTimeoutError as exc:

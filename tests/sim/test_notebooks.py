@@ -152,6 +152,28 @@ def test_runner_fails_on_an_error_and_on_the_time_limit(tmp_path):
         execute_notebook(slow, timeout_s=3)
 
 
+def test_the_kernel_runs_over_ipc_without_the_tcp_warning(tmp_path, capfd):
+    """``zrp notebooks`` printed ipykernel's "Kernel is running over TCP without encryption"
+    once a notebook (issue 33): the kernel now talks over local sockets, and says so; a cell's
+    own warnings still reach its output."""
+    import zmq
+
+    _runner_installed()
+    if not zmq.has("ipc"):
+        pytest.skip("ZeroMQ has no IPC transport here")
+    tiny = tmp_path / "tiny.py"
+    tiny.write_text("# %%\nimport json, warnings\nfrom ipykernel.connect import "
+                    "get_connection_file\nprint(json.load(open(get_connection_file()))"
+                    "['transport'])\nwarnings.warn('a warning of our own')\n")
+    nb, _ = execute_notebook(tiny, timeout_s=60)
+    outputs = nb.cells[0].outputs
+    assert [o["text"] for o in outputs if o.get("name") == "stdout"] == ["ipc\n"]
+    assert "a warning of our own" in "".join(o["text"] for o in outputs
+                                              if o.get("name") == "stderr")
+    err = capfd.readouterr().err
+    assert "without encryption" not in err, err
+
+
 BROWSER = next((b for b in ("chromium", "chromium-browser", "google-chrome")
                 if shutil.which(b)), None)
 
