@@ -169,6 +169,7 @@ def render_video(
     options: VideoOptions | None = None,
     overwrite: bool = False,
     progress: bool = True,
+    progress_name: str | None = None,
 ) -> VideoResult:
     """Render segments one after the other into one video, at ONE magnification and one plot
     scale (so a deviation that grows from segment to segment visibly grows).
@@ -182,6 +183,9 @@ def render_video(
         options: size, frame rate, length per segment, magnification, format, GL backend.
         overwrite: replace an existing file.
         progress: tqdm bar over the frames.
+        progress_name: the file name the bar shows (default: ``out_path``'s own); give the
+            final name when ``out_path`` is a temporary file that is moved onto it afterwards
+            (:meth:`zrp.output.OutputDir.path`).
     """
     start = time.perf_counter()
     opts = options or VideoOptions()
@@ -196,8 +200,9 @@ def render_video(
             backend = r.backend
             writer = (_mp4_writer(tmp, opts.width, opts.height, opts.fps) if fmt == "mp4"
                       else _gif_writer(tmp, opts.fps))
-            with writer as write, tqdm(total=prep.frames, desc=f"render {path.name}",
-                                       unit="frame", disable=not progress) as bar:
+            bar = tqdm(total=prep.frames, desc=f"render {progress_name or path.name}",
+                       unit="frame", disable=not progress)
+            with writer as write, bar:
                 for frame in _frames(prep, opts, title, r):
                     write(frame)
                     bar.update(1)

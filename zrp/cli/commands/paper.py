@@ -104,7 +104,7 @@ def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
         with folder.path(name) as tmp:
             sim.render_video(scene.segments, tmp, title=scene.title, overwrite=True,
                              options=sim.VideoOptions(magnify=scene.magnify),
-                             progress=not args.json)
+                             progress=not args.json, progress_name=name)
     except (sim.GLUnavailableError, sim.GLBackendError) as exc:
         # no OpenGL backend on this machine: the tables and figures are still valid
         return {"status": f"skipped (no offscreen OpenGL: {exc})"}
