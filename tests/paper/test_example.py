@@ -147,3 +147,43 @@ def test_figures_2_3_say_why_the_curves_miss_the_squares(example):
     assert ours < paper   # the reason holds: our joints turn less than the paper's
     assert "go through the squares" in why_apart(replace(example, circle="recovered"))
     assert why_apart(replace(example, cells=[])) == ""
+
+
+def test_je_over_le_says_in_words_what_it_compares_and_why_it_differs(example, tmp_path,
+                                                                       capsys):
+    """`zrp paper` printed "JE > LE: paper 2.13, ours 0.643" with no word on why (issue 33):
+    the line and comparison.md say what the ratios are, whether the ordering agrees and why
+    the sizes differ, with the numbers of this run."""
+    import copy
+    import re
+
+    from zrp.paper.claims import je_over_le_text
+
+    jl = example.checks["je_greater_than_le_at_0.1pct"]
+    ours = jl["ours"]["mean_ratio_JE_over_LE"]
+    paper = jl["published_typos_corrected"]["mean_ratio_JE_over_LE"]
+    turns = max(v["max_abs_q_deg"] for v in example.checks["table3_closed_form"].values())
+    implied = min(v["deg_min"] for v in implied_joint_angles().values())
+    text = je_over_le_text(example.checks, example.circle)
+    assert "joint-axis errors JE" in text and "link errors LE" in text
+    assert f"paper {paper:.3g} (typos corrected), ours {ours:.3g}." in text
+    assert ours < 1 < paper   # on the default circle the paper's ordering is not ours ...
+    assert "Not the paper's ordering, not its size" in text
+    assert f"at most {turns:.0f} deg" in text and f"{implied:.0f}-180 deg" in text
+    assert turns < implied    # ... because its joints turn less than the paper's
+    assert "`--circle recovered` agrees" in text
+    # the words follow the numbers: another ratio, another verdict
+    moved = copy.deepcopy(example.checks)
+    moved["je_greater_than_le_at_0.1pct"]["ours"]["mean_ratio_JE_over_LE"] = paper * 1.02
+    assert f"ours {paper * 1.02:.3g}. Same ordering as the paper, and the same size" in \
+        je_over_le_text(moved, example.circle)
+    recovered = run_paper_example(steps=120, circle="recovered")
+    assert "Same ordering as the paper, and the same size" in je_over_le_text(
+        recovered.checks, recovered.circle)
+    # the command line prints it (wrapped), comparison.md has it whole
+    out = tmp_path / "r"
+    assert main(["paper", "--out", str(out), "--no-video", "--no-figures",
+                 "--steps", "120"]) == 0
+    printed = re.sub(r"\s+", " ", capsys.readouterr().out)
+    assert text in printed
+    assert text in (out / "comparison.md").read_text(encoding="utf-8")

@@ -21,7 +21,7 @@ from zrp.paper.published import (
     implied_joint_angles,
 )
 
-__all__ = ["check_claims"]
+__all__ = ["check_claims", "je_over_le_text"]
 
 
 def _linearity(study: StudyResult, published: bool) -> dict[str, Any]:
@@ -123,3 +123,46 @@ def check_claims(study: StudyResult, path: JointPath, published: bool = True) ->
     out["table3_closed_form"] = _table3_closed_form(study, path, je, j01)
     out["paper_implied_max_abs_q_deg"] = implied_joint_angles() if published else {}
     return out
+
+
+def _joint_turns(checks: dict[str, Any]) -> str:
+    """How far our joints turn, and how far the paper's Table 3 implies its turned."""
+    ours = checks.get("table3_closed_form") or {}
+    paper = checks.get("paper_implied_max_abs_q_deg") or {}
+    if not ours:
+        return ""
+    most = max(v["max_abs_q_deg"] for v in ours.values())
+    text = f"this path turns the joints at most {most:.0f} deg"
+    if paper:
+        least = min(v["deg_min"] for v in paper.values())
+        text += f", the paper's unpublished circle {least:.0f}-180 deg by its Table 3"
+    return text
+
+
+def je_over_le_text(checks: dict[str, Any], circle: str = "custom") -> str:
+    """The paper's claim "joint-axis errors (JE) move the tool more than link errors (LE)" in
+    words, from :func:`check_claims`' ``checks``: what the ratios compare, whether our
+    ordering agrees with the paper's, and why their sizes differ (a JE deviation grows with
+    how far its joint turns, 2 |sin(q_k / 2)|; the paper does not publish its circle; an LE
+    deviation does not depend on the path). ``circle``: the named circle run ("default" points
+    to the recovered one). Empty without JE or LE columns."""
+    jl = checks["je_greater_than_le_at_0.1pct"]
+    ours, paper = jl["ours"], jl["published_typos_corrected"]
+    if ours is None:
+        return ""
+    o = ours["mean_ratio_JE_over_LE"]
+    what = ("JE > LE at 0.1 % (mean largest tool-position deviation of joint-axis errors JE / "
+            "of link errors LE): ")
+    if paper is None:
+        return what + f"ours {o:.3g}: " + ("holds." if o > 1 else "does not hold.")
+    p = paper["mean_ratio_JE_over_LE"]
+    what += f"paper {p:.3g} (typos corrected), ours {o:.3g}."
+    order = ("Same ordering as the paper" if (o > 1) == (p > 1)
+             else "Not the paper's ordering")
+    turns = _joint_turns(checks)
+    if abs(o / p - 1.0) <= 0.05:
+        return f"{what} {order}, and the same size" + (f" ({turns})." if turns else ".")
+    hint = "; `--circle recovered` agrees" if circle == "default" else ""
+    return (f"{what} {order}, not its size: a JE deviation grows with how far its joint turns "
+            "(2 |sin(q_k / 2)|)" + (f" and {turns}" if turns else "")
+            + f"; an LE deviation does not depend on the path{hint}.")

@@ -13,6 +13,7 @@ from typing import Any
 from zrp.escape import csv_text, md_text
 from zrp.output import OutputDir
 from zrp.paper.circles import RECOVERED_FIGURES, circles_markdown
+from zrp.paper.claims import je_over_le_text
 from zrp.paper.comparison import kind_columns
 from zrp.paper.example import PaperExample
 from zrp.paper.figures import FIGURES, figure_names, paper_figures
@@ -142,6 +143,8 @@ def _je_le_section(ex: PaperExample) -> list[str]:
     u = ex.study.unit
     jl = ex.checks["je_greater_than_le_at_0.1pct"]
     lines = ["### Joint-axis errors vs link errors (max delta_p at 0.1 %)", ""]
+    summary = je_over_le_text(ex.checks, ex.circle)   # the sentence `zrp paper` prints
+    lines += [summary, ""] if summary else []
     verdict = []
     for who, v in (("in the paper's own table (typos corrected)",
                     jl["published_typos_corrected"]), ("on our trajectory", jl["ours"])):
@@ -151,9 +154,10 @@ def _je_le_section(ex: PaperExample) -> list[str]:
                      f"{v['mean_LE']:.4g} {u}, ratio {v['mean_ratio_JE_over_LE']:.3g}; JE > LE "
                      f"in {v['pairs_JE_greater']} (JE, LE) pairs; JE columns below the largest "
                      f"LE: {', '.join(v['JE_below_max_LE']) or 'none'}.")
-        avg = "holds on average" if v["mean_ratio_JE_over_LE"] > 1 else "fails on average"
-        col = ("and column by column" if not v["JE_below_max_LE"]
-               else "but not column by column")
+        holds = v["mean_ratio_JE_over_LE"] > 1
+        avg = "holds on average" if holds else "fails on average"
+        col = ("nor column by column" if not holds else "and column by column"
+               if not v["JE_below_max_LE"] else "but not column by column")
         verdict.append(f"{who} the claim {avg} {col}")
     if verdict:
         lines += ["", "; ".join(verdict).capitalize() + ". How large an axis error is depends "
