@@ -230,6 +230,35 @@ def test_single_reflector_says_no_noise_floor():
     assert d.final.rms <= d.assessment.baseline.model_withheld.rms  # by construction (fallback.py)
 
 
+
+def test_shrink_plot_says_no_noise_floor_over_no_bar():
+    """The shrink plot's "no noise floor can be estimated" sat inside the axes, over the last
+    bars (issue 33): drawn, its box overlaps no bar's visible part."""
+    from matplotlib.text import Text
+    from matplotlib.transforms import Bbox
+
+    from zrp.gap.report.plots import figures
+
+    m = _meas(Injection(joint_offset={2: 1e-3}), tool_offsets=((50, 0, 30),))
+    d = _quiet(PUMA, m, seed=0)
+    assert d.noise_floor.rms is None
+    fig = None
+    for name, fig in figures(d):
+        if name == "shrink.png":
+            fig.canvas.draw()
+            renderer = fig.canvas.get_renderer()
+            notes = [t for t in fig.findobj(Text) if "no noise floor" in t.get_text()]
+            assert len(notes) == 1
+            note = notes[0].get_window_extent(renderer)
+            ax = fig.axes[0]
+            bars = [Bbox.intersection(b.get_window_extent(renderer), ax.bbox)
+                    for b in ax.patches]
+            assert len(bars) == 2 * (len(d.steps) + 3)   # RMS and p95 of each step
+            assert all(b is not None and b.height > 1 for b in bars)   # each one shows
+            assert not [b for b in bars if note.overlaps(b)], (note, bars[-2:])
+            break
+    assert fig is not None and fig.axes[0].get_title().startswith("Withheld error per step")
+
 SEVEN = """name = "7-axis test arm"
 length_unit = "mm"
 [[joint]]

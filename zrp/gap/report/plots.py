@@ -121,9 +121,8 @@ def _shrink(plt: Any, diag: Diagnosis) -> Any:
     ax.bar(xs + 0.2, p95, 0.4, label="p95")
     if floor:
         ax.axhline(floor, color="k", ls="--", lw=1, label=f"noise floor RMS {floor:.3g}")
-    else:
-        ax.text(0.99, 0.02, "no noise floor can be estimated", transform=ax.transAxes,
-                ha="right", fontsize=8)
+    else:  # a legend entry beside the axes: inside them it covered the last bars
+        ax.plot([], [], " ", label="no noise floor\ncan be estimated")
     ax.set_yscale("log")
     ax.set_xticks(xs, labels, rotation=20, ha="right")
     ax.set_ylabel(f"withheld error ({unit}, log)")
