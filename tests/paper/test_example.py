@@ -175,10 +175,10 @@ def test_je_over_le_says_in_words_what_it_compares_and_why_it_differs(example, t
     # the words follow the numbers: another ratio, another verdict
     moved = copy.deepcopy(example.checks)
     moved["je_greater_than_le_at_0.1pct"]["ours"]["mean_ratio_JE_over_LE"] = paper * 1.02
-    assert f"ours {paper * 1.02:.3g}. Same ordering as the paper, and the same size" in \
+    assert f"ours {paper * 1.02:.3g}. Same ordering as the paper, and its size within 5 %" in \
         je_over_le_text(moved, example.circle)
     recovered = run_paper_example(steps=120, circle="recovered")
-    assert "Same ordering as the paper, and the same size" in je_over_le_text(
+    assert "Same ordering as the paper, and its size within 5 %" in je_over_le_text(
         recovered.checks, recovered.circle)
     # the command line prints it (wrapped), comparison.md has it whole
     out = tmp_path / "r"

@@ -161,7 +161,7 @@ def je_over_le_text(checks: dict[str, Any], circle: str = "custom") -> str:
              else "Not the paper's ordering")
     turns = _joint_turns(checks)
     if abs(o / p - 1.0) <= 0.05:
-        return f"{what} {order}, and the same size" + (f" ({turns})." if turns else ".")
+        return f"{what} {order}, and its size within 5 %" + (f" ({turns})." if turns else ".")
     hint = "; `--circle recovered` agrees" if circle == "default" else ""
     return (f"{what} {order}, not its size: a JE deviation grows with how far its joint turns "
             "(2 |sin(q_k / 2)|)" + (f" and {turns}" if turns else "")
