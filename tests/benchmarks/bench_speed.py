@@ -1,17 +1,19 @@
 """Speed against the issue-15 targets, every figure beside a baseline measured in the same run.
 
-Run: python3 tests/benchmarks/bench_speed.py [--quick] [--only diagnosis] [--out FILE.md]
-[--force]   (from the repository root; writes the table to renders/benchmarks/bench_speed.md
-and .json, bench_speed_diagnosis.md with --only diagnosis)
+Run: python3 tests/benchmarks/bench_speed.py [--quick] [--only diagnosis|single]
+[--out FILE.md] [--force]   (from the repository root; writes the table to
+renders/benchmarks/bench_speed.md and .json, bench_speed_<only>.md with --only)
 
 One core for the kernels (NUMBA_NUM_THREADS=1, set before numba loads). Prints one table:
 figure, measured value, target, the baseline of the same run and the ratio:
 
 * batched FK kernel (1e6 PUMA poses) and the API; baseline: the kernel (API within 1.2x);
 * batched Jacobians; baseline: the FK kernel (a Jacobian needs ~2.5x the work of a pose);
-* one FK call and one Jacobian from Python; baselines: Pinocchio (``pin``)
-  forwardKinematics / computeJointJacobians + getJointJacobian, MuJoCo mj_kinematics /
-  mj_kinematics + mj_comPos + mj_jacBody, on the same arm (where installed);
+* one FK call and one Jacobian from Python (CPU time per call, interleaved rounds,
+  ``_timing``); baselines: Pinocchio (``pin``) forwardKinematics + updateFramePlacements (the
+  target: within 2x) and forwardKinematics alone / computeJointJacobians + getJointJacobian,
+  MuJoCo mj_kinematics / mj_kinematics + mj_comPos + mj_jacBody, on the same arm (where
+  installed);
 * Monte Carlo 1e5 robots x 360 points on one core (baseline: the FK kernel's rate), gathered
   and reduced on the workers (histograms); then on a Dask LocalCluster of 1 and of 2 workers
   (baseline: 1 worker; the chunk chosen from the work, zrp.manufacturing.chunks.chunk_size);
@@ -34,7 +36,6 @@ import argparse
 import sys
 import tempfile
 import time
-import timeit
 import warnings
 from pathlib import Path
 
@@ -45,11 +46,13 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
 
 from _report import Report, add_output_arguments, output_path
+from _timing import Timing, interleaved
 
 import zrp
 from zrp.kinematics import _kernels as K
 from zrp.kinematics._range_kernels import joint_limits
 from zrp.kinematics.forward import _karrays
+from zrp.rotations.rodrigues import matrix_from_er
 
 ROOT = Path(__file__).resolve().parents[2]
 SHARED = ROOT.parent / "shared" / "data" / "irb120-lasertracker"
@@ -77,16 +80,22 @@ def best(*fns, repeat=5):
     return mins[0] if len(fns) == 1 else mins
 
 
-def per_call(*fns, number=20000, repeat=9) -> list[float]:
-    """Best time per call of each function, measured interleaved (the machine's load changes
-    within seconds: each repeat times every function once, back to back)."""
-    for fn in fns:
-        fn()
-    times: list[list[float]] = [[] for _ in fns]
-    for _ in range(repeat):
-        for t, fn in zip(times, fns, strict=True):
-            t.append(timeit.timeit(fn, number=number) / number)
-    return [min(t) for t in times]
+def per_call(*fns, number=20000, repeat=9) -> list[Timing]:
+    """Best time per call of each function: CPU time (process time) of ``number`` calls in a
+    loop, the functions timed in turn within each round (_timing.interleaved), the wall time
+    and the load average beside it."""
+    def loop(fn):
+        def run():
+            for _ in range(number):
+                fn()
+        return run
+
+    return [Timing(t.cpu / number, t.wall / number, t.load)
+            for t in interleaved(*(loop(fn) for fn in fns), repeat=repeat)]
+
+
+def _us(t: Timing) -> str:
+    return f"{t.cpu * 1e6:.2f}"
 
 
 def batched(model: zrp.Manipulator, n: int) -> float:
@@ -131,63 +140,88 @@ def pinocchio_model(model: zrp.Manipulator):
     return pm
 
 
-def single_calls(model: zrp.Manipulator) -> None:
-    q = np.array([0.1, -0.4, 0.3, 0.7, 1.2, -0.5])
-    t_fk, t_j = per_call(lambda: zrp.end_effector_pose(model, q),
-                         lambda: zrp.jacobian(model, q))
-    base_fk = base_j = "not installed"
-    r_fk = r_j = ""
+def _pinocchio_calls(model: zrp.Manipulator, q: np.ndarray) -> dict:
+    """Pinocchio's calls on the same arm (empty where it is not installed): forward
+    kinematics alone, with the frame placements (the tool's pose), and the Jacobian. Checked
+    against zrp first: the same tool position and rotation."""
     try:
         import pinocchio as pin
+    except ImportError:
+        return {}
+    pm = pinocchio_model(model)
+    pd = pm.createData()
+    fid = pm.getFrameId("tool")
+    pin.forwardKinematics(pm, pd, q)
+    pin.updateFramePlacements(pm, pd)
+    p, er = zrp.end_effector_pose(model, q)
+    assert np.allclose(pd.oMf[fid].translation, p)
+    assert np.allclose(pd.oMf[fid].rotation, matrix_from_er(er))
 
-        pm = pinocchio_model(model)
-        pd = pm.createData()
-        fid = pm.getFrameId("tool")
+    def fk_frames():
         pin.forwardKinematics(pm, pd, q)
         pin.updateFramePlacements(pm, pd)
-        assert np.allclose(pd.oMf[fid].translation, zrp.end_effector_pose(model, q)[0])
-        t_fk, t_pin, t_j, t_pinj = per_call(
-            lambda: zrp.end_effector_pose(model, q), lambda: pin.forwardKinematics(pm, pd, q),
-            lambda: zrp.jacobian(model, q),
-            lambda: (pin.computeJointJacobians(pm, pd, q),
-                     pin.getJointJacobian(pm, pd, model.n, pin.LOCAL_WORLD_ALIGNED)))
-        base_fk = f"Pinocchio {t_pin * 1e6:.2f} us"
-        base_j = f"Pinocchio {t_pinj * 1e6:.2f} us"
-        r_fk = f"{t_fk / t_pin:.2f}x Pinocchio"
-        r_j = f"{t_j / t_pinj:.2f}x Pinocchio"
-    except ImportError:
-        pass
-    row("one FK call, end_effector_pose (us)", f"{t_fk * 1e6:.2f}", "<= 1.5", base_fk, r_fk)
-    row("one Jacobian call, jacobian (us)", f"{t_j * 1e6:.2f}", "<= 2", base_j, r_j)
+
+    return {"fk": lambda: pin.forwardKinematics(pm, pd, q), "fk_frames": fk_frames,
+            "jac": lambda: (pin.computeJointJacobians(pm, pd, q),
+                            pin.getJointJacobian(pm, pd, model.n, pin.LOCAL_WORLD_ALIGNED))}
+
+
+def _mujoco_calls(model: zrp.Manipulator, q: np.ndarray) -> dict:
+    """MuJoCo's mj_kinematics and its Jacobian on the equivalent MJCF (empty without it)."""
     try:
         import mujoco
 
         import mjcf
-
-        m = mjcf.build(model).model
-        d = mujoco.MjData(m)
-        d.qpos[:] = q
-        jp = np.empty((3, m.nv))
-        jr = np.empty((3, m.nv))
-
-        def mj_fk():
-            d.qpos[:] = q
-            mujoco.mj_kinematics(m, d)
-
-        def mj_jac():
-            d.qpos[:] = q
-            mujoco.mj_kinematics(m, d)
-            mujoco.mj_comPos(m, d)
-            mujoco.mj_jacBody(m, d, jp, jr, m.nbody - 1)
-
-        t_fk, t_m, t_j, t_mj = per_call(lambda: zrp.end_effector_pose(model, q), mj_fk,
-                                        lambda: zrp.jacobian(model, q), mj_jac)
-        row("  MuJoCo mj_kinematics per call (us)", f"{t_m * 1e6:.2f}", "",
-            f"zrp {t_fk * 1e6:.2f} us", f"zrp {t_fk / t_m:.2f}x")
-        row("  MuJoCo kinematics+comPos+jacBody (us)", f"{t_mj * 1e6:.2f}", "",
-            f"zrp {t_j * 1e6:.2f} us", f"zrp {t_j / t_mj:.2f}x")
     except ImportError:
-        pass
+        return {}
+    m = mjcf.build(model).model
+    d = mujoco.MjData(m)
+    d.qpos[:] = q
+    jp = np.empty((3, m.nv))
+    jr = np.empty((3, m.nv))
+
+    def mj_fk():
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+
+    def mj_jac():
+        d.qpos[:] = q
+        mujoco.mj_kinematics(m, d)
+        mujoco.mj_comPos(m, d)
+        mujoco.mj_jacBody(m, d, jp, jr, m.nbody - 1)
+
+    return {"fk": mj_fk, "jac": mj_jac}
+
+
+def single_calls(model: zrp.Manipulator) -> None:
+    """One FK call and one Jacobian through the public API against Pinocchio and MuJoCo on
+    the same arm, all timed in turn within each round (CPU time per call)."""
+    q = np.array([0.1, -0.4, 0.3, 0.7, 1.2, -0.5])
+    pin_calls, mj_calls = _pinocchio_calls(model, q), _mujoco_calls(model, q)
+    fns = {"fk": lambda: zrp.end_effector_pose(model, q), "jac": lambda: zrp.jacobian(model, q),
+           **{f"pin_{k}": f for k, f in pin_calls.items()},
+           **{f"mj_{k}": f for k, f in mj_calls.items()}}
+    t = dict(zip(fns, per_call(*fns.values()), strict=True))
+    fk, jac = t["fk"], t["jac"]
+    print(f"  (single calls: CPU time; wall {fk.wall * 1e6:.2f} us for one FK call; "
+          f"load {fk.load[0]:.1f}-{fk.load[1]:.1f})")
+    if pin_calls:
+        frames, bare, pj = t["pin_fk_frames"], t["pin_fk"], t["pin_jac"]
+        row("one FK call, end_effector_pose (us)", _us(fk), "<= 2x Pinocchio",
+            f"Pinocchio FK + frames {_us(frames)} us", f"{fk.cpu / frames.cpu:.2f}x Pinocchio")
+        row("  the same against forwardKinematics alone", _us(fk), "",
+            f"Pinocchio FK {_us(bare)} us", f"{fk.cpu / bare.cpu:.2f}x Pinocchio")
+        row("one Jacobian call, jacobian (us)", _us(jac), "<= 2", f"Pinocchio {_us(pj)} us",
+            f"{jac.cpu / pj.cpu:.2f}x Pinocchio")
+    else:
+        row("one FK call, end_effector_pose (us)", _us(fk), "<= 2x Pinocchio",
+            "Pinocchio not installed", "")
+        row("one Jacobian call, jacobian (us)", _us(jac), "<= 2", "Pinocchio not installed", "")
+    if mj_calls:
+        row("  MuJoCo mj_kinematics per call (us)", _us(t["mj_fk"]), "",
+            f"zrp {_us(fk)} us", f"zrp {fk.cpu / t['mj_fk'].cpu:.2f}x")
+        row("  MuJoCo kinematics+comPos+jacBody (us)", _us(t["mj_jac"]), "",
+            f"zrp {_us(jac)} us", f"zrp {jac.cpu / t['mj_jac'].cpu:.2f}x")
 
 
 def monte_carlo(n_robots: int, workers: bool, fk_rate: float) -> None:
@@ -329,7 +363,8 @@ def simulation(poses: int) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="smaller sizes, no cluster")
-    ap.add_argument("--only", choices=("diagnosis",), help="only this figure")
+    ap.add_argument("--only", choices=("diagnosis", "single"), help="only this figure "
+                    "(single: one FK call and one Jacobian against Pinocchio and MuJoCo)")
     add_output_arguments(ap, "bench_speed")
     args = ap.parse_args()
     if args.only:
@@ -338,6 +373,8 @@ def main() -> None:
     print(f"issue-15 speed figures (one core for the kernels; load {os.getloadavg()[0]:.1f})")
     if args.only == "diagnosis":
         diagnosis()
+    elif args.only == "single":
+        single_calls(zrp.load_model("puma"))
     else:
         model = zrp.load_model("puma")
         fk_rate = batched(model, 200_000 if args.quick else 1_000_000)

@@ -252,3 +252,45 @@ def test_end_effector_pose_into_a_given_buffer(rng):
             zrp.end_effector_pose(puma, q, out=bad)
     with pytest.raises(zrp.InputError):  # the range is still checked
         zrp.end_effector_pose(puma, np.full((2, 6), np.inf), out=np.empty((2, 7)))
+
+
+def test_one_pose_path_reads_any_joint_vector_right_and_names_bad_input(rng):
+    """The one-pose path (a 1-D float64 array: the kernels' bare entry points, no dispatcher
+    type check) against the batch kernel: strided, reversed and read-only vectors give the
+    same bits as a contiguous copy; each call returns fresh arrays; a wrong length, a NaN, a
+    2-D array, another dtype and a model that is not one are named as before."""
+    puma = zrp.load_model("puma")
+    q = rng.uniform(-3, 3, 6)
+    p_ref, e_ref = zrp.end_effector_pose(puma, q[None])  # the batch kernel
+    j_ref = zrp.jacobian(puma, q[None])[0]
+    wide = np.zeros((6, 3))
+    wide[:, 1] = q
+    backwards = q[::-1].copy()[::-1]
+    frozen = q.copy()
+    frozen.flags.writeable = False
+    for v in (q, wide[:, 1], backwards, frozen):
+        p, e = zrp.end_effector_pose(puma, v)
+        assert p.shape == (3,) and e.shape == (4,)
+        np.testing.assert_array_equal(p, p_ref[0])
+        np.testing.assert_array_equal(e, e_ref[0])
+        np.testing.assert_allclose(zrp.jacobian(puma, v), j_ref, rtol=0, atol=1e-12)
+    p1, e1 = zrp.end_effector_pose(puma, q)
+    p2, _ = zrp.end_effector_pose(puma, q)
+    assert not np.shares_memory(p1, p2) and not np.shares_memory(p1, e1)
+    assert zrp.end_effector_pose(puma, q[None])[0].shape == (1, 3)  # (1, 6) stays a batch
+    with pytest.raises(zrp.InputError, match=r"shape \(\.\.\., 6\)"):
+        zrp.end_effector_pose(puma, np.zeros(5))
+    with pytest.raises(zrp.InputError, match=r"shape \(\.\.\., 6\)"):
+        zrp.end_effector_pose(puma, np.zeros(7)[1:].reshape(2, 3))
+    with pytest.raises(zrp.InputError, match=r"joint 5 \(q5\) is nan"):
+        zrp.end_effector_pose(puma, np.array([0, 0, 0, 0, np.nan, 0.0]))
+    with pytest.raises(zrp.InputError, match=r"joint 2 \(q2\) is inf"):
+        zrp.jacobian(puma, np.array([0, np.inf, 0, 0, 0, 0.0]))
+    np.testing.assert_array_equal(zrp.end_effector_pose(puma, q.astype(np.float32))[0],
+                                  zrp.end_effector_pose(puma, q.astype(np.float32)
+                                                        .astype(float))[0])
+    for not_a_model in ("puma", None, puma.bodies):
+        with pytest.raises(zrp.InputError, match=r"^model: expected a zrp\.Manipulator"):
+            zrp.end_effector_pose(not_a_model, q)
+        with pytest.raises(zrp.InputError, match=r"^model: expected a zrp\.Manipulator"):
+            zrp.jacobian(not_a_model, q)

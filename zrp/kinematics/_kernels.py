@@ -512,8 +512,13 @@ def jac_batch(q, axes, bodies, prism, lim, pose, jac):
 
 @njit(inline="always")
 def _packed_q_ok(q, n):
-    """True when every |q[k]| <= 1e6 (the revolute range of _range_kernels; non-finite values
-    fail): otherwise the packed kernels decline and the general path names the joint."""
+    """True when q is contiguous and every |q[k]| <= 1e6 (the revolute range of
+    _range_kernels; non-finite values fail): otherwise the packed kernels decline and the
+    general path names the joint. Contiguity is checked here, not by the caller: the one-pose
+    paths call the kernels' bare entry points (forward._entry), which take any 1-D float64
+    array as a contiguous one."""
+    if n > 1 and q.strides[0] != q.itemsize:
+        return False
     for k in range(n):
         if not abs(q[k]) <= 1e6:
             return False
@@ -521,9 +526,11 @@ def _packed_q_ok(q, n):
 
 
 @njit(cache=True, fastmath=_FM)
-def fk_pose_packed(q, packed, out):
-    """:func:`fk_pose_one` on the packed model; returns False (out untouched) when q has a
-    non-finite value, |q| > 1e6 or not the model's n values."""
+def fk_pose_packed(q, packed, p, er):
+    """:func:`fk_pose_one` on the packed model into the position ``p`` (3) and the
+    Euler-Rodrigues parameters ``er`` (4): two arrays, which the caller returns as they are
+    (two fresh arrays cost less than one and two views of it); returns False (p and er
+    untouched) when q has a non-finite value, |q| > 1e6 or not the model's n values."""
     n = (packed.shape[0] - 3) // 7
     if q.shape[0] != n or not _packed_q_ok(q, n):
         return False
@@ -549,13 +556,13 @@ def fk_pose_packed(q, packed, out):
         else:
             e0, e1, e2, e3 = turn_code(_code(packed[a], packed[a + 1], packed[a + 2]), e0, e1,
                                        e2, e3, packed[a], packed[a + 1], packed[a + 2], q[k])
-    out[0] = px
-    out[1] = py
-    out[2] = pz
-    out[3] = e0
-    out[4] = e1
-    out[5] = e2
-    out[6] = e3
+    p[0] = px
+    p[1] = py
+    p[2] = pz
+    er[0] = e0
+    er[1] = e1
+    er[2] = e2
+    er[3] = e3
     return True
 
 

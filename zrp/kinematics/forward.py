@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -135,9 +136,9 @@ def _flat(model: Manipulator, q: ArrayLike) -> tuple[F64, tuple[int, ...]]:
     array of the right shape passes as is: the batch kernels check its range themselves on
     their way through it (a separate pass cost 40 % of the FK kernel's time) and
     :func:`_range_error` then names the joint; anything else goes through :func:`check_q`."""
-    if not (type(q) is np.ndarray and q.dtype is _F64 and q.ndim >= 1  # type: ignore[union-attr]
-            and q.shape[-1] == model.n and q.flags.c_contiguous  # type: ignore[union-attr]
-            and isinstance(model, Manipulator)):
+    if not (isinstance(model, Manipulator) and type(q) is np.ndarray and q.dtype is _F64
+            and q.ndim >= 1 and q.shape[-1] == model.n  # type: ignore[union-attr]
+            and q.flags.c_contiguous):  # type: ignore[union-attr]
         q = check_q(model, q)
     assert isinstance(q, np.ndarray)
     return np.ascontiguousarray(q.reshape(-1, model.n)), q.shape[:-1]
@@ -163,17 +164,52 @@ def _karrays(model: Manipulator) -> tuple:
 
 
 def _packed(model: Manipulator) -> F64:
-    """The single-pose kernels' packed model (built once per model)."""
+    """The single-pose kernels' packed model (built once per model, then read as
+    ``model._kernel_packed`` by the one-pose paths)."""
     return derived(model, "_kernel_packed", _pack)
 
 
 _F64 = np.dtype(np.float64)
+_empty = np.empty  # one global read, not two, on the one-pose paths (~0.03 us of ~0.75)
 
 
-def _one(q: object) -> bool:
-    """q may be one joint vector for the single-pose kernels (a 1-D float64 array; they check
-    its length and values and decline otherwise). Kept to ~0.1 us: attribute reads only."""
-    return type(q) is np.ndarray and q.ndim == 1 and q.dtype is _F64  # type: ignore[union-attr]
+def _entry(kernel: object, *ndims: int) -> object:
+    """``kernel`` compiled for C-contiguous float64 arrays of ``ndims`` dimensions, as its
+    bare entry point: a call skips the dispatcher's per-call type resolution (0.33 -> 0.24
+    us of a one-pose FK call). The caller vouches for the types, which the entry point does
+    not check (it would read another dtype or number of dimensions wrongly): q a 1-D float64
+    ndarray, the rest arrays it made itself; the packed kernels decline a q that is not
+    contiguous. The kernel itself where numba compiles nothing (NUMBA_DISABLE_JIT)."""
+    compile_ = getattr(kernel, "compile", None)
+    if compile_ is None:
+        return kernel
+    return compile_(tuple(numba.types.Array(numba.types.float64, d, "C") for d in ndims))
+
+
+_FK_ONE = None  # fk_pose_packed's entry point (_entry), built by the first one-pose call
+_JAC_ONE = None  # jac_packed's
+
+
+def _model_packed(model: object) -> F64 | None:
+    """The packed model (None when ``model`` is not a Manipulator: the general path names
+    it)."""
+    return _packed(model) if isinstance(model, Manipulator) else None
+
+
+def _fk_one(model: object) -> tuple[F64 | None, object]:
+    """The packed model and the one-pose FK entry point (built on the first call)."""
+    global _FK_ONE
+    if _FK_ONE is None:
+        _FK_ONE = _entry(K.fk_pose_packed, 1, 1, 1, 1)
+    return _model_packed(model), _FK_ONE
+
+
+def _jac_one(model: object) -> tuple[F64 | None, object]:
+    """The packed model and the one-pose Jacobian entry point (built on the first call)."""
+    global _JAC_ONE
+    if _JAC_ONE is None:
+        _JAC_ONE = _entry(K.jac_packed, 1, 1, 2)
+    return _model_packed(model), _JAC_ONE
 
 
 def _length_scale(model: Manipulator, length_unit: str | None) -> float:
@@ -217,16 +253,27 @@ def end_effector_pose(model: Manipulator, q: ArrayLike, *,
         InputError: q out of range or malformed, or ``out`` not a float64 C-contiguous
             array of shape (..., 7) matching q's batch shape.
     """
+    if (out is None and length_unit is None and type(q) is np.ndarray and q.ndim == 1
+            and q.dtype is _F64):  # type: ignore[union-attr]
+        # one pose, ~0.7 us a call: the packed model kept on the model, the kernel's bare
+        # entry point (_entry); the kernel declines a wrong length or value and the general
+        # path below names it
+        try:
+            packed = model._kernel_packed  # type: ignore[attr-defined]  # kept by _packed
+        except AttributeError:
+            packed = None
+        fk = _FK_ONE
+        if packed is None or fk is None:
+            packed, fk = _fk_one(model)
+        p, er = _empty(3), _empty(4)
+        if packed is not None and fk(q, packed, p, er):  # type: ignore[operator]
+            return p, er
     if length_unit is not None:
         s = _length_scale(model, length_unit)
         p, er = end_effector_pose(model, _q_in_model_unit(model, q, s), out=out,
                                   threads=threads)
         p *= s
         return p, er
-    if out is None and _one(q):  # one pose: ~1 us per call (one kernel call, three arguments)
-        res = np.empty(7)
-        if K.fk_pose_packed(q, _packed(model), res):
-            return res[:3], res[3:]
     qf, batch = _flat(model, q)
     res = _out_buffer(out, (*batch, 7)).reshape(-1, 7)
     t = thread_count(qf.shape[0], MIN_FK_POSES, threads)
@@ -271,10 +318,18 @@ def jacobian(model: Manipulator, q: ArrayLike, *, rows: str = "wv",
         jac[..., 3:, :] *= np.where(model.prismatic, 1.0, s)  # m/m stays for a slide
         return np.concatenate([jac[..., 3:, :], jac[..., :3, :]], axis=-2) if rows == "vw" \
             else jac
-    if _one(q):  # one pose: one kernel call, three arguments
-        jac = np.empty((6, model.n))
-        if K.jac_packed(q, _packed(model), jac):
-            return jac
+    if type(q) is np.ndarray and q.ndim == 1 and q.dtype is _F64:  # type: ignore[union-attr]
+        try:  # one pose: as in end_effector_pose
+            packed = model._kernel_packed  # type: ignore[attr-defined]  # kept by _packed
+        except AttributeError:
+            packed = None
+        jac_one = _JAC_ONE
+        if packed is None or jac_one is None:
+            packed, jac_one = _jac_one(model)
+        if packed is not None:
+            jac = _empty((6, model.n))
+            if jac_one(q, packed, jac):  # type: ignore[operator]
+                return jac
     qf, batch = _flat(model, q)
     jac = recycled_empty((qf.shape[0], 6, model.n))
     t = thread_count(qf.shape[0], MIN_JAC_POSES, threads)

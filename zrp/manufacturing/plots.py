@@ -12,7 +12,7 @@ from zrp.errors import InputError
 from zrp.manufacturing.histogram import Histogram
 from zrp.manufacturing.population import MonteCarloResult
 from zrp.manufacturing.reduction import MonteCarloSummary
-from zrp.output import atomic_path
+from zrp.output import atomic_path, tight_layout_once
 
 __all__ = ["check_png_path", "histogram_png"]
 
@@ -90,7 +90,7 @@ def histogram_png(mc: MonteCarloResult | MonteCarloSummary, path: str | Path, *,
             reduced = ", reduced on the workers" if isinstance(mc, MonteCarloSummary) else ""
             fig.suptitle(title or f"Monte Carlo, {mc.n_robots:,} robots x {mc.n_points} points, "
                          f"{mc.distribution}{reduced}")
-            fig.tight_layout()
+            tight_layout_once(fig)
             fig.savefig(tmp, dpi=110, format="png")
         finally:
             plt.close(fig)

@@ -36,12 +36,13 @@ Typical use::
 * A command's input is never its output, even with ``--force``: the command line registers
   the files it reads (:func:`reading`) and every write refuses them (:func:`check_not_input`).
 
-The policy lives in six modules: :mod:`zrp.output.paths` (names and file kinds, the refusal to
+The policy lives in seven modules: :mod:`zrp.output.paths` (names and file kinds, the refusal to
 replace), :mod:`zrp.output.atomic` (the atomic writes, the default folders' mark),
 :mod:`zrp.output.names` (default names from inputs, no links on the way),
 :mod:`zrp.output.inputs` (inputs are not outputs),
-:mod:`zrp.output.lock` (one run a folder) and :mod:`zrp.output.folder` (:class:`OutputDir`);
-import the names from here.
+:mod:`zrp.output.lock` (one run a folder), :mod:`zrp.output.folder` (:class:`OutputDir`) and
+:mod:`zrp.output.figures` (a figure drawn once for each file it is saved to); import the names
+from here.
 """
 
 from __future__ import annotations
@@ -55,6 +56,7 @@ from zrp.output.atomic import (
     write_json,
     write_text,
 )
+from zrp.output.figures import tight_layout_once
 from zrp.output.folder import OutputDir
 from zrp.output.inputs import check_not_input, reading
 from zrp.output.lock import LOCK_NAME, LOCK_WAIT_S
@@ -76,6 +78,7 @@ __all__ = [
     "default_overwrite",
     "reading",
     "safe_name",
+    "tight_layout_once",
     "write_bytes",
     "write_json",
     "write_text",

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 
 from zrp.arrays import F64
-from zrp.output import OutputDir
+from zrp.output import OutputDir, tight_layout_once
 from zrp.paper.comparison import kind_columns
 from zrp.paper.example import PaperExample
 from zrp.paper.published import LIKELY_TYPOS, PUBLISHED_ROWS, PUBLISHED_TABLE2, PUBLISHED_TABLE3
@@ -211,7 +211,7 @@ def paper_figures(ex: PaperExample, out: OutputDir, *, suffix: str = "",
                     if style == "sweep" and pubs else "")
             fig.text(0.99, 0.01, f"{note}{conv}; {ex.path.label}", ha="right", va="bottom",
                      fontsize=7, color="0.4")
-            fig.tight_layout(rect=(0, _draw_caption(fig, caption), 1, 1))
+            tight_layout_once(fig, rect=(0, _draw_caption(fig, caption), 1, 1))
             files.append(out.savefig(name.replace(".png", f"{suffix}.png"), fig, dpi=110))
         finally:
             plt.close(fig)

@@ -23,7 +23,7 @@ from zrp.gap.dynamics.validation import Validation
 from zrp.gap.dynamics.verdict import effect_words, headline, overall_rms, validation_words
 from zrp.gap.report.html import report_html
 from zrp.jsonio import to_jsonable
-from zrp.output import OutputDir, write_text
+from zrp.output import OutputDir, tight_layout_once, write_text
 
 __all__ = ["REPORT_FILES", "diagnosis_json", "report_markdown", "run_json", "write_report",
            "write_run"]
@@ -150,7 +150,7 @@ def _figure(d: DynamicDiagnosis, which: str, xlabel: str) -> Any:
         axes[k // cols][k % cols].axis("off")
     axes[0][0].legend(fontsize=7, markerscale=5, loc="best")
     fig.suptitle("torque residuals (grey: +-2 sigma noise)", fontsize=10)
-    fig.tight_layout()
+    tight_layout_once(fig)
     return fig, plt
 
 

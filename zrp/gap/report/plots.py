@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from zrp.gap.results import Diagnosis
+from zrp.output import tight_layout_once
 
 __all__ = ["PLOT_FILES", "figures", "implicated_joint", "withheld_rows"]
 
@@ -65,7 +66,7 @@ def _before_after(plt: Any, diag: Diagnosis) -> Any:
     ax[1].set_ylabel(f"withheld |error| ({unit})")
     ax[1].legend(fontsize=8)
     fig.suptitle("Withheld residuals before and after the diagnosed corrections")
-    fig.tight_layout()
+    tight_layout_once(fig)
     return fig
 
 
@@ -94,7 +95,7 @@ def _against_joint(plt: Any, diag: Diagnosis) -> Any:
         axs[k // cols][k % cols].set_visible(False)
     axs[0][0].legend(fontsize=7, markerscale=3)
     fig.suptitle("Withheld residual of the final model per axis (signed) against each joint")
-    fig.tight_layout()
+    tight_layout_once(fig)
     return fig
 
 
@@ -128,7 +129,7 @@ def _shrink(plt: Any, diag: Diagnosis) -> Any:
     ax.set_ylabel(f"withheld error ({unit}, log)")
     ax.set_title("Withheld error per step (log axis)")
     ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # beside, not over bars
-    fig.tight_layout()
+    tight_layout_once(fig)
     return fig
 
 
@@ -166,7 +167,7 @@ def _correlation(plt: Any, diag: Diagnosis) -> Any:
     ax.set_yticks(range(k), c.names, fontsize=fs)
     fig.colorbar(im, ax=ax, label="correlation")
     ax.set_title("Parameter correlations of the final model (robust covariance)")
-    fig.tight_layout()
+    tight_layout_once(fig)
     return fig
 
 
