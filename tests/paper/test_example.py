@@ -103,7 +103,7 @@ def test_outputs_written_and_not_overwritten(example, tmp_path):
 
 
 def test_cli_paper_study_tolerance(tmp_path, capsys):
-    assert main(["paper", "--out", str(tmp_path / "r"), "--no-video", "--no-figures",
+    assert main(["paper", "--out", str(tmp_path / "r"), "--no-video", "--no-plots",
                  "--steps", "60", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["cell_status_counts"]["match"] == 12

@@ -73,7 +73,7 @@ def deprecated_alias(parser: argparse.ArgumentParser | argparse._ArgumentGroup, 
     """Accept ``old`` as ``new`` (the action of the current name), with a one-line notice on
     stderr; hidden from ``--help``. ``new_name``: the option string ``new`` is called with
     (default its first; e.g. ``--no-progress`` of a ``--progress/--no-progress`` pair)."""
-    parser.add_argument(old, dest=new.dest, nargs=new.nargs, type=new.type,
+    parser.add_argument(old, dest=new.dest, nargs=new.nargs, type=new.type, choices=new.choices,
                         metavar=new.metavar, action=DeprecatedAlias, help=argparse.SUPPRESS,
                         default=argparse.SUPPRESS, target=new,
                         new_name=new_name or new.option_strings[0])

@@ -39,7 +39,7 @@ __all__ = ["API_TO_CLI", "build_parser", "cli_message", "emit", "main", "one_lin
 
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
-        prog="zrp",
+        prog="zrp", allow_abbrev=False,
         description="Robot accuracy: zero-reference-position kinematics, manufacturing-error "
         "analysis, MuJoCo playback and video, sim-to-real gap diagnosis.",
     )
@@ -48,6 +48,10 @@ def build_parser() -> argparse.ArgumentParser:
     for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
         mod = importlib.import_module(f"{commands.__name__}.{info.name}")
         mod.register(sub)
+    # no abbreviations: `measure --temp` would silently be --temp-rise, and a new option could
+    # change what an abbreviation typed in a script means (tests/cli/test_one_name.py)
+    for cmd in sub.choices.values():
+        cmd.allow_abbrev = False
     return parser
 
 
