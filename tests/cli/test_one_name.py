@@ -126,3 +126,26 @@ def test_a_shortened_option_is_refused(argv, capsys):
     with pytest.raises(SystemExit):
         build_parser().parse_args(argv)
     assert f"unrecognized arguments: {argv[-1]}" in capsys.readouterr().err
+
+
+class _Stream:
+    def __init__(self, tty: bool) -> None:
+        self.tty = tty
+
+    def isatty(self) -> bool:
+        return self.tty
+
+
+@pytest.mark.parametrize(("tty", "argv", "drawn"), [
+    (True, [], True), (True, ["--no-progress"], False), (False, [], False),
+    (False, ["--progress"], False)])
+def test_a_bar_is_drawn_on_a_terminal_only(tty, argv, drawn, monkeypatch):
+    # a bar's carriage returns would garble a pipe or a log: --progress (the default) draws
+    # one only when stderr is a terminal
+    from zrp.cli.options import draw_bar
+
+    args = build_parser().parse_args(["tolerance", *argv])
+    monkeypatch.setattr(sys, "stderr", _Stream(tty))
+    assert draw_bar(args) is drawn
+    monkeypatch.setattr(sys, "stderr", None)  # started with stderr closed (`2>&-`)
+    assert draw_bar(args) is False
