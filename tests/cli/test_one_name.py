@@ -112,7 +112,9 @@ def test_temp_is_not_temp_rise(capsys):
     with pytest.raises(SystemExit) as exc:
         parser.parse_args(["measure", "--out", "d.csv", "--temp", "20"])
     assert exc.value.code == 2
-    assert "unrecognized arguments: --temp 20" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "zrp measure: error: unrecognized arguments: --temp 20 (options are not " \
+           "abbreviated: --temp could be --temp-rise)" in err
     assert parser.parse_args(["measure", "--out", "d.csv", "--temp-rise", "20"]).temp_rise == 20
     args = parser.parse_args(["compensate", "--calibration", "c.json", "--targets", "t.csv",
                               "--out", "o.csv", "--temp", "20"])
@@ -125,7 +127,9 @@ def test_temp_is_not_temp_rise(capsys):
 def test_a_shortened_option_is_refused(argv, capsys):
     with pytest.raises(SystemExit):
         build_parser().parse_args(argv)
-    assert f"unrecognized arguments: {argv[-1]}" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert f"zrp {argv[0]}: error: unrecognized arguments: {argv[-1]} (options are not " \
+           f"abbreviated: {argv[-1]} could be {argv[-1]}" in err
 
 
 class _Stream:
