@@ -79,7 +79,7 @@ def test_every_old_name_in_the_table_is_still_accepted_somewhere():
 def _has_progress_display(p: argparse.ArgumentParser) -> bool:
     """The command's code hands a progress setting to the library or draws its own bar."""
     src = inspect.getsource(sys.modules[p._defaults["func"].__module__])
-    return bool(re.search(r"\bprogress=|\btqdm\b|args\.progress", src))
+    return bool(re.search(r"\bprogress=(?!False)|\btqdm\b|args\.progress", src))
 
 
 def test_every_command_with_a_progress_display_has_progress_no_progress():
