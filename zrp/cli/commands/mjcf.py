@@ -59,7 +59,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true",
                    help="replace --out if it exists (refused otherwise, before writing)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.set_defaults(func=_run, api_names={"body": "--end-link", "site": "--site"})
+    p.set_defaults(func=_run, api_names={"body": "--end-link", "end_link": "--end-link",
+                                         "site": "--site"})
 
 
 def _slug(text: str) -> str:
