@@ -24,6 +24,7 @@ actually measured) is recorded per design, to set precision beside diagnosis.
 
 from __future__ import annotations
 
+import sys
 import tempfile
 import warnings
 from dataclasses import dataclass
@@ -227,7 +228,7 @@ def run_k_study(model: Manipulator, config: BenchmarkConfig, ks: tuple[int, ...]
         candidates: int = 1000, scenarios: tuple[int, ...] | None = None,
         progress: bool = False, random_ks: tuple[int, ...] = ()) -> list[DesignScore]:
     """:func:`study_scenario` over the blind benchmark's scenarios of ``config`` (all, or
-    the indices ``scenarios``)."""
+    the indices ``scenarios``); ``progress``: a line per scenario and design on stderr."""
     if any(int(k) < 2 for k in (*ks, *random_ks)):
         raise InputError(f"ks, random_ks: expected pose counts >= 2, got {ks!r}, "
                          f"{random_ks!r}")
@@ -246,7 +247,7 @@ def run_k_study(model: Manipulator, config: BenchmarkConfig, ks: tuple[int, ...]
                 for r in rows:
                     print(f"scenario {r.scenario:3d} {r.design:7s} {r.poses:4d}: "
                           f"found {', '.join(r.found):40s} ratio {r.ratio:6.2f} "
-                          f"ok {r.success}", flush=True)
+                          f"ok {r.success}", file=sys.stderr, flush=True)
     return out
 
 

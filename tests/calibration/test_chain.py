@@ -28,7 +28,7 @@ from zrp.cli import main
 ARMS = {  # folder, file in example-robot-data's robots/, and the import's options
     "ur10": ("ur_description", "ur10_robot.urdf", []),
     "xarm7": ("xarm_description", "xarm7.urdf", []),
-    "panda": ("panda_description", "panda.urdf", ["--end", "panda_hand_tcp"]),
+    "panda": ("panda_description", "panda.urdf", ["--end-link", "panda_hand_tcp"]),
 }
 #: 10 urad/(N m) is a stiffness of 1e5 N m/rad, in the range of harmonic-drive and cycloid
 #: joints of arms this size; under the shoulder's gravity torque (URDF inertias: up to 121 N m on

@@ -200,7 +200,7 @@ def test_cli_measurements_to_a_patched_urdf(tmp_path, capsys):
     from zrp.kinematics import uniform_joint_values
 
     src = os.path.join(erd_root(), "ur_description/urdf/ur10_joint_limited_robot.urdf")
-    assert main(["import", src, "--end", "tool0", "--out", str(tmp_path / "ur10.toml")]) == 0
+    assert main(["import", src, "--end-link", "tool0", "--out", str(tmp_path / "ur10.toml")]) == 0
     model = import_urdf(src, end_link="tool0").model
     rng = np.random.default_rng(8)
     meas = synthesize(model, uniform_joint_values(model, 60, rng),
@@ -215,7 +215,7 @@ def test_cli_measurements_to_a_patched_urdf(tmp_path, capsys):
     comp = tmp_path / "out" / "compensation.json"
     out = tmp_path / "ur10_cal.urdf"
     capsys.readouterr()
-    assert main(["export", "--calibration", str(comp), "--urdf", src, "--end", "tool0",
+    assert main(["export", "--calibration", str(comp), "--urdf", src, "--end-link", "tool0",
                  "--to", "urdf", "--out", str(out), "--json"]) == 0
     payload = json.loads(capsys.readouterr().out)
     assert payload["side_file"] == str(tmp_path / "ur10_cal.calibration.json")

@@ -18,6 +18,15 @@ CASES = [
      "a.urdf"),
     (["render", "--out-dir", "videos"], ["render", "--out", "videos"], "out", "videos"),
     (["render", "--quiet"], ["render", "--no-progress"], "progress", False),
+    (["export", "--to", "urdf", "--end", "tool0"], ["export", "--to", "urdf", "--end-link",
+                                                    "tool0"], "end_link", "tool0"),
+    (["import", "a.urdf", "--end", "tool0"], ["import", "a.urdf", "--end-link", "tool0"],
+     "end_link", "tool0"),
+    (["mjcf", "--from", "a.xml", "--body", "hand"], ["mjcf", "--from", "a.xml", "--end-link",
+                                                     "hand"], "end_link", "hand"),
+    (["paper", "--no-figures"], ["paper", "--no-plots"], "no_plots", True),
+    (["gap-benchmark", "--poses-from", "circle"], ["gap-benchmark", "--trajectory", "circle"],
+     "trajectory", "circle"),
 ]
 
 
@@ -30,6 +39,13 @@ def test_an_old_name_gives_the_new_value_and_says_so(old, new, dest, value, caps
     err = capsys.readouterr().err
     name = next(a for a in old if a.startswith("--") and a not in new)
     assert f"{name} is deprecated and will be removed in {REMOVED_IN}; use " in err
+
+
+def test_an_old_choice_is_still_checked(capsys):
+    # the alias keeps the new option's choices: a typo through the old name is refused too
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["gap-benchmark", "--poses-from", "square"])
+    assert "invalid choice: 'square'" in capsys.readouterr().err
 
 
 def test_the_old_names_are_hidden_from_help(capsys):

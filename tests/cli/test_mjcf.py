@@ -34,3 +34,14 @@ def test_import_round_trip_to_toml(tmp_path):
 def test_bad_perturbation_is_a_clear_error(tmp_path, capsys):
     assert main(["mjcf", "--perturb", "JE2:0.1", "--out", str(tmp_path / "x.xml")]) == 2
     assert "NAME=XI" in capsys.readouterr().err
+
+
+def test_an_unknown_end_body_names_the_option(tmp_path, capsys):
+    # the end body is --end-link (was --body, issue 33): the error names the option typed
+    xml = tmp_path / "puma.xml"
+    assert main(["mjcf", "--out", str(xml)]) == 0
+    capsys.readouterr()
+    assert main(["mjcf", "--from", str(xml), "--end-link", "nope",
+                 "--out", str(tmp_path / "x.toml")]) == 2
+    err = capsys.readouterr().err
+    assert "--end-link: no body named 'nope'" in err and "body:" not in err

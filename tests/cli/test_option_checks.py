@@ -140,7 +140,7 @@ def test_a_users_renders_folder_is_kept(tmp_path, capsys, monkeypatch, out):
     mine.write_text("mine")
     table.write_text("mine")
     _refused(capsys, ["ik", "--steps", "40"], "--force")
-    _refused(capsys, ["paper", "--steps", "40", "--no-video", "--no-figures", "--out", out],
+    _refused(capsys, ["paper", "--steps", "40", "--no-video", "--no-plots", "--out", out],
              "--force")
     assert mine.read_text() == "mine" and table.read_text() == "mine"
 

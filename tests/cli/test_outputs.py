@@ -14,7 +14,7 @@ import pytest
 from zrp.cli import build_parser, main
 from zrp.output import LOCK_NAME
 
-OUTPUT_OPTIONS = {"--out", "--out-dir", "--hist", "--truth", "--workdir"}
+OUTPUT_OPTIONS = {"--out", "--hist", "--truth", "--workdir"}
 
 
 def subcommands() -> dict[str, argparse.ArgumentParser]:
@@ -42,7 +42,7 @@ def cases(tmp: Path, data: Path) -> dict[str, tuple[list[str], Path]]:
                    "--out", str(tmp / "study")], tmp / "study"),
         "tolerance": (["tolerance", "--robots", "100", "--steps", "40", "--no-progress",
                        "--hist", str(tmp / "h.png")], tmp / "h.png"),
-        "paper": (["paper", "--steps", "40", "--no-video", "--no-figures",
+        "paper": (["paper", "--steps", "40", "--no-video", "--no-plots",
                    "--out", str(tmp / "paper")], tmp / "paper"),
         "diagnose": (["diagnose", "--model", "puma", "--data", str(data), "--max-steps", "1",
                       "--no-plots", "--out", str(tmp / "diag")], tmp / "diag"),

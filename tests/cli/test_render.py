@@ -37,17 +37,20 @@ def test_render_unknown_backend(tmp_path, capsys):
     assert "vulkan" in err and "egl" in err and "osmesa" in err
 
 
-def test_paper_video_bar_shows_the_file_the_user_gets(backend, tmp_path, capsys):
+def test_paper_video_bar_shows_the_file_the_user_gets(backend, tmp_path, capsys, monkeypatch):
     """``zrp paper`` renders its video into a temporary file moved into place afterwards; the
     progress bar showed that file (".zrp-PID-N.tmp.mp4", issue 33), now the final name."""
     from argparse import Namespace
 
+    from zrp.cli.commands import paper
     from zrp.cli.commands.paper import _video, _video_name
     from zrp.model.files import load_model
     from zrp.output import OutputDir
 
     model = load_model("puma")
-    args = Namespace(no_video=False, steps=40, json=False)
+    args = Namespace(no_video=False, steps=40, json=False, progress=True)
+    # the bar is drawn on a terminal only (zrp.cli.options.draw_bar); captured stderr is not one
+    monkeypatch.setattr(paper, "draw_bar", lambda a: a.progress)
     name = _video_name(args, model)
     with OutputDir(tmp_path, names=[name]) as out:
         res = _video(args, out, name, model, "default")

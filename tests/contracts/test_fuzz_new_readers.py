@@ -131,7 +131,7 @@ def _write(tmp_dir: Path, name: str, data: bytes) -> Path:
 def test_urdf_import(tmp_dir, data, end, base):
     path = _write(tmp_dir, "arm.urdf", data)
     _only_project_errors(import_urdf, path, end_link=end, base_link=base)
-    args = argparse.Namespace(source=str(path), end=end, base=base, site=None, unit="mm",
+    args = argparse.Namespace(source=str(path), end_link=end, base=base, site=None, unit="mm",
                               name=None)
     _only_project_errors(import_read, args)  # zrp import: format detection, then the reader
 

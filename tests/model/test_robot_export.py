@@ -148,8 +148,8 @@ def test_cli_import_export(tmp_path, capsys):
 def test_cli_import_errors_name_the_option(tmp_path, capsys):
     src = tmp_path / "arm.urdf"
     src.write_text(URDF)
-    assert main(["import", str(src), "--end", "nope", "--out", str(tmp_path / "x.toml")]) == 2
-    assert "--end: no link named 'nope'" in capsys.readouterr().err
+    assert main(["import", str(src), "--end-link", "nope", "--out", str(tmp_path / "x.toml")]) == 2
+    assert "--end-link: no link named 'nope'" in capsys.readouterr().err
 
 
 def test_cli_ik_target_and_posture(tmp_path, capsys):

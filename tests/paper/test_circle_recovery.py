@@ -114,7 +114,7 @@ def _zrp(*args: str, cwd: Path) -> subprocess.CompletedProcess:
 
 @pytest.mark.slow
 def test_cli_recovered_circle(tmp_path):
-    p = _zrp("paper", "--circle", "recovered", "--no-video", "--no-figures", "--json",
+    p = _zrp("paper", "--circle", "recovered", "--no-video", "--no-plots", "--json",
              "--out", str(tmp_path / "rec"), cwd=tmp_path)
     assert p.returncode == 0, p.stderr
     import json

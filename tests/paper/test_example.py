@@ -103,7 +103,7 @@ def test_outputs_written_and_not_overwritten(example, tmp_path):
 
 
 def test_cli_paper_study_tolerance(tmp_path, capsys):
-    assert main(["paper", "--out", str(tmp_path / "r"), "--no-video", "--no-figures",
+    assert main(["paper", "--out", str(tmp_path / "r"), "--no-video", "--no-plots",
                  "--steps", "60", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["cell_status_counts"]["match"] == 12
@@ -182,7 +182,7 @@ def test_je_over_le_says_in_words_what_it_compares_and_why_it_differs(example, t
         recovered.checks, recovered.circle)
     # the command line prints it (wrapped), comparison.md has it whole
     out = tmp_path / "r"
-    assert main(["paper", "--out", str(out), "--no-video", "--no-figures",
+    assert main(["paper", "--out", str(out), "--no-video", "--no-plots",
                  "--steps", "120"]) == 0
     printed = re.sub(r"\s+", " ", capsys.readouterr().out)
     assert text in printed

@@ -37,9 +37,35 @@ from zrp.packages import PackageShadowedError, check_own_packages
 __all__ = ["API_TO_CLI", "build_parser", "cli_message", "emit", "main", "one_line_warnings"]
 
 
+class _Parser(argparse.ArgumentParser):
+    """The ``zrp`` parser: an option it does not know is refused by the command's own parser,
+    naming the options it may have been short for (options are never abbreviated)."""
+
+    def parse_args(self, args: Sequence[str] | None = None,  # type: ignore[override]
+                   namespace: argparse.Namespace | None = None) -> argparse.Namespace:
+        ns, extras = self.parse_known_args(args, namespace)
+        if extras:
+            sub = next(a for a in self._actions if isinstance(a, argparse._SubParsersAction))
+            cmd = sub.choices.get(getattr(ns, "command", None) or "", self)
+            cmd.error(f"unrecognized arguments: {' '.join(extras)}"
+                      + "".join(_near(cmd, e) for e in extras))
+        return ns
+
+
+def _near(cmd: argparse.ArgumentParser, extra: str) -> str:
+    """The hint after a refused ``extra``: the options of ``cmd`` it is the start of
+    (``--temp`` could be ``--temp-rise``), or "" if none."""
+    typed = extra.split("=")[0]
+    near = sorted(o for a in cmd._actions if a.help != argparse.SUPPRESS
+                  for o in a.option_strings if o.startswith(typed))
+    if not typed.startswith("--") or not near:
+        return ""
+    return f" (options are not abbreviated: {typed} could be {' or '.join(near)})"
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
-        prog="zrp",
+    parser = _Parser(
+        prog="zrp", allow_abbrev=False,
         description="Robot accuracy: zero-reference-position kinematics, manufacturing-error "
         "analysis, MuJoCo playback and video, sim-to-real gap diagnosis.",
     )
@@ -48,6 +74,10 @@ def build_parser() -> argparse.ArgumentParser:
     for info in sorted(pkgutil.iter_modules(commands.__path__), key=lambda m: m.name):
         mod = importlib.import_module(f"{commands.__name__}.{info.name}")
         mod.register(sub)
+    # no abbreviations: `measure --temp` would silently be --temp-rise, and a new option could
+    # change what an abbreviation typed in a script means (tests/cli/test_one_name.py)
+    for cmd in sub.choices.values():
+        cmd.allow_abbrev = False
     return parser
 
 

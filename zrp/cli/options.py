@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
@@ -36,6 +37,8 @@ __all__ = [
     "SEED",
     "TOLERANCE",
     "add_deg",
+    "add_progress",
+    "draw_bar",
     "joint_angles",
     "real",
     "whole",
@@ -130,6 +133,27 @@ DEG_HELP = ("angles in degrees: the values typed, the joint columns read that de
 def add_deg(p: argparse.ArgumentParser | argparse._ArgumentGroup) -> None:
     """``--deg``: one flag meaning the same in every command (:data:`DEG_HELP`)."""
     p.add_argument("--deg", action="store_true", help=DEG_HELP)
+
+
+#: The help of ``--progress/--no-progress`` where a bar is drawn (tqdm): on a terminal only.
+PROGRESS_HELP = ("show a progress bar on stderr when it is a terminal (default on; "
+                 "--no-progress: none)")
+
+
+def add_progress(p: argparse.ArgumentParser | argparse._ArgumentGroup,
+                 help: str = PROGRESS_HELP) -> argparse.Action:
+    """``--progress/--no-progress``: the one progress option of every command with a progress
+    display, default on (tests/cli/test_one_name.py). A bar is drawn only on a terminal
+    (:func:`draw_bar`): its carriage returns would garble a pipe or a log file; a command
+    whose library prints plain periodic lines when piped (diagnose) says so in ``help``.
+    Returns the action (for a deprecated alias such as render's ``--quiet``)."""
+    return p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
+                          help=help)
+
+
+def draw_bar(args: argparse.Namespace) -> bool:
+    """Draw a progress bar: ``--progress`` (the default) and stderr is a terminal."""
+    return bool(args.progress) and sys.stderr is not None and sys.stderr.isatty()
 
 
 def joint_angles(model: Manipulator, values: list[float] | np.ndarray, deg: bool,

@@ -139,7 +139,7 @@ class BenchmarkConfig:
             return "PUMA 560 literature inertias (the arm's own)"
         kind = "PUMA 560" if model.n == 6 and not model.prismatic.any() else "uniform-rod"
         return (f"FALLBACK: {kind} inertias (no inertias given for this arm; pass its "
-                "URDF/MJCF, --arm)")
+                "URDF/MJCF, --mjcf)")
 
     def noise_range(self, model: Manipulator) -> tuple[float, float]:
         """(low, high) tracker noise sigma per coordinate in ``model``'s length unit:

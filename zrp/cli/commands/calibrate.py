@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     from zrp.calibration.fullpose import FullPoseCalibration
     from zrp.calibration.recipe import Calibration, CalibrationOptions
 from zrp.cli.app import emit
-from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
+from zrp.cli.options import LENGTH, SEED, add_deg, add_progress, real, whole
 from zrp.errors import InputError
 from zrp.gap.model.choices import EFFECTS
 from zrp.gap.model.domains import DOMAINS  # light: no NumPy
@@ -66,9 +66,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "diagnose --residual-model); kept only when it lowers the withheld error "
                    "clearly, it is then written into compensation.json (learned_residual) and "
                    "applied by zrp compensate within its training ranges")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
-                   help="show the diagnosis's progress on stderr (default on; --no-progress: "
-                        "silent)")
+    add_progress(p, help="show the diagnosis's progress on stderr: a bar on a terminal, a line "
+                 "every 10 s when piped (default on; --no-progress: silent)")
     p.add_argument("--json", action="store_true", help="print the compensation file")
     p.set_defaults(func=_run, api_names={"noise_sigma": "--noise", "seed": "--seed",
                                          "effects": "--effects", "max_steps": "--max-steps",

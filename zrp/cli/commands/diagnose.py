@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import sys
 from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.fleet import add_fleet_options, is_fleet, refuse_fleet_options, run_fleet
-from zrp.cli.options import LENGTH, SEED, add_deg, real, whole
+from zrp.cli.options import LENGTH, SEED, add_deg, add_progress, draw_bar, real, whole
 from zrp.errors import InputError
 from zrp.gap.data.choices import MAX_POINTS, MAX_ROWS, MAX_WITHHELD
 from zrp.gap.model.choices import EFFECTS
@@ -61,9 +60,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "final model; kept only when it lowers the withheld error clearly "
                         "(its withheld RMS beside the physical model's)")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
-    p.add_argument("--progress", action=argparse.BooleanOptionalAction, default=True,
-                   help="show progress on stderr: a bar on a terminal, a line every 10 s "
-                        "when piped (default on; --no-progress: silent)")
+    add_progress(p, help="show progress on stderr: a bar on a terminal, a line every 10 s "
+                 "when piped (default on; --no-progress: silent)")
     p.add_argument("--max-points", type=whole(0), default=MAX_POINTS, metavar="N",
                    help=f"most measured points diagnosed (default {MAX_POINTS}); beyond it a "
                         "seeded random subsample of whole poses, announced and recorded in "
@@ -109,9 +107,8 @@ def _run(args: argparse.Namespace) -> int:
     # reading the inputs creates nothing: a bad input leaves no output folder behind
     model = load_model(args.model)
     # the reader's bar only on a terminal; piped runs get the diagnosis's periodic lines
-    progress = args.progress and sys.stderr.isatty()
     meas = load_measurements(args.data, model, deg=args.deg, frame=args.frame,
-                             progress=progress, max_rows=args.max_rows)
+                             progress=draw_bar(args), max_rows=args.max_rows)
     tau = None if args.mjcf is None else gravity_torques(
         args.mjcf, meas.q_pose, field="--mjcf", joint_names=[j.name for j in model.joints])
     out_dir = Path(args.out)

@@ -46,7 +46,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true", help="replace outputs in --out")
     p.add_argument("--json", action="store_true", help="print diagnosis.json")
     p.set_defaults(func=_run, api_names={"torque_constant": "--torque-constant",
-                                         "window_s": "--window"})
+                                         "window_s": "--window", "end_link": "--end-link"})
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -61,7 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true", help="replace --out")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_run, api_names={
-        "q0": "--q0", "amplitude": "--amplitude", "q_amp": "--amplitude",
+        "end_link": "--end-link", "q0": "--q0", "amplitude": "--amplitude", "q_amp": "--amplitude",
         "max_velocity": "--max-velocity", "qd_max": "--max-velocity",
         "max_acceleration": "--max-acceleration", "qdd_max": "--max-acceleration",
         "max_torque": "--max-torque", "torque_limit": "--max-torque", "period_s": "--period",

@@ -8,7 +8,7 @@ from pathlib import Path
 from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
-from zrp.cli.options import FRACTION, SEED, real, whole
+from zrp.cli.options import FRACTION, SEED, add_progress, draw_bar, real, whole
 from zrp.errors import InputError
 from zrp.model.builtin import builtin_models
 from zrp.output import OutputDir, claim_generated
@@ -44,8 +44,9 @@ def register(sub: argparse._SubParsersAction) -> None:
                    nargs=2, default=None, metavar=("LO", "HI"),
                    help="range of the tracker noise sigma per coordinate, model length unit "
                         "(default 0.01-0.03 mm in the model's unit)")
-    p.add_argument("--poses-from", choices=("random", "circle"), default="random",
-                   help="random reachable poses (default) or the PUMA circle")
+    traj = p.add_argument("--trajectory", choices=("random", "circle"), default="random",
+                          help="random reachable poses (default) or the PUMA circle")
+    deprecated_alias(p, "--poses-from", traj)
     p.add_argument("--approach", choices=("gravity", "random", "order"), default="gravity",
                    help="final approach against gravity for the gravity-loaded joints and "
                         "from a random side for the others (default), from a random side for "
@@ -80,7 +81,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true",
                    help="replace existing output files in --out (checked before the run)")
     p.add_argument("--no-plots", action="store_true", help="skip confusion.png")
-    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    add_progress(p)
     p.add_argument("--json", action="store_true", help="print results.json to stdout")
     p.set_defaults(func=_run)
 
@@ -106,7 +107,7 @@ def _run(args: argparse.Namespace) -> int:
                           none_fraction=args.none, pair_fraction=args.pairs,
                           effects=tuple(args.effects),
                           noise=None if args.noise is None else tuple(args.noise),
-                          poses_from=args.poses_from, approach=args.approach,
+                          poses_from=args.trajectory, approach=args.approach,
                           use_mjcf=not args.no_mjcf, compensate=args.compensate,
                           reflectors=args.reflectors, arm_file=args.mjcf)
     model = load_model(args.model)
@@ -114,7 +115,7 @@ def _run(args: argparse.Namespace) -> int:
     with OutputDir(out, overwrite=overwrite, names=output_names(True), prune=True) as folder:
         # the work folder must be visible to the workers (same path on a remote cluster)
         with executor_from_args(args) as ex:
-            result = run_benchmark(model, cfg, work, progress=not args.no_progress, executor=ex,
+            result = run_benchmark(model, cfg, work, progress=draw_bar(args), executor=ex,
                                    resume=args.resume)
         files = write_outputs(result, folder, plots=not args.no_plots)
     text = render_text(result) + "\n" + "\n".join(f"wrote {f}" for f in files)

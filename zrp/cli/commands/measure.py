@@ -14,7 +14,7 @@ if TYPE_CHECKING:
 
 from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
-from zrp.cli.options import SEED, add_deg, real, whole
+from zrp.cli.options import SEED, add_deg, add_progress, draw_bar, real, whole
 from zrp.errors import InputError
 from zrp.model.builtin import builtin_models
 from zrp.output import check_writable, write_text
@@ -90,7 +90,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true",
                    help="replace --out and --truth if they exist (refused otherwise, before "
                         "anything is simulated)")
-    p.add_argument("--progress", action="store_true", help="show a progress bar")
+    add_progress(p)
     p.add_argument("--json", action="store_true", help="print a JSON summary")
     p.set_defaults(func=_run, writes=("truth",),
                    api_names={"count": "--poses", "specs": "--effect", "rate_hz": "--stream"})
@@ -165,7 +165,7 @@ def _run(args: argparse.Namespace) -> int:
     t0 = time.perf_counter()
     robot = sim.RealRobot(model, effects, _robot_options(args.mjcf, model))
     procedure = sim.Procedure(approach=args.approach, temp_rise=args.temp_rise)
-    run = sim.measure(robot, q, inst, rng, procedure, progress=args.progress,
+    run = sim.measure(robot, q, inst, rng, procedure, progress=draw_bar(args),
                       directions=directions)
     wall = time.perf_counter() - t0
     sim.write_measurements(run, out, deg=args.deg, overwrite=args.force, model=model)

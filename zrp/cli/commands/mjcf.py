@@ -6,6 +6,7 @@ import argparse
 import re
 from pathlib import Path
 
+from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH_UNIT, real
 from zrp.errors import InputError
@@ -47,7 +48,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--from", dest="source", metavar="XML", default=None,
                    help="import: MJCF or URDF file to read (writes a model TOML)")
     p.add_argument("--site", default=None, help="import: end-effector site name")
-    p.add_argument("--body", default=None, help="import: end body name (if no site)")
+    end = p.add_argument("--end-link", default=None, metavar="NAME",
+                         help="import: the chain's end body (MJCF) or link (URDF), if no site")
+    deprecated_alias(p, "--body", end)
     p.add_argument("--unit", type=LENGTH_UNIT, default=None,
                    help="import: length unit of the TOML (default mm; only with --from)")
     p.add_argument("--out", default=None, metavar="FILE",
@@ -56,7 +59,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true",
                    help="replace --out if it exists (refused otherwise, before writing)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.set_defaults(func=_run)
+    p.set_defaults(func=_run, api_names={"body": "--end-link", "end_link": "--end-link",
+                                         "site": "--site"})
 
 
 def _slug(text: str) -> str:
@@ -73,7 +77,7 @@ def _run(args: argparse.Namespace) -> int:
         raise InputError("--unit: only with --from (the length unit of the imported TOML); "
                          "the MJCF written is in metres whatever the model's unit")
     if args.source:
-        model = mjcf.from_mjcf(args.source, site=args.site, body=args.body,
+        model = mjcf.from_mjcf(args.source, site=args.site, body=args.end_link,
                                length_unit=args.unit or "mm")
         out = Path(args.out or f"renders/{_slug(Path(args.source).stem)}.toml")
         save_model(model, out, overwrite=args.force)

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.cli.options import SEED, whole
+from zrp.cli.options import SEED, add_progress, draw_bar, whole
 from zrp.errors import InputError
 from zrp.output import claim_generated
 
@@ -27,7 +27,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="joint moves per scenario (default 10)")
     p.add_argument("--out", metavar="DIR", help=f"output folder (default {DEFAULT_OUT})")
     p.add_argument("--force", action="store_true", help="replace outputs in --out")
-    p.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    add_progress(p)
     p.add_argument("--json", action="store_true", help="print the summary JSON")
     p.set_defaults(func=_run, api_names={"count": "--scenarios", "moves": "--moves"})
 
@@ -44,6 +44,6 @@ def _run(args: argparse.Namespace) -> int:
                                    moves=args.moves,
                                    overwrite=args.force or (args.out is None
                                                             and claim_generated(out)),
-                                   progress=not args.no_progress)
+                                   progress=draw_bar(args))
     emit(args, summary, markdown(summary) + f"wrote {out}/summary.json, {out}/summary.md")
     return 0

@@ -11,8 +11,10 @@ import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
+from zrp.cli.options import add_progress, draw_bar
 from zrp.errors import InputError
 
 if TYPE_CHECKING:
@@ -47,9 +49,11 @@ def register(sub: argparse._SubParsersAction) -> None:
                         "held hand) or recovered (fitted to the published Tables 2-3, hand "
                         "turning; output into renders/recovered/ unless --out). Without "
                         "trajectory options the default circle is used")
-    p.add_argument("--no-figures", action="store_true", help="skip the PNG figures")
+    plots = p.add_argument("--no-plots", action="store_true", help="skip the PNG figures")
+    deprecated_alias(p, "--no-figures", plots)
     p.add_argument("--no-video", action="store_true",
                    help="skip the video of the nominal and perturbed arm")
+    add_progress(p)
     p.set_defaults(func=_paper, api_names={"q0": "--q0", "steps": "--steps",
                                            "circle": "--circle"})
 
@@ -104,7 +108,7 @@ def _video(args: argparse.Namespace, folder: OutputDir, name: str | None,
         with folder.path(name) as tmp:
             sim.render_video(scene.segments, tmp, title=scene.title, overwrite=True,
                              options=sim.VideoOptions(magnify=scene.magnify),
-                             progress=not args.json, progress_name=name)
+                             progress=draw_bar(args), progress_name=name)
     except (sim.GLUnavailableError, sim.GLBackendError) as exc:
         # no OpenGL backend on this machine: the tables and figures are still valid
         return {"status": f"skipped (no offscreen OpenGL: {exc})"}
@@ -127,7 +131,7 @@ def _compute(args: argparse.Namespace, model: Manipulator, out: OutputDir
     ex.timings_s["total_compute"] = sum(v for k, v in ex.timings_s.items()
                                         if k != "total_compute")
     t0 = time.perf_counter()
-    files = write_paper_outputs(ex, out, figures=not args.no_figures)
+    files = write_paper_outputs(ex, out, figures=not args.no_plots)
     return ex, files, time.perf_counter() - t0
 
 
@@ -197,7 +201,7 @@ def _paper(args: argparse.Namespace) -> int:
     check_path_options(args, model)
     _named_circle(args, model)
     video_name = _video_name(args, model)
-    names = [*output_names(figures=not args.no_figures), *([video_name] if video_name else []),
+    names = [*output_names(figures=not args.no_plots), *([video_name] if video_name else []),
              INDEX_NAME]
     with OutputDir(out, overwrite=overwrite, names=names) as folder:
         ex, files, t_write = _compute(args, model, folder)

@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.cli.options import SEED, whole
+from zrp.cli.options import SEED, add_progress, whole
 from zrp.errors import InputError
 from zrp.output import OutputDir, claim_generated
 
@@ -42,6 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", metavar="DIR", help=f"output folder (default {DEFAULT_OUT}, "
                    "generated output that is replaced)")
     p.add_argument("--force", action="store_true", help="replace existing files in --out")
+    add_progress(p, help="print a line per scenario and design on stderr as it is scored "
+                 "(default on; --no-progress: none)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.set_defaults(func=_run)
 
@@ -65,7 +67,7 @@ def _run(args: argparse.Namespace) -> int:
         scores = run_k_study(model, cfg, tuple(args.ks), random_poses=args.random_poses,
                              validation=args.validation, candidates=args.candidates,
                              scenarios=tuple(args.only) if args.only else None,
-                             progress=not args.json, random_ks=tuple(args.random_ks))
+                             progress=args.progress, random_ks=tuple(args.random_ks))
         text = render_k_study(scores, cfg.ratio_target)
         folder.write_text("summary.md", text)
         doc = {"rows": design_rows(scores), "designs": [{**s.row(), "std": s.std}

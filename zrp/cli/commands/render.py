@@ -9,7 +9,17 @@ from typing import TYPE_CHECKING, Any
 
 from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
-from zrp.cli.options import MAX_FPS, MAX_HEIGHT, MAX_SECONDS, MAX_WIDTH, PERCENT, real, whole
+from zrp.cli.options import (
+    MAX_FPS,
+    MAX_HEIGHT,
+    MAX_SECONDS,
+    MAX_WIDTH,
+    PERCENT,
+    add_progress,
+    draw_bar,
+    real,
+    whole,
+)
 from zrp.output import OutputDir, claim_generated
 
 if TYPE_CHECKING:
@@ -58,9 +68,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "the first that works)")
     p.add_argument("--no-dynamics", action="store_true",
                    help="skip the dynamic playback (PD servos under gravity, PUMA 560 inertias)")
-    progress = p.add_argument("--progress", action=argparse.BooleanOptionalAction,
-                              default=True, help="show a progress bar (default on; "
-                              "--no-progress: silent)")
+    progress = add_progress(p)
     deprecated_alias(p, "--out-dir", out)
     deprecated_alias(p, "--quiet", progress, "--no-progress")
     p.add_argument("--json", action="store_true", help="print JSON")
@@ -137,7 +145,7 @@ def _run(args: argparse.Namespace) -> int:
         checks = [sim.consistency_check(m, seg.q) for m in (seg.nominal, seg.perturbed)]
         dyn = None if args.no_dynamics else sim.dynamic_playback(seg.perturbed, seg.t, seg.q)
         results = [sim.render_video(scene.segments, out.root / name, title=scene.title,
-                                    options=o, overwrite=overwrite, progress=args.progress)
+                                    options=o, overwrite=overwrite, progress=draw_bar(args))
                    for (scene, o), name in zip(videos, names, strict=True)]
     emit(args, _payload(results, checks, dyn, seg), _text(results, checks, dyn))
     return 0

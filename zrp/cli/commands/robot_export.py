@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from zrp.model.manipulator import Manipulator
+from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
 from zrp.errors import InputError
 from zrp.model.builtin import builtin_models
@@ -43,16 +44,18 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "zrp import")
     p.add_argument("--base", metavar="LINK",
                    help="with --urdf: the chain's base link, as given to zrp import")
-    p.add_argument("--end", metavar="LINK",
-                   help="with --urdf: the chain's end link, as given to zrp import")
+    end = p.add_argument("--end-link", metavar="LINK",
+                         help="with --urdf: the chain's end link (with --mjcf: its end body), "
+                         "as given to zrp import")
+    deprecated_alias(p, "--end", end)
     p.add_argument("--to", choices=tuple(FORMATS), required=True, help="output format")
     p.add_argument("--out", default=None, metavar="FILE",
                    help="file to write (default renders/<model><suffix>)")
     p.add_argument("--force", action="store_true",
                    help="replace --out if it exists (refused otherwise, before the work)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.set_defaults(func=_run, api_names={"end_link": "--end", "base_link": "--base",
-                                         "site": "--site", "body": "--end"})
+    p.set_defaults(func=_run, api_names={"end_link": "--end-link", "base_link": "--base",
+                                         "site": "--site", "body": "--end-link"})
 
 
 def _text(model: Manipulator, fmt: str) -> str:
@@ -88,14 +91,14 @@ def _calibrated(args: argparse.Namespace, out: Path) -> tuple[Manipulator, Path]
         # mjcf loads MuJoCo: only for this export
         from mjcf.patch import export_mjcf
 
-        export_mjcf(cal, args.mjcf, out, side, site=args.site, body=args.end,
+        export_mjcf(cal, args.mjcf, out, side, site=args.site, body=args.end_link,
                     overwrite=args.force)
         return cal.model, side
     if args.urdf is not None:
         if args.to != "urdf":
             raise InputError("--urdf: patches a URDF; use it with --to urdf")
         export_urdf(cal, args.urdf, out, side, base_link=args.base,
-                    end_link=args.end, overwrite=args.force)
+                    end_link=args.end_link, overwrite=args.force)
         return cal.model, side
     write_text(out, _text(cal.model, args.to), overwrite=args.force)
     write_text(side, dumps(side_document(cal, out.name, "", None, None)),
@@ -128,7 +131,7 @@ def _refuse_calibrated_model(model: str) -> None:
 def _run(args: argparse.Namespace) -> int:
     from zrp.model.files import load_model  # on use: keeps --help quick
 
-    if args.calibration is None and (args.urdf or args.mjcf or args.base or args.end
+    if args.calibration is None and (args.urdf or args.mjcf or args.base or args.end_link
                                      or args.site):
         raise InputError("--urdf, --mjcf: patch the robot's file with a calibration; give "
                          "--calibration C.json")

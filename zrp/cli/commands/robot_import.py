@@ -7,6 +7,7 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from zrp.cli.aliases import deprecated_alias
 from zrp.cli.app import emit
 from zrp.cli.options import LENGTH_UNIT
 from zrp.errors import InputError, ModelFileError
@@ -25,9 +26,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "MJCF (compiled by MuJoCo), or a DH/MDH table TOML (see zrp/model/README.md). Joint "
         "names and limits are kept. Writes a model TOML file.")
     p.add_argument("source", metavar="FILE", help=".urdf, MJCF .xml, or a DH table .toml")
-    p.add_argument("--end", default=None, metavar="NAME",
+    end = p.add_argument("--end-link", default=None, metavar="NAME",
                    help="end-effector link (URDF) or body (MJCF); default: the end of the only "
                         "chain (a branching tree is an error listing the branch ends)")
+    deprecated_alias(p, "--end", end)
     p.add_argument("--site", default=None, help="MJCF: end-effector site")
     p.add_argument("--base", default=None, metavar="LINK",
                    help="URDF: base link (default the root; e.g. the arm's base on a mobile "
@@ -40,8 +42,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true",
                    help="replace --out if it exists (refused otherwise, before reading)")
     p.add_argument("--json", action="store_true", help="print JSON")
-    p.set_defaults(func=_run, api_names={"end_link": "--end", "base_link": "--base",
-                                         "site": "--site", "body": "--end"})
+    p.set_defaults(func=_run, api_names={"end_link": "--end-link", "base_link": "--base",
+                                         "site": "--site", "body": "--end-link"})
 
 
 def _slug(text: str) -> str:
@@ -68,8 +70,8 @@ def _read(args: argparse.Namespace) -> tuple[Manipulator, dict[str, object]]:
     kind = _kind(text)
     if kind == "urdf":
         if args.site:
-            raise InputError("--site: a URDF has no sites; name the end link with --end")
-        imp = import_urdf(src, end_link=args.end, base_link=args.base, length_unit=args.unit,
+            raise InputError("--site: a URDF has no sites; name the end link with --end-link")
+        imp = import_urdf(src, end_link=args.end_link, base_link=args.base, length_unit=args.unit,
                           name=args.name)
         return imp.model, {"format": "urdf", "base_link": imp.base_link,
                            "end_link": imp.end_link, "notes": list(imp.notes)}
@@ -83,7 +85,7 @@ def _read(args: argparse.Namespace) -> tuple[Manipulator, dict[str, object]]:
     # mjcf loads MuJoCo: only for an MJCF source
     import mjcf
 
-    model = mjcf.from_mjcf(src, site=args.site, body=args.end, length_unit=args.unit,
+    model = mjcf.from_mjcf(src, site=args.site, body=args.end_link, length_unit=args.unit,
                            name=args.name)
     return model, {"format": "mjcf"}
 

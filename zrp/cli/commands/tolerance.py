@@ -15,7 +15,7 @@ if TYPE_CHECKING:
 from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.commands.study import add_path_options, check_path_options, path_from_args
-from zrp.cli.options import LENGTH, SEED, TOLERANCE, real, whole
+from zrp.cli.options import LENGTH, SEED, TOLERANCE, add_progress, draw_bar, real, whole
 from zrp.errors import InputError
 
 if TYPE_CHECKING:
@@ -86,7 +86,7 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="write a histogram PNG (checked before the Monte Carlo runs)")
     m.add_argument("--top", type=whole(1, 100_000),
                    default=10, help="rows of the contribution table (10)")
-    m.add_argument("--no-progress", action="store_true", help="hide the progress bar")
+    add_progress(m)
     a = p.add_argument_group("allocation")
     a.add_argument("--allocate", action="store_true",
                    help="find per-parameter tolerances meeting --max-dp/--max-angle at "
@@ -174,7 +174,7 @@ def _allocate(args: argparse.Namespace, model: Manipulator, path: JointPath,
                              max_angle_rad=args.max_angle, percentile=args.percentile,
                              distribution=args.distribution, angle_scale_mm=args.angle_scale,
                              fixed=_parse_tol(args.fixed), n_search=args.n_search,
-                             n_verify=args.robots, progress=not args.no_progress,
+                             n_verify=args.robots, progress=draw_bar(args),
                              executor=ex)
     s = al.summary()
     s["trajectory"] = path.label
@@ -236,7 +236,7 @@ def _analyse(args: argparse.Namespace, model: Manipulator, path: JointPath,
                            joint_offsets=offsets)
     reduced = args.reduce or args.checkpoint is not None or args.robots > GATHER_LIMIT
     common = dict(seed=args.seed, distribution=args.distribution,
-                  progress=not args.no_progress, first_order=True, executor=ex)
+                  progress=draw_bar(args), first_order=True, executor=ex)
     mc: MonteCarloResult | MonteCarloSummary = (
         monte_carlo_summary(model, path.q, tol, args.robots, checkpoint=args.checkpoint,
                             resume=args.resume, overwrite=args.force, **common)

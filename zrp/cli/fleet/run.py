@@ -7,14 +7,13 @@ import argparse
 import glob
 import json
 import os
-import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from zrp.cli.app import emit
 from zrp.cli.cluster import add_cluster_options, check_cluster_options, executor_from_args
 from zrp.cli.fleet.summary import fleet_csv, fleet_figure, fleet_markdown, fleet_summary
-from zrp.cli.options import LENGTH
+from zrp.cli.options import LENGTH, draw_bar
 from zrp.errors import InputError
 from zrp.output import OutputDir, check_no_links, check_writable, safe_name
 from zrp.tasks import TaskFailure, map_tasks
@@ -124,9 +123,8 @@ def _diagnose_all(args: argparse.Namespace, todo: list[RobotTask]
 
     rows: list[dict[str, Any]] = []
     failures: list[TaskFailure] = []
-    show = sys.stderr.isatty() if args.progress is None else args.progress
     with executor_from_args(args) as ex, \
-            tqdm(total=len(todo), desc="fleet", unit="robot", disable=not show) as bar:
+            tqdm(total=len(todo), desc="fleet", unit="robot", disable=not draw_bar(args)) as bar:
         for _, res in map_tasks(diagnose_robot, todo, ex, capture=True, describe=str):
             if isinstance(res, TaskFailure):
                 failures.append(res)
