@@ -30,3 +30,14 @@ def test_no_fit_stopped_early_and_final_beats_the_geometric_calibration(irb120_r
     assert d.assessment.baseline.fit.converged
     assert not any("least squares" in str(w.message) for w in irb120_real.warnings)
     assert d.final.rms <= d.assessment.baseline.model_withheld.rms
+
+
+def test_a_combined_final_model_is_a_finding_not_a_warning(irb120_real):
+    """The final model is the geometric calibration plus the search's non-geometric effects;
+    that choice is said in the report, not as a 100-word warning ahead of the headline (a
+    warning is kept for a search that went wrong: the geometric calibration alone wins)."""
+    d = irb120_real.diagnosis
+    assert d.assessment.choice.source == "geometric_plus_non_geometric"
+    assert "Neither the search's model" in d.assessment.choice.note("mm")
+    assert not any("Neither the search's model" in str(w.message)
+                   for w in irb120_real.warnings)

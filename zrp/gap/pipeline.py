@@ -300,7 +300,7 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
     baseline = geometric_baseline(ctx, reg, found.final_fit, prep.fitting, prep.withheld,
                                   prep.folds, regd.rb0)
     final_fit, after, choice = choose_final(ctx, found.final_fit, baseline, prep.withheld)
-    if choice.source != "search":
+    if choice.fell_back:  # the search went wrong; a combination is a finding, in the report
         warnings.warn(choice.note(model.length_unit), GapWarning, stacklevel=2)
     final = Metrics.of(after)
     unexplained = (None if floor.rms is None
