@@ -312,9 +312,8 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
     assessment = _assess(ctx, baseline, choice, final_fit, len(reg.specs),
                          where.after_final_model or where_nominal, resolution)
     if opts.residual_model:
-        st = assessment.remainder.structure
         assessment = dataclasses.replace(assessment, residual_model=fit_residual_model(
-            ctx, final_fit, prep.withheld, after, structured=st is not None and st.structured))
+            ctx, final_fit, prep.withheld, after, structure=assessment.remainder.structure))
     return Diagnosis(model.name, model.length_unit, Metrics.of(regd.withheld_residual),
                      regd.fitting, parameter_estimates(regd.fit, 0), found.steps, final, floor,
                      unexplained, _split_ids(meas, prep, opts), where, found.aliased, (),

@@ -51,6 +51,7 @@ from zrp.gap.analysis.kernel import (
     pose_inputs,
     pose_targets,
 )
+from zrp.gap.analysis.structure import Structure
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.model.context import Context
@@ -139,11 +140,12 @@ def _hybrid_residual(ctx: Context, withheld: NDArray[np.int64], r_after: F64,
 
 
 def fit_residual_model(ctx: Context, final: FitResult, withheld: NDArray[np.int64],
-                       r_after: F64, *, structured: bool) -> ResidualModel | None:
+                       r_after: F64, *, structure: Structure | None) -> ResidualModel | None:
     """Train the learned term on ``final``'s residual over its fitting poses and test it on
-    the ``withheld`` poses (whose final residual is ``r_after``, 3Rw); ``structured``: the
-    test of what remains found structure (else the term is not kept, whatever it gains).
-    None with too few complete poses or no input that varies."""
+    the ``withheld`` poses (whose final residual is ``r_after``, 3Rw); ``structure``: the test
+    of what remains on the same fitting poses (without structure, or None, the term is not
+    kept, whatever it gains). None with too few complete poses or no input that varies."""
+    structured = structure is not None and structure.structured
     Y, first = pose_targets(ctx, final.poses, final.residual)
     rng = np.random.default_rng(SEED)
     if Y.shape[0] > MAX_POSES:
