@@ -53,8 +53,8 @@ def test_unmodelled_sag_is_found_with_its_joints():
     truth = _true_share(d)
     assert s is not None and s.structured
     # the out-of-fold share is what a smooth model predicts on unseen poses: it never
-    # overstates the truth, and here finds most of it (found 0.43, 95 % 0.39-0.46, for a true
-    # 0.50: the estimation error of 300 poses in 12 inputs, documented in structure.py)
+    # overstates the truth, and here finds most of it (found 0.51, 95 % 0.47-0.54, for a true
+    # 0.55: the estimation error of 300 poses in 12 inputs, documented in structure.py)
     assert s.interval[0] <= truth, (truth, s.share, s.interval)
     assert s.share >= 0.6 * truth, (truth, s.share, s.interval)
     assert {"q2", "q3"} <= set(s.named)

@@ -3,12 +3,11 @@ truth never reaches the diagnosis (the proof of tests/sim/test_benchmark.py: the
 the files opened while diagnosing, and the same answer without the truth files), and on the
 simulated robot the diagnosis says what remains: structure and the effect's joints for gear
 errors at harmonics the library lacks, and a learned term that is kept and recovers most of
-the structure; "no structure" and no term for the effect-free and scatter-only scenarios.
-
-The benchmark's own criterion for the learned term, a withheld RMS within 1.2x the noise, is
-NOT asserted here: on these gear errors it ended 1.22x and 1.25x with 800 poses, 1.18x and
-1.22x with 1600 (renders/benchmarks/bench_gap_remainder.md, tests/benchmarks/
-bench_gap_remainder.py); on the synthetic sag of tests/gap/test_residual_model.py it is met."""
+the structure, its withheld RMS within 1.2x the noise (the benchmark's criterion: measured
+1.15x and 1.16x with 800 poses, as with 1600; 1.22x and 1.25x before the per-component ridge of
+zrp/gap/analysis/kernel.py, renders/benchmarks/bench_gap_remainder.md from
+tests/benchmarks/bench_gap_remainder.py); "no structure" and no term for the effect-free and
+scatter-only scenarios."""
 
 from __future__ import annotations
 
@@ -97,6 +96,4 @@ def test_remainder_scenarios_on_the_simulated_robot(puma, tmp_path):
                 (x.name, x.joints) for x in rb.REMAINDER_SCENARIOS)[s.name]}
             assert s.structured and joints <= set(s.named) and s.kept, s
             assert s.recovered >= 0.75, s  # most of what the physics leaves
-            assert s.withheld_hybrid < 1.3 * s.noise_rms, s  # measured 1.22x and 1.25x
-        else:
-            assert s.passed, (s.name, s.why)
+        assert s.passed, (s.name, s.why)  # lacking: within 1.2x the noise (1.15x, 1.16x)

@@ -61,10 +61,11 @@ class CalibrationOptions:
         instrument: the measuring instrument (recorded in the conditions).
         progress: show the diagnosis's progress on stderr.
         residual_model: also train the learned residual term on the joint angles
-            (``zrp diagnose --residual-model``); when the diagnosis keeps it (it lowers the
-            withheld error clearly) the calibrated robot carries it (``learned``,
-            :mod:`zrp.calibration.learned`), unless the calibration is a full-pose refit
-            (the term was trained on the position-only final model's residual).
+            (``zrp diagnose --residual-model``); when the diagnosis keeps it (what remains has
+            structure and it lowers the withheld error clearly) the calibrated robot carries
+            it (``learned``, :mod:`zrp.calibration.learned`), unless the calibration is a
+            full-pose refit (the term was trained on the position-only final model's
+            residual).
     """
 
     gravity_torque: ArrayLike | None = None

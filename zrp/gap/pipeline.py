@@ -115,7 +115,8 @@ def diagnose(model: Manipulator, measurements: Measurements, *,
             ``axis_misalignment``, :mod:`zrp.gap.model.domains`): widen it for a part known
             to be tilted.
         residual_model: also train a learned residual term after the final model, kept only
-            when it lowers the withheld error clearly (:mod:`zrp.gap.analysis.residual`);
+            when what remains has structure and the term lowers the withheld error clearly
+            (:mod:`zrp.gap.analysis.residual`);
             the final model stays the physical one.
 
     Returns:
@@ -312,7 +313,7 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
                          where.after_final_model or where_nominal, resolution)
     if opts.residual_model:
         assessment = dataclasses.replace(assessment, residual_model=fit_residual_model(
-            ctx, final_fit, prep.withheld, after))
+            ctx, final_fit, prep.withheld, after, structure=assessment.remainder.structure))
     return Diagnosis(model.name, model.length_unit, Metrics.of(regd.withheld_residual),
                      regd.fitting, parameter_estimates(regd.fit, 0), found.steps, final, floor,
                      unexplained, _split_ids(meas, prep, opts), where, found.aliased, (),

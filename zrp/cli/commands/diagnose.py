@@ -57,7 +57,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    help="ignore measured orientations (qw..qz): no full-pose refit")
     p.add_argument("--residual-model", action="store_true",
                    help="also train a learned residual term on the joint angles after the "
-                        "final model; kept only when it lowers the withheld error clearly "
+                        "final model; kept only when what remains has structure and it "
+                        "lowers the withheld error clearly "
                         "(its withheld RMS beside the physical model's)")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     add_progress(p, help="show progress on stderr: a bar on a terminal, a line every 10 s "

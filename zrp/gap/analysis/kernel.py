@@ -9,9 +9,14 @@ final model (:mod:`.structure`, :mod:`.residual`).
 * **model** (:func:`fit_kernel_ridge`) - a Gaussian (RBF) kernel on the inputs scaled by
   per-input length scales (ARD) that a scikit-learn Gaussian process sets on at most
   :data:`ARD_POSES` poses (its leading :data:`ARD_COMPONENTS` principal components of the
-  targets: its cost grows with their number); then the kernel width and the ridge of least
-  exact leave-one-out error (eigendecomposition of the kernel matrix: every ridge value costs
-  O(n^2)).
+  targets: its cost grows with their number); then the kernel width and, **per principal
+  component of the targets**, the ridge of least exact leave-one-out error (eigendecomposition
+  of the kernel matrix: every ridge value costs O(n^2)). One ridge per component, not one for
+  all targets: an effect moves a pose's points together, so it lies in a few components of
+  the 3M targets and the rest is noise; a single ridge, chosen on all of them, smooths the
+  effect too much to keep the noise components from being fitted (on the two simulated gear
+  errors of the remainder benchmark, 800 poses, the withheld RMS with the learned term fell
+  from 1.22 and 1.25 to 1.15 and 1.16 times the noise's).
 
 scikit-learn is imported inside the functions, so that ``import zrp`` stays fast.
 """
@@ -38,9 +43,10 @@ ARD_POSES = 200
 ARD_COMPONENTS = 3
 #: kernel widths tried on the inputs scaled by their length scales: RBF
 #: exp(-gamma |x - x'|^2) (0.5: the Gaussian process's own).
-GAMMAS = (0.125, 0.5, 2.0)
-#: ridge values tried, relative to the mean eigenvalue of the kernel matrix.
-RIDGES = tuple(10.0 ** np.arange(-5.0, 1.5, 0.5))
+GAMMAS = (0.125, 0.25, 0.5, 1.0, 2.0)
+#: ridge values tried, relative to the mean eigenvalue of the kernel matrix (the largest
+#: ones shrink a component that is noise to nearly nothing).
+RIDGES = tuple(10.0 ** np.arange(-5.0, 3.5, 0.5))
 
 
 @dataclass(frozen=True)
@@ -189,25 +195,36 @@ class KernelModel:
 
 
 def fit_kernel_ridge(X: F64, Y: F64, scale: F64) -> KernelModel:
-    """Kernel ridge on the inputs multiplied by ``scale`` (1 / length scales), with the width
-    and ridge of least exact leave-one-out error."""
+    """Kernel ridge on the inputs multiplied by ``scale`` (1 / length scales): the width of
+    least exact leave-one-out error, with each principal component of the centred targets
+    given its own ridge of least leave-one-out error (module docstring)."""
     Xs = X * scale
     mean = Y.mean(0)
     Yc = Y - mean
-    best: tuple[float, float, float, F64, F64] | None = None
+    _, _, Vt = np.linalg.svd(Yc, full_matrices=False)
+    Z = Yc @ Vt.T  # the targets' principal components
+    best: tuple[float, float, F64, F64, F64] | None = None
     for gamma in GAMMAS:
         w, V = np.linalg.eigh(_kernel(Xs, Xs, gamma))
         w = np.clip(w, 0.0, None)
-        VtY = V.T @ Yc
-        V2 = V**2
-        for lam in RIDGES:
-            lam_abs = lam * max(float(w.mean()), 1e-12)
-            h = w / (w + lam_abs)
-            loo = (Yc - V @ (h[:, None] * VtY)) / (1.0 - V2 @ h)[:, None]
-            sse = float(np.sum(loo**2))
-            if best is None or sse < best[0]:
-                best = (sse, gamma, lam_abs, w, V)
+        lam = np.asarray(RIDGES) * max(float(w.mean()), 1e-12)
+        sse = _loo_sse(w, V, Z, lam)  # (ridges, components)
+        if best is None or float(sse.min(0).sum()) < best[0]:
+            best = (float(sse.min(0).sum()), gamma, w, V, lam[sse.argmin(0)])
     assert best is not None
-    _, gamma, lam_abs, w, V = best
-    coef = V @ ((1.0 / (w + lam_abs))[:, None] * (V.T @ Yc))
-    return KernelModel(Xs, coef, mean, gamma, scale)
+    _, gamma, w, V, lam_of = best
+    coef = V @ ((V.T @ Z) / (w[:, None] + lam_of[None, :]))
+    return KernelModel(Xs, coef @ Vt, mean, gamma, scale)
+
+
+def _loo_sse(w: F64, V: F64, Z: F64, lam: F64) -> F64:
+    """Exact leave-one-out squared error per ridge (rows) and target column, for the kernel
+    matrix V diag(w) V^T."""
+    VtZ = V.T @ Z
+    V2 = V**2
+    out = np.empty((lam.size, Z.shape[1]))
+    for i, lam_abs in enumerate(lam):
+        h = w / (w + lam_abs)
+        loo = (Z - V @ (h[:, None] * VtZ)) / (1.0 - V2 @ h)[:, None]
+        out[i] = np.sum(loo**2, axis=0)
+    return out

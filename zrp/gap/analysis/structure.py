@@ -14,9 +14,9 @@ kernel (scikit-learn's kernel; one target vector per pose, all its points' x, y,
   process (scikit-learn) sets once on a subsample of the poses (:mod:`.kernel`; a few
   hyperparameters against hundreds of poses: a negligible optimism). It is the share a smooth
   function of the inputs predicts on unseen poses: a lower bound of the structured share, below
-  it by the regression's estimation error (on the simulated sag of the tests, 0.43 found for a
-  true 0.50 with 300 poses, 95 % 0.39-0.46). Its 95 % interval: a bootstrap over poses of the
-  out-of-fold errors.
+  it by the regression's estimation error (on the simulated sag of the tests, 0.51 found for a
+  true 0.55 with 300 poses, 95 % 0.47-0.54; 0.49 with one ridge for all targets). Its 95 %
+  interval: a bootstrap over poses of the out-of-fold errors.
 * **structure** - the share is clearly above zero (S2): the interval's lower end above 0 and
   the share at least :data:`MIN_SHARE` (below it a model of it would lower the RMS by < 2.5 %).
 * **frame** - each pose's residual is taken in the arm's frame, the data's frame turned with
