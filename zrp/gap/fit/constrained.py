@@ -30,7 +30,8 @@ from zrp.gap.fit.sumzero import fit_sum_zero, summed_groups
 from zrp.gap.model.context import REGISTRATION, Context, ParamSpec
 from zrp.gap.model.domains import DOMAINS, domain_violations
 
-__all__ = ["HELD_AT_SUM_0", "held_reason", "n_registration", "outside_domains", "within_domains"]
+__all__ = ["HELD_AT_SUM_0", "held_reason", "n_registration", "outside_domains", "sorted_out",
+           "within_domains"]
 
 #: the words that name a joint's lumped weights held at sum 0 in a reason.
 HELD_AT_SUM_0 = "lumped weights held at sum 0"
@@ -70,19 +71,28 @@ def within_domains(ctx: Context, result: FitResult, first: int, fitting: NDArray
         bad = outside_domains(ctx, result, first)
         if not bad:
             return result, tuple(dict.fromkeys(reasons))
-        sums = summed_groups(result.specs, first)
-        in_sum = {i: j for j, idx in sums.items() for i in idx}
-        to_hold = {in_sum[i] for i, _ in bad if i in in_sum and len(sums[in_sum[i]]) > 1}
-        out = {i for i, _ in bad if in_sum.get(i) not in to_hold}
-        reasons += [why for i, why in bad if i in out]
-        reasons += [held_reason(result.specs, result.theta, j, sums[j])
-                    for j in sorted(to_hold)]
+        out, to_hold, why = sorted_out(result.specs, result.theta, bad, first)
+        reasons += why
         held |= to_hold
         keep: Sequence[int] = [i for i in range(len(result.specs)) if i not in out]
         specs = [result.specs[i] for i in keep]
         theta0 = result.theta[list(keep)]
         result = (fit_sum_zero(ctx, specs, held, fitting, theta0, rb0) if held
                   else fit(ctx, specs, fitting, theta0, rb0))
+
+
+def sorted_out(specs: Sequence[ParamSpec], theta: F64, bad: Sequence[tuple[int, str]],
+               first: int) -> tuple[set[int], set[str], list[str]]:
+    """The violations ``bad`` ((index, reason), indices into ``specs``) sorted: the indices
+    to take out, the joints whose lumped weights to hold at sum 0 (those with two or more
+    weights; a single weight is taken out), and the reasons in words."""
+    sums = summed_groups(specs, first)
+    in_sum = {i: j for j, idx in sums.items() for i in idx}
+    to_hold = {in_sum[i] for i, _ in bad if i in in_sum and len(sums[in_sum[i]]) > 1}
+    out = {i for i, _ in bad if in_sum.get(i) not in to_hold}
+    reasons = [why for i, why in bad if i in out]
+    reasons += [held_reason(specs, theta, j, sums[j]) for j in sorted(to_hold)]
+    return out, to_hold, reasons
 
 
 def held_reason(specs: Sequence[ParamSpec], theta: F64, joint: str, idx: Sequence[int]) -> str:

@@ -36,7 +36,7 @@ from scipy.spatial.transform import Rotation
 
 from zrp.arrays import F64
 from zrp.errors import InputError
-from zrp.gap.fit.constrained import held_reason, n_registration
+from zrp.gap.fit.constrained import n_registration, sorted_out
 from zrp.gap.fit.heldname import tilt_reading
 from zrp.gap.fit.leastsq import FitResult, FitWarning, fit, initial_registration
 from zrp.gap.fit.orientation import (
@@ -45,7 +45,7 @@ from zrp.gap.fit.orientation import (
     probe_start,
     stacked,
 )
-from zrp.gap.fit.sumzero import SumZero, expanded, mapped_cov, summed_groups
+from zrp.gap.fit.sumzero import SumZero, expanded, mapped_cov
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, OrientationWeights, ParamSpec
 from zrp.gap.model.domains import domain_violations
@@ -131,13 +131,9 @@ def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
                                 max_tilt_rad=ctx.max_tilt_rad)
         if not bad:
             return dataclasses.replace(fp, outside_domain=tuple(dict.fromkeys(reasons)))
-        sums = summed_groups(fp.specs, first)
-        in_sum = {i: j for j, idx in sums.items() for i in idx}
-        to_hold = {in_sum[first + i] for i, _ in bad
-                   if first + i in in_sum and len(sums[in_sum[first + i]]) > 1}
-        out = {first + i for i, _ in bad if in_sum.get(first + i) not in to_hold}
-        reasons += [why for i, why in bad if first + i in out]
-        reasons += [held_reason(fp.specs, fp.theta, j, sums[j]) for j in sorted(to_hold)]
+        out, to_hold, why = sorted_out(fp.specs, fp.theta, [(first + i, w) for i, w in bad],
+                                       first)
+        reasons += why
         held |= to_hold
         specs = [x for i, x in enumerate(fp.specs) if i not in out]
 
