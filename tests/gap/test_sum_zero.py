@@ -11,10 +11,12 @@ import math
 import warnings
 
 import numpy as np
+import pytest
 
 import zrp
 from zrp.gap.data.synthetic import Injection, synthesize
 from zrp.gap.fit.constrained import outside_domains, within_domains
+from zrp.gap.fit.fullpose import fit_full_pose
 from zrp.gap.fit.leastsq import fit, initial_registration
 from zrp.gap.model.context import Context
 from zrp.gap.model.domains import SUM_RTOL, sum_inside
@@ -71,3 +73,23 @@ def test_weights_held_at_sum_zero_fit_better_than_taken_out():
     assert held.n_free == len(held.specs) - 1 and held.dof == held.n_res - held.n_free
     assert a @ held.cov @ a <= 1e-9 * np.max(np.diag(held.cov)[w])
     assert np.all(np.diag(held.cov)[w] > 0)
+
+
+def test_full_pose_fit_holds_the_sum_too():
+    """The full-pose fit's own domain loop (here its position-only variant) holds the weights
+    at sum 0 as the position fits do: the same values, the eliminated weight's standard error
+    from the others' covariance."""
+    ctx, poses, reg, specs, free, _, rb0 = _setup()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        held, _ = within_domains(ctx, free, len(reg), poses, rb0)
+        fp = fit_full_pose(ctx, reg + specs, poses, orientation=False)
+    w = slice(len(reg), None)
+    assert [s.name for s in fp.specs] == [s.name for s in held.specs]
+    assert sum_inside(fp.theta[w]) and abs(math.fsum(fp.theta[w])) <= SUM_RTOL * math.fsum(
+        np.abs(fp.theta[w]))
+    np.testing.assert_allclose(fp.theta[w], held.theta[w], rtol=1e-6)
+    assert any("q2 lumped weights held at sum 0" in r for r in fp.outside_domain)
+    others = fp.cov[w, w][:-1, :-1]
+    assert fp.stderr[-1] == pytest.approx(math.sqrt(others.sum()), rel=1e-9)
+    assert fp.position.tied is not None and fp.position.n_free == len(fp.specs) - 1

@@ -42,8 +42,9 @@ the arm's real masses are represented by weights that sum to the mass they stand
 weight alone may be negative: a centre of mass behind a joint or a counterweight lumped on the
 points ahead of it. What physics fixes is their sum per joint, c_k times the mass joint k
 carries (domain ``lumped_compliance``: >= 0, a joint deflects with its load in total); a
-negative sum leaves the domain as a negative ``q{k}.compliance`` does (every weight of that
-joint taken out by the search, refused by the writers). ``q{k}.w_load`` is a known mass (per
+negative sum leaves the domain as a negative ``q{k}.compliance`` does (the fits then hold
+that joint's weights at sum 0, the domain's bound, :mod:`zrp.gap.fit.sumzero`; the writers
+refuse a negative sum, allowing :data:`SUM_RTOL` for the rounding of a sum held at 0). ``q{k}.w_load`` is a known mass (per
 kg of payload at the tool) and has the ``compliance`` domain itself (>= 0).
 
 The tolerances scale the parameters of the well-posed identification
