@@ -15,7 +15,12 @@ import numpy as np
 import pytest
 
 import zrp
-from zrp.calibration import CalibrationOptions, calibrate, write_calibration
+from zrp.calibration import (
+    CalibrationOptions,
+    calibrate,
+    read_calibration,
+    write_calibration,
+)
 from zrp.calibration.jointmap import Term
 from zrp.gap import Injection, synthesize
 from zrp.gap.fit.leastsq import fit
@@ -50,6 +55,8 @@ def test_negative_lumped_compliance_never_written(tmp_path):
     assert sum_inside(comp) and abs(math.fsum(comp)) <= SUM_RTOL * math.fsum(map(abs, comp))
     assert max(map(abs, comp)) > 1e-7  # not all taken out (nominal 0)
     assert any("q2 lumped weights held at sum 0" in n for n in doc["taken_out_non_physical"])
+    back = read_calibration(tmp_path / "compensation.json")  # validated again on reading
+    assert [t.value for t in back.terms if t.name.startswith("q2.w_")] == comp
     assert "TAKEN OUT as non-physical" in (tmp_path / "calibrated.toml").read_text()
     bad = dataclasses.replace(result.robot, terms=(
         Term("q2.w_ee", "joint_compliance", 2, "rad/mm", -1.5e-6),))

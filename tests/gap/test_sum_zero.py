@@ -17,7 +17,8 @@ import zrp
 from zrp.gap.data.synthetic import Injection, synthesize
 from zrp.gap.fit.constrained import outside_domains, within_domains
 from zrp.gap.fit.fullpose import fit_full_pose
-from zrp.gap.fit.leastsq import fit, initial_registration
+from zrp.gap.fit.leastsq import fit, initial_registration, wald_groups
+from zrp.gap.fit.wellposed import rank_chi2
 from zrp.gap.model.context import Context
 from zrp.gap.model.domains import SUM_RTOL, sum_inside
 from zrp.gap.model.effects import effect_parameters, registration_parameters
@@ -73,6 +74,9 @@ def test_weights_held_at_sum_zero_fit_better_than_taken_out():
     assert held.n_free == len(held.specs) - 1 and held.dof == held.n_res - held.n_free
     assert a @ held.cov @ a <= 1e-9 * np.max(np.diag(held.cov)[w])
     assert np.all(np.diag(held.cov)[w] > 0)
+    # the Wald test of the joint's weights on that singular covariance: its rank, 2 of 3
+    assert rank_chi2(held.theta[w], held.cov[w, w], held.cov[w, w])[1] == len(specs) - 1
+    assert wald_groups(held, len(reg))["joint_compliance:q2"] < 1e-12
 
 
 def test_full_pose_fit_holds_the_sum_too():

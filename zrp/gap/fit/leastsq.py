@@ -354,7 +354,7 @@ def wald_groups(result: FitResult, first: int,
         if not np.all(np.isfinite(C)):
             out[g] = 1.0
             continue
-        if result.tied is not None:  # constrained: C is singular along the constraints
+        if result.tied is not None and np.any(result.tied[idx] < 0):  # singular: constrained
             chi2, df = rank_chi2(th, C, C)
             out[g] = float(special.chdtrc(df, chi2)) if df else 1.0
             continue
