@@ -44,8 +44,9 @@ points ahead of it. What physics fixes is their sum per joint, c_k times the mas
 carries (domain ``lumped_compliance``: >= 0, a joint deflects with its load in total); a
 negative sum leaves the domain as a negative ``q{k}.compliance`` does (the fits then hold
 that joint's weights at sum 0, the domain's bound, :mod:`zrp.gap.fit.sumzero`; the writers
-refuse a negative sum, allowing :data:`SUM_RTOL` for the rounding of a sum held at 0). ``q{k}.w_load`` is a known mass (per
-kg of payload at the tool) and has the ``compliance`` domain itself (>= 0).
+refuse a negative sum, allowing :data:`SUM_RTOL` for the rounding of a sum held at 0).
+``q{k}.w_load`` is a known mass (per kg of payload at the tool) and has the ``compliance``
+domain itself (>= 0).
 
 The tolerances scale the parameters of the well-posed identification
 (:mod:`zrp.gap.fit.wellposed`): one unit of scaled parameter is one typical manufacturing or
