@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import zrp
+from zrp.gap import diagnose
 from zrp.gap.data.synthetic import Injection, synthesize
 from zrp.gap.fit.constrained import outside_domains, within_domains
 from zrp.gap.fit.fullpose import fit_full_pose
@@ -22,6 +23,7 @@ from zrp.gap.fit.wellposed import rank_chi2
 from zrp.gap.model.context import Context
 from zrp.gap.model.domains import SUM_RTOL, sum_inside
 from zrp.gap.model.effects import effect_parameters, registration_parameters
+from zrp.gap.report.verdict import identification_text
 from zrp.kinematics import uniform_joint_values
 
 PUMA = zrp.load_model("puma")
@@ -97,3 +99,21 @@ def test_full_pose_fit_holds_the_sum_too():
     others = fp.cov[w, w][:-1, :-1]
     assert fp.stderr[-1] == pytest.approx(math.sqrt(others.sum()), rel=1e-9)
     assert fp.position.tied is not None and fp.position.n_free == len(fp.specs) - 1
+
+
+def test_the_diagnosis_says_the_weights_are_held_not_taken_out():
+    """The search holds them (not "taken out") and says so in the verdict and in the record a
+    calibration takes (``taken_out_non_physical``)."""
+    rng = np.random.default_rng(7)
+    meas = synthesize(PUMA, uniform_joint_values(PUMA, 150, rng),
+                      Injection(compliance={2: -4e-5}, masses={"ee": 5.0}), rng=rng,
+                      noise_sigma=0.01)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        d = diagnose(PUMA, meas, seed=0, effects=("joint_compliance",))
+    w = [p for p in d.final_fit.specs if p.name.startswith("q2.w_")]
+    assert len(w) >= 2  # kept, held at sum 0
+    assert sum_inside([d.final_fit.value(p.name) for p in w])
+    said = [t for t in identification_text(d) if "q2 lumped weights held at sum 0" in t]
+    assert said and all("taken out (" not in t for t in said)
+    assert any("q2 lumped weights held at sum 0" in t for t in d.calibration_record.taken_out)

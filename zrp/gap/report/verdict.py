@@ -191,8 +191,7 @@ def _domain_notes(diag: Diagnosis) -> list[str]:
                          f"outside its physical domain ({why}); the residual has a shape "
                          "that effect cannot produce physically.")
         elif HELD_AT_SUM_0 in note and "taken out, outside" not in note:
-            parts.append(f"{effect}: lumped compliance weights whose sum left its physical "
-                         f"domain were held at its bound, sum 0 ({why}).")
+            parts.append(f"{effect}: {why}.")
         else:
             parts.append(f"{effect}: parameters whose fitted values left their physical "
                          f"domain were taken out ({why}).")
