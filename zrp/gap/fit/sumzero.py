@@ -36,7 +36,7 @@ from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.domains import SUMMED, domain_key
 from zrp.gap.model.problem import Problem
 
-__all__ = ["SumZero", "expanded", "fit_sum_zero", "mapped_cov", "summed_groups"]
+__all__ = ["SumZero", "expanded", "fit_sum_zero", "held_joints", "mapped_cov", "summed_groups"]
 
 
 def summed_groups(specs: Sequence[ParamSpec], first: int = 0) -> dict[str, list[int]]:
@@ -94,6 +94,15 @@ class SumZero:
         """The free coordinates of ``theta`` (the eliminated weights dropped)."""
         gone = {last for last, _ in self.eliminated}
         return np.array([v for i, v in enumerate(theta) if i not in gone], dtype=float)
+
+
+def held_joints(result: FitResult) -> set[str]:
+    """The joints (``q3``) whose lumped weights ``result`` holds at sum 0 (its eliminated
+    weights: the rows of ``tied`` with a -1)."""
+    if result.tied is None:
+        return set()
+    rows = np.flatnonzero(np.any(result.tied < 0, axis=1))
+    return {result.specs[i].name.split(".", 1)[0] for i in rows}
 
 
 def _minus(a: F64 | None, b: F64 | None) -> F64:

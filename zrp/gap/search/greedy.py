@@ -36,6 +36,7 @@ from zrp.gap.fit.leastsq import (
 )
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.fit.profiles import switch_bands, with_backlash_switch
+from zrp.gap.fit.sumzero import fit_sum_zero, held_joints, summed_groups
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.domains import SUMMED, domain_key
 from zrp.gap.model.effects import effect_parameters
@@ -204,12 +205,18 @@ def _in_domains(ctx: Context, f1: FitResult, specs: list[ParamSpec], s: SearchSe
 
 def _nested(ctx: Context, current: FitResult, f1: FitResult, s: SearchSettings) -> FitResult:
     """The model the F test compares ``f1`` with: ``current``, or, when the domains took some
-    of its parameters out of ``f1``, ``current`` refitted without them (nested in ``f1``)."""
+    of its parameters out of ``f1`` or held lumped weights at sum 0 there, ``current``
+    refitted without them or with them held (nested in ``f1``)."""
     names = {p.name for p in f1.specs}
     idx = [i for i, p in enumerate(current.specs) if p.name in names]
-    if len(idx) == len(current.specs):
+    if len(idx) == len(current.specs) and held_joints(f1) <= held_joints(current):
         return current
-    return fit(ctx, [current.specs[i] for i in idx], s.fitting, current.theta[idx], s.rb0)
+    specs = [current.specs[i] for i in idx]
+    groups = summed_groups(specs)
+    held = {j for j in held_joints(f1) | held_joints(current) if len(groups.get(j, ())) > 1}
+    if held:
+        return fit_sum_zero(ctx, specs, held, s.fitting, current.theta[idx], s.rb0)
+    return fit(ctx, specs, s.fitting, current.theta[idx], s.rb0)
 
 
 def _try_backlash(ctx: Context, current: FitResult, current_cv: float,
