@@ -73,3 +73,18 @@ def test_the_lumped_weights_of_a_joint_are_bounded_by_their_sum():
     # a negative payload weight is out by itself
     bad = domain_violations(names, eff, units, [1e-5, -6e-6, 2e-6, 1e-6, 2e-6, -1e-7])
     assert [i for i, _ in bad] == [5]
+
+
+def test_a_sum_held_at_zero_is_inside_within_one_rounding():
+    """Weights held at sum 0 (zrp.gap.fit.sumzero) sum to 0 up to one rounding: a sum of one
+    ulp below 0 (-2e-22 with magnitudes 1e-6) is on the bound (SUM_RTOL = 4 eps of the
+    magnitudes), a sum of -1e-15 (1e-9 of them) is outside."""
+    from zrp.gap.model.domains import SUM_RTOL, domain_violations, sum_inside
+
+    names, eff, units = ["q2.w_p3", "q2.w_ee"], ["joint_compliance"] * 2, ["rad/mm"] * 2
+    w = [1.3e-6, -math.nextafter(1.3e-6, 1.0)]
+    assert math.fsum(w) < 0 and sum_inside(w) and domain_violations(names, eff, units, w) == []
+    assert -math.fsum(w) < SUM_RTOL * 2.6e-6 < 1e-15
+    w = [1.3e-6, -1.3e-6 - 1e-15]
+    assert not sum_inside(w) and len(domain_violations(names, eff, units, w)) == 2
+    assert not sum_inside([1e-6, math.nan])

@@ -165,7 +165,8 @@ def _toml_header(cal: CalibratedRobot, comp_name: str) -> str:
         lines += [f"#   {' '.join(u.split())}" for u in cal.undetermined]
     if cal.taken_out:
         lines.append("# TAKEN OUT as non-physical (outside their physical domains, held at "
-                     "nominal; compensation.json 'taken_out_non_physical'):")
+                     "nominal; lumped compliance weights whose sum left its domain held at "
+                     "sum 0; compensation.json 'taken_out_non_physical'):")
         lines += [f"#   {one_line(' '.join(u.split()))}" for u in cal.taken_out]
     return "\n".join(lines) + "\n"
 

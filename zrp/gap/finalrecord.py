@@ -285,6 +285,10 @@ def _undetermined(diag: Diagnosis, fit: FitResult) -> tuple[str, ...]:
 def _taken_out(diag: Diagnosis) -> tuple[str, ...]:
     """The effects' values the search or the full-pose refit took out as non-physical."""
     out = [f"{e}: {n}" for e, n in diag.outside_domain]
+    b = None if diag.assessment is None else diag.assessment.baseline
+    if b is not None and b.combined_fit is not None and diag.final_fit is b.combined_fit:
+        out += [f"final model (geometry + non-geometric effects): {n}"
+                for n in b.combined_outside]
     if diag.full_pose is not None:
         out += [f"full-pose refit: {n}" for n in diag.full_pose.fit.outside_domain]
     return tuple(dict.fromkeys(out))

@@ -71,6 +71,8 @@ class GeometricBaseline:
             :mod:`zrp.gap.analysis.fallback`).
         combined_fit: the fit of geometric + non-geometric (None with ``combined``; the final
             model when it clearly beats both others on the withheld poses, same module).
+        combined_outside: that fit's parameters taken out or held (lumped weights at sum 0)
+            by the physical domains, in words.
     """
 
     n_parameters: int
@@ -84,6 +86,7 @@ class GeometricBaseline:
     outside: tuple[str, ...] = ()
     fit: FitResult | None = field(default=None, compare=False, repr=False)
     combined_fit: FitResult | None = field(default=None, compare=False, repr=False)
+    combined_outside: tuple[str, ...] = ()
 
     @property
     def model_withheld(self) -> Metrics:
@@ -151,11 +154,11 @@ def geometric_baseline(ctx: Context, reg: FitResult, final: FitResult,
     nreg = len(reg.specs)
     non_geo = [s for s in final.specs[nreg:] if s.effect not in KINEMATIC]
     effects = tuple(dict.fromkeys(s.effect for s in non_geo))
-    combined, n_ng, both = None, 0, None
+    combined, n_ng, both, both_out = None, 0, None, ()
     if non_geo:
-        _, both, _, n_ng, _ = _on_top(ctx, base, non_geo, fitting, rb0)
+        _, both, both_out, n_ng, _ = _on_top(ctx, base, non_geo, fitting, rb0)
         combined = _withheld(ctx, both, withheld)
     held = None if base is plain else _withheld(ctx, base, withheld)
     return GeometricBaseline(n_geo, n_drop, _withheld(ctx, plain, withheld),
                              cv_rms(ctx, plain, folds), effects, n_ng, combined, held,
-                             outside if held is not None else (), base, both)
+                             outside if held is not None else (), base, both, both_out)

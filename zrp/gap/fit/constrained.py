@@ -8,6 +8,13 @@ value is inside. This is the active-set answer to a bound-constrained least-squa
 whose bounds are met at the nominal (Lawson & Hanson 1974, ch. 23: a variable at its bound
 leaves the free set), without ever clamping a value silently: every parameter taken out is
 reported with the reason.
+
+The lumped compliance weights of a joint have a domain on their sum only: when the fit wants
+them to sum below 0, they are held at sum 0 (the boundary of that domain, the weights otherwise
+free, :mod:`zrp.gap.fit.sumzero`) rather than taken out, and that is reported in words too
+(``q3 lumped weights held at sum 0 (their free fit summed to -2.1e-06 rad/mm): ...``). A joint
+with a single weight has it taken out (sum 0 is then the nominal). A joint once held stays
+held in the refits of the same loop, as a parameter taken out stays out.
 """
 
 from __future__ import annotations
@@ -19,10 +26,15 @@ from numpy.typing import NDArray
 
 from zrp.arrays import F64
 from zrp.gap.fit.leastsq import FitResult, fit
+from zrp.gap.fit.sumzero import fit_sum_zero, summed_groups
 from zrp.gap.model.context import REGISTRATION, Context, ParamSpec
-from zrp.gap.model.domains import domain_violations
+from zrp.gap.model.domains import DOMAINS, domain_violations
 
-__all__ = ["n_registration", "outside_domains", "within_domains"]
+__all__ = ["HELD_AT_SUM_0", "held_reason", "n_registration", "outside_domains", "sorted_out",
+           "within_domains"]
+
+#: the words that name a joint's lumped weights held at sum 0 in a reason.
+HELD_AT_SUM_0 = "lumped weights held at sum 0"
 
 
 def n_registration(specs: Sequence[ParamSpec]) -> int:
@@ -46,19 +58,47 @@ def outside_domains(ctx: Context, result: FitResult, first: int = 0) -> list[tup
 def within_domains(ctx: Context, result: FitResult, first: int, fitting: NDArray[np.int64],
                    rb0: F64) -> tuple[FitResult, tuple[str, ...]]:
     """``result`` without the parameters (from index ``first`` on) whose values leave their
-    domains, refitted until none does (module docstring).
+    domains, and with the lumped weights of a joint whose sum leaves it held at sum 0,
+    refitted until none does (module docstring).
 
     Returns:
         the fit (``result`` itself when nothing left a domain) and the reasons of the
-        parameters taken out, in words.
+        parameters taken out or held, in words.
     """
     reasons: list[str] = []
+    held: set[str] = set()
     while True:
         bad = outside_domains(ctx, result, first)
         if not bad:
             return result, tuple(dict.fromkeys(reasons))
-        out = {i for i, _ in bad}
-        reasons += [why for _, why in bad]
+        out, to_hold, why = sorted_out(result.specs, result.theta, bad, first)
+        reasons += why
+        held |= to_hold
         keep: Sequence[int] = [i for i in range(len(result.specs)) if i not in out]
-        result = fit(ctx, [result.specs[i] for i in keep], fitting, result.theta[list(keep)],
-                     rb0)
+        specs = [result.specs[i] for i in keep]
+        theta0 = result.theta[list(keep)]
+        result = (fit_sum_zero(ctx, specs, held, fitting, theta0, rb0) if held
+                  else fit(ctx, specs, fitting, theta0, rb0))
+
+
+def sorted_out(specs: Sequence[ParamSpec], theta: F64, bad: Sequence[tuple[int, str]],
+               first: int) -> tuple[set[int], set[str], list[str]]:
+    """The violations ``bad`` ((index, reason), indices into ``specs``) sorted: the indices
+    to take out, the joints whose lumped weights to hold at sum 0 (those with two or more
+    weights; a single weight is taken out), and the reasons in words."""
+    sums = summed_groups(specs, first)
+    in_sum = {i: j for j, idx in sums.items() for i in idx}
+    to_hold = {in_sum[i] for i, _ in bad if i in in_sum and len(sums[in_sum[i]]) > 1}
+    out = {i for i, _ in bad if in_sum.get(i) not in to_hold}
+    reasons = [why for i, why in bad if i in out]
+    reasons += [held_reason(specs, theta, j, sums[j]) for j in sorted(to_hold)]
+    return out, to_hold, reasons
+
+
+def held_reason(specs: Sequence[ParamSpec], theta: F64, joint: str, idx: Sequence[int]) -> str:
+    """Why the lumped weights ``idx`` of ``joint`` (values ``theta``) are held at sum 0."""
+    total = float(np.sum(theta[list(idx)]))
+    names = ", ".join(specs[i].name for i in idx)
+    return (f"{joint} {HELD_AT_SUM_0} (their free fit summed to {total:.3g} "
+            f"{specs[idx[0]].unit}: {names}), not taken out: "
+            f"{DOMAINS['lumped_compliance'].why}")

@@ -36,7 +36,7 @@ from scipy.spatial.transform import Rotation
 
 from zrp.arrays import F64
 from zrp.errors import InputError
-from zrp.gap.fit.constrained import n_registration
+from zrp.gap.fit.constrained import n_registration, sorted_out
 from zrp.gap.fit.heldname import tilt_reading
 from zrp.gap.fit.leastsq import FitResult, FitWarning, fit, initial_registration
 from zrp.gap.fit.orientation import (
@@ -45,6 +45,7 @@ from zrp.gap.fit.orientation import (
     probe_start,
     stacked,
 )
+from zrp.gap.fit.sumzero import SumZero, expanded, mapped_cov
 from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
 from zrp.gap.model.context import Context, OrientationWeights, ParamSpec
 from zrp.gap.model.domains import domain_violations
@@ -71,7 +72,8 @@ class FullPoseFit:
         converged, stop_reason, held: the solver's report (:mod:`zrp.gap.fit.wellposed`;
             held: the combinations positions and orientations together cannot pin).
         outside_domain: parameters taken out because their values left their physical
-            domains, with the reasons.
+            domains (or lumped weights held at sum 0), with the reasons.
+        cov: the covariance of theta (p, p), or None when not kept.
     """
 
     specs: tuple[ParamSpec, ...]
@@ -88,6 +90,7 @@ class FullPoseFit:
     stop_reason: str = ""
     held: tuple[HeldDirection, ...] = ()
     outside_domain: tuple[str, ...] = ()
+    cov: F64 | None = None
 
     def __post_init__(self) -> None:
         p = len(self.specs)
@@ -111,23 +114,39 @@ def fit_full_pose(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
                   orientation: bool = True, orientation_sigma: float | None = None,
                   passes: int = 3) -> FullPoseFit:
     """:func:`_fit_once` inside the physical domains: a parameter whose value leaves its domain
-    (:mod:`zrp.gap.model.domains`) is taken out and the rest refitted, as in the position fits
-    (:mod:`zrp.gap.fit.constrained`), so the result's ``specs`` may be fewer (the reasons are
-    in ``outside_domain``)."""
+    (:mod:`zrp.gap.model.domains`) is taken out and the rest refitted, and the lumped weights
+    of a joint whose sum leaves it are held at sum 0 (:mod:`zrp.gap.fit.sumzero`), as in the
+    position fits (:mod:`zrp.gap.fit.constrained`), so the result's ``specs`` may be fewer
+    (the reasons are in ``outside_domain``)."""
     reasons: list[str] = []
+    held: set[str] = set()
     while True:
-        fp = _fit_once(ctx, specs, poses, orientation=orientation,
-                       orientation_sigma=orientation_sigma, passes=passes)
+        sz = SumZero.of(specs, held)
+        fp = _expanded(ctx, sz, _fit_once(ctx, sz.free, poses, orientation=orientation,
+                                          orientation_sigma=orientation_sigma, passes=passes))
         first = n_registration(fp.specs)
         bad = domain_violations([x.name for x in fp.specs[first:]],
                                 [x.effect for x in fp.specs[first:]],
                                 [x.unit for x in fp.specs[first:]], fp.theta[first:],
                                 max_tilt_rad=ctx.max_tilt_rad)
         if not bad:
-            return dataclasses.replace(fp, outside_domain=tuple(reasons))
-        reasons += [why for _, why in bad]
-        out = {first + i for i, _ in bad}
+            return dataclasses.replace(fp, outside_domain=tuple(dict.fromkeys(reasons)))
+        out, to_hold, why = sorted_out(fp.specs, fp.theta, [(first + i, w) for i, w in bad],
+                                       first)
+        reasons += why
+        held |= to_hold
         specs = [x for i, x in enumerate(fp.specs) if i not in out]
+
+
+def _expanded(ctx: Context, sz: SumZero, fp: FullPoseFit) -> FullPoseFit:
+    """``fp``, a fit of the free coordinates of ``sz``, as a fit of its ``specs``."""
+    if not sz.eliminated:
+        return fp
+    cov = mapped_cov(sz.tied, fp.cov) if fp.cov is not None else None
+    se = (np.sqrt(np.clip(np.diag(cov), 0.0, None)) if cov is not None
+          else np.full(len(sz.specs), np.nan))
+    return dataclasses.replace(fp, specs=sz.specs, theta=sz.theta(fp.theta), stderr=se,
+                               position=expanded(ctx, sz, fp.position), cov=cov)
 
 
 def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
@@ -154,7 +173,7 @@ def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
     nan = float("nan")
     if not orientation:
         return FullPoseFit(tuple(specs), pos.theta, pos.stderr, np.eye(3), sp, nan, nan, pos,
-                           False)
+                           False, cov=pos.cov)
     if orientation_sigma is not None and not (np.isfinite(orientation_sigma)
                                               and orientation_sigma > 0):
         raise InputError(f"orientation_sigma: expected a positive angle (rad), got "
@@ -193,7 +212,8 @@ def _fit_once(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike, *,
     rt = Rotation.from_rotvec(x[p:]).as_matrix() @ rt0
     ang = float(np.sqrt(np.mean(np.sum(e ** 2, axis=1))))
     return FullPoseFit(tuple(specs), x[:p], se, rt, sp, so, ang, pos, True,
-                       orientation_sigma is not None, sol.converged, sol.reason, sol.held)
+                       orientation_sigma is not None, sol.converged, sol.reason, sol.held,
+                       cov=cov[:p, :p])
 
 
 def orientation_weights(ctx: Context, specs: Sequence[ParamSpec], poses: ArrayLike,

@@ -50,6 +50,7 @@ import numpy as np
 from scipy import special
 
 from zrp.gap.fit.leastsq import FitResult, group_key, wald_groups
+from zrp.gap.fit.wellposed import rank_chi2
 from zrp.gap.model.context import ParamSpec
 
 __all__ = ["RANK_RTOL", "group_pvalues", "wald_groups_given_held"]
@@ -61,14 +62,7 @@ RANK_RTOL = 1e-10
 
 def _chi2(theta: np.ndarray, c_est: np.ndarray, c_full: np.ndarray) -> tuple[float, int]:
     """chi2 and df of (H1) for one group."""
-    d = np.sqrt(np.clip(np.diag(c_full), 0.0, None))
-    d = np.where(d > 0, d, 1.0)
-    w, v = np.linalg.eigh(c_est / np.outer(d, d))
-    ok = w > RANK_RTOL * max(1.0, float(w.max()) if w.size else 0.0)
-    if not np.any(ok):
-        return 0.0, 0
-    z = v[:, ok].T @ (theta / d)
-    return float(np.sum(z * z / w[ok])), int(ok.sum())
+    return rank_chi2(theta, c_est, c_full, RANK_RTOL)
 
 
 def wald_groups_given_held(result: FitResult, first: int,

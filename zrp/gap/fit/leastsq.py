@@ -19,7 +19,7 @@ from zrp.errors import InputError, ZRPWarning
 from zrp.gap.fit.aliasing import Acceptance, Aliased
 from zrp.gap.fit.heldname import tilt_reading
 from zrp.gap.fit.orientation import alias_jacobian, solve_with_orientation
-from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, solve
+from zrp.gap.fit.wellposed import HeldDirection, parameter_scales, prior_values, rank_chi2, solve
 from zrp.gap.model.context import Context, ParamSpec
 from zrp.gap.model.problem import Evaluation, Problem
 from zrp.kinematics.forward import forward_kinematics
@@ -72,6 +72,10 @@ class FitResult:
             the positions' in both cases; ``cov`` is the fit's (with orientations: of both).
         held_cov: the held directions' share of ``cov`` (their prior's, eq. W3), shape
             (p, p), or None when not known (then ``cov`` is taken as all estimated).
+        tied: the linear equality constraints the fit met, as the map theta = tied @ phi
+            from its free coordinates phi, shape (p, f), or None when every parameter was
+            free (:mod:`zrp.gap.fit.sumzero`: lumped weights held at sum 0). ``cov`` and
+            ``jac`` are the parameters' (``cov`` of rank f); the statistics count f.
     """
 
     specs: tuple[ParamSpec, ...]
@@ -87,12 +91,26 @@ class FitResult:
     iterations: int = 0
     probe_rotation: F64 | None = None
     held_cov: F64 | None = None
+    tied: F64 | None = None
 
     def __post_init__(self) -> None:
         p = len(self.specs)
         if self.theta.shape != (p,) or self.cov.shape != (p, p):
             raise InputError(f"FitResult: theta/cov shapes {self.theta.shape}/{self.cov.shape} "
                              f"do not match {p} parameters")
+        if self.tied is not None and (self.tied.ndim != 2 or self.tied.shape[0] != p):
+            raise InputError(f"FitResult: tied of shape {self.tied.shape} does not map onto "
+                             f"{p} parameters")
+
+    @property
+    def n_free(self) -> int:
+        """The number of free parameters (``len(specs)`` less the equality constraints)."""
+        return len(self.specs) if self.tied is None else int(self.tied.shape[1])
+
+    @property
+    def free_jac(self) -> F64:
+        """The Jacobian in the free coordinates (``jac @ tied``; ``jac`` when all are free)."""
+        return self.jac if self.tied is None else self.jac @ self.tied
 
     @property
     def rss(self) -> float:
@@ -105,7 +123,7 @@ class FitResult:
 
     @property
     def dof(self) -> int:
-        return max(self.n_res - len(self.specs), 1)
+        return max(self.n_res - self.n_free, 1)
 
     @property
     def sigma(self) -> float:
@@ -120,7 +138,7 @@ class FitResult:
     @property
     def bic(self) -> float:
         """Bayesian information criterion (Gaussian errors, unknown variance)."""
-        return float(self.n_res * np.log(self.rss / self.n_res) + len(self.specs)
+        return float(self.n_res * np.log(self.rss / self.n_res) + self.n_free
                      * np.log(self.n_res))
 
     def value(self, name: str) -> float:
@@ -336,6 +354,10 @@ def wald_groups(result: FitResult, first: int,
         if not np.all(np.isfinite(C)):
             out[g] = 1.0
             continue
+        if result.tied is not None and np.any(result.tied[idx] < 0):  # singular: constrained
+            chi2, df = rank_chi2(th, C, C)
+            out[g] = float(special.chdtrc(df, chi2)) if df else 1.0
+            continue
         try:
             chi2 = float(th @ np.linalg.solve(C, th))
         except np.linalg.LinAlgError:
@@ -347,7 +369,7 @@ def wald_groups(result: FitResult, first: int,
 
 def f_test(small: FitResult, big: FitResult) -> float:
     """p-value of the F test that the extra parameters of ``big`` do not help."""
-    dp = len(big.specs) - len(small.specs)
+    dp = big.n_free - small.n_free
     if dp <= 0 or big.rss <= 0:
         return 1.0
     f = ((small.rss - big.rss) / dp) / (big.rss / big.dof)
@@ -364,8 +386,9 @@ def cv_rms(ctx: Context, result: FitResult, folds: Sequence[NDArray[np.int64]]) 
     rows = np.flatnonzero(np.isin(ctx.meas.pose_index, result.poses))  # Problem's row order
     prob_rows_pose = ctx.meas.pose_index[rows]
     r = result.residual.reshape(-1, 3)
-    J = result.jac.reshape(r.shape[0], 3, -1)
-    d = np.linalg.norm(result.jac, axis=0)
+    jac = result.free_jac  # a constrained fit: refitted within its constraints
+    J = jac.reshape(r.shape[0], 3, -1)
+    d = np.linalg.norm(jac, axis=0)
     d = np.where(d > 0, d, 1.0)
     Js = J / d
     A = np.einsum("rcp,rcq->pq", Js, Js)

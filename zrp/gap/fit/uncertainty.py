@@ -41,6 +41,7 @@ from scipy import special
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.fit.leastsq import FitResult
+from zrp.gap.fit.sumzero import mapped_cov
 from zrp.gap.model.context import Context
 
 __all__ = [
@@ -78,7 +79,7 @@ def _row_pose(ctx: Context, result: FitResult) -> NDArray[np.int64]:
 def robust_covariance(ctx: Context, result: FitResult) -> F64:
     """Pose-clustered sandwich covariance of ``result.theta``, shape (p, p) (see the module
     docstring; columns scaled for conditioning; inf where the normal-theory one is)."""
-    J, r = result.jac, result.residual
+    J, r = result.free_jac, result.residual  # a constrained fit: its free coordinates
     p = J.shape[1]
     if p == 0:
         return np.zeros((0, 0))
@@ -108,6 +109,8 @@ def _unscaled(cov_scaled: F64, d: F64, result: FitResult) -> F64:
     """A covariance of the scaled parameters theta d (p, p) back in the units of theta, inf in
     the rows and columns where the normal-theory one (``result.cov``) is not finite."""
     cov = cov_scaled / np.outer(d, d)
+    if result.tied is not None:  # back from the free coordinates (zrp.gap.fit.sumzero)
+        cov = mapped_cov(result.tied, cov)
     bad = ~np.isfinite(np.diag(result.cov))
     cov[bad, :] = np.inf
     cov[:, bad] = np.inf
@@ -118,7 +121,7 @@ def jackknife_covariance(ctx: Context, result: FitResult) -> F64:
     """Pose-clustered jackknife covariance of ``result.theta``, shape (p, p) (eqs J1-J2 of the
     module docstring; inf where the normal-theory one is, and for every parameter when a
     single pose alone determines one, leverage 1)."""
-    J, r = result.jac, result.residual
+    J, r = result.free_jac, result.residual  # a constrained fit: its free coordinates
     p = J.shape[1]
     if p == 0:
         return np.zeros((0, 0))
@@ -139,7 +142,7 @@ def jackknife_covariance(ctx: Context, result: FitResult) -> F64:
         except np.linalg.LinAlgError:
             u = np.full(rows.size, np.inf)
         if not np.all(np.isfinite(u)) or np.linalg.cond(m) > 1e12:
-            return np.full((p, p), np.inf)
+            return np.full((len(result.specs),) * 2, np.inf)
         deltas[g] = bread @ (jg.T @ u)
     dev = deltas - deltas.mean(axis=0)
     return _unscaled(dev.T @ dev * ((G - 1) / max(G, 1)), d, result)

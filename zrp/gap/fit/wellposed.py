@@ -59,7 +59,7 @@ from zrp.jsonio import dict_from_dataclass
 from zrp.units import units_per_mm
 
 __all__ = ["MAX_ITERATIONS", "HeldDirection", "Solution", "parameter_scales", "prior_values",
-           "solve"]
+           "rank_chi2", "solve"]
 
 #: Gauss-Newton iterations before the solver stops and says so.
 MAX_ITERATIONS = 200
@@ -294,3 +294,17 @@ def solve(evaluate: Callable[[F64], tuple[F64, F64]], residual: Callable[[F64], 
                  reading)
     cov, held_cov = _covariance(r, s, Vt, keep, scales)
     return Solution(theta, r, J, cov, held, converged, it, reason, held_cov)
+
+
+def rank_chi2(theta: F64, c_est: F64, c_full: F64, rtol: float = 1e-10) -> tuple[float, int]:
+    """chi2 = theta^T c_est^+ theta and its rank (df), the pseudo-inverse in the scale of the
+    variances of ``c_full`` (eigenvalues below ``rtol`` of the largest: directions without an
+    estimate, not tested)."""
+    d = np.sqrt(np.clip(np.diag(c_full), 0.0, None))
+    d = np.where(d > 0, d, 1.0)
+    w, v = np.linalg.eigh(c_est / np.outer(d, d))
+    ok = w > rtol * max(1.0, float(w.max()) if w.size else 0.0)
+    if not np.any(ok):
+        return 0.0, 0
+    z = v[:, ok].T @ (theta / d)
+    return float(np.sum(z * z / w[ok])), int(ok.sum())

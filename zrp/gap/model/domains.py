@@ -42,9 +42,11 @@ the arm's real masses are represented by weights that sum to the mass they stand
 weight alone may be negative: a centre of mass behind a joint or a counterweight lumped on the
 points ahead of it. What physics fixes is their sum per joint, c_k times the mass joint k
 carries (domain ``lumped_compliance``: >= 0, a joint deflects with its load in total); a
-negative sum leaves the domain as a negative ``q{k}.compliance`` does (every weight of that
-joint taken out by the search, refused by the writers). ``q{k}.w_load`` is a known mass (per
-kg of payload at the tool) and has the ``compliance`` domain itself (>= 0).
+negative sum leaves the domain as a negative ``q{k}.compliance`` does (the fits then hold
+that joint's weights at sum 0, the domain's bound, :mod:`zrp.gap.fit.sumzero`; the writers
+refuse a negative sum, allowing :data:`SUM_RTOL` for the rounding of a sum held at 0).
+``q{k}.w_load`` is a known mass (per kg of payload at the tool) and has the ``compliance``
+domain itself (>= 0).
 
 The tolerances scale the parameters of the well-posed identification
 (:mod:`zrp.gap.fit.wellposed`): one unit of scaled parameter is one typical manufacturing or
@@ -63,10 +65,10 @@ from dataclasses import dataclass
 
 from zrp.errors import InputError
 
-__all__ = ["DEFAULT_MAX_TILT_RAD", "DOMAINS", "GROUPED", "SUMMED", "Domain",
+__all__ = ["DEFAULT_MAX_TILT_RAD", "DOMAINS", "GROUPED", "SUMMED", "SUM_RTOL", "Domain",
            "ImplausibleValueError",
            "domain_key", "domain_violations", "parameter_bounds", "parameter_domain",
-           "tolerance", "violation"]
+           "sum_inside", "tolerance", "violation"]
 
 #: Largest axis tilt accepted by default (rad): a few mrad of a machined part.
 DEFAULT_MAX_TILT_RAD = 5e-3
@@ -165,6 +167,10 @@ DOMAINS: dict[str, Domain] = {d.key: d for d in (
 GROUPED = ("cyclic_amplitude", "axis_tilt")
 #: domains bounding the sum of a joint's parameters (a member alone has no bound).
 SUMMED = ("lumped_compliance",)
+#: a sum held at its bound 0 is computed with one rounding (:mod:`zrp.gap.fit.sumzero`):
+#: a sum down to -SUM_RTOL sum |w| is on the bound (4 eps: four
+#: times the bound eps sum |w| of that rounding).
+SUM_RTOL = 4.0 * 2.0 ** -52
 
 _CYCLIC = re.compile(r"(sin|cos)\d+$")
 _BY_EFFECT = {"joint_offset": "joint_offset", "encoder_scale": "encoder_scale",
@@ -314,6 +320,17 @@ def domain_violations(names: Sequence[str], effects: Sequence[str], units: Seque
     return out
 
 
+def sum_inside(values: Sequence[float]) -> bool:
+    """Whether lumped weights ``values`` of one joint sum inside ``lumped_compliance``: the
+    fsum >= -:data:`SUM_RTOL` times the sum of their magnitudes (a sum held at 0 rounds to
+    either side of it; every value finite)."""
+    v = [float(x) for x in values]
+    if not all(math.isfinite(x) for x in v):
+        return False
+    return math.fsum(v) >= DOMAINS["lumped_compliance"].lower - SUM_RTOL * math.fsum(
+        abs(x) for x in v)
+
+
 def _sum_violations(names: Sequence[str], effects: Sequence[str], units: Sequence[str],
                     values: Sequence[float]) -> list[tuple[int, str]]:
     """Every member of a joint's :data:`SUMMED` group whose sum leaves its domain."""
@@ -324,7 +341,7 @@ def _sum_violations(names: Sequence[str], effects: Sequence[str], units: Sequenc
     out: list[tuple[int, str]] = []
     for joint, idx in sums.items():
         total = math.fsum(float(values[i]) for i in idx)
-        if not total >= DOMAINS["lumped_compliance"].lower:
+        if not sum_inside([float(values[i]) for i in idx]):
             out += [(i, f"{names[i]} = {float(values[i]):.3g} {units[i]} (the lumped weights "
                      f"of {joint} sum to {total:.3g}) outside 0 <= sum: a joint deflects with "
                      "its load in total") for i in idx]

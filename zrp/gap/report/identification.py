@@ -38,8 +38,9 @@ def identification_markdown(diag: Diagnosis) -> list[str]:
     else:
         L.append("Every combination of the final model's parameters is pinned by the data.\n")
     if diag.outside_domain:
-        L.append("Fitted values outside their physical domain (taken out, never used; the "
-                 "first time per effect, all in diagnosis.json `identification`):\n")
+        L.append("Fitted values outside their physical domain (taken out, never used; "
+                 "lumped compliance weights whose sum left it held at sum 0; the first time "
+                 "per effect, all in diagnosis.json `identification`):\n")
         seen: set[str] = set()
         for e, note in diag.outside_domain:
             if e not in seen:

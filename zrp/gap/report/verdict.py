@@ -7,6 +7,7 @@ import numpy as np
 
 from zrp.gap.analysis.baseline import GeometricBaseline
 from zrp.gap.analysis.where import WhereAnalysis
+from zrp.gap.fit.constrained import HELD_AT_SUM_0
 from zrp.gap.report.headline import effect_joints, headline_text, summary_terminal
 from zrp.gap.report.headline import ranges as _ranges
 from zrp.gap.results import Diagnosis
@@ -166,7 +167,19 @@ def identification_text(diag: Diagnosis) -> list[str]:
                      f"than the physical domain, or moving the points by more than the error "
                      f"before calibration): {names}; the tables say what each trades "
                      "against.")
-    seen: set[str] = set()  # named only while a gap remains: then it says why it was not closed
+    parts += _domain_notes(diag)
+    stops = diag.solver_stops
+    if stops:
+        parts.append(f"{len(stops)} fit(s) stopped before converging ({stops[0]}): their "
+                     "values are not at the least-squares minimum.")
+    return parts
+
+
+def _domain_notes(diag: Diagnosis) -> list[str]:
+    """Per effect, the first time its values left their physical domains (taken out, or lumped
+    weights held at sum 0), while a gap remains: then it says why it was not closed."""
+    parts: list[str] = []
+    seen: set[str] = set()
     for effect, note in (diag.outside_domain if diag.unexplained is not False else ()):
         if effect in seen:
             continue
@@ -177,13 +190,11 @@ def identification_text(diag: Diagnosis) -> list[str]:
             parts.append(f"{effect} was not accepted: fitted to these data it needs values "
                          f"outside its physical domain ({why}); the residual has a shape "
                          "that effect cannot produce physically.")
+        elif HELD_AT_SUM_0 in note and "taken out, outside" not in note:
+            parts.append(f"{effect}: {why}.")
         else:
             parts.append(f"{effect}: parameters whose fitted values left their physical "
                          f"domain were taken out ({why}).")
-    stops = diag.solver_stops
-    if stops:
-        parts.append(f"{len(stops)} fit(s) stopped before converging ({stops[0]}): their "
-                     "values are not at the least-squares minimum.")
     return parts
 
 

@@ -23,7 +23,7 @@ from zrp.gap.analysis.checks import GapWarning
 from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.identifiability import GEOMETRIC, geometric_overlap
 from zrp.gap.fit.aliasing import Aliased
-from zrp.gap.fit.constrained import n_registration, within_domains
+from zrp.gap.fit.constrained import HELD_AT_SUM_0, n_registration, within_domains
 from zrp.gap.fit.heldwald import group_pvalues
 from zrp.gap.fit.leastsq import (
     FitResult,
@@ -36,7 +36,9 @@ from zrp.gap.fit.leastsq import (
 )
 from zrp.gap.fit.metrics import Metrics
 from zrp.gap.fit.profiles import switch_bands, with_backlash_switch
+from zrp.gap.fit.sumzero import fit_sum_zero, held_joints, summed_groups
 from zrp.gap.model.context import Context, ParamSpec
+from zrp.gap.model.domains import SUMMED, domain_key
 from zrp.gap.model.effects import effect_parameters
 from zrp.gap.model.problem import Problem
 from zrp.gap.search.lookalike import temperature_needed
@@ -176,9 +178,13 @@ def _judged(pval: float, dbic: float, cv_ratio: float, s: SearchSettings, own: l
     note = "" if ok else ("F test not significant" if pval >= s.alpha else
                           "BIC does not improve" if dbic >= 0 else
                           f"cross-validated RMS improves by less than {s.min_gain:.0%}")
+    out = [w for w in own if HELD_AT_SUM_0 not in w]
+    held = [w for w in own if HELD_AT_SUM_0 in w]
     return ok, "; ".join(filter(None, [
-        note, own and "parameters taken out, outside the physical domain: " + "; ".join(own),
-        others and "earlier parameters taken out, outside their domains: " + "; ".join(others)]))
+        note, out and "parameters taken out, outside the physical domain: " + "; ".join(out),
+        held and "held at the bound of the physical domain: " + "; ".join(held),
+        others and "earlier parameters taken out or held, outside their domains: "
+        + "; ".join(others)]))
 
 
 def _in_domains(ctx: Context, f1: FitResult, specs: list[ParamSpec], s: SearchSettings
@@ -188,19 +194,29 @@ def _in_domains(ctx: Context, f1: FitResult, specs: list[ParamSpec], s: SearchSe
     ones taken out."""
     f1, outside = within_domains(ctx, f1, n_registration(f1.specs), s.fitting, s.rb0)
     own_names = {p.name for p in specs}
-    own = [w for w in outside if w.split(" = ")[0] in own_names]
-    others = [w.split(" outside ")[0] for w in outside if w not in own]
+    own_joints = {p.name.split(".", 1)[0] for p in specs
+                  if domain_key(p.name, p.effect) in SUMMED}
+    held = [w for w in outside if HELD_AT_SUM_0 in w]
+    own = [w for w in outside if w.split(" = ")[0] in own_names
+           or (w in held and w.split(" ", 1)[0] in own_joints)]
+    others = [w.split(" outside ")[0].split(" (")[0] for w in outside if w not in own]
     return f1, own, others
 
 
 def _nested(ctx: Context, current: FitResult, f1: FitResult, s: SearchSettings) -> FitResult:
     """The model the F test compares ``f1`` with: ``current``, or, when the domains took some
-    of its parameters out of ``f1``, ``current`` refitted without them (nested in ``f1``)."""
+    of its parameters out of ``f1`` or held lumped weights at sum 0 there, ``current``
+    refitted without them or with them held (nested in ``f1``)."""
     names = {p.name for p in f1.specs}
     idx = [i for i, p in enumerate(current.specs) if p.name in names]
-    if len(idx) == len(current.specs):
+    if len(idx) == len(current.specs) and held_joints(f1) <= held_joints(current):
         return current
-    return fit(ctx, [current.specs[i] for i in idx], s.fitting, current.theta[idx], s.rb0)
+    specs = [current.specs[i] for i in idx]
+    groups = summed_groups(specs)
+    held = {j for j in held_joints(f1) | held_joints(current) if len(groups.get(j, ())) > 1}
+    if held:
+        return fit_sum_zero(ctx, specs, held, s.fitting, current.theta[idx], s.rb0)
+    return fit(ctx, specs, s.fitting, current.theta[idx], s.rb0)
 
 
 def _try_backlash(ctx: Context, current: FitResult, current_cv: float,
