@@ -7,14 +7,14 @@ its width and ridge chosen by leave-one-out cross-validation there. It is **kept
 the test of what remains (:mod:`.structure`, on the fitting poses) finds structure and the
 term lowers the withheld error clearly, by the rule the choice of the final model uses
 (:mod:`.fallback`): a lower withheld RMS that is not "equally good" (paired z of the per-pose
-squared errors of at least 2, or an RMS ratio above 1.1). Both, because on many withheld
-poses the paired test calls a gain of 1 % clear (the shared IRB 120: 0.412 -> 0.408 mm,
-z = 3.4) while the structure test says what remains is scatter (a structured share of 1 %,
-below :data:`~.structure.MIN_SHARE`): a term kept there would contradict the report and
-carry a model of next to nothing into the calibration files. Its withheld RMS is shown beside the
-physical model's either way; the physical model stays the final model whose effects the
-report names, and the learned term only adds to it. The training ranges of its inputs are
-recorded: outside them it is not valid.
+squared errors of at least 2, or an RMS ratio above 1.1). Both, because on many withheld poses
+the paired test calls a gain of 1 % clear (the shared IRB 120 with the physical model of an
+earlier version: 0.412 -> 0.408 mm, z = 3.4) while the structure test says what remains is
+scatter (a structured share of 1 %, below :data:`~.structure.MIN_SHARE`): a term kept there
+would contradict the report and carry a model of next to nothing into the calibration files.
+Its withheld RMS is shown beside the physical model's either way; the physical model stays the
+final model whose effects the report names, and the learned term only adds to it. The training
+ranges of its inputs are recorded: outside them it is not valid.
 
 Only the joint angles are inputs (not the logged time, temperature or load, which the test of
 what remains, :mod:`.structure`, does take): the term is meant to be applied to commands

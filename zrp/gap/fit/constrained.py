@@ -25,7 +25,7 @@ import numpy as np
 from numpy.typing import NDArray
 
 from zrp.arrays import F64
-from zrp.gap.fit.leastsq import FitResult, fit
+from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.fit.sumzero import fit_sum_zero, summed_groups
 from zrp.gap.model.context import REGISTRATION, Context, ParamSpec
 from zrp.gap.model.domains import DOMAINS, domain_violations
@@ -77,8 +77,7 @@ def within_domains(ctx: Context, result: FitResult, first: int, fitting: NDArray
         keep: Sequence[int] = [i for i in range(len(result.specs)) if i not in out]
         specs = [result.specs[i] for i in keep]
         theta0 = result.theta[list(keep)]
-        result = (fit_sum_zero(ctx, specs, held, fitting, theta0, rb0) if held
-                  else fit(ctx, specs, fitting, theta0, rb0))
+        result = fit_sum_zero(ctx, specs, held, fitting, theta0, rb0)
 
 
 def sorted_out(specs: Sequence[ParamSpec], theta: F64, bad: Sequence[tuple[int, str]],

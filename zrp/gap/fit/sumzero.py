@@ -33,7 +33,7 @@ from numpy.typing import NDArray
 from zrp.arrays import F64
 from zrp.gap.fit.leastsq import FitResult, fit
 from zrp.gap.model.context import Context, ParamSpec
-from zrp.gap.model.domains import SUMMED, domain_key
+from zrp.gap.model.domains import summed_members
 from zrp.gap.model.problem import Problem
 
 __all__ = ["SumZero", "expanded", "fit_sum_zero", "held_joints", "mapped_cov", "summed_groups"]
@@ -41,11 +41,7 @@ __all__ = ["SumZero", "expanded", "fit_sum_zero", "held_joints", "mapped_cov", "
 
 def summed_groups(specs: Sequence[ParamSpec], first: int = 0) -> dict[str, list[int]]:
     """Per joint (``q3``), the indices (from ``first`` on) of its lumped weights."""
-    out: dict[str, list[int]] = {}
-    for i in range(first, len(specs)):
-        if domain_key(specs[i].name, specs[i].effect) in SUMMED:
-            out.setdefault(specs[i].name.split(".", 1)[0], []).append(i)
-    return out
+    return summed_members([s.name for s in specs], [s.effect for s in specs], first)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -115,7 +111,10 @@ def _minus(a: F64 | None, b: F64 | None) -> F64:
 def fit_sum_zero(ctx: Context, specs: Sequence[ParamSpec], joints: Collection[str],
                  fitting: NDArray[np.int64], theta0: F64, rb0: F64) -> FitResult:
     """:func:`~zrp.gap.fit.leastsq.fit` of ``specs`` with the lumped weights of ``joints``
-    summing to 0 (S1), mapped back to ``specs`` (:func:`expanded`)."""
+    summing to 0 (S1), mapped back to ``specs`` (:func:`expanded`); the plain fit when
+    ``joints`` is empty."""
+    if not joints:
+        return fit(ctx, list(specs), fitting, theta0, rb0)
     sz = SumZero.of(specs, joints)
     fr = fit(ctx, list(sz.free), fitting, sz.phi(np.asarray(theta0, dtype=float)), rb0)
     return expanded(ctx, sz, fr)

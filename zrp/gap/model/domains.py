@@ -68,7 +68,7 @@ from zrp.errors import InputError
 __all__ = ["DEFAULT_MAX_TILT_RAD", "DOMAINS", "GROUPED", "SUMMED", "SUM_RTOL", "Domain",
            "ImplausibleValueError",
            "domain_key", "domain_violations", "parameter_bounds", "parameter_domain",
-           "sum_inside", "tolerance", "violation"]
+           "sum_inside", "summed_members", "tolerance", "violation"]
 
 #: Largest axis tilt accepted by default (rad): a few mrad of a machined part.
 DEFAULT_MAX_TILT_RAD = 5e-3
@@ -331,15 +331,22 @@ def sum_inside(values: Sequence[float]) -> bool:
         abs(x) for x in v)
 
 
+def summed_members(names: Sequence[str], effects: Sequence[str],
+                   first: int = 0) -> dict[str, list[int]]:
+    """Per joint (``q3``), the indices (from ``first`` on) of its parameters in a
+    :data:`SUMMED` domain (its lumped weights)."""
+    out: dict[str, list[int]] = {}
+    for i in range(first, len(names)):
+        if domain_key(names[i], effects[i]) in SUMMED:
+            out.setdefault(names[i].split(".", 1)[0], []).append(i)
+    return out
+
+
 def _sum_violations(names: Sequence[str], effects: Sequence[str], units: Sequence[str],
                     values: Sequence[float]) -> list[tuple[int, str]]:
     """Every member of a joint's :data:`SUMMED` group whose sum leaves its domain."""
-    sums: dict[str, list[int]] = {}
-    for i, (n, e) in enumerate(zip(names, effects, strict=True)):
-        if domain_key(n, e) in SUMMED:
-            sums.setdefault(n.split(".", 1)[0], []).append(i)
     out: list[tuple[int, str]] = []
-    for joint, idx in sums.items():
+    for joint, idx in summed_members(names, effects).items():
         total = math.fsum(float(values[i]) for i in idx)
         if not sum_inside([float(values[i]) for i in idx]):
             out += [(i, f"{names[i]} = {float(values[i]):.3g} {units[i]} (the lumped weights "

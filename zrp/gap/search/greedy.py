@@ -214,9 +214,7 @@ def _nested(ctx: Context, current: FitResult, f1: FitResult, s: SearchSettings) 
     specs = [current.specs[i] for i in idx]
     groups = summed_groups(specs)
     held = {j for j in held_joints(f1) | held_joints(current) if len(groups.get(j, ())) > 1}
-    if held:
-        return fit_sum_zero(ctx, specs, held, s.fitting, current.theta[idx], s.rb0)
-    return fit(ctx, specs, s.fitting, current.theta[idx], s.rb0)
+    return fit_sum_zero(ctx, specs, held, s.fitting, current.theta[idx], s.rb0)
 
 
 def _try_backlash(ctx: Context, current: FitResult, current_cv: float,
