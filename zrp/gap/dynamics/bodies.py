@@ -27,6 +27,10 @@ __all__ = ["BODY_EFFECTS", "body_effects", "link_centre", "point_mass_columns"]
 
 BODY_EFFECTS = ("absent_part", "link_mass")
 
+#: A link's mass grows by at most this share of the model's (a CAD mass off by more is not
+#: a link's mass off: a part the model lacks, named as a payload, or another effect).
+MAX_GAIN = 1.0
+
 #: A link whose mass columns move the torques by less than this share of the largest link's
 #: is not a candidate (it cannot be seen in the log).
 VISIBLE = 1e-3
@@ -84,7 +88,7 @@ def _link_masses(arm: Arm, y: F64, bodies: list[int]) -> list[Effect]:
         cols = point_mass_columns(y[..., 10 * i:10 * i + 10], link_centre(arm, b))
         out.append(Effect("link_mass", None, cols, ("mass", "m*dx", "m*dy", "m*dz"),
                           ("kg", "kg m", "kg m", "kg m"), np.array([-m0, -inf, -inf, -inf]),
-                          np.full(4, inf), arm.body_name(b)))
+                          np.array([MAX_GAIN * m0, inf, inf, inf]), arm.body_name(b)))
     return out
 
 

@@ -11,6 +11,8 @@ separators listed.
 form              per-joint columns (group: base names; separators)
 ================  ==========================================================================
 zrp               q, qd, tau, i (currents), qc (command): ``q1``, ``tau1`` ...; ``payload``
+motor side        the same at the motors (``qm1``, ``qdm1``, ``taum1``, ``im1``), read
+                  through a transmission (:mod:`zrp.gap.dynamics.transmission`)
 libfranka         q: ``q``; qd: ``dq``; tau: ``tau_J``; qc: ``q_d``; as ``q0``, ``q_0``,
                   ``q[0]``, ``q.0``; and as ``franka::logToCSV`` writes them:
                   ``state.q[0]``, ``state.dq[0]``, ``state.tau_J[0]``, ``state.q_d[0]``
@@ -67,12 +69,13 @@ GROUP_KIND = {"q": "position", "qd": "velocity", "tau": "effort", "i": "current"
 #: Longest accepted column name (a real header has names of tens of characters).
 MAX_NAME = 1000
 
-_SEPS = {"zrp": ("",), "libfranka": ("", "_", "[]", "."), "UR RTDE": ("_", "[]", ""),
+_SEPS = {"zrp": ("",), "motor side": ("",), "libfranka": ("", "_", "[]", "."), "UR RTDE": ("_", "[]", ""),
          "KUKA FRI/Sunrise": ("_a", "a", "_", "[]", ""), "KUKA FRI pyfri": ("",)}
 
 #: form -> group -> base names (lowercase).
 FORMS: dict[str, dict[str, tuple[str, ...]]] = {
     "zrp": {"q": ("q",), "qd": ("qd",), "tau": ("tau",), "i": ("i",), "qc": ("qc",)},
+    "motor side": {"q": ("qm",), "qd": ("qdm",), "tau": ("taum",), "i": ("im",)},
     "libfranka": {"q": ("q", "state.q"), "qd": ("dq", "state.dq"),
                   "tau": ("tau_j", "state.tau_j"), "qc": ("q_d", "state.q_d", "cmd.q_d")},
     "UR RTDE": {"q": ("actual_q",), "qd": ("actual_qd",), "tau": ("actual_current_as_torque",),
@@ -138,7 +141,7 @@ class Mapping:
 
     form: str
     n: int
-    time: int
+    time: int | None
     groups: dict[str, tuple[int, ...]]
     units: dict[int, str | None]
     defaults: dict[int, str] = field(default_factory=dict)
@@ -154,9 +157,10 @@ class Mapping:
         cols = ", ".join(f"{g} <- {self.names[c[0]]}..{self.names[c[-1]]}"
                          for g, c in self.groups.items())
         base = "" if self.index_base is None else f", {self.index_base}-based"
+        clock = "none (the given rate)" if self.time is None else self.names[self.time]
         text = (f"columns read as the {self.form} form ({self.n} joints{base}): time <- "
-                f"{self.names[self.time]}, {cols}")
-        if self.form != "zrp":
+                f"{clock}, {cols}")
+        if self.form not in ("zrp", "motor side"):
             text += ("; undeclared units are the form's own (SI: rad, rad/s, N m, A; KUKA "
                      "A1..A7 in deg)")
         if self.ignored:
@@ -308,17 +312,20 @@ def _choose(names: list[str], src: str) -> tuple[str, dict]:
                      f"reader knows; accepted: {accepted_forms()}")
 
 
-def _unused(form: str, found: dict, names: list[str], src: str
-            ) -> tuple[int, int | None, tuple[str, ...]]:
-    """The time and payload columns, and the columns not used (an error in the zrp form)."""
+def _unused(form: str, found: dict, names: list[str], src: str, clock_required: bool
+            ) -> tuple[int | None, int | None, tuple[str, ...]]:
+    """The time and payload columns, and the columns not used (an error in the zrp forms)."""
     t = _time_column(names)
-    if t is None:
+    if t is not None and not clock_required:
+        raise InputError(f"--rate: {src} has its own clock (column {names[t]}); give the "
+                         "rate only for a log without a time column")
+    if t is None and clock_required:
         raise InputError(f"{src} line 1: missing column(s) t: no time column (accepted: "
                          "t, tsec, time, timestamp, field.header.stamp, __time, ZeitInSec, %time)")
     payload = next((i for i, c in enumerate(names) if c.lower() == "payload"), None)
-    used = _claimed(found) | {t, payload, _nanoseconds(names, t)}
+    used = _claimed(found) | {t, payload, None if t is None else _nanoseconds(names, t)}
     ignored = tuple(names[i] for i in range(len(names)) if i not in used)
-    if form == "zrp" and ignored:
+    if form in ("zrp", "motor side") and ignored:
         raise InputError(f"{src} line 1: unknown column {ignored[0]!r}; valid columns are t, "
                          "q1..qn, qd1..qdn, tau1..taun, i1..in, qc1..qcn, payload (or a "
                          f"controller's form: {accepted_forms()})")
@@ -348,12 +355,13 @@ def _defaults(form: str, groups: dict[str, tuple[int, ...]], names: list[str]) -
             if (form, b) in DEFAULT_UNITS and pat.fullmatch(names[c])}
 
 
-def map_header(header: list[str], src: str) -> Mapping:
+def map_header(header: list[str], src: str, *, clock_required: bool = True) -> Mapping:
     """The :class:`Mapping` of ``header`` (module docstring); an InputError naming what is
-    missing, or listing the accepted forms when nothing matches."""
+    missing, or listing the accepted forms when nothing matches. ``clock_required=False``:
+    the log has no time column (its rate is given; :attr:`Mapping.time` is None)."""
     names, units = _checked_names(header, src)
     form, found = _choose(names, src)
-    t, payload, ignored = _unused(form, found, names, src)
+    t, payload, ignored = _unused(form, found, names, src, clock_required)
     joint_names: tuple[str, ...] = ()
     name_cells: tuple[int, ...] = ()
     base: int | None = None
@@ -367,4 +375,4 @@ def map_header(header: list[str], src: str) -> Mapping:
         n, base, groups = _order_indexed(found, names, src)
     return Mapping(form, n, t, groups, dict(enumerate(units)), _defaults(form, groups, names),
                    dict(enumerate(names)), payload, joint_names, name_cells, base, ignored,
-                   _nanoseconds(names, t))
+                   None if t is None else _nanoseconds(names, t))

@@ -47,6 +47,7 @@ from zrp.gap.dynamics.columns import GROUP_KIND, Mapping, map_header
 from zrp.gap.dynamics.logcheck import check_log, unmeasured_joints
 from zrp.gap.dynamics.logfile import RawTable, read_table
 from zrp.gap.dynamics.timebase import Conditioning, clock, condition
+from zrp.gap.dynamics.transmission import Transmission
 from zrp.output import atomic_path
 from zrp.units import SI_UNITS, si_factor
 
@@ -79,6 +80,8 @@ class TorqueLog:
         unmeasured: joint index (0-based) -> why its torque is not data (excluded).
         joint_names: the joints' names in log order when the log names them (ROS), else ().
         conditioning: what was done to the log on reading (:class:`Conditioning`).
+        transmission: the motor-to-joint map the log was read through (a motor-side log),
+            or None (the log is at the joints).
     """
 
     t: F64
@@ -94,6 +97,7 @@ class TorqueLog:
     unmeasured: dict[int, str] = field(default_factory=dict)
     joint_names: tuple[str, ...] = ()
     conditioning: Conditioning = field(default_factory=Conditioning)
+    transmission: Transmission | None = None
 
     def __post_init__(self) -> None:
         check_log(self)
@@ -124,7 +128,8 @@ class TorqueLog:
         return TorqueLog(self.t[:k], self.q[:k], cut(self.qd), self.tau[:k], cut(self.qc),
                          cut(self.payload), self.lines[:k] if self.lines.size else self.lines,
                          self.source, self.torque_from, segs if len(segs) > 1 else (),
-                         dict(self.unmeasured), self.joint_names, self.conditioning)
+                         dict(self.unmeasured), self.joint_names, self.conditioning,
+                         self.transmission)
 
     @property
     def dt(self) -> float:
@@ -142,7 +147,7 @@ def _factors(m: Mapping, src: str) -> tuple[dict[int, float], list[str]]:
         kinds[m.payload] = "mass"
     for c, kind in kinds.items():
         unit = m.units[c] or m.defaults.get(c)
-        if m.units[c] is None and c not in m.defaults and m.form == "zrp":
+        if m.units[c] is None and c not in m.defaults and m.form in ("zrp", "motor side"):
             bare.append(m.names[c])  # a controller's form has its documented (SI) units
         out[c] = si_factor(kind, unit, f"{src} line 1: column {m.names[c]}")
     return out, bare
@@ -183,30 +188,72 @@ def _excluded(unmeasured: dict[int, str], names: tuple[str, ...]) -> tuple[str, 
                  "not used" for k, why in sorted(unmeasured.items()))
 
 
-def _read(p: Path, src: str, n_joints: int | None, max_rows: int | None
+def _read(p: Path, src: str, n_joints: int | None, max_rows: int | None, clock_required: bool
           ) -> tuple[Mapping, dict[int, int], RawTable, dict[int, float], list[str]]:
     """The mapping, column -> position in the numbers read, the numbers, the factors to SI
     and the columns of no declared unit."""
     try:
         header, _ = read_table(p, src, None, max_rows)
-        m = map_header(header, src)
+        m = map_header(header, src, clock_required=clock_required)
         if n_joints is not None and n_joints != m.n:
             raise InputError(f"{src} line 1: the log has {m.n} joints ({m.form} form), but "
                              f"the model has {n_joints}")
         factor, bare = _factors(m, src)
-        cols = sorted({m.time, *(c for g in m.groups.values() for c in g)}
-                      | {c for c in (m.payload, m.time_ns) if c is not None})
+        cols = sorted({c for g in m.groups.values() for c in g}
+                      | {c for c in (m.time, m.payload, m.time_ns) if c is not None})
         _, raw = read_table(p, src, cols, max_rows)
     except OSError as exc:
         raise InputError(f"{src}: cannot read ({exc.strerror or exc})") from None
     if raw is None:
         raise InputError(f"{src}: no data rows after the header")
-    bare = ([m.names[m.time]] if m.units[m.time] is None and m.form == "zrp" else []) + bare
+    bare = ([m.names[m.time]] if m.time is not None and m.units[m.time] is None
+            and m.form == "zrp" else []) + bare
     return m, {c: k for k, c in enumerate(cols)}, raw, factor, bare
 
 
+def _time(m: Mapping, raw: RawTable, at: dict[int, int], rate_hz: float | None, src: str
+          ) -> tuple[F64, str]:
+    """The clock in s and what was assumed: the log's own, or the given rate."""
+    if m.time is None:
+        if rate_hz is None or not np.isfinite(rate_hz) or not 1.0 <= rate_hz <= 1e6:
+            raise InputError(f"--rate: expected a sampling rate of 1 Hz .. 1 MHz for {src}, "
+                             f"got {rate_hz!r}")
+        n = raw.values.shape[0]
+        return np.arange(n) / float(rate_hz), (f"no clock column: samples {1e3 / rate_hz:.4g} "
+                                               f"ms apart (the given rate, {rate_hz:g} Hz)")
+    t_raw = raw.values[:, at[m.time]]
+    if m.time_ns is not None:  # a Sunrise trace: ZeitInSec + ZeitInNanoSec
+        t_raw = (t_raw - t_raw[0]) + raw.values[:, at[m.time_ns]] * 1e-9
+    return clock(t_raw, m.units[m.time], _default_time(m), m.names[m.time], src)
+
+
+def _at_joints(block: dict[str, F64], tau: F64, m: Mapping, tr: Transmission | None, src: str
+               ) -> tuple[dict[str, F64], F64]:
+    """Motor-side positions and torques mapped to the joints (eq. T1 of
+    :mod:`zrp.gap.dynamics.transmission`), or the block as it is."""
+    if tr is None:
+        if m.form == "motor side":
+            raise InputError(f"--transmission: {src} is a motor-side log (qm.., taum..); give "
+                             "the transmission that maps it to the joints (gear ratios, "
+                             "coupling, offsets)")
+        return block, tau
+    if tr.n != m.n:
+        raise InputError(f"--transmission: {tr.source} maps {tr.n} motors, but {src} has "
+                         f"{m.n}")
+    out = dict(block)
+    out["q"] = tr.positions(block["q"])
+    for g in ("qd",):
+        if g in block:
+            out[g] = tr.velocities(block[g])
+    if "qc" in block:
+        out["qc"] = tr.positions(block["qc"])
+    return out, tr.torques(tau)
+
+
 def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[float] | None = None,
-                    n_joints: int | None = None, max_rows: int | None = MAX_ROWS) -> TorqueLog:
+                    n_joints: int | None = None, max_rows: int | None = MAX_ROWS,
+                    transmission: Transmission | None = None,
+                    rate_hz: float | None = None) -> TorqueLog:
     """Read a torque log (format in the module docstring), converting to SI.
 
     Args:
@@ -214,6 +261,9 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
         torque_constant: per joint, N m/A at the joint; needed when the log has currents only.
         n_joints: the model's number of joints; None: as many as the position columns.
         max_rows: most data rows read; a larger file is refused (None: no limit).
+        transmission: the log is motor side (positions, torques or currents at the motors):
+            mapped to the joints by it (a torque constant is then N m/A at the motor).
+        rate_hz: the sampling rate of a log without a time column.
 
     Raises:
         InputError: naming the file, line and column of the first problem.
@@ -223,16 +273,14 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
     if not p.is_file():
         raise InputError(f"{path}: no such file" if not p.exists() else
                          f"{path}: not a regular file")
-    m, at, raw, factor, bare = _read(p, src, n_joints, max_rows)
-    t_raw = raw.values[:, at[m.time]]
-    if m.time_ns is not None:  # a Sunrise trace: ZeitInSec + ZeitInNanoSec
-        t_raw = (t_raw - t_raw[0]) + raw.values[:, at[m.time_ns]] * 1e-9
-    t, said = clock(t_raw, m.units[m.time], _default_time(m), m.names[m.time], src)
+    m, at, raw, factor, bare = _read(p, src, n_joints, max_rows, rate_hz is None)
+    t, said = _time(m, raw, at, rate_hz, src)
     kept, segments, rec = condition(t, raw.values, raw.lines, src)
     vals, lines, t = raw.values[kept], raw.lines[kept], t[kept]
     block = {g: vals[:, [at[c] for c in cs]] * np.array([factor[c] for c in cs])
              for g, cs in m.groups.items()}
     tau, tfrom = _torques(block, m, torque_constant, src)
+    block, tau = _at_joints(block, tau, m, transmission, src)
     payload = None if m.payload is None else vals[:, at[m.payload]] * factor[m.payload]
     names = _joint_names(m, raw.first_row)
     unmeasured = unmeasured_joints(block["q"], tau)
@@ -243,10 +291,12 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
         warnings.warn(f"{src}: no unit declared for {', '.join(bare)}; "
                       f"taken as SI ({', '.join(f'{k} {u}' for k, u in SI_UNITS.items())}; m, "
                       "m/s, N for slides)", DataWarning, stacklevel=2)
-    cond = Conditioning(columns=m.describe(), clock=said, skipped_lines=raw.skipped,
+    columns = m.describe() + ("" if transmission is None else "; " + transmission.describe())
+    cond = Conditioning(columns=columns, clock=said, skipped_lines=raw.skipped,
                         excluded=_excluded(unmeasured, names), **rec)  # type: ignore[arg-type]
     return TorqueLog(t, block["q"], block.get("qd"), tau, block.get("qc"), payload, lines, src,
-                     tfrom, segments if len(segments) > 1 else (), unmeasured, names, cond)
+                     tfrom, segments if len(segments) > 1 else (), unmeasured, names, cond,
+                     transmission)
 
 
 def _default_time(m: Mapping) -> str:

@@ -36,7 +36,13 @@ from zrp.blas import blas_threads
 from zrp.errors import InputError
 from zrp.gap.dynamics.arm import DynamicArm as Arm
 from zrp.gap.dynamics.data import TorqueLog
-from zrp.gap.dynamics.effects import JOINT_EFFECTS, Effect, candidate_effects, payload_columns
+from zrp.gap.dynamics.effects import (
+    JOINT_EFFECTS,
+    MOTOR_EFFECTS,
+    Effect,
+    candidate_effects,
+    payload_columns,
+)
 from zrp.gap.dynamics.fit import cross_validate, design, solve
 from zrp.gap.dynamics.localpoly import local_fit
 from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
@@ -154,7 +160,7 @@ def _cannot_tell(effects: list[Effect], sigma: F64, limit: float) -> list[str]:
 
 
 #: Every effect name the diagnosis can try.
-EFFECT_NAMES = (*JOINT_EFFECTS, "payload", *BODY_CHANGES[1:], "inertial")
+EFFECT_NAMES = (*JOINT_EFFECTS, *MOTOR_EFFECTS, "payload", *BODY_CHANGES[1:], "inertial")
 
 
 def _known_effects(names: tuple[str, ...]) -> tuple[str, ...]:
@@ -372,7 +378,8 @@ def _setup(arm: Arm, log: TorqueLog, opt: DynamicsOptions) -> _Setup:
     s, stride = _decimated(log, opt)
     tau0 = model_torques(arm, log, s, stride)
     b, b_raw = s.tau - tau0, s.tau_raw - tau0
-    effects = candidate_effects(arm, s.q, s.qd, s.qdd, tau0, inertial=opt.inertial)
+    effects = candidate_effects(arm, s.q, s.qd, s.qdd, tau0, inertial=opt.inertial,
+                                transmission=log.transmission)
     m = log.measured
     if not np.all(m):
         b[:, ~m] = 0.0

@@ -10,6 +10,16 @@ Per joint k (column only on joint k's torque; w = qd_k):
 * ``offset``:   1 (a torque sensor's zero offset)                [N m]
 * ``gain``:     tau0_k (a torque sensor's or torque constant's scale error) [1]
 
+Per coupled motor k of a motor-side log's transmission (a motor that turns several joints,
+:meth:`~zrp.gap.dynamics.transmission.Transmission.coupled_motors`; g_k its joint-scale
+direction, w = g_k . qd its velocity at the scale of its own joint; the column is g_k times):
+
+* ``motor_coulomb``:  tanh(w / V_EPS)                          [N m]
+* ``motor_viscous``:  w                                        [N m s/rad]
+* ``motor_armature``: g_k . qdd (the rotor's inertia r_kk^2 J_m) [kg m^2]
+
+(A motor that turns one joint is that joint's ``coulomb``, ``viscous``, ``armature``.)
+
 Arm-wide:
 
 * ``payload``: a mass m at the tool point p plus its first moment m d about p (eq. E2: the
@@ -34,8 +44,10 @@ from zrp.gap.dynamics.arm import DynamicArm as Arm
 from zrp.gap.dynamics.bodies import body_effects, point_mass_columns
 from zrp.gap.dynamics.effect import Effect
 from zrp.gap.dynamics.inertia import V_EPS, base_directions
+from zrp.gap.dynamics.transmission import Transmission
 
-__all__ = ["JOINT_EFFECTS", "STRIBECK_SPEEDS", "Effect", "candidate_effects", "payload_columns"]
+__all__ = ["JOINT_EFFECTS", "MOTOR_EFFECTS", "STRIBECK_SPEEDS", "Effect", "candidate_effects",
+           "motor_effects", "payload_columns"]
 
 #: Stribeck speeds tried, rad/s (each a separate candidate; the diagnosis picks by data).
 STRIBECK_SPEEDS = (0.03, 0.1, 0.3)
@@ -49,6 +61,9 @@ EXCITED = 1e-2
 SOFT_SIGNS = (0.05,)
 
 JOINT_EFFECTS = ("coulomb", "viscous", "stribeck", "armature", "offset", "gain")
+
+#: The effects of a coupled motor (friction and rotor inertia at the motor).
+MOTOR_EFFECTS = ("motor_coulomb", "motor_viscous", "motor_armature")
 
 
 def _on_joint(col: F64, k: int, n: int) -> F64:
@@ -80,6 +95,24 @@ def _joint_effects(arm: Arm, qd: F64, qdd: F64, tau0: F64) -> list[Effect]:
     return out
 
 
+def motor_effects(transmission: Transmission | None, qd: F64, qdd: F64) -> list[Effect]:
+    """The coupled motors' friction and rotor inertia (module docstring); none without a
+    coupled motor."""
+    if transmission is None:
+        return []
+    out: list[Effect] = []
+    inf = np.inf
+    for k, g in transmission.coupled_motors():
+        w, a = qd @ g, qdd @ g
+        detail = f"motor {k + 1}"
+        for name, col, unit in (("motor_coulomb", np.tanh(w / V_EPS), "N m"),
+                                ("motor_viscous", w, "N m s/rad"),
+                                ("motor_armature", a, "kg m^2")):
+            out.append(Effect(name, k, (col[:, None] * g[None, :])[..., None], (name,),
+                              (unit,), np.array([0.0]), np.array([inf]), detail))
+    return out
+
+
 def payload_columns(arm: Arm, q: F64, qd: F64, qdd: F64) -> F64:
     """The payload block (eq. E2), shape (S, n, 4)."""
     y, _ = arm.regressor(q, qd, qdd, [arm.tool_body])
@@ -87,9 +120,10 @@ def payload_columns(arm: Arm, q: F64, qd: F64, qdd: F64) -> F64:
 
 
 def candidate_effects(arm: Arm, q: F64, qd: F64, qdd: F64, tau0: F64,
-                      inertial: bool = True) -> list[Effect]:
+                      inertial: bool = True, transmission: Transmission | None = None
+                      ) -> list[Effect]:
     """Every candidate effect along the states (module docstring)."""
-    out = _joint_effects(arm, qd, qdd, tau0)
+    out = _joint_effects(arm, qd, qdd, tau0) + motor_effects(transmission, qd, qdd)
     inf = np.inf
     # a negative payload is a tool lighter than modelled: the tool body's mass stays >= 0
     tool_mass = float(arm.body_params(arm.tool_body)[0])

@@ -27,6 +27,7 @@ from zrp.gap.dynamics.diagnosis import (
     torque_noise,
 )
 from zrp.gap.dynamics.effects import candidate_effects
+from zrp.gap.dynamics.transmission import Transmission
 
 __all__ = ["Validation", "validate"]
 
@@ -67,11 +68,12 @@ class Validation:
         return self._overall(self.noise_nm)
 
 
-def _prediction(arm: Arm, diag: DynamicDiagnosis, q: F64, qd: F64, qdd: F64, tau0: F64
-                ) -> F64:
+def _prediction(arm: Arm, diag: DynamicDiagnosis, q: F64, qd: F64, qdd: F64, tau0: F64,
+                transmission: Transmission | None = None) -> F64:
     """Eq. V1: the found effects' torques along the states (S, n)."""
     keys = {e.key for e in diag.effects}
-    cols = {e.key: e for e in candidate_effects(arm, q, qd, qdd, tau0, inertial=False)
+    cols = {e.key: e for e in candidate_effects(arm, q, qd, qdd, tau0, inertial=False,
+                                                transmission=transmission)
             if e.key in keys}
     pred = np.zeros_like(tau0)
     # the changed bodies at their resulting inertials (eq. R2): every part, link and payload
@@ -102,7 +104,7 @@ def validate(arm: Arm, diag: DynamicDiagnosis, log: TorqueLog,
     sigma = torque_noise(log, opt.window_s)
     s, stride = decimated_states(log, opt)
     tau0 = model_torques(arm, log, s, stride)
-    pred = _prediction(arm, diag, s.q, s.qd, s.qdd, tau0)
+    pred = _prediction(arm, diag, s.q, s.qd, s.qdd, tau0, log.transmission)
     b_raw = s.tau_raw - tau0
     return Validation(log.source, sigma, np.sqrt(np.mean(b_raw**2, axis=0)),
                       np.sqrt(np.mean((b_raw - pred) ** 2, axis=0)), int(b_raw.shape[0]),
