@@ -12,7 +12,7 @@ from zrp.gap.dynamics.physical import InertialFit
 from zrp.gap.dynamics.resulting import BodyChange
 from zrp.gap.dynamics.select import Step
 
-__all__ = ["DynamicDiagnosis", "FoundEffect", "Param", "Samples"]
+__all__ = ["Baseline", "DynamicDiagnosis", "FoundEffect", "Param", "Samples"]
 
 
 @dataclass(frozen=True)
@@ -38,11 +38,45 @@ class FoundEffect:
     params: dict[str, Param]
     chi2_drop: float
     rms_nm: F64 | None = None  # the RMS torque it adds on each joint along the log (n,)
+    small: bool = False  # in the model, but lowers the withheld error by too little to name
 
     @property
     def label(self) -> str:
         where = "arm" if self.joint is None else f"joint {self.joint + 1}"
         return f"{self.name} ({where}{', ' + self.detail if self.detail else ''})"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Baseline:
+    """The standard identification (:mod:`zrp.gap.dynamics.baseline`) on the diagnosis's samples.
+
+    Attributes:
+        keys: its effects (keys of :class:`~zrp.gap.dynamics.effect.Effect`).
+        effects: their fitted values (as the diagnosis's, so that a second log can be
+            scored by the same code).
+        bodies: the bodies its link inertias change (resulting inertials).
+        chi2: the withheld chi2 (eq. S1; 1 is the noise floor).
+        rms_withheld: per joint RMS of measured minus baseline torques, each segment
+            predicted by the fit on the others, N m (n,).
+        notes: what was done (link combinations left out as non-physical, ...).
+    """
+
+    keys: tuple[str, ...]
+    effects: list[FoundEffect] = field(default_factory=list)
+    bodies: dict[int, BodyChange] = field(default_factory=dict)
+    chi2: float = float("nan")
+    rms_withheld: F64 = field(default_factory=lambda: np.zeros(0))
+    notes: tuple[str, ...] = ()
+
+    @property
+    def description(self) -> str:
+        parts = ["Coulomb (0 at standstill) and viscous friction, rotor inertia and a torque "
+                 "offset on every joint"]
+        if any(k.startswith("motor_") for k in self.keys):
+            parts.append("friction and rotor inertia of the coupled motors")
+        if "inertial" in self.keys:
+            parts.append("the link inertias' identifiable combinations (physically consistent)")
+        return "IDIM-LS: " + "; ".join(parts)
 
 
 @dataclass(frozen=True)
@@ -84,6 +118,9 @@ class DynamicDiagnosis:
             (:mod:`zrp.gap.dynamics.resulting`).
         unmeasured: joints whose torque is not data (constant, zero), excluded from the fit
             and from every overall figure, with why.
+        baseline: the standard identification on the same samples and withheld segments
+            (:mod:`zrp.gap.dynamics.baseline`), or None.
+        window_s: the derivative filter's window used (chosen from the data).
     """
 
     arm: str
@@ -101,6 +138,14 @@ class DynamicDiagnosis:
     samples: Samples | None = None
     bodies: dict[int, BodyChange] = field(default_factory=dict)
     unmeasured: dict[int, str] = field(default_factory=dict)
+    baseline: Baseline | None = None
+    window_s: float = 0.1
+
+    @property
+    def found(self) -> list[FoundEffect]:
+        """The findings: the effects that clearly lower the withheld error (the others are
+        in the model but small)."""
+        return [e for e in self.effects if not e.small]
 
     @property
     def measured(self) -> np.ndarray:
