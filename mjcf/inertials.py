@@ -11,13 +11,19 @@ spec, after the joints off the arm's chain are made fixed, so that it compiles:
 * **a moving link** (one that turns with a joint of the arm, itself or rigidly attached):
 
   - principal moments below ``I_MIN`` (a point mass, or eigenvalues <= 0: not positive
-    definite) are raised to the floor ``max(2/5 m r0^2, I_MIN)`` with ``r0 = R_BALL`` = 1 mm:
-    the link becomes a uniform ball of 1 mm radius with the same mass and centre. A point
-    mass is exact physics (its torques are the m (point) terms, which are kept); the ball adds
-    ``2/5 m r0^2`` (8e-8 kg m^2 for the TX40's 0.2 kg) to the inertia about the centre, so a
-    torque changes by at most that times the link's angular acceleration (8e-7 N m at
-    10 rad/s^2, tested against Pinocchio's RNEA on the TX40). MuJoCo's own
-    ``boundinertia`` does the same to every body silently; this says which link changed;
+    definite) are raised to the floor ``max(2/5 m r0^2, I_MIN)`` with ``r0 = R_BALL`` =
+    0.1 mm: the link becomes a uniform ball of 0.1 mm radius with the same mass and centre.
+    A point mass is exact physics (its torques are the m (point) terms, which are kept); the
+    ball adds ``2/5 m r0^2`` to the inertia about the centre (8e-10 kg m^2 for the TX40's
+    0.2 kg), so a torque changes by at most that times the link's angular acceleration, a
+    fraction 0.4 (r0/d)^2 of the point mass's own m d^2 at a distance d from an axis:
+    1.6e-6 at d = 5 cm, below the 5 significant digits of a torque log. (A 1 mm ball, tried
+    first, changed a light arm's torques by 5.6e-6 of their size.) Tested against
+    Pinocchio's RNEA on the TX40 and on the point-mass arms of tests/mjcf/test_arm.py.
+    MuJoCo's own ``boundinertia`` raises the moments of every body, silently; this names
+    the link. The floor leaves a joint that turns only a point mass on its axis (the
+    TX40's joint 6) with an inertia of that size: a forward simulation of it without
+    armature is stiff (MuJoCo warns), as the file's model is singular there;
   - a triangle violation A + B < C is removed by the nearest change of the principal moments
     (the Euclidean projection onto A + B = C, landing 1e-9 C inside): A and B grow and C
     shrinks by (C - A - B)/3 each; the principal axes are kept. (MuJoCo's ``balanceinertia``
@@ -55,7 +61,7 @@ I_MIN = 1e-12
 #: The mass given to a massless moving link, kg.
 M_MIN = 1e-9
 #: The radius of the ball a point mass becomes, m.
-R_BALL = 1e-3
+R_BALL = 1e-4
 #: How far inside the triangle inequality a repaired inertia lands, relative to C.
 _INSIDE = 1e-9
 
@@ -85,8 +91,7 @@ def _tensor(body: mujoco._specs.MjsBody) -> F64:
 
 
 def _set_tensor(body: mujoco._specs.MjsBody, tensor: F64) -> None:
-    t = 0.5 * (tensor + tensor.T)
-    body.fullinertia = [t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[0, 2], t[1, 2]]
+    body.fullinertia = list(_six(0.5 * (tensor + tensor.T)))
     body.inertia = [0.0, 0.0, 0.0]
 
 
@@ -124,8 +129,8 @@ def _repair_moving(body: mujoco._specs.MjsBody) -> str | None:
     tensor = _tensor(body)
     if not (math.isfinite(mass) and mass >= 0.0 and np.isfinite(tensor).all()):
         raise MJCFImportError(f"link {body.name!r}: its inertial (mass {mass:g} kg, inertia "
-                              f"{_fmt(np.diag(tensor))} kg m^2 diagonal) is not physical and "
-                              "the link moves with the arm: correct the URDF")
+                              f"{_fmt(_six(tensor))} kg m^2 as xx, yy, zz, xy, xz, yz) is not "
+                              "physical and the link moves with the arm: correct the URDF")
     w, v = np.linalg.eigh(tensor)
     why = _invalid(mass, w)
     if why is None:
@@ -139,16 +144,24 @@ def _repair_moving(body: mujoco._specs.MjsBody) -> str | None:
 def _drop_static(body: mujoco._specs.MjsBody) -> str | None:
     mass = float(body.mass)
     tensor = _tensor(body)
-    finite = math.isfinite(mass) and np.isfinite(tensor).all()
-    why = None if not finite else _invalid(mass, np.linalg.eigh(tensor)[0])
-    if finite and mass >= 0.0 and why is None:
+    if not (math.isfinite(mass) and np.isfinite(tensor).all()):
+        why: str | None = "not finite"
+    elif mass < 0.0:
+        why = "a negative mass"
+    else:
+        why = _invalid(mass, np.linalg.eigh(tensor)[0])
+    if why is None:
         return None
     body.mass = 0.0
     body.fullinertia = [math.nan, 0.0, 0.0, 0.0, 0.0, 0.0]
     body.inertia = [0.0, 0.0, 0.0]
     return (f"link {body.name!r} does not move with the arm and its inertial is invalid "
-            f"(mass {mass:g} kg, inertia diagonal {_fmt(np.diag(tensor))} kg m^2): left out "
-            "(no effect on the arm's torques with the base fixed)")
+            f"({why}: mass {mass:g} kg, inertia {_fmt(_six(tensor))} kg m^2 as xx, yy, zz, "
+            "xy, xz, yz): left out (no effect on the arm's torques with the base fixed)")
+
+
+def _six(t: F64) -> F64:
+    return np.array([t[0, 0], t[1, 1], t[2, 2], t[0, 1], t[0, 2], t[1, 2]])
 
 
 def _group(body: mujoco._specs.MjsBody) -> list[mujoco._specs.MjsBody]:
