@@ -153,6 +153,8 @@ def test_whole_robot_to_its_flange_is_the_arm_of_pinocchio(tmp_path):
     arm = load_arm(path, end_link="arm_flange")
     assert arm.joint_names == ["torso_lift", *_ARM]
     assert arm.model.neq == 0
+    assert list(arm.model.jnt_limited) == [1, 1, 1, 1, 0, 1, 1]  # arm_joint4 continuous
+    assert arm.revolute().tolist() == [False, *[True] * 6]
     notes = "\n".join(arm.notes)
     for joint in ("wheel_l_joint", "wheel_r_joint", "head_pan", "finger_l_joint",
                   "finger_r_joint"):
@@ -204,6 +206,16 @@ def test_point_mass_end_after_a_massless_link_equals_pinocchio(tmp_path):
     tau = arm.inverse_dynamics(q, qd, qdd)
     err = np.abs(tau - ref).max(axis=1) / np.abs(ref).max(axis=1)
     assert err.max() < 1e-6, err
+
+
+def test_a_log_with_fewer_joints_fixes_the_rest_before_the_repair(tmp_path):
+    path = tmp_path / "point.urdf"
+    path.write_text(_POINT_END)
+    arm = load_arm(path, n_joints=2)  # l3 (a point mass) welded to the massless l2
+    assert arm.joint_names == ["j1", "j2"]
+    assert any("joints after link 'l2'" in n for n in arm.notes)
+    assert not any("'l2' moves with joint" in n for n in arm.notes)  # l3's mass carries it
+    assert any("link 'l3': a point mass" in n for n in arm.notes)
 
 
 def test_a_negative_mass_on_the_arm_is_refused_by_name(tmp_path):
