@@ -31,7 +31,8 @@ def _tx40_log(folder, out, rows: int = 10000, step: int = 5):
     return out
 
 
-def test_tx40_urdf_is_diagnosed(shared_dir, tmp_path, capsys):
+def test_tx40_urdf_is_diagnosed(shared_dir, tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # MuJoCo's warnings of the re-simulation go to ./MUJOCO_LOG.TXT
     folder = shared_dir.joinpath(*_DIR)
     if not (folder / "tx40_mdh_modified.urdf").is_file():
         pytest.skip("../shared/data/tx40-currents not present")
