@@ -3,9 +3,18 @@ joint, its editable spec (for the corrected model) and the tool body (where a pa
 
 Sources: an MJCF file, a URDF file with inertials (both read by
 :func:`mjcf.load_shipped_spec`: inertials, limits, damping and friction kept, ``package://``
-meshes resolved or dropped; joints off the chain to ``end_link`` are made fixed, e.g. a
-gripper's fingers), a :class:`mujoco.MjSpec`, or a ZRP manipulator built with PUMA 560
-inertias (:func:`arm_from_manipulator`).
+meshes resolved or dropped), a :class:`mujoco.MjSpec`, or a ZRP manipulator built with PUMA
+560 inertias (:func:`arm_from_manipulator`).
+
+A file may be a whole robot (a mobile base with wheels, a torso, a head, antennas, two arms,
+fingers): with ``end_link`` the arm is the chain of moving joints from the model's root to
+``end_link``, and every other moving joint is made fixed (what hangs on the chain, e.g. a
+gripper, stays as mass on its link; what is elsewhere, e.g. the wheels, is welded to the
+fixed base and does not enter the arm's torques). A floating or planar joint (a mobile
+base's, MuJoCo's free joint) is made fixed: the base is fixed. Continuous joints are hinges
+without limits. A URDF's inertials MuJoCo would refuse (point masses, massless moving links,
+inertias not positive definite or violating the triangle inequality) are repaired or, off
+the arm, left out (:mod:`mjcf.inertials`). Every such change is said in :attr:`Arm.notes`.
 """
 
 from __future__ import annotations
@@ -24,6 +33,7 @@ from numpy.typing import NDArray
 from mjcf.attachments import find_attachments
 from mjcf.builder import MJCFOptions, build
 from mjcf.errors import MJCFImportError
+from mjcf.inertials import kinematic_copy, repair_inertials
 from mjcf.inverse import body_params, gravity_torques, inverse_dynamics, regressor
 from mjcf.shipped import load_shipped_spec
 from zrp.arrays import F64
@@ -172,7 +182,7 @@ def _chain_end(spec: mujoco.MjSpec, n_joints: int, field: str) -> str | None:
     log and its first ``n_joints`` form one chain (the rest, e.g. a gripper's fingers, hang
     off its end); None otherwise."""
     try:
-        m = spec.compile()
+        m = kinematic_copy(spec)  # the joints' order, whatever the inertials
     except ValueError as exc:
         raise InputError(f"{field}: MuJoCo could not compile it: {exc}") from exc
     if m.njnt <= n_joints or n_joints < 1:
@@ -187,10 +197,10 @@ def _chain_end(spec: mujoco.MjSpec, n_joints: int, field: str) -> str | None:
     return mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, bodies[-1])
 
 
-def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> None:
+def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> list[str]:
     """Make every joint off the chain from the root to body ``end_link`` fixed (delete it:
     its body is then welded to its parent), with the equality constraints on it (a URDF
-    ``<mimic>``, e.g. a gripper's second finger)."""
+    ``<mimic>``, e.g. a gripper's second finger); the names of the joints made fixed."""
     end = spec.body(end_link)
     if end is None:
         raise InputError(f"end_link: no link (body) {end_link!r} in the model")
@@ -198,13 +208,47 @@ def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> None:
     while end.parent is not None and end.parent.name != end.name:
         end = end.parent
         chain.add(end.name)
-    off = {j.name for j in spec.joints if j.parent.name not in chain}
+    off = [j.name for j in spec.joints if j.parent.name not in chain]
+    _delete_joints(spec, set(off))
+    return off
+
+
+def _delete_joints(spec: mujoco.MjSpec, names: set[str]) -> None:
+    """Delete the joints ``names`` and the equality constraints on them."""
     for eq in list(spec.equalities):
-        if eq.name1 in off or eq.name2 in off:
+        if eq.name1 in names or eq.name2 in names:
             spec.delete(eq)
     for j in list(spec.joints):
-        if j.name in off:
+        if j.name in names:
             spec.delete(j)
+
+
+def _fix_base(spec: mujoco.MjSpec, path: Path) -> tuple[str, ...]:
+    """Make the free joints of ``spec`` and a URDF's floating and planar joints (MuJoCo's
+    ``NAME_TX``, ``NAME_TY``, ``NAME_RZ``) fixed: a mobile base becomes a fixed base."""
+    planar: set[str] = set()
+    if path.suffix.lower() == ".urdf":
+        try:
+            tree = read_urdf(path)
+        except ModelFileError:
+            tree = None  # its joints are read again (velocity limits), and said there
+        for j in tree.joints.values() if tree is not None else ():
+            if j.type in ("floating", "planar"):
+                planar |= {j.name, f"{j.name}_TX", f"{j.name}_TY", f"{j.name}_RZ"}
+    free = int(mujoco.mjtJoint.mjJNT_FREE)
+    names = [j.name for j in spec.joints if j.name in planar or int(j.type) == free]
+    if not names:
+        return ()
+    _delete_joints(spec, set(names))
+    return (f"the floating/planar joint(s) {', '.join(map(repr, names))} (a mobile base) "
+            "are made fixed: the base is fixed",)
+
+
+def _urdf_inertials(spec: mujoco.MjSpec, field: str) -> tuple[str, ...]:
+    try:
+        return repair_inertials(spec)
+    except MJCFImportError as exc:
+        raise InputError(f"{field}: {exc}") from exc
 
 
 def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | None = None,
@@ -214,7 +258,8 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
 
     Args:
         source: MJCF (.xml) or URDF (.urdf) path, or a :class:`mujoco.MjSpec`.
-        end_link: the last link (body) of the arm: joints off its chain are fixed.
+        end_link: the last link (body) of the arm: joints off its chain from the root are
+            made fixed (a whole robot's wheels, head, other arm, fingers).
         tool_site: the site where a payload sits; None: the last joint's body origin.
         name: for reports (default: the file's stem).
         n_joints: the joints the log has: a model with more, whose first ``n_joints`` form a
@@ -231,16 +276,20 @@ def load_arm(source: str | os.PathLike[str] | mujoco.MjSpec, *, end_link: str | 
         spec = load_shipped_spec(path)
     except MJCFImportError as exc:
         raise InputError(f"{field}: cannot load: {exc}") from exc
-    notes: tuple[str, ...] = ()
+    notes = _fix_base(spec, path)
     if end_link is None and n_joints is not None:
         end_link = _chain_end(spec, n_joints, field)
         if end_link is not None:
-            notes = (f"the model has more joints than the log's {n_joints}: joints after "
-                     f"link {end_link!r} (e.g. a gripper's fingers) are made fixed",)
+            notes += (f"the model has more joints than the log's {n_joints}: joints after "
+                      f"link {end_link!r} (e.g. a gripper's fingers) are made fixed",)
     if end_link is not None:
-        _fix_off_chain(spec, end_link)
+        off = _fix_off_chain(spec, end_link)
+        if off:
+            notes += (f"the arm is the chain from the root to link {end_link!r}; the other "
+                      f"moving joints are made fixed: {', '.join(off)}",)
     velocity = None
     if path.suffix.lower() == ".urdf":
+        notes += _urdf_inertials(spec, field)
         try:
             velocity = urdf_velocity_limits(path)
         except ModelFileError as exc:
