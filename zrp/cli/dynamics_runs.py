@@ -21,6 +21,7 @@ from zrp.gap.dynamics.data import load_torque_log
 from zrp.gap.dynamics.diagnosis import DynamicsOptions
 from zrp.gap.dynamics.report import REPORT_FILES, run_json, write_run
 from zrp.gap.dynamics.run import TrackingOptions, run_dynamics
+from zrp.gap.dynamics.transmission import load_transmission
 from zrp.gap.dynamics.verdict import headline
 from zrp.output import OutputDir, check_writable
 
@@ -35,14 +36,17 @@ def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = Fals
     check_writable([out / n for n in REPORT_FILES], overwrite)
     if (args.kp is None) != (args.kv is None):
         raise InputError("--kp, --kv: give both (the servo's stiffness and damping) or neither")
-    log = load_torque_log(args.data, torque_constant=args.torque_constant)
+    tr = None if args.transmission is None else load_transmission(args.transmission)
+    log = load_torque_log(args.data, torque_constant=args.torque_constant, transmission=tr,
+                          rate_hz=args.rate)
     arm = resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site,
                       n_joints=log.n_joints)
     if log.n_joints != arm.n:
         raise InputError(f"--data: {log.source} has {log.n_joints} joints, but the model "
                          f"{args.model!r} has {arm.n}")
     second = None if args.validate is None else load_torque_log(
-        args.validate, torque_constant=args.torque_constant, n_joints=arm.n)
+        args.validate, torque_constant=args.torque_constant, n_joints=arm.n, transmission=tr,
+        rate_hz=args.rate)
     run = run_dynamics(arm, log, options=DynamicsOptions(window_s=args.window,
                                                          inertial=not args.no_inertial),
                        validation_log=second, writer=CorrectedMJCF(arm),

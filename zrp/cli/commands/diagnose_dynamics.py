@@ -28,6 +28,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tool-site", metavar="SITE", help="MJCF site where a payload sits")
     p.add_argument("--torque-constant", type=GAIN, nargs="+", metavar="KT",
                    help="N m/A per joint, when the log has currents i1..in")
+    p.add_argument("--transmission", metavar="T.toml",
+                   help="the log is motor side (positions and torques at the motors): the "
+                   "drive's transmission, a TOML file with `ratio` (motor = ratio @ joint; "
+                   "couplings off the diagonal) and `joint_offset` (rad); the coupled motors' "
+                   "friction and rotor inertia become effects (zrp/gap/dynamics/README.md)")
+    p.add_argument("--rate", type=real(1.0, 1e6, unit="Hz"), metavar="HZ",
+                   help="the sampling rate of a log without a time column")
     p.add_argument("--validate", metavar="LOG2.csv",
                    help="a second torque log of the same arm (another run): the corrected "
                    "model, fitted on --data, is scored on it (nothing refitted)")
@@ -46,7 +53,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--force", action="store_true", help="replace outputs in --out")
     p.add_argument("--json", action="store_true", help="print diagnosis.json")
     p.set_defaults(func=_run, api_names={"torque_constant": "--torque-constant",
-                                         "window_s": "--window", "end_link": "--end-link"})
+                                         "window_s": "--window", "end_link": "--end-link",
+                                         "rate_hz": "--rate"})
 
 
 def _run(args: argparse.Namespace) -> int:

@@ -240,6 +240,11 @@ def _at_joints(block: dict[str, F64], tau: F64, m: Mapping, tr: Transmission | N
     if tr.n != m.n:
         raise InputError(f"--transmission: {tr.source} maps {tr.n} motors, but {src} has "
                          f"{m.n}")
+    if tr.log == "joint":
+        if m.form == "motor side":
+            raise InputError(f"--transmission: {tr.source} says log = \"joint\", but {src} "
+                             "names motor-side columns (qm.., taum..)")
+        return block, tau
     out = dict(block)
     out["q"] = tr.positions(block["q"])
     for g in ("qd",):

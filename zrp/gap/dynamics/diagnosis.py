@@ -35,12 +35,15 @@ from zrp.arrays import F64
 from zrp.blas import blas_threads
 from zrp.errors import InputError
 from zrp.gap.dynamics.arm import DynamicArm as Arm
+from zrp.gap.dynamics.baseline import standard_effects
+from zrp.gap.dynamics.cvgram import CVGram
 from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.effects import (
     JOINT_EFFECTS,
     MOTOR_EFFECTS,
     Effect,
     candidate_effects,
+    inertial_correction,
     payload_columns,
 )
 from zrp.gap.dynamics.fit import cross_validate, design, solve
@@ -48,8 +51,8 @@ from zrp.gap.dynamics.localpoly import local_fit
 from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
 from zrp.gap.dynamics.resulting import BodyChange, ChangedArm, link_changes, resulting_bodies
-from zrp.gap.dynamics.results import DynamicDiagnosis, FoundEffect, Param, Samples
-from zrp.gap.dynamics.select import Step, forward_select
+from zrp.gap.dynamics.results import Baseline, DynamicDiagnosis, FoundEffect, Param, Samples
+from zrp.gap.dynamics.select import Step, chi2_of, forward_select
 from zrp.gap.dynamics.states import States, derive_states
 
 __all__ = ["EFFECT_NAMES", "DynamicDiagnosis", "DynamicsOptions", "FoundEffect", "decimated_states",
@@ -308,6 +311,73 @@ def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, si
     return chosen, fitted, notes
 
 
+_Gated = tuple[list[Effect], "_Fitted", list[str]]
+
+
+def _baseline(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int) -> Baseline:
+    """The standard identification (:mod:`zrp.gap.dynamics.baseline`) on the same samples
+    and withheld segments: unconstrained least squares, as the field fits it (its link
+    combinations are a score, never written to a file)."""
+    std = standard_effects(su.effects)
+    pred = CVGram(std, su.b, su.sigma, opt.folds, guard).predict([e.key for e in std])
+    d = design(std, *su.b.shape)
+    theta = solve(d, su.b, su.sigma, with_cov=False).theta
+    found, phi = [], {}
+    for e, sl in zip(std, d.slices, strict=True):
+        if e.name == "inertial" and e.basis is not None:
+            phi = {b: p - arm.body_params(b)
+                   for b, p in inertial_correction(arm, theta[sl], e.basis).items()}
+            continue
+        params = {p: Param(float(theta[sl][i]), float(theta[sl][i]), float(theta[sl][i]),
+                           e.units[i]) for i, p in enumerate(e.params)}
+        found.append(FoundEffect(e.key, e.name, e.joint, e.detail, params, 0.0))
+    r = su.b_raw - pred
+    return Baseline(keys=tuple(e.key for e in std), effects=found, phi_change=phi,
+                    chi2=chi2_of(su.b_raw, pred, su.sigma),
+                    rms_withheld=np.sqrt(np.mean(r * r, axis=0)))
+
+
+def _not_worse(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int, steps: list[Step],
+               selected: _Gated) -> tuple[Baseline, list[Effect], _Fitted, list[str]]:
+    """The final model never worse on the withheld segments than the standard
+    identification (eq. B0): when the selected effects lose to it, they are completed with
+    its terms (or replaced by it when that is still worse), said in the notes."""
+    base = _baseline(arm, su, opt, guard)
+    chosen, fitted, notes = selected
+    chi2 = chi2_of(su.b_raw, fitted.pred, su.sigma)
+    if base.chi2 >= chi2 * (1.0 - 1e-3):
+        return base, chosen, fitted, notes
+    taken = {(e.name, e.joint) for e in chosen}
+    more = [e for e in standard_effects(su.effects) if (e.name, e.joint) not in taken]
+    union = _physical_gate(arm, chosen + more, steps, su.b, su.sigma, opt, guard, None)
+    c_union = chi2_of(su.b_raw, union[1].pred, su.sigma)
+    if c_union >= chi2:
+        return base, chosen, fitted, [*notes, (
+            f"the standard identification predicts the withheld segments better (chi2 "
+            f"{base.chi2:.3g} against {chi2:.3g}) with link combinations that are not "
+            "physical; the physical model with its terms does not (chi2 "
+            f"{c_union:.3g}): the selected effects are kept")]
+    added = [e.key for e in union[0] if e.key not in {c.key for c in chosen}]
+    why = (f"the selected effects alone predict the withheld segments worse than the standard "
+           f"identification (chi2 {chi2:.3g} against {base.chi2:.3g}); completed with its "
+           f"terms {', '.join(added) or '-'} (withheld chi2 now {c_union:.3g})")
+    return base, union[0], union[1], [*union[2], why]
+
+
+def _small(chosen: list[Effect], found: list[FoundEffect], su: _Setup, opt: DynamicsOptions,
+           guard: int) -> list[FoundEffect]:
+    """Each effect's withheld chi2 drop in the final set (the rise without it, the others
+    refitted); one below the selection's threshold is small: in the model, not a finding."""
+    cv = CVGram(chosen, su.b, su.sigma, opt.folds, guard)
+    keys = [e.key for e in chosen]
+    full = chi2_of(su.b_raw, cv.predict(keys), su.sigma)
+    limit = max(opt.min_rel * full, opt.min_abs)
+    drops = {k: chi2_of(su.b_raw, cv.predict([c for c in keys if c != k]), su.sigma) - full
+             for k in keys}
+    return [replace(f, chi2_drop=drops.get(f.key, f.chi2_drop),
+                    small=drops.get(f.key, np.inf) < limit) for f in found]
+
+
 def _idle(found: list[FoundEffect], sigma: F64) -> list[str]:
     """The effects the final fit leaves at nothing (their torques taken by others): no
     findings."""
@@ -412,6 +482,9 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
                                          guard=guard, min_rel=opt.min_rel, min_abs=opt.min_abs,
                                          max_effects=opt.max_effects or 3 * arm.n + 4)
     chosen, fitted, gate_notes = _physical_gate(arm, chosen, steps, b, sigma, opt, guard, pred)
+    base, chosen, fitted, gate_notes = _not_worse(arm, su, opt, guard, steps,
+                                                  (chosen, fitted, gate_notes))
+    fitted = replace(fitted, found=_small(chosen, fitted.found, su, opt, guard))
     masks = regime_masks(s.qd, arm.gravity_torques(s.q), guard)
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
             "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
@@ -426,4 +499,5 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
                             opt.collinear),
         {"before": regime_rms(b_raw, masks), "after": regime_rms(b_raw - pred, masks)},
         inert, {} if inert is None else inert.phi, _notes(arm, log, su, fitted, gate_notes),
-        Samples(s.t, s.q, s.qd, b_raw, b_raw - pred), bodies, dict(log.unmeasured))
+        Samples(s.t, s.q, s.qd, b_raw, b_raw - pred), bodies, dict(log.unmeasured), base,
+        s.window_s)

@@ -41,15 +41,15 @@ def _fmt(v: float | None) -> str:
 def _verdict(d: DynamicDiagnosis, validation: Validation | None) -> list[str]:
     """The headline, then one line per finding in words."""
     out = [md_text(headline(d, validation))]
-    if d.effects:
-        out += ["", *(md_line("- {}", effect_words(d, e)) for e in d.effects)]
+    if d.found:
+        out += ["", *(md_line("- {}", effect_words(d, e)) for e in d.found)]
     return out
 
 
 def _effects(d: DynamicDiagnosis) -> list[str]:
     out = ["| effect | parameter | value | 95 % interval | unit | withheld chi2 drop |",
            "|---|---|---|---|---|---|"]
-    for e in d.effects:
+    for e in d.found:
         for k, p in e.params.items():
             if k.startswith("beta"):
                 continue
@@ -83,6 +83,30 @@ def _validation(v: Validation, joints: list[str]) -> list[str]:
     return out
 
 
+def _step(s: Any) -> str:
+    if s.replaces:
+        return md_line("{} for {} {}", s.key, s.replaces, f"{s.chi2:.3g}")
+    return md_line("{} {}", s.key, f"{s.chi2:.3g}")
+
+
+def _baseline(d: DynamicDiagnosis, v: Validation | None) -> list[str]:
+    """The standard identification on the same samples (and the second log)."""
+    b = d.baseline
+    if b is None:
+        return ["- not fitted"]
+    m = d.measured
+    out = [md_line("{}, fitted on the same samples and scored on the same withheld time "
+                   "segments: {} N m RMS (withheld chi2 {}); the corrected model {} N m "
+                   "(chi2 {}).", b.description, f"{overall_rms(b.rms_withheld, m):.3g}",
+                   f"{b.chi2:.3g}", f"{overall_rms(d.rms_after, m):.3g}",
+                   f"{d.steps[-1].chi2 if d.steps else float('nan'):.3g}")]
+    if v is not None and v.overall_baseline is not None:
+        out.append(md_line("On {}: the standard identification {} N m, the corrected model {} "
+                           "N m.", v.source, f"{v.overall_baseline:.3g}",
+                           f"{v.overall_after:.3g}"))
+    return out
+
+
 def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
                     validation: Validation | None = None) -> str:
     """The report's text (``extra``: more sections, heading -> lines; ``validation``: the
@@ -106,10 +130,16 @@ def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
     if validation is not None:
         lines += ["", "## Validation on another log (N m RMS)", "",
                   *_validation(validation, d.joints)]
+    lines += ["", "## Against the standard identification", "", *_baseline(d, validation)]
     lines += ["", "## Effects found", ""]
-    lines += _effects(d) if d.effects else ["None: the torques are explained to the noise."]
+    lines += _effects(d) if d.found else ["None: the torques are explained to the noise."]
+    small = [e for e in d.effects if e.small]
+    if small:
+        lines += ["", "Small effects (in the corrected model; each lowers the withheld error by "
+                  "less than the selection's threshold, so none is a finding): "
+                  + md_text(", ".join(e.label for e in small)) + "."]
     lines += ["", "## Selection (withheld chi2: 1 is the noise floor)", "",
-              " -> ".join(md_line("{} {}", s.key, f"{s.chi2:.3g}") for s in d.steps), "",
+              " -> ".join(_step(s) for s in d.steps), "",
               "## Where: residual RMS per regime (N m; before / after)", ""]
     lines += _regimes(d)
     lines += ["", "## Cannot tell", ""]
@@ -170,7 +200,8 @@ def _validation_json(v: Validation | None) -> dict[str, Any] | None:
     return {"source": v.source, "samples": v.samples, "noise_nm": v.noise_nm,
             "rms_before_nm": v.rms_before, "rms_after_nm": v.rms_after,
             "overall_before_nm": v.overall_before, "overall_after_nm": v.overall_after,
-            "overall_noise_nm": v.overall_noise}
+            "overall_noise_nm": v.overall_noise, "rms_baseline_nm": v.rms_baseline,
+            "overall_baseline_nm": v.overall_baseline}
 
 
 def _bodies_json(d: DynamicDiagnosis) -> list[dict[str, Any]]:
@@ -191,6 +222,12 @@ def diagnosis_json(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
            "validation": _validation_json(validation), "bodies": _bodies_json(d),
            "steps": [asdict(s) for s in d.steps],
            "effects": [asdict(e) for e in d.effects], "cannot_tell": d.cannot_tell,
+           "baseline": None if d.baseline is None else {
+               "method": d.baseline.description, "effects": list(d.baseline.keys),
+               "withheld_chi2": d.baseline.chi2,
+               "rms_withheld_nm": d.baseline.rms_withheld,
+               "overall_withheld_nm": overall_rms(d.baseline.rms_withheld, d.measured)},
+           "window_s": d.window_s,
            "regimes": d.regimes, "inertial_fit": _inertial_fit(d),
            "inertial_phi": {str(b): v for b, v in d.inertial_phi.items()}, "notes": d.notes}
     return to_jsonable({**out, **(extra or {})})

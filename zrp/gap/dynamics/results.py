@@ -52,21 +52,19 @@ class Baseline:
 
     Attributes:
         keys: its effects (keys of :class:`~zrp.gap.dynamics.effect.Effect`).
-        effects: their fitted values (as the diagnosis's, so that a second log can be
-            scored by the same code).
-        bodies: the bodies its link inertias change (resulting inertials).
+        effects: the fitted values of its joint and motor terms (no intervals: a score).
+        phi_change: the change of each moving body's phi (eq. R1) by its link combinations
+            (unconstrained: may be no physical body; never written to a model).
         chi2: the withheld chi2 (eq. S1; 1 is the noise floor).
         rms_withheld: per joint RMS of measured minus baseline torques, each segment
             predicted by the fit on the others, N m (n,).
-        notes: what was done (link combinations left out as non-physical, ...).
     """
 
     keys: tuple[str, ...]
     effects: list[FoundEffect] = field(default_factory=list)
-    bodies: dict[int, BodyChange] = field(default_factory=dict)
+    phi_change: dict[int, F64] = field(default_factory=dict)
     chi2: float = float("nan")
     rms_withheld: F64 = field(default_factory=lambda: np.zeros(0))
-    notes: tuple[str, ...] = ()
 
     @property
     def description(self) -> str:
@@ -75,7 +73,8 @@ class Baseline:
         if any(k.startswith("motor_") for k in self.keys):
             parts.append("friction and rotor inertia of the coupled motors")
         if "inertial" in self.keys:
-            parts.append("the link inertias' identifiable combinations (physically consistent)")
+            parts.append("the link inertias' identifiable combinations (least squares, "
+                         "unconstrained)")
         return "IDIM-LS: " + "; ".join(parts)
 
 

@@ -26,7 +26,9 @@ Read from a small TOML file (``zrp diagnose-dynamics --transmission FILE``)::
     joint_offset = [0.0, -1.5707963267948966, 1.5707963267948966, 0.0, 0.0, 0.0]  # rad
 
 ``ratio`` may also be a list of n numbers (no coupling). ``joint_offset`` (rad or m, added
-after the inverse; default 0) is optional.
+after the inverse; default 0) is optional. ``log = "joint"`` says that the log was already
+converted to the joints (by hand, or by the controller): nothing is mapped, and the coupled
+motors' effects are still candidates (default ``log = "motor"``).
 """
 
 from __future__ import annotations
@@ -52,7 +54,8 @@ __all__ = ["MAX_RATIO", "Transmission", "load_transmission"]
 MAX_RATIO = 1e4
 #: Largest transmission file read, bytes.
 MAX_BYTES = 1_000_000
-_KEYS = ("ratio", "joint_offset")
+_KEYS = ("ratio", "joint_offset", "log")
+_SIDES = ("motor", "joint")
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -63,14 +66,19 @@ class Transmission:
         ratio: R, shape (n, n): motor positions = R @ joint positions.
         joint_offset: added to the joint positions after R^-1, shape (n,).
         source: where it was read (for messages and the report).
+        log: "motor" (the log is at the motors: mapped) or "joint" (already at the joints).
     """
 
     ratio: F64
     joint_offset: F64
     source: str = "transmission"
+    log: str = "motor"
 
     def __post_init__(self) -> None:
         _check(self.ratio, self.joint_offset, self.source)
+        if self.log not in _SIDES:
+            raise InputError(f"{self.source}: log must be one of {', '.join(_SIDES)}, got "
+                             f"{self.log!r}")
 
     @property
     def n(self) -> int:
@@ -104,8 +112,9 @@ class Transmission:
     def describe(self) -> str:
         """One line for the report's notes."""
         ratios = ", ".join(f"{r:g}" for r in np.diag(self.ratio))
-        text = (f"motor-side log mapped to the joints by the transmission of {self.source} "
-                f"(gear ratios {ratios}")
+        what = ("motor-side log mapped to the joints by" if self.log == "motor" else
+                "joint-side log; the drive's motors as declared in")
+        text = f"{what} the transmission of {self.source} (gear ratios {ratios}"
         couples = [f"motor {k + 1} turns with joints "
                    + " and ".join(str(j + 1) for j in self.joints_of(k))
                    for k, _ in self.coupled_motors()]
@@ -117,7 +126,7 @@ class Transmission:
 
     def as_json(self) -> dict[str, Any]:
         return {"source": self.source, "ratio": self.ratio.tolist(),
-                "joint_offset": self.joint_offset.tolist()}
+                "joint_offset": self.joint_offset.tolist(), "log": self.log}
 
 
 def _check(ratio: F64, offset: F64, src: str) -> None:
@@ -177,4 +186,6 @@ def load_transmission(path: str | os.PathLike[str]) -> Transmission:
         offset = np.asarray(data.get("joint_offset", np.zeros(n)), dtype=float).ravel()
     except (TypeError, ValueError):
         raise InputError(f"--transmission: {src}: joint_offset must be numbers") from None
-    return Transmission(ratio=ratio, joint_offset=offset, source=src)
+    side = data.get("log", "motor")
+    return Transmission(ratio=ratio, joint_offset=offset, source=src,
+                        log=side if isinstance(side, str) else repr(side))

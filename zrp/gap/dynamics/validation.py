@@ -27,6 +27,7 @@ from zrp.gap.dynamics.diagnosis import (
     torque_noise,
 )
 from zrp.gap.dynamics.effects import candidate_effects
+from zrp.gap.dynamics.results import Baseline
 from zrp.gap.dynamics.transmission import Transmission
 
 __all__ = ["Validation", "validate"]
@@ -50,6 +51,11 @@ class Validation:
     rms_after: F64
     samples: int
     measured: np.ndarray | None = None  # per joint: its torque is data (None: all)
+    rms_baseline: F64 | None = None  # the standard identification's, nothing refitted
+
+    @property
+    def overall_baseline(self) -> float | None:
+        return None if self.rms_baseline is None else self._overall(self.rms_baseline)
 
     def _overall(self, x: F64) -> float:
         m = np.ones(x.size, dtype=bool) if self.measured is None else self.measured
@@ -93,6 +99,22 @@ def _prediction(arm: Arm, diag: DynamicDiagnosis, q: F64, qd: F64, qdd: F64, tau
     return pred
 
 
+def _baseline_prediction(arm: Arm, base: Baseline, q: F64, qd: F64, qdd: F64, tau0: F64,
+                         transmission: Transmission | None) -> F64:
+    """The standard identification's torques along the states (its link combinations as the
+    change of every body's phi, its joint and motor terms by their columns)."""
+    pred = np.zeros_like(tau0)
+    if base.phi_change:
+        bodies = sorted(base.phi_change)
+        y, _ = arm.regressor(q, qd, qdd, bodies)
+        pred += y @ np.concatenate([base.phi_change[b] for b in bodies])
+    cols = {e.key: e for e in candidate_effects(arm, q, qd, qdd, tau0, inertial=False,
+                                                transmission=transmission)}
+    for f in base.effects:
+        pred += cols[f.key].columns @ np.array([f.params[p].value for p in f.params])
+    return pred
+
+
 def validate(arm: Arm, diag: DynamicDiagnosis, log: TorqueLog,
              options: DynamicsOptions | None = None) -> Validation:
     """Score ``diag``'s corrected model on ``log`` (module docstring); ``options`` as the
@@ -106,6 +128,11 @@ def validate(arm: Arm, diag: DynamicDiagnosis, log: TorqueLog,
     tau0 = model_torques(arm, log, s, stride)
     pred = _prediction(arm, diag, s.q, s.qd, s.qdd, tau0, log.transmission)
     b_raw = s.tau_raw - tau0
+    base = None
+    if diag.baseline is not None:
+        r = b_raw - _baseline_prediction(arm, diag.baseline, s.q, s.qd, s.qdd, tau0,
+                                         log.transmission)
+        base = np.sqrt(np.mean(r * r, axis=0))
     return Validation(log.source, sigma, np.sqrt(np.mean(b_raw**2, axis=0)),
                       np.sqrt(np.mean((b_raw - pred) ** 2, axis=0)), int(b_raw.shape[0]),
-                      log.measured & diag.measured)
+                      log.measured & diag.measured, base)

@@ -26,6 +26,9 @@ _JOINT_WORDS = {"coulomb": "Coulomb friction", "viscous": "viscous friction",
                 "stribeck": "a Stribeck friction bump", "armature": "rotor inertia (armature)",
                 "offset": "a torque-sensor offset", "gain": "a torque-sensor gain"}
 
+_MOTOR_WORDS = {"motor_coulomb": "Coulomb friction", "motor_viscous": "viscous friction",
+                "motor_armature": "rotor inertia"}
+
 
 def overall_rms(per_joint: F64, measured: np.ndarray | None = None) -> float:
     """The RMS over the (measured) joints of per-joint RMS values (equal samples per
@@ -84,6 +87,12 @@ def effect_words(d: DynamicDiagnosis, e: FoundEffect) -> str:
     if e.joint is not None and e.name in _JOINT_WORDS:
         p = next(iter(e.params.values()))
         return f"{_JOINT_WORDS[e.name]} on joint {e.joint + 1} ({p.value:.3g} {p.unit})"
+    if e.name in _MOTOR_WORDS:
+        p = next(iter(e.params.values()))
+        turns = " and ".join(str(k + 1) for k in np.flatnonzero(e.rms_nm)) if (
+            e.rms_nm is not None) else ""
+        return (f"{_MOTOR_WORDS[e.name]} of {e.detail}, which turns with joints {turns} "
+                f"({p.value:.3g} {p.unit} at joint scale)")
     return e.label
 
 
@@ -100,7 +109,7 @@ def _findings(d: DynamicDiagnosis) -> str:
     """The findings, the joint effects of one kind grouped."""
     parts: list[str] = []
     grouped: dict[str, list[FoundEffect]] = {}
-    for e in d.effects:
+    for e in d.found:
         if e.joint is not None and e.name in _JOINT_WORDS:
             if e.name not in grouped:
                 parts.append(e.name)
@@ -144,7 +153,7 @@ def _headline(d: DynamicDiagnosis) -> str:
     head = (f"Withheld torque error {before:.3g} -> {after:.3g} N m RMS over all joints "
             f"({removed:.0%} removed; noise floor {noise:.3g} N m). Largest misses: "
             f"{_misses(np.where(m, d.rms_before, 0.0), d.rms_after, d.noise_nm)}.")
-    if not d.effects:
+    if not d.found:
         return head.split(" Largest")[0] + (" The model's torques match the log down to the "
                                             "noise; no effect is needed.")
     ratio = np.where(m, d.rms_after / d.noise_nm, 0.0)
@@ -153,4 +162,6 @@ def _headline(d: DynamicDiagnosis) -> str:
                "What remains: " + ", ".join(f"joint {k + 1} at {ratio[k]:.1f}x its noise "
                                             f"({d.rms_after[k]:.3g} N m)" for k in left[:2])
                + ".")
-    return f"{head} Found: {_findings(d)}. {remains}"
+    small = sum(e.small for e in d.effects)
+    also = f" ({small} small effect{'s' if small > 1 else ''} too, listed apart)" if small else ""
+    return f"{head} Found: {_findings(d)}{also}. {remains}"
