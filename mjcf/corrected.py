@@ -48,6 +48,10 @@ __all__ = ["CorrectedMJCF", "Corrections", "corrected_spec", "corrected_xml", "c
 #: The smallest mass written for a body (kg): MuJoCo refuses a moving body without mass.
 MIN_MASS_KG = 1e-6
 
+#: The smallest principal inertia written for a body (kg m^2): above MuJoCo's mjMINVAL
+#: (1e-15), far below any torque it could move.
+MIN_INERTIA = 1e-12
+
 #: Relative agreement of a written body with what MuJoCo compiled from it.
 HELD_RTOL = 1e-9
 
@@ -107,11 +111,24 @@ def _body_name(m: mujoco.MjModel, b: int) -> str:
     return name
 
 
+def compilable_inertia(w: F64) -> F64:
+    """Principal inertias (3,) of a physical body (eq. R5) as MuJoCo's compiler takes them:
+    each at least :data:`MIN_INERTIA`, none above the sum of the other two. A physical body
+    satisfies both but for rounding; a body on the boundary (a model's own flat link, a
+    point mass, a link the log never moves keeps its values to rounding) would otherwise be
+    refused ("inertia must satisfy A + B >= C"). The change is of the order of rounding."""
+    w = np.maximum(np.asarray(w, dtype=float), MIN_INERTIA)
+    for i in range(3):
+        others = w[(i + 1) % 3] + w[(i + 2) % 3]
+        w[i] = min(w[i], others)
+    return w
+
+
 def _set_inertial(body: mujoco.MjsBody, phi: F64) -> None:
     """Write phi_b (eq. R1) as mass, centre, principal inertias and their frame."""
     mass = max(float(phi[0]), MIN_MASS_KG)  # a link emptied of its mass stays compilable
     c, quat, w = principal_inertia(phi, mass)
-    w = np.maximum(w, 0.0)  # rounding of a physical body (eq. R5) never below zero
+    w = compilable_inertia(w)
     body.explicitinertial = True
     body.mass = mass
     body.ipos = c
