@@ -150,7 +150,28 @@ def _tool(m: mujoco.MjModel, tool_site: str | None, field: str) -> tuple[int, F6
         if sid < 0:
             raise InputError(f"tool_site: no site {tool_site!r} in {field}")
         return int(m.site_bodyid[sid]), np.array(m.site_pos[sid], dtype=float)
-    return int(m.jnt_bodyid[m.njnt - 1]), np.zeros(3)
+    return _end_body(m), np.zeros(3)
+
+
+def _ancestors(m: mujoco.MjModel, b: int) -> list[int]:
+    out = [b]
+    while b > 0:
+        b = int(m.body_parentid[b])
+        out.append(b)
+    return out
+
+
+def _end_body(m: mujoco.MjModel) -> int:
+    """The arm's last link: the last joint's body, or, when the joints end in branches (a
+    gripper's fingers, each on its own joint), the body they all hang from (the hand's link),
+    so that a payload never sits on a finger."""
+    bodies = {int(m.jnt_bodyid[k]) for k in range(m.njnt)}
+    leaves = [b for b in bodies if not any(b in _ancestors(m, c)[1:] for c in bodies)]
+    common = set(_ancestors(m, leaves[0]))
+    for b in leaves[1:]:
+        common &= set(_ancestors(m, b))
+    end = max(common, key=lambda b: len(_ancestors(m, b)))
+    return end if end > 0 else int(m.jnt_bodyid[m.njnt - 1])
 
 
 def _from_spec(spec: mujoco.MjSpec, name: str, tool_site: str | None, field: str,

@@ -88,6 +88,10 @@ def gravity_torques(m: mujoco.MjModel, q: F64) -> F64:
         m.dof_frictionloss[:] = fl
 
 
+#: The body fields :func:`set_body_params` writes.
+_BODY_FIELDS = ("body_sameframe", "body_mass", "body_ipos", "body_iquat", "body_inertia")
+
+
 def _steps(phi: F64) -> F64:
     """A step per parameter of the scale of the body (eq. R3 holds for any step)."""
     mass = max(abs(phi[0]), 1e-3)
@@ -103,6 +107,8 @@ def regressor(m: mujoco.MjModel, bodies: Iterable[int], q: F64, qd: F64, qdd: F6
     cols, labels = [], []
     for b in bodies:
         phi0 = body_params(m, b)
+        # the model's own fields, restored bit for bit (writing phi0 back would round them)
+        saved = [np.array(getattr(m, f)[b]) for f in _BODY_FIELDS]
         for j, step in enumerate(_steps(phi0)):
             phi = phi0.copy()
             phi[j] += step
@@ -110,6 +116,7 @@ def regressor(m: mujoco.MjModel, bodies: Iterable[int], q: F64, qd: F64, qdd: F6
             try:
                 cols.append((inverse_dynamics(m, q, qd, qdd) - tau0) / step)
             finally:
-                set_body_params(m, b, phi0)
+                for f, v in zip(_BODY_FIELDS, saved, strict=True):
+                    getattr(m, f)[b] = v
             labels.append((b, PARAM_NAMES[j]))
     return np.stack(cols, axis=-1), labels

@@ -11,8 +11,9 @@ scored on the same withheld time segments (and on a second log by
 :func:`zrp.gap.dynamics.validation.validate`).
 
 The diagnosis names the effects that explain the gap; this is the bar it must clear: its
-final model (:class:`~zrp.gap.dynamics.results.Baseline` holds this one's) is never worse on the withheld segments than the baseline (eq. B0, applied in
-:mod:`zrp.gap.dynamics.diagnosis`).
+final model is never worse on the withheld segments than the baseline (eq. B0, applied in
+:mod:`zrp.gap.dynamics.diagnosis`; :class:`~zrp.gap.dynamics.results.Baseline` holds the
+baseline's figures).
 """
 
 from __future__ import annotations

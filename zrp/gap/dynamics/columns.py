@@ -69,8 +69,9 @@ GROUP_KIND = {"q": "position", "qd": "velocity", "tau": "effort", "i": "current"
 #: Longest accepted column name (a real header has names of tens of characters).
 MAX_NAME = 1000
 
-_SEPS = {"zrp": ("",), "motor side": ("",), "libfranka": ("", "_", "[]", "."), "UR RTDE": ("_", "[]", ""),
-         "KUKA FRI/Sunrise": ("_a", "a", "_", "[]", ""), "KUKA FRI pyfri": ("",)}
+_SEPS = {"zrp": ("",), "motor side": ("",), "libfranka": ("", "_", "[]", "."),
+         "UR RTDE": ("_", "[]", ""), "KUKA FRI/Sunrise": ("_a", "a", "_", "[]", ""),
+         "KUKA FRI pyfri": ("",)}
 
 #: form -> group -> base names (lowercase).
 FORMS: dict[str, dict[str, tuple[str, ...]]] = {

@@ -3,10 +3,8 @@ one run; its effects, with the values fitted there, predict the torques of a sec
 fit never saw (another excitation, another day). Per joint and overall RMS before (the
 model) and after (the corrected model), against that log's own noise floor.
 
-The prediction (eq. V1) along the second log's states is the model's inverse dynamics plus
-the exact torque change Y_b (phi_b - phi0_b) (eq. R2) of every body the diagnosis changed
-(:attr:`DynamicDiagnosis.bodies`: link inertias, a part not on the arm, a link's mass, a
-payload), and each other found effect's columns (:mod:`.effects`) times its fitted values.
+The prediction along the second log's states is the corrected model's torques (eq. V1,
+:func:`zrp.gap.dynamics.prediction.corrected_torques`).
 """
 
 from __future__ import annotations
@@ -26,9 +24,7 @@ from zrp.gap.dynamics.diagnosis import (
     model_torques,
     torque_noise,
 )
-from zrp.gap.dynamics.effects import candidate_effects
-from zrp.gap.dynamics.results import Baseline
-from zrp.gap.dynamics.transmission import Transmission
+from zrp.gap.dynamics.prediction import baseline_torques, corrected_torques
 
 __all__ = ["Validation", "validate"]
 
@@ -74,47 +70,6 @@ class Validation:
         return self._overall(self.noise_nm)
 
 
-def _prediction(arm: Arm, diag: DynamicDiagnosis, q: F64, qd: F64, qdd: F64, tau0: F64,
-                transmission: Transmission | None = None) -> F64:
-    """Eq. V1: the found effects' torques along the states (S, n)."""
-    keys = {e.key for e in diag.effects}
-    cols = {e.key: e for e in candidate_effects(arm, q, qd, qdd, tau0, inertial=False,
-                                                transmission=transmission)
-            if e.key in keys}
-    pred = np.zeros_like(tau0)
-    # the changed bodies at their resulting inertials (eq. R2): every part, link and payload
-    # effect and the link inertias at once
-    in_bodies = {k for c in diag.bodies.values() for k in c.effects}
-    if diag.bodies:
-        bodies = sorted(diag.bodies)
-        y, _ = arm.regressor(q, qd, qdd, bodies)
-        pred += y @ np.concatenate([diag.bodies[b].phi - diag.bodies[b].phi0 for b in bodies])
-    for f in diag.effects:
-        if f.key in in_bodies:
-            continue
-        e = cols.get(f.key)
-        if e is None:
-            raise InputError(f"validate: effect {f.key} cannot be evaluated on this arm")
-        pred += e.columns @ np.array([f.params[p].value for p in e.params])
-    return pred
-
-
-def _baseline_prediction(arm: Arm, base: Baseline, q: F64, qd: F64, qdd: F64, tau0: F64,
-                         transmission: Transmission | None) -> F64:
-    """The standard identification's torques along the states (its link combinations as the
-    change of every body's phi, its joint and motor terms by their columns)."""
-    pred = np.zeros_like(tau0)
-    if base.phi_change:
-        bodies = sorted(base.phi_change)
-        y, _ = arm.regressor(q, qd, qdd, bodies)
-        pred += y @ np.concatenate([base.phi_change[b] for b in bodies])
-    cols = {e.key: e for e in candidate_effects(arm, q, qd, qdd, tau0, inertial=False,
-                                                transmission=transmission)}
-    for f in base.effects:
-        pred += cols[f.key].columns @ np.array([f.params[p].value for p in f.params])
-    return pred
-
-
 def validate(arm: Arm, diag: DynamicDiagnosis, log: TorqueLog,
              options: DynamicsOptions | None = None) -> Validation:
     """Score ``diag``'s corrected model on ``log`` (module docstring); ``options`` as the
@@ -126,12 +81,12 @@ def validate(arm: Arm, diag: DynamicDiagnosis, log: TorqueLog,
     sigma = torque_noise(log, opt.window_s)
     s, stride = decimated_states(log, opt)
     tau0 = model_torques(arm, log, s, stride)
-    pred = _prediction(arm, diag, s.q, s.qd, s.qdd, tau0, log.transmission)
+    pred = corrected_torques(arm, diag, s.q, s.qd, s.qdd, tau0, log.transmission)
     b_raw = s.tau_raw - tau0
     base = None
     if diag.baseline is not None:
-        r = b_raw - _baseline_prediction(arm, diag.baseline, s.q, s.qd, s.qdd, tau0,
-                                         log.transmission)
+        r = b_raw - baseline_torques(arm, diag.baseline, s.q, s.qd, s.qdd, tau0,
+                                     log.transmission)
         base = np.sqrt(np.mean(r * r, axis=0))
     return Validation(log.source, sigma, np.sqrt(np.mean(b_raw**2, axis=0)),
                       np.sqrt(np.mean((b_raw - pred) ** 2, axis=0)), int(b_raw.shape[0]),
