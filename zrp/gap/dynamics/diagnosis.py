@@ -52,7 +52,7 @@ from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, phys
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
 from zrp.gap.dynamics.resulting import BodyChange, ChangedArm, link_changes, resulting_bodies
 from zrp.gap.dynamics.results import Baseline, DynamicDiagnosis, FoundEffect, Param, Samples
-from zrp.gap.dynamics.select import Step, chi2_of, forward_select
+from zrp.gap.dynamics.select import KEPT, Step, chi2_of, forward_select
 from zrp.gap.dynamics.states import States, derive_states
 
 __all__ = ["EFFECT_NAMES", "DynamicDiagnosis", "DynamicsOptions", "FoundEffect", "decimated_states",
@@ -296,7 +296,9 @@ def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, si
         if not culprits:
             break
         # the link inertias are the last resort: a named part or link stays, they go
-        key = "inertial" if "inertial" in culprits else culprits[-1]
+        order = [e.key for e in chosen]
+        key = "inertial" if "inertial" in culprits else max(
+            culprits, key=lambda k: order.index(k) if k in order else -1)
         body = next(c for c in bad if key in c.effects)
         notes.append(f"{key} left out: with it link {body.name} would not be physical (mass "
                      f"{body.phi[0]:.3g} kg, or a centre or inertia no body can have)")
@@ -340,12 +342,13 @@ def _baseline(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int) -> Baselin
 def _not_worse(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int, steps: list[Step],
                selected: _Gated) -> tuple[Baseline, list[Effect], _Fitted, list[str]]:
     """The final model never worse on the withheld segments than the standard
-    identification (eq. B0): when the selected effects lose to it, they are completed with
-    its terms (or replaced by it when that is still worse), said in the notes."""
+    identification (eq. B0): when the selected effects lose to it clearly (by the
+    selection's own threshold, ``min_rel``), they are completed with its terms, said in the
+    notes."""
     base = _baseline(arm, su, opt, guard)
     chosen, fitted, notes = selected
     chi2 = chi2_of(su.b_raw, fitted.pred, su.sigma)
-    if base.chi2 >= chi2 * (1.0 - 1e-3):
+    if base.chi2 >= chi2 * (1.0 - opt.min_rel):
         return base, chosen, fitted, notes
     taken = {(e.name, e.joint) for e in chosen}
     more = [e for e in standard_effects(su.effects) if (e.name, e.joint) not in taken]
@@ -361,19 +364,28 @@ def _not_worse(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int, steps: li
     why = (f"the selected effects alone predict the withheld segments worse than the standard "
            f"identification (chi2 {chi2:.3g} against {base.chi2:.3g}); completed with its "
            f"terms {', '.join(added) or '-'} (withheld chi2 now {c_union:.3g})")
-    return base, union[0], union[1], [*union[2], why]
+    return base, union[0], union[1], [*notes, *union[2], why]
 
 
 def _small(chosen: list[Effect], found: list[FoundEffect], su: _Setup, opt: DynamicsOptions,
            guard: int) -> list[FoundEffect]:
     """Each effect's withheld chi2 drop in the final set (the rise without it, the others
-    refitted); one below the selection's threshold is small: in the model, not a finding."""
+    refitted); one below the selection's threshold is small: in the model, not a finding. A
+    part of the model (payload, a part not on the arm) is weighed without the link
+    combinations, which can carry any body's torques (the selection named the part)."""
+    if not chosen:
+        return found
     cv = CVGram(chosen, su.b, su.sigma, opt.folds, guard)
     keys = [e.key for e in chosen]
     full = chi2_of(su.b_raw, cv.predict(keys), su.sigma)
     limit = max(opt.min_rel * full, opt.min_abs)
-    drops = {k: chi2_of(su.b_raw, cv.predict([c for c in keys if c != k]), su.sigma) - full
-             for k in keys}
+    drops = {}
+    for e in chosen:
+        with_ = [k for k in keys if e.name not in KEPT or not k.startswith("inertial")]
+        ref = full if len(with_) == len(keys) else chi2_of(su.b_raw, cv.predict(with_),
+                                                            su.sigma)
+        drops[e.key] = chi2_of(su.b_raw, cv.predict([k for k in with_ if k != e.key]),
+                               su.sigma) - ref
     return [replace(f, chi2_drop=drops.get(f.key, f.chi2_drop),
                     small=drops.get(f.key, np.inf) < limit) for f in found]
 
