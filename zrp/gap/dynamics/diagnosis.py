@@ -316,10 +316,11 @@ def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, si
 _Gated = tuple[list[Effect], "_Fitted", list[str]]
 
 
-def _baseline(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int) -> Baseline:
+def _baseline(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int
+              ) -> tuple[Baseline, F64]:
     """The standard identification (:mod:`zrp.gap.dynamics.baseline`) on the same samples
     and withheld segments: unconstrained least squares, as the field fits it (its link
-    combinations are a score, never written to a file)."""
+    combinations are a score, never written to a file); and its withheld prediction."""
     std = standard_effects(su.effects)
     pred = CVGram(std, su.b, su.sigma, opt.folds, guard).predict([e.key for e in std])
     d = design(std, *su.b.shape)
@@ -336,35 +337,43 @@ def _baseline(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int) -> Baselin
     r = su.b_raw - pred
     return Baseline(keys=tuple(e.key for e in std), effects=found, phi_change=phi,
                     chi2=chi2_of(su.b_raw, pred, su.sigma),
-                    rms_withheld=np.sqrt(np.mean(r * r, axis=0)))
+                    rms_withheld=np.sqrt(np.mean(r * r, axis=0))), pred
 
 
 def _not_worse(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int, steps: list[Step],
                selected: _Gated) -> tuple[Baseline, list[Effect], _Fitted, list[str]]:
     """The final model never worse on the withheld segments than the standard
-    identification (eq. B0): when the selected effects lose to it clearly (by the
-    selection's own threshold, ``min_rel``), they are completed with its terms, said in the
-    notes."""
-    base = _baseline(arm, su, opt, guard)
+    identification (eq. B0), in noise units (chi2) and in N m over the joints (what the
+    report gives): when the selected effects lose to it clearly (by the selection's own
+    threshold, ``min_rel``), they are completed with its terms, said in the notes."""
+    base, base_pred = _baseline(arm, su, opt, guard)
     chosen, fitted, notes = selected
-    chi2 = chi2_of(su.b_raw, fitted.pred, su.sigma)
-    if base.chi2 >= chi2 * (1.0 - opt.min_rel):
+    score, ref = _scores(su, fitted.pred), _scores(su, base_pred)
+    if all(r >= x * (1.0 - opt.min_rel) for r, x in zip(ref, score, strict=True)):
         return base, chosen, fitted, notes
     taken = {(e.name, e.joint) for e in chosen}
     more = [e for e in standard_effects(su.effects) if (e.name, e.joint) not in taken]
     union = _physical_gate(arm, chosen + more, steps, su.b, su.sigma, opt, guard, None)
-    c_union = chi2_of(su.b_raw, union[1].pred, su.sigma)
-    if c_union >= chi2:
+    got = _scores(su, union[1].pred)
+    if not all(g <= x for g, x in zip(got, score, strict=True)):
         return base, chosen, fitted, [*notes, (
             f"the standard identification predicts the withheld segments better (chi2 "
-            f"{base.chi2:.3g} against {chi2:.3g}) with link combinations that are not "
-            "physical; the physical model with its terms does not (chi2 "
-            f"{c_union:.3g}): the selected effects are kept")]
+            f"{ref[0]:.3g}, {ref[1]:.3g} N m against {score[0]:.3g}, {score[1]:.3g} N m) but "
+            f"not once physical with the selected effects (chi2 {got[0]:.3g}, {got[1]:.3g} "
+            "N m): the selected effects are kept")]
     added = [e.key for e in union[0] if e.key not in {c.key for c in chosen}]
     why = (f"the selected effects alone predict the withheld segments worse than the standard "
-           f"identification (chi2 {chi2:.3g} against {base.chi2:.3g}); completed with its "
-           f"terms {', '.join(added) or '-'} (withheld chi2 now {c_union:.3g})")
+           f"identification (chi2 {score[0]:.3g}, {score[1]:.3g} N m against {ref[0]:.3g}, "
+           f"{ref[1]:.3g} N m); completed with its terms {', '.join(added) or '-'} (now chi2 "
+           f"{got[0]:.3g}, {got[1]:.3g} N m)")
     return base, union[0], union[1], [*notes, *union[2], why]
+
+
+def _scores(su: _Setup, pred: F64) -> tuple[float, float]:
+    """The withheld chi2 and the withheld RMS over the joints (N m) of a prediction (a
+    joint whose torque is not data has no residual: it counts as zero in both)."""
+    r = su.b_raw - pred
+    return chi2_of(su.b_raw, pred, su.sigma), float(np.sqrt(np.mean(r * r)))
 
 
 def _small(chosen: list[Effect], found: list[FoundEffect], su: _Setup, opt: DynamicsOptions,
