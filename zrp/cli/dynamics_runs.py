@@ -10,15 +10,18 @@ from pathlib import Path
 
 import numpy as np
 
-from mjcf.arm import resolve_arm
+from mjcf.arm import Arm, resolve_arm
 from mjcf.corrected import CorrectedMJCF
+from mjcf.joint_names import chain_end, model_joints
 from sim.studies.dynamics import benchmark as bm
 from sim.studies.dynamics.arms import available_arms
 from sim.studies.dynamics.scenarios import KINDS
 from zrp.errors import InputError
 from zrp.escape import md_row
-from zrp.gap.dynamics.data import load_torque_log
+from zrp.gap.dynamics.bag import read_log
+from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.diagnosis import DynamicsOptions
+from zrp.gap.dynamics.joints import match_joints
 from zrp.gap.dynamics.report import REPORT_FILES, run_json, write_run
 from zrp.gap.dynamics.run import TrackingOptions, run_dynamics
 from zrp.gap.dynamics.verdict import headline
@@ -35,14 +38,13 @@ def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = Fals
     check_writable([out / n for n in REPORT_FILES], overwrite)
     if (args.kp is None) != (args.kv is None):
         raise InputError("--kp, --kv: give both (the servo's stiffness and damping) or neither")
-    log = load_torque_log(args.data, torque_constant=args.torque_constant)
-    arm = resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site,
-                      n_joints=log.n_joints)
-    if log.n_joints != arm.n:
-        raise InputError(f"--data: {log.source} has {log.n_joints} joints, but the model "
-                         f"{args.model!r} has {arm.n}")
-    second = None if args.validate is None else load_torque_log(
-        args.validate, torque_constant=args.torque_constant, n_joints=arm.n)
+    log = read_log(args.data, torque_constant=args.torque_constant, topic=args.topic)
+    arm = _arm(args, log)
+    every = model_joints(args.model) or tuple(arm.joint_names)
+    log = match_joints(log, arm.joint_names, model_joints=every, option="--data")
+    second = None if args.validate is None else match_joints(
+        read_log(args.validate, torque_constant=args.torque_constant, topic=args.topic),
+        arm.joint_names, model_joints=every, option="--validate")
     run = run_dynamics(arm, log, options=DynamicsOptions(window_s=args.window,
                                                          inertial=not args.no_inertial),
                        validation_log=second, writer=CorrectedMJCF(arm),
@@ -52,6 +54,25 @@ def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = Fals
     text = headline(run.diagnosis, run.validation) + (
         f"\nwrote {folder}/report.html, report.md, diagnosis.json, corrected.xml")
     return run_json(run), text
+
+
+def _arm(args: argparse.Namespace, log: TorqueLog) -> Arm:
+    """The arm: the chain of ``--joints`` or to ``--end-link``; for a log naming its joints,
+    the whole model otherwise (its joints matched by name); for an unnamed log, as many
+    leading joints as the log has when they form a chain (said in the notes)."""
+    joints = getattr(args, "joints", None)
+    if joints and args.end_link:
+        raise InputError("--joints, --end-link: give one (both choose the arm's chain)")
+    if joints:
+        end = chain_end(args.model, joints)
+        arm = resolve_arm(args.model, end_link=end, tool_site=args.tool_site)
+        if sorted(arm.joint_names) != sorted(joints):
+            raise InputError(f"--joints: the chain from the model's root to link {end!r} has "
+                             f"the joints {', '.join(arm.joint_names)}; --joints names "
+                             f"{', '.join(joints)}")
+        return arm
+    return resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site,
+                       n_joints=None if log.joint_names else log.n_joints)
 
 
 def _gains(values: list[float] | None) -> np.ndarray | None:

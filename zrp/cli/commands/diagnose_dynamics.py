@@ -13,6 +13,15 @@ DEFAULT_OUT = Path("renders") / "dynamics"
 GAIN = real(0.0, 1e9, open_lo=True)
 
 
+def KT(text: str) -> float:
+    """A signed torque constant, N m/A: finite, nonzero, |kt| <= 1e9."""
+    value = real(-1e9, 1e9)(text)
+    if value == 0.0:
+        raise argparse.ArgumentTypeError("0 is no torque constant (nonzero; negative when the "
+                                         "drive's current counts the other way)")
+    return value
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "diagnose-dynamics", help="where a MuJoCo model's joint torques miss a torque log, and why",
@@ -23,12 +32,22 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Writes report.html/.md, the residual plots, diagnosis.json and corrected.xml.")
     p.add_argument("--model", required=True, metavar="M.xml|M.urdf|NAME",
                    help="MJCF or URDF (with inertials) of the arm, or a ZRP model")
-    p.add_argument("--data", required=True, metavar="LOG.csv", help="the torque log")
+    p.add_argument("--data", required=True, metavar="LOG.csv|BAG",
+                   help="the torque log: a CSV, or a ROS bag (.mcap, .db3, a ROS 2 bag "
+                   "folder, a ROS 1 .bag) of sensor_msgs/msg/JointState")
+    p.add_argument("--topic", metavar="NAME", help="the bag's JointState topic (default: its "
+                   "only one)")
     p.add_argument("--end-link", metavar="LINK", help="URDF: the arm's last link")
+    p.add_argument("--joints", nargs="+", metavar="NAME",
+                   help="the arm's joints by name (its chain; default: those the log names, "
+                   "or to --end-link); the log's others the model has are left out")
     p.add_argument("--tool-site", metavar="SITE", help="MJCF site where a payload sits")
-    p.add_argument("--torque-constant", type=GAIN, nargs="+", metavar="KT",
-                   help="N m/A per joint, when the log has currents i1..in")
-    p.add_argument("--validate", metavar="LOG2.csv",
+    p.add_argument("--torque-constant", type=KT, nargs="+", metavar="KT",
+                   help="the drive's signed torque constant per joint, N m/A at the joint "
+                   "(gear included; negative when its current counts the other way), in the "
+                   "log's joint order, when the log has currents i1..in (a bag: its efforts "
+                   "are then the currents)")
+    p.add_argument("--validate", metavar="LOG2.csv|BAG2",
                    help="a second torque log of the same arm (another run): the corrected "
                    "model, fitted on --data, is scored on it (nothing refitted)")
     p.add_argument("--window", type=real(0.0, 10.0, open_lo=True, unit="s"), default=0.1,
