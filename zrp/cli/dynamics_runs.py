@@ -30,15 +30,44 @@ from zrp.output import OutputDir, check_writable
 __all__ = ["run_benchmark", "run_diagnosis"]
 
 
-def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = False
-                  ) -> tuple[dict, str]:
+class Stages:
+    """The stages of a run on stderr: a bar naming the stage, on a terminal only
+    (``progress``: from :func:`zrp.cli.options.draw_bar`)."""
+
+    def __init__(self, total: int, progress: bool, desc: str) -> None:
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=total, desc=desc, unit="stage", disable=not progress,
+                        leave=False)
+
+    def __call__(self, name: str) -> None:
+        self.bar.set_postfix_str(name, refresh=False)
+        self.bar.update(1)
+
+    def close(self) -> None:
+        self.bar.close()
+
+
+def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = False,
+                  progress: bool = False) -> tuple[dict, str]:
     """Diagnose (:func:`zrp.gap.dynamics.run.run_dynamics`), write the outputs; the JSON and
     the summary text (``overwrite``: replace files in ``out``, from --force or the default
-    folder's mark; checked before any work)."""
+    folder's mark; checked before any work; ``progress``: the stages on stderr)."""
     check_writable([out / n for n in REPORT_FILES], overwrite)
     if (args.kp is None) != (args.kv is None):
         raise InputError("--kp, --kv: give both (the servo's stiffness and damping) or neither")
+    stage = Stages(7 if args.validate else 6, progress, "diagnose-dynamics")
+    try:
+        return _diagnose(args, out, overwrite, stage)
+    finally:
+        stage.close()
+
+
+def _diagnose(args: argparse.Namespace, out: Path, overwrite: bool, stage: Stages
+              ) -> tuple[dict, str]:
+    stage("reading the log")
     log = read_log(args.data, torque_constant=args.torque_constant, topic=args.topic)
+    stage("loading the model")
     arm = _arm(args, log)
     every = model_joints(args.model) or tuple(arm.joint_names)
     log = match_joints(log, arm.joint_names, model_joints=every, option="--data")
@@ -49,7 +78,9 @@ def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = Fals
                                                          inertial=not args.no_inertial),
                        validation_log=second, writer=CorrectedMJCF(arm),
                        tracking=TrackingOptions(kp=_gains(args.kp), kv=_gains(args.kv),
-                                                seconds=args.seconds))
+                                                seconds=args.seconds),
+                       progress=stage)
+    stage("writing the report")
     folder = write_run(run, out, overwrite=overwrite)
     text = headline(run.diagnosis, run.validation) + (
         f"\nwrote {folder}/report.html, report.md, diagnosis.json, corrected.xml")

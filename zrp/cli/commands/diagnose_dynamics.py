@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.cli.options import DURATION, real
+from zrp.cli.options import DURATION, add_progress, draw_bar, real
 from zrp.output import claim_generated, safe_name
 
 DEFAULT_OUT = Path("renders") / "dynamics"
@@ -64,6 +64,8 @@ def register(sub: argparse._SubParsersAction) -> None:
                    "replaced; elsewhere existing files need --force)")
     p.add_argument("--force", action="store_true", help="replace outputs in --out")
     p.add_argument("--json", action="store_true", help="print diagnosis.json")
+    add_progress(p, help="show the stage (reading, diagnosing, validating, re-simulating, "
+                 "writing) on stderr when it is a terminal (default on; --no-progress: none)")
     p.set_defaults(func=_run, api_names={"torque_constant": "--torque-constant",
                                          "window_s": "--window", "end_link": "--end-link"})
 
@@ -75,6 +77,6 @@ def _run(args: argparse.Namespace) -> int:
     out = Path(args.out) if args.out else DEFAULT_OUT / safe_name(Path(args.data).stem,
                                                                   default="log")
     overwrite = args.force or (args.out is None and claim_generated(out))
-    payload, text = run_diagnosis(args, out, overwrite=overwrite)
+    payload, text = run_diagnosis(args, out, overwrite=overwrite, progress=draw_bar(args))
     emit(args, payload, text)
     return 0

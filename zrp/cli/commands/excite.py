@@ -6,7 +6,7 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.cli.options import FINITE, SEED, real, whole
+from zrp.cli.options import FINITE, SEED, add_progress, draw_bar, real, whole
 from zrp.limits import (
     MAX_COMMAND_SAMPLES,
     MAX_DESIGN_CANDIDATES,
@@ -60,6 +60,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", required=True, metavar="COMMAND.csv")
     p.add_argument("--force", action="store_true", help="replace --out")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
+    add_progress(p, help="show the design's starts and steps as a bar on stderr when it is a "
+                 "terminal (default on; --no-progress: none)")
     p.set_defaults(func=_run, api_names={
         "end_link": "--end-link", "q0": "--q0", "amplitude": "--amplitude", "q_amp": "--amplitude",
         "max_velocity": "--max-velocity", "qd_max": "--max-velocity",
@@ -74,15 +76,21 @@ def _one(values: list[float] | None) -> float | list[float] | None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
     from mjcf.arm import resolve_arm  # MuJoCo: only when this command runs
     from zrp.gap.dynamics import command as c  # on use: keeps --help quick
 
     arm = resolve_arm(args.model, end_link=args.end_link)
-    cmd = c.excitation_command(arm, c.ExciteOptions(
+    opts = c.ExciteOptions(
         q0=args.q0, amplitude=_one(args.amplitude), max_velocity=_one(args.max_velocity),
         max_acceleration=_one(args.max_acceleration), max_torque=_one(args.max_torque),
         deg=args.deg, period_s=args.period, rate_hz=args.rate, harmonics=args.harmonics,
-        candidates=args.candidates, iterations=args.iterations, seed=args.seed))
+        candidates=args.candidates, iterations=args.iterations, seed=args.seed)
+    with tqdm(total=args.candidates + args.iterations, desc="excite", unit="design",
+              disable=not draw_bar(args), leave=False) as bar:
+        cmd = c.excitation_command(arm, opts,
+                                   progress=lambda done, _total: bar.update(done - bar.n))
     out = c.write_excitation_command(cmd, Path(args.out), model=args.model, overwrite=args.force)
     payload, text = c.command_summary(cmd, notes=getattr(arm, "notes", ()))
     emit(args, payload, text + f"\nwrote {out}")
