@@ -190,7 +190,8 @@ def _chain_end(spec: mujoco.MjSpec, n_joints: int, field: str) -> str | None:
 def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> None:
     """Make every joint off the chain from the root to body ``end_link`` fixed (delete it:
     its body is then welded to its parent), with the equality constraints on it (a URDF
-    ``<mimic>``, e.g. a gripper's second finger)."""
+    ``<mimic>``, e.g. a gripper's second finger), the actuators driving it and the keyframes
+    (an MJCF's)."""
     end = spec.body(end_link)
     if end is None:
         raise InputError(f"end_link: no link (body) {end_link!r} in the model")
@@ -202,6 +203,11 @@ def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> None:
     for eq in list(spec.equalities):
         if eq.name1 in off or eq.name2 in off:
             spec.delete(eq)
+    for act in list(spec.actuators):  # an MJCF's motor on a joint made fixed (issue 44)
+        if act.target in off:
+            spec.delete(act)
+    for key in list(spec.keys) if off else []:  # its keyframes' qpos no longer fit
+        spec.delete(key)
     for j in list(spec.joints):
         if j.name in off:
             spec.delete(j)
