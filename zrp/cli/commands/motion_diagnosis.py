@@ -86,10 +86,10 @@ def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[obje
 
 def _trajectory(args: argparse.Namespace, model: object, load_csv: object) -> object:
     """The trajectory of --data: a ROS bag's two topics, or the CSV."""
-    from zrp.gap.data.rosbag import is_bag
+    from zrp.gap.data.rosbag import is_bag  # on use: keeps --help quick
 
     if is_bag(args.data):
-        from zrp.gap.motion.trajbag import load_trajectory_bag
+        from zrp.gap.motion.trajbag import load_trajectory_bag  # on use: keeps --help quick
 
         return load_trajectory_bag(args.data, model, topic=args.topic,  # type: ignore[arg-type]
                                    point_topic=args.point_topic, frame=args.frame,
