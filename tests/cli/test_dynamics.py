@@ -174,3 +174,11 @@ def test_diagnose_dynamics_joints_and_signed_constants(ur5e_bags, tmp_path, caps
 
     parsed = build_parser().parse_args([*args, "-8.7", "1", "1", "1", "1", "1"])
     assert parsed.torque_constant[0] == -8.7
+    # excite takes the same --joints
+    code = main(["excite", "--model", model, "--joints", *five, "--q0", "0", "-1.2", "1.2",
+                 "-1.5", "-1.5", "--amplitude", "0.3", "--candidates", "1", "--iterations",
+                 "1", "--rate", "100", "--out", str(tmp_path / "cmd.csv"), "--json",
+                 "--no-progress"])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert len(json.loads(captured.out)["q0"]) == 5

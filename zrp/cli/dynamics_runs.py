@@ -27,7 +27,7 @@ from zrp.gap.dynamics.run import TrackingOptions, run_dynamics
 from zrp.gap.dynamics.verdict import headline
 from zrp.output import OutputDir, check_writable
 
-__all__ = ["run_benchmark", "run_diagnosis"]
+__all__ = ["arm_of_joints", "run_benchmark", "run_diagnosis"]
 
 
 class Stages:
@@ -95,15 +95,21 @@ def _arm(args: argparse.Namespace, log: TorqueLog) -> Arm:
     if joints and args.end_link:
         raise InputError("--joints, --end-link: give one (both choose the arm's chain)")
     if joints:
-        end = chain_end(args.model, joints)
-        arm = resolve_arm(args.model, end_link=end, tool_site=args.tool_site)
-        if sorted(arm.joint_names) != sorted(joints):
-            raise InputError(f"--joints: the chain from the model's root to link {end!r} has "
-                             f"the joints {', '.join(arm.joint_names)}; --joints names "
-                             f"{', '.join(joints)}")
-        return arm
+        return arm_of_joints(args.model, joints, tool_site=args.tool_site)
     return resolve_arm(args.model, end_link=args.end_link, tool_site=args.tool_site,
                        n_joints=None if log.joint_names else log.n_joints)
+
+
+def arm_of_joints(model: str, joints: list[str], *, tool_site: str | None = None) -> Arm:
+    """The arm whose chain is ``joints`` (``--joints``, by name): the model's chain to the
+    last of them, which must hold exactly them."""
+    end = chain_end(model, joints)
+    arm = resolve_arm(model, end_link=end, tool_site=tool_site)
+    if sorted(arm.joint_names) != sorted(joints):
+        raise InputError(f"--joints: the chain from the model's root to link {end!r} has the "
+                         f"joints {', '.join(arm.joint_names)}; --joints names "
+                         f"{', '.join(joints)}")
+    return arm
 
 
 def _gains(values: list[float] | None) -> np.ndarray | None:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from zrp.cli.app import emit
 from zrp.cli.options import FINITE, SEED, add_progress, draw_bar, real, whole
+from zrp.errors import InputError
 from zrp.limits import (
     MAX_COMMAND_SAMPLES,
     MAX_DESIGN_CANDIDATES,
@@ -28,6 +29,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "torque log.")
     p.add_argument("--model", required=True, metavar="M.xml|M.urdf|NAME")
     p.add_argument("--end-link", metavar="LINK", help="URDF: the arm's last link")
+    p.add_argument("--joints", nargs="+", metavar="NAME",
+                   help="instead of --end-link: the arm's joints by name (its chain)")
     p.add_argument("--q0", type=FINITE, nargs="+", required=True, metavar="RAD",
                    help="the posture the motion is centred on, rad (--deg: degrees); inside "
                    "the joint limits")
@@ -81,7 +84,14 @@ def _run(args: argparse.Namespace) -> int:
     from mjcf.arm import resolve_arm  # MuJoCo: only when this command runs
     from zrp.gap.dynamics import command as c  # on use: keeps --help quick
 
-    arm = resolve_arm(args.model, end_link=args.end_link)
+    if args.joints:
+        from zrp.cli.dynamics_runs import arm_of_joints  # MuJoCo: only when this command runs
+
+        if args.end_link:
+            raise InputError("--joints, --end-link: give one (both choose the arm's chain)")
+        arm = arm_of_joints(args.model, args.joints)
+    else:
+        arm = resolve_arm(args.model, end_link=args.end_link)
     opts = c.ExciteOptions(
         q0=args.q0, amplitude=_one(args.amplitude), max_velocity=_one(args.max_velocity),
         max_acceleration=_one(args.max_acceleration), max_torque=_one(args.max_torque),
