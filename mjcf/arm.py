@@ -221,7 +221,8 @@ def _chain_end(spec: mujoco.MjSpec, n_joints: int, field: str) -> str | None:
 def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> list[str]:
     """Make every joint off the chain from the root to body ``end_link`` fixed (delete it:
     its body is then welded to its parent), with the equality constraints on it (a URDF
-    ``<mimic>``, e.g. a gripper's second finger); the names of the joints made fixed."""
+    ``<mimic>``, e.g. a gripper's second finger), the actuators driving it and the keyframes
+    (an MJCF's); the names of the joints made fixed."""
     end = spec.body(end_link)
     if end is None:
         raise InputError(f"end_link: no link (body) {end_link!r} in the model")
@@ -235,10 +236,16 @@ def _fix_off_chain(spec: mujoco.MjSpec, end_link: str) -> list[str]:
 
 
 def _delete_joints(spec: mujoco.MjSpec, names: set[str]) -> None:
-    """Delete the joints ``names`` and the equality constraints on them."""
+    """Delete the joints ``names``, the equality constraints on them, the actuators driving
+    them and (when any joint goes) the keyframes, whose qpos no longer fit."""
     for eq in list(spec.equalities):
         if eq.name1 in names or eq.name2 in names:
             spec.delete(eq)
+    for act in list(spec.actuators):  # an MJCF's motor on a joint made fixed (issue 44)
+        if act.target in names:
+            spec.delete(act)
+    for key in list(spec.keys) if names else []:
+        spec.delete(key)
     for j in list(spec.joints):
         if j.name in names:
             spec.delete(j)

@@ -26,8 +26,10 @@ ROOT = Path(__file__).resolve().parents[2]
 PACKAGES = ("zrp", "mjcf", "sim")
 LAYER = {"core": 0, "mjcf": 1, "sim": 2, "cli": 3}
 # threadpoolctl: BLAS thread limits for the diagnosis (zrp/blas.py); sklearn: the Gaussian
-# process and kernels of the test of what remains (zrp/gap/analysis/kernel.py, imported lazily)
-CORE_THIRD_PARTY = {"numpy", "scipy", "numba", "tqdm", "tomli", "threadpoolctl", "sklearn"}
+# process and kernels of the test of what remains (zrp/gap/analysis/kernel.py, imported lazily);
+# rosbags: ROS 1/2 bags read without ROS (zrp/gap/data/rosbag.py, imported lazily; issue 44)
+CORE_THIRD_PARTY = {"numpy", "scipy", "numba", "tqdm", "tomli", "threadpoolctl", "sklearn",
+                    "rosbags"}
 REPORT_ONLY = {"matplotlib", "PIL"}
 MAX_LINES = 400
 MAX_COMPLEXITY = 15

@@ -74,8 +74,13 @@ def test_currents_need_torque_constant(tmp_path):
     log = load_torque_log(p, torque_constant=[10.0, 5.0])
     np.testing.assert_allclose(log.tau, [[10, 5], [20, 10]])
     assert log.torque_from == "current"
-    with pytest.raises(InputError, match="2 positive"):
-        load_torque_log(p, torque_constant=[1.0, -1.0])
+    # a drive whose current counts the other way has a negative constant (issue 44)
+    log = load_torque_log(p, torque_constant=[-8.7, 5.0])
+    np.testing.assert_allclose(log.tau, [[-8.7, 5], [-17.4, 10]])
+    with pytest.raises(InputError, match="zero for joint 2"):
+        load_torque_log(p, torque_constant=[1.0, 0.0])
+    with pytest.raises(InputError, match="2 finite"):
+        load_torque_log(p, torque_constant=[1.0])
 
 
 @pytest.mark.parametrize(("header", "rows", "match"), [

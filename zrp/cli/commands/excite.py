@@ -6,7 +6,8 @@ import argparse
 from pathlib import Path
 
 from zrp.cli.app import emit
-from zrp.cli.options import FINITE, SEED, real, whole
+from zrp.cli.options import FINITE, SEED, add_progress, draw_bar, real, whole
+from zrp.errors import InputError
 from zrp.limits import (
     MAX_COMMAND_SAMPLES,
     MAX_DESIGN_CANDIDATES,
@@ -28,6 +29,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "torque log.")
     p.add_argument("--model", required=True, metavar="M.xml|M.urdf|NAME")
     p.add_argument("--end-link", metavar="LINK", help="URDF: the arm's last link")
+    p.add_argument("--joints", nargs="+", metavar="NAME",
+                   help="instead of --end-link: the arm's joints by name (its chain)")
     p.add_argument("--q0", type=FINITE, nargs="+", required=True, metavar="RAD",
                    help="the posture the motion is centred on, rad (--deg: degrees); inside "
                    "the joint limits")
@@ -60,6 +63,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", required=True, metavar="COMMAND.csv")
     p.add_argument("--force", action="store_true", help="replace --out")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
+    add_progress(p, help="show the design's starts and steps as a bar on stderr when it is a "
+                 "terminal (default on; --no-progress: none)")
     p.set_defaults(func=_run, api_names={
         "end_link": "--end-link", "q0": "--q0", "amplitude": "--amplitude", "q_amp": "--amplitude",
         "max_velocity": "--max-velocity", "qd_max": "--max-velocity",
@@ -74,15 +79,28 @@ def _one(values: list[float] | None) -> float | list[float] | None:
 
 
 def _run(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
     from mjcf.arm import resolve_arm  # MuJoCo: only when this command runs
     from zrp.gap.dynamics import command as c  # on use: keeps --help quick
 
-    arm = resolve_arm(args.model, end_link=args.end_link)
-    cmd = c.excitation_command(arm, c.ExciteOptions(
+    if args.joints:
+        from zrp.cli.dynamics_runs import arm_of_joints  # MuJoCo: only when this command runs
+
+        if args.end_link:
+            raise InputError("--joints, --end-link: give one (both choose the arm's chain)")
+        arm = arm_of_joints(args.model, args.joints)
+    else:
+        arm = resolve_arm(args.model, end_link=args.end_link)
+    opts = c.ExciteOptions(
         q0=args.q0, amplitude=_one(args.amplitude), max_velocity=_one(args.max_velocity),
         max_acceleration=_one(args.max_acceleration), max_torque=_one(args.max_torque),
         deg=args.deg, period_s=args.period, rate_hz=args.rate, harmonics=args.harmonics,
-        candidates=args.candidates, iterations=args.iterations, seed=args.seed))
+        candidates=args.candidates, iterations=args.iterations, seed=args.seed)
+    with tqdm(total=args.candidates + args.iterations, desc="excite", unit="design",
+              disable=not draw_bar(args), leave=False) as bar:
+        cmd = c.excitation_command(arm, opts,
+                                   progress=lambda done, _total: bar.update(done - bar.n))
     out = c.write_excitation_command(cmd, Path(args.out), model=args.model, overwrite=args.force)
     payload, text = c.command_summary(cmd, notes=getattr(arm, "notes", ()))
     emit(args, payload, text + f"\nwrote {out}")

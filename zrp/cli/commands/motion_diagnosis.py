@@ -26,7 +26,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "gap, where along the path it lies and how far it shrinks on withheld time segments "
         "(zrp/gap/README.md).")
     p.add_argument("--model", required=True, metavar="M.toml", help="model file or built-in name")
-    p.add_argument("--data", required=True, metavar="D.csv", help="trajectory CSV")
+    p.add_argument("--data", required=True, metavar="D.csv|BAG",
+                   help="trajectory CSV, or a ROS bag (.mcap, .db3, a ROS 2 bag folder, a "
+                   "ROS 1 .bag) with the joint states and the instrument's points")
+    p.add_argument("--topic", metavar="NAME", help="a bag's sensor_msgs/msg/JointState topic "
+                   "(default: its only one)")
+    p.add_argument("--point-topic", metavar="NAME", help="a bag's instrument topic, "
+                   "geometry_msgs/msg/PointStamped or PoseStamped, in m (default: its only "
+                   "one); each topic on its own clock, aligned as the CSV's tq column")
     add_deg(p)
     p.add_argument("--time-unit", choices=sorted(TIME_UNITS), default="s",
                    help="unit of the t (and tq) column (default s; a median sample rate outside "
@@ -77,6 +84,22 @@ def _torque(args: argparse.Namespace, model: object, traj: object) -> tuple[obje
             mode_terms(src, *qs, field="--mjcf"))
 
 
+def _trajectory(args: argparse.Namespace, model: object, load_csv: object) -> object:
+    """The trajectory of --data: a ROS bag's two topics, or the CSV."""
+    from zrp.gap.data.rosbag import is_bag  # on use: keeps --help quick
+
+    if is_bag(args.data):
+        from zrp.gap.motion.trajbag import load_trajectory_bag  # on use: keeps --help quick
+
+        return load_trajectory_bag(args.data, model, topic=args.topic,  # type: ignore[arg-type]
+                                   point_topic=args.point_topic, frame=args.frame,
+                                   max_rows=args.max_rows)
+    if args.topic or args.point_topic:
+        raise InputError("--topic, --point-topic: for a ROS bag; --data is a CSV")
+    return load_csv(args.data, model, deg=args.deg, frame=args.frame,  # type: ignore[operator]
+                    time_unit=args.time_unit, max_rows=args.max_rows)
+
+
 def _run(args: argparse.Namespace) -> int:
     from zrp.gap.motion import diagnose_motion, load_trajectory  # on use: keeps --help quick
     from zrp.jsonio import dumps  # on use: keeps --help quick
@@ -85,8 +108,7 @@ def _run(args: argparse.Namespace) -> int:
     model = load_model(args.model)
     if args.video:
         check_writable([args.video], args.force)  # before the work
-    traj = load_trajectory(args.data, model, deg=args.deg, frame=args.frame,
-                           time_unit=args.time_unit, max_rows=args.max_rows)
+    traj = _trajectory(args, model, load_trajectory)
     tau, terms = _torque(args, model, traj)
     with OutputDir(Path(args.out), overwrite=args.force, names=OUTPUT_FILES) as folder:
         diag = diagnose_motion(model, traj, torque=tau, mode_terms=terms, effects=args.effects,

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -228,8 +229,11 @@ def _check_envelope(q0: F64, amp: F64, lim: JointLimits) -> None:
                          f"{room[k]:.6g} {u} there, or move q0")
 
 
-def excitation_command(arm: Arm, options: ExciteOptions) -> ExcitationCommand:
-    """Design the exciting command and sample it (module docstring); every sample checked.
+def excitation_command(arm: Arm, options: ExciteOptions, *,
+                       progress: Callable[[int, int], None] | None = None
+                       ) -> ExcitationCommand:
+    """Design the exciting command and sample it (module docstring); every sample checked;
+    ``progress(done, total)`` after each start and step of the design.
 
     Raises:
         InputError: a size beyond its bound, a limit that is not a finite number > 0, a limit
@@ -251,7 +255,7 @@ def excitation_command(arm: Arm, options: ExciteOptions) -> ExcitationCommand:
     e = design_excitation(arm, q0, amp, lim.velocity, lim.acceleration,
                           torque_limit=lim.torque, harmonics=o.harmonics,
                           f0_hz=1.0 / o.period_s, candidates=o.candidates,
-                          iterations=o.iterations, seed=o.seed)
+                          iterations=o.iterations, seed=o.seed, progress=progress)
     t = np.arange(samples) / float(o.rate_hz)
     f, tau = within_torque(arm, e.command, lim.torque, t)  # at the samples written
     if f is not e.command:

@@ -11,7 +11,8 @@ the units of :data:`zrp.units.QUANTITY_UNITS`; without one a column is SI):
   Without them the velocities are derived (:func:`zrp.gap.dynamics.states.derive_states`).
 * ``tau1`` .. ``taun``: measured joint torques; N m (``mNm``), N for slides. Or
 * ``i1`` .. ``in``: motor currents; A (``mA``), with ``torque_constant`` (N m/A at the joint,
-  gear ratio included): torque = k_t * i. One of the two groups is required; with both, the
+  gear ratio included, signed: negative when the drive's current counts the other way; zero
+  refused): torque = k_t * i. One of the two groups is required; with both, the
   torques are used and the currents are ignored (said in a warning).
 * ``qc1`` .. ``qcn`` (optional, all n): the commanded positions (the re-simulation drives them).
 * ``payload`` (optional): an external payload mass at the tool, kg (``g``), per row.
@@ -51,8 +52,8 @@ from zrp.gap.dynamics.transmission import Transmission
 from zrp.output import atomic_path
 from zrp.units import SI_UNITS, si_factor
 
-__all__ = ["GROUPS", "MAX_ROWS", "Conditioning", "TorqueLog", "load_torque_log",
-           "write_torque_log"]
+__all__ = ["GROUPS", "MAX_ROWS", "Conditioning", "TorqueLog", "excluded_notes",
+           "load_torque_log", "torque_constants", "write_torque_log"]
 
 #: Most data rows read by default (about 0.2 GB of numbers at 12 joints).
 MAX_ROWS = 5_000_000
@@ -154,7 +155,7 @@ def _factors(m: Mapping, src: str) -> tuple[dict[int, float], list[str]]:
 
 
 def _torques(block: dict[str, F64], m: Mapping, torque_constant: Sequence[float] | None,
-             src: str) -> tuple[F64, str]:
+             src: str, first_row: list[str]) -> tuple[F64, str]:
     n = m.n
     if "tau" in block:
         if "i" in block:
@@ -165,14 +166,29 @@ def _torques(block: dict[str, F64], m: Mapping, torque_constant: Sequence[float]
         raise InputError(f"torque_constant: {src} has motor currents ({m.form} form) but no "
                          f"torques; give the {n} torque constants (N m/A at the joint, gear "
                          "included)")
+    return block["i"] * torque_constants(torque_constant, n, _joint_names(m, first_row)), \
+        "current"
+
+
+def torque_constants(torque_constant: Sequence[float], n: int, names: Sequence[str] = ()
+                     ) -> F64:
+    """The drives' signed torque constants, N m/A at the joint (gear included), one per
+    joint: finite and nonzero; negative is a drive whose current counts the other way. A
+    zero is refused naming the joint (``names``: the log's, else numbered)."""
     try:
         kt = np.asarray(torque_constant, dtype=float).ravel()
     except (TypeError, ValueError):
         kt = np.zeros(0)
-    if kt.shape != (n,) or not np.all(np.isfinite(kt)) or np.any(kt <= 0.0):
-        raise InputError(f"torque_constant: expected {n} positive finite values (N m/A), got "
+    if kt.shape != (n,) or not np.all(np.isfinite(kt)):
+        raise InputError(f"torque_constant: expected {n} finite values (N m/A, signed), got "
                          f"{torque_constant!r}")
-    return block["i"] * kt, "current"
+    zero = [k for k in range(n) if kt[k] == 0.0]
+    if zero:
+        who = ", ".join(f"joint {k + 1}" + (f" ({names[k]})" if len(names) == n else "")
+                        for k in zero)
+        raise InputError(f"torque_constant: zero for {who}; a drive's torque constant is "
+                         "nonzero (negative when its current counts the other way)")
+    return kt
 
 
 def _joint_names(m: Mapping, first_row: list[str]) -> tuple[str, ...]:
@@ -183,7 +199,8 @@ def _joint_names(m: Mapping, first_row: list[str]) -> tuple[str, ...]:
     return ()
 
 
-def _excluded(unmeasured: dict[int, str], names: tuple[str, ...]) -> tuple[str, ...]:
+def excluded_notes(unmeasured: dict[int, str], names: tuple[str, ...]) -> tuple[str, ...]:
+    """The words of :attr:`TorqueLog.unmeasured` for :attr:`Conditioning.excluded`."""
     return tuple(f"joint {k + 1}{f' ({names[k]})' if names else ''}: {why}; its torque is "
                  "not used" for k, why in sorted(unmeasured.items()))
 
@@ -263,7 +280,8 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
 
     Args:
         path: the CSV file.
-        torque_constant: per joint, N m/A at the joint; needed when the log has currents only.
+        torque_constant: per joint, N m/A at the joint, signed; needed when the log has
+            currents only.
         n_joints: the model's number of joints; None: as many as the position columns.
         max_rows: most data rows read; a larger file is refused (None: no limit).
         transmission: the log is motor side (positions, torques or currents at the motors):
@@ -284,7 +302,7 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
     vals, lines, t = raw.values[kept], raw.lines[kept], t[kept]
     block = {g: vals[:, [at[c] for c in cs]] * np.array([factor[c] for c in cs])
              for g, cs in m.groups.items()}
-    tau, tfrom = _torques(block, m, torque_constant, src)
+    tau, tfrom = _torques(block, m, torque_constant, src, raw.first_row)
     block, tau = _at_joints(block, tau, m, transmission, src)
     payload = None if m.payload is None else vals[:, at[m.payload]] * factor[m.payload]
     names = _joint_names(m, raw.first_row)
@@ -298,7 +316,7 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
                       "m/s, N for slides)", DataWarning, stacklevel=2)
     columns = m.describe() + ("" if transmission is None else "; " + transmission.describe())
     cond = Conditioning(columns=columns, clock=said, skipped_lines=raw.skipped,
-                        excluded=_excluded(unmeasured, names), **rec)  # type: ignore[arg-type]
+                        excluded=excluded_notes(unmeasured, names), **rec)  # type: ignore[arg-type]
     return TorqueLog(t, block["q"], block.get("qd"), tau, block.get("qc"), payload, lines, src,
                      tfrom, segments if len(segments) > 1 else (), unmeasured, names, cond,
                      transmission)

@@ -22,6 +22,7 @@ max(200, 20 L) samples of one period (400 and 40 L for the torques).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -164,8 +165,10 @@ def _check_envelope(arm: Arm, q0: F64, q_amp: F64) -> None:
 def design_excitation(arm: Arm, q0: F64, q_amp: F64 | float, qd_max: F64 | float,
                       qdd_max: F64 | float, *, torque_limit: F64 | None = None,
                       harmonics: int = 5, f0_hz: float = 0.1, candidates: int = 8,
-                      iterations: int = 20, step: float = 0.2, seed: int = 0) -> Excitation:
+                      iterations: int = 20, step: float = 0.2, seed: int = 0,
+                      progress: Callable[[int, int], None] | None = None) -> Excitation:
     """Design the exciting command (module docstring); limits per joint (or one for all).
+    ``progress(done, total)`` is called after each start and each step.
 
     Raises:
         InputError: q0 not n finite values, q0 +- q_amp beyond the arm's position limits, a
@@ -188,11 +191,16 @@ def design_excitation(arm: Arm, q0: F64, q_amp: F64 | float, qd_max: F64 | float
         f, _ = _within_torque(arm, scale_into(f, *lims), tlim)
         return f, condition_number(arm, f, basis=basis, rank=rank)
 
-    starts = [fit(random_fourier(q0, *lims, harmonics=harmonics, f0_hz=f0_hz, seed=rng))
-              for _ in range(candidates)]
+    tick = progress or (lambda done, total: None)
+    total = candidates + iterations
+    starts = []
+    for k in range(candidates):
+        starts.append(fit(random_fourier(q0, *lims, harmonics=harmonics, f0_hz=f0_hz, seed=rng)))
+        tick(k + 1, total)
     best, kappa = min(starts, key=lambda s: s[1])
     kappa_start = kappa
-    for _ in range(iterations):
+    for k in range(iterations):
+        tick(candidates + k + 1, total)
         a = best.a * (1.0 + step * rng.normal(size=best.a.shape))
         b = best.b * (1.0 + step * rng.normal(size=best.b.shape))
         # keep the start-at-rest conditions: perturb, then project as random_fourier does

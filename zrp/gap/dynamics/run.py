@@ -10,6 +10,7 @@ for the diagnosis, :class:`ModelWriter` (optional) for the corrected model and t
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol, runtime_checkable
 
@@ -62,15 +63,23 @@ class DynamicsRun:
 
 def run_dynamics(arm: DynamicArm, log: TorqueLog, *, options: DynamicsOptions | None = None,
                  validation_log: TorqueLog | None = None, writer: ModelWriter | None = None,
-                 tracking: TrackingOptions | None = None) -> DynamicsRun:
+                 tracking: TrackingOptions | None = None,
+                 progress: Callable[[str], None] | None = None) -> DynamicsRun:
     """Diagnose ``log`` (module docstring); ``validation_log`` a second run to score on;
-    ``writer`` the arm's corrected-model writer (:class:`mjcf.corrected.CorrectedMJCF`)."""
+    ``writer`` the arm's corrected-model writer (:class:`mjcf.corrected.CorrectedMJCF`);
+    ``progress(stage)`` is called as each stage starts (its name, in words)."""
+    stage = progress or (lambda name: None)
     opt = options or DynamicsOptions()
+    stage("diagnosing")
     diag = diagnose_dynamics(arm, log, opt)
+    if validation_log is not None:
+        stage("validating on the second log")
     check = None if validation_log is None else validate(arm, diag, validation_log, opt)
     if writer is None:
         return DynamicsRun(diag, check)
+    stage("writing the corrected model")
     text, notes = writer.corrected_model(diag)
     tr = tracking or TrackingOptions()
+    stage("re-simulating the command")
     track = writer.track(text, log, kp=tr.kp, kv=tr.kv, seconds=tr.seconds)
     return DynamicsRun(diag, check, text, notes, track)

@@ -71,6 +71,7 @@ class Conditioning:
         dropped: the segments dropped as too short, in words.
         skipped_lines: blank, whitespace-only and comment lines skipped.
         excluded: the joints whose torque is not used (:attr:`TorqueLog.unmeasured`), words.
+        joints: how the log's joints were matched to the model's (names, order, left out).
     """
 
     columns: str = ""
@@ -86,6 +87,7 @@ class Conditioning:
     dropped: tuple[str, ...] = ()
     skipped_lines: int = 0
     excluded: tuple[str, ...] = ()
+    joints: tuple[str, ...] = ()
 
     def describe(self) -> list[str]:
         """What was done to the log, one line each (for the report)."""
@@ -110,6 +112,7 @@ class Conditioning:
                        f"{shown}{' ...' if len(self.gaps) > _SHOWN else ''}")
         out += [f"dropped: {d}" for d in self.dropped]
         out += [f"excluded: {e}" for e in self.excluded]
+        out += [f"joints: {j}" for j in self.joints]
         if self.skipped_lines:
             out.append(f"{self.skipped_lines} blank or comment line(s) skipped")
         return out

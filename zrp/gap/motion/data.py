@@ -23,7 +23,8 @@ from zrp.errors import InputError
 from zrp.gap.data.measurements import FRAMES, Measurements
 from zrp.gap.motion.choices import RATE_RANGE_HZ, TIME_UNITS
 
-__all__ = ["MIN_SAMPLES", "RATE_RANGE_HZ", "TIME_UNITS", "Trajectory", "check_rate"]
+__all__ = ["MIN_SAMPLES", "RATE_RANGE_HZ", "TIME_UNITS", "Trajectory", "check_rate",
+           "joints_at"]
 
 #: fewest samples a trajectory diagnosis accepts.
 MIN_SAMPLES = 50
@@ -46,6 +47,20 @@ def check_rate(t: F64, lines: NDArray[np.int64] | None, source: str) -> None:
             "the time stamps must be in s (or name their unit with time_unit, --time-unit)")
     raise InputError(f"{where}: column t has a median sample interval of {dt:g} s "
                      f"({rate:g} Hz); a tracker stream is {lo:g} Hz to {hi:g} Hz: {hint}")
+
+
+def joints_at(t: F64, tq: F64, q: F64, source: str, lines: NDArray[np.int64]) -> F64:
+    """The joint values at the tracker times ``t`` from the controller's stream (``tq``, its
+    own clock, s; ``q`` (K, n)): a cubic spline through the stream (eq. M0), a repeated
+    ``tq`` keeping its first sample; ``tq`` going backwards is refused naming the line
+    (``lines``: of each stream sample). The one aligner of a tracker with joint samples: the
+    CSV's ``tq`` column and a bag's joint-state topic."""
+    keep = np.r_[True, np.diff(tq) > 0]
+    if np.any(np.diff(tq) < 0):
+        i = int(np.argmax(np.diff(tq) < 0)) + 1
+        raise InputError(f"{source} line {lines[i]}: tq goes backwards; the controller's "
+                         "time stamps must be in order")
+    return CubicSpline(tq[keep], q[keep], axis=0)(t)
 
 
 def _frozen(a: ArrayLike) -> F64:

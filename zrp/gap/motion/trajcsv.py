@@ -30,12 +30,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from zrp.errors import InputError
 from zrp.escape import csv_text, csv_uncell
 from zrp.gap.data.choices import MAX_ROWS
-from zrp.gap.motion.data import TIME_UNITS, Trajectory, check_rate
+from zrp.gap.motion.data import TIME_UNITS, Trajectory, check_rate, joints_at
 from zrp.model.manipulator import Manipulator
 from zrp.output import atomic_path
 from zrp.textio import iter_lines
@@ -192,13 +191,7 @@ def _assemble(a: np.ndarray, numeric: list[str], points: list[str] | None,
         rows = starts[:, None] + order
     ts = t[starts]
     if "tq" in numeric:
-        tq = a[:, -1]
-        keep = np.r_[True, np.diff(tq) > 0]
-        if np.any(np.diff(tq) < 0):
-            i = int(np.argmax(np.diff(tq) < 0)) + 1
-            raise InputError(f"{name} line {lines[i]}: tq goes backwards; the controller's "
-                             "time stamps must be in order")
-        qs = CubicSpline(tq[keep], q[keep], axis=0)(ts)
+        qs = joints_at(ts, a[:, -1], q, name, lines)
     else:
         qs = q[starts]
     return Trajectory(ts, qs, xyz[rows], tuple(labels), frame, lines[starts], name)
