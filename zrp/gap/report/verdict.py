@@ -236,7 +236,7 @@ def _structure_words(diag: Diagnosis, *, always: bool) -> list[str]:
     a = diag.assessment
     s = None if a is None else a.remainder.structure
     out = [] if s is None or not (always or s.structured) else [s.words(diag.length_unit)]
-    if a is not None and a.remainder.structure_not_run and always:
+    if a is not None and a.remainder.structure_not_run:
         out.append("The multivariate test of what remains did not run: "
                    f"{a.remainder.structure_not_run}.")
     if a is not None and a.residual_model is not None:
