@@ -21,7 +21,7 @@ def _plot(ver: Any, unit: str, path: Path) -> None:
     import matplotlib.pyplot as plt
     import numpy as np
 
-    from zrp.output.figures import tight_layout_once
+    from zrp.output.figures import tight_layout_once  # with matplotlib: on use only
 
     d = ver.to_dict()
     fig, ax = plt.subplots(figsize=(6.4, 3.6))
@@ -65,7 +65,7 @@ def _page(ver: Any, unit: str, cal_path: str, data_path: str) -> str:
 
 
 def _errors_csv(ver: Any, meas: Any, unit: str) -> str:
-    from zrp.escape import csv_text
+    from zrp.escape import csv_text  # on use: keeps --help quick
 
     rows = ([p, pt, repr(float(e)), int(o)] for p, pt, e, o in zip(
         meas.pose, meas.point, ver.errors, ver.outside, strict=True))
@@ -75,10 +75,10 @@ def _errors_csv(ver: Any, meas: Any, unit: str) -> str:
 def run_data(args: argparse.Namespace) -> tuple[dict[str, Any], str]:
     """The --data mode: (summary, text); writes the folder --out when given."""
     from zrp.calibration import read_calibration  # on use: keeps --help quick
-    from zrp.calibration.verification import verify_measurements
-    from zrp.gap.data.csvfile import load_measurements
-    from zrp.jsonio import dumps
-    from zrp.output import check_writable, write_text
+    from zrp.calibration.verification import verify_measurements  # on use: quick --help
+    from zrp.gap.data.csvfile import load_measurements  # on use: keeps --help quick
+    from zrp.jsonio import dumps  # NumPy: on use
+    from zrp.output import check_writable, write_text  # on use: keeps --help quick
 
     if args.truth or args.targets or args.commands:
         raise InputError("--data: a fresh measurement is verified on its own; --truth, "

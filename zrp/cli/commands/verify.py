@@ -61,7 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _run(args: argparse.Namespace) -> int:
     if args.data is not None:
-        from zrp.cli.verify_data import run_data
+        from zrp.cli.verify_data import run_data  # on use: keeps --help quick
 
         summary, text = run_data(args)
         emit(args, summary, text)
