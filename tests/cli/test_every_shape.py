@@ -108,8 +108,8 @@ def test_an_analysis_that_cannot_run_says_so_and_the_others_run(tmp_path, capsys
     assert rc == dict.fromkeys(("diagnose", "calibrate", "export", "compensate"), 0)
     doc = json.loads((tmp_path / "diag" / "diagnosis.json").read_text(encoding="utf-8"))
     assert doc["remainder"]["structure"] is None and doc["residual_model"] is None
-    assert "fitting poses measure the same points" in doc["remainder"]["structure_not_run"]
-    assert "measure every point" in doc["residual_model_not_run"]
+    assert "fitting poses measure the same 1 point(s)" in doc["remainder"]["structure_not_run"]
+    assert "measure every one of the 3 points" in doc["residual_model_not_run"]
     report = (tmp_path / "diag" / "report.md").read_text(encoding="utf-8")
     assert "The multivariate test of what remains did not run: only " in report
     assert "The learned residual term did not run: only 0 fitting poses" in report

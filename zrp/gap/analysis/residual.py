@@ -159,10 +159,9 @@ def fit_residual_model(ctx: Context, final: FitResult, withheld: NDArray[np.int6
         keep = np.sort(rng.choice(Y.shape[0], MAX_POSES, replace=False))
         Y, first = Y[keep], first[keep]
     if Y.shape[0] < MIN_POSES:
-        labels = ", ".join(ctx.meas.point_labels)
-        raise NotRun(f"only {Y.shape[0]} fitting poses measure every point ({labels}); the "
-                     f"learned term predicts all of a pose's points and needs {MIN_POSES} such "
-                     "poses")
+        raise NotRun(f"only {Y.shape[0]} fitting poses measure every one of the "
+                     f"{len(ctx.meas.point_labels)} points; the learned term predicts all of a "
+                     f"pose's points and needs {MIN_POSES} such poses")
     inputs = pose_inputs(ctx, first, logged=False)
     X = inputs(ctx, first)
     if X.shape[1] == 0:

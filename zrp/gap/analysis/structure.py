@@ -130,8 +130,9 @@ class Structure:
 
     def words(self, unit: str) -> str:
         """One short sentence for the verdict (``unit``: the length unit)."""
-        on = (f" (tested on the {self.n_poses} fitting poses that measure "
-              f"{_and(list(self.points))})" if self.subset and self.points else "")
+        on = (f" (tested on the {self.n_poses} fitting poses that measure the same "
+              f"{len(self.points)} point(s), listed in diagnosis.json)"
+              if self.subset and self.points else "")
         text = self._words(unit)
         return text[:-1] + on + "." if on else text
 
@@ -224,8 +225,8 @@ def _targets(ctx: Context, fit: FitResult, max_poses: int, rng: np.random.Genera
     Y, first = pose_targets(ctx, fit.poses, fit.residual, pts)
     subset = len(labels) < len(ctx.meas.point_labels) or Y.shape[0] < np.unique(fit.poses).size
     if Y.shape[0] < MIN_POSES:
-        raise NotRun(f"only {Y.shape[0]} fitting poses measure the same points "
-                     f"({', '.join(labels)}); the test needs {MIN_POSES}")
+        raise NotRun(f"only {Y.shape[0]} fitting poses measure the same {len(labels)} "
+                     f"point(s); the test needs {MIN_POSES}")
     if Y.shape[0] > max_poses:
         keep = np.sort(rng.choice(Y.shape[0], max_poses, replace=False))
         Y, first = Y[keep], first[keep]
