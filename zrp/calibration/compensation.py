@@ -329,14 +329,20 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
             load given; a temperature or payload outside the measured range.
 
     Raises:
-        InputError: bad shapes, or a seed or command beyond a joint limit (naming the target
-            and joint).
+        InputError: bad shapes, a seed or command beyond a joint limit (naming the target
+            and joint), or instrument-frame targets without ``point`` (the instrument measured
+            the tool points, not the model's end point: naming the points).
         PayloadConditionError: a payload the calibration cannot predict (identified at one
             payload, never varied, without the MJCF's masses).
         UnmeasuredTargetError: a command outside the measured joint ranges (unless
             ``accept_flagged``).
         NearSingularTargetError: a near-singular command (unless ``accept_flagged``).
     """
+    if frame == "instrument" and point is None and cal.tool_labels:
+        raise InputError(
+            f"point: the targets are in the instrument's frame, where the calibration measured "
+            f"the tool points {', '.join(cal.tool_labels)}, not the model's end point; name "
+            "the point the targets are for (point=...)")
     y, q0, ids, rot = _checked_targets(cal, targets, seed, orientations, frame, target_ids)
     lim = joint_limits(cal, limits)
     check_joint_limits(q0, lim, ids, "the seed (program) value")

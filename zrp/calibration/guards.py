@@ -98,6 +98,12 @@ def _outside(q: F64, conditions: Conditions | None) -> NDArray[np.bool_]:
     return out
 
 
+def outside_measured(q: F64, conditions: Conditions | None) -> NDArray[np.bool_]:
+    """Per joint value of ``q`` (T, n): outside the range the calibration measured by more
+    than :data:`RANGE_SHARE` of its width (False without a recorded range)."""
+    return _outside(q, conditions)
+
+
 def guard(ids: tuple[str, ...], q: F64, sigma_min: F64, conditions: Conditions | None,
           reference: Callable[[], float], *, accept_flagged: bool,
           singular_tol: float | None = None, learned: LearnedTerm | None = None

@@ -38,6 +38,7 @@ from zrp.gap.analysis.checks import (
 from zrp.gap.analysis.excitation import excited_only
 from zrp.gap.analysis.fallback import FinalChoice, choose_final
 from zrp.gap.analysis.identifiability import ReferencePoses, registration_identifiable, survey
+from zrp.gap.analysis.notrun import NotRun
 from zrp.gap.analysis.residual import fit_residual_model
 from zrp.gap.analysis.where import WhereAnalysis, where_analysis
 from zrp.gap.data.digest import measurements_sha256
@@ -312,14 +313,24 @@ def run_diagnosis(model: Manipulator, meas: Measurements, gravity_torque: ArrayL
     assessment = _assess(ctx, baseline, choice, final_fit, len(reg.specs),
                          where.after_final_model or where_nominal, resolution)
     if opts.residual_model:
-        assessment = dataclasses.replace(assessment, residual_model=fit_residual_model(
-            ctx, final_fit, prep.withheld, after, structure=assessment.remainder.structure))
+        assessment = _with_residual_model(assessment, ctx, final_fit, prep.withheld, after)
     return Diagnosis(model.name, model.length_unit, Metrics.of(regd.withheld_residual),
                      regd.fitting, parameter_estimates(regd.fit, 0), found.steps, final, floor,
                      unexplained, _split_ids(meas, prep, opts), where, found.aliased, (),
                      regd.fit,
                      final_fit, regd.withheld_residual, after, ctx, prep.fitting,
                      prep.withheld, _settings(ctx, opts), assessment)
+
+
+def _with_residual_model(assessment: Assessment, ctx: Context, final_fit: FitResult,
+                         withheld: NDArray[np.int64], after: F64) -> Assessment:
+    """The assessment with the learned residual term, or with why it did not run."""
+    try:
+        rm = fit_residual_model(ctx, final_fit, withheld, after,
+                                structure=assessment.remainder.structure)
+    except NotRun as exc:
+        return dataclasses.replace(assessment, residual_model_not_run=str(exc))
+    return dataclasses.replace(assessment, residual_model=rm)
 
 
 def _with_orientation(ctx: Context, reg: FitResult, fitting: NDArray[np.int64], rb0: F64,

@@ -31,8 +31,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--out", required=True, metavar="OUT.csv", help="commands CSV")
     p.add_argument("--force", action="store_true", help="overwrite the output file")
     add_deg(p)
-    p.add_argument("--point", help="tool point the x, y, z targets are for (default: the "
-                   "model's end point)")
+    p.add_argument("--point", help="tool point the x, y, z targets are for (default with "
+                   "--frame base: the model's end point; required with --frame instrument)")
     p.add_argument("--frame", choices=("base", "instrument"), default="base",
                    help="frame of x, y, z (default base)")
     p.add_argument("--limits", metavar="LO:HI,...",
@@ -86,6 +86,7 @@ def _run(args: argparse.Namespace) -> int:
     )
     from zrp.calibration import compensate as compensate_targets  # on use: quick --help
     from zrp.calibration.conditions import missing_conditions  # on use: keeps --help quick
+    from zrp.calibration.expected import expected_accuracy, expected_words  # on use
     from zrp.calibration.targets import load_targets, write_commands  # on use: keeps --help quick
 
     check_writable([args.out], args.force)
@@ -120,11 +121,10 @@ def _run(args: argparse.Namespace) -> int:
                           target_ids=tg.ids, conditions=cond,
                           accept_flagged=args.accept_flagged)
     path = write_commands(comp, args.out, deg=args.deg, overwrite=args.force)
-    s = comp.summary()
-    text = (f"{s['targets']} targets: predicted RMS error {s['rms_before']:.4g} -> "
-            f"{s['rms_after']:.3g} {cal.model.length_unit} (max {s['max_after']:.3g}); "
-            f"{s['not_converged']} not converged, {s['near_singular']} near a singularity, "
-            f"{s['near_limit']} near a limit, {s['outside_measured']} outside the measured "
-            f"joint ranges\nwrote {path}")
+    acc = expected_accuracy(cal, comp)
+    s = {**comp.summary(), **acc}
+    text = (f"{expected_words(acc, cal.model.length_unit)}\n{s['not_converged']} not "
+            f"converged, {s['near_singular']} near a singularity, {s['near_limit']} near a "
+            f"limit, {s['outside_measured']} outside the measured joint ranges\nwrote {path}")
     emit(args, s, text)
     return 0

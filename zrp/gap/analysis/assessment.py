@@ -30,6 +30,7 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.gap.analysis.baseline import GeometricBaseline
 from zrp.gap.analysis.fallback import FinalChoice
+from zrp.gap.analysis.notrun import NotRun
 from zrp.gap.analysis.residual import ResidualModel
 from zrp.gap.analysis.structure import Structure, remainder_structure
 from zrp.gap.analysis.where import WhereAnalysis
@@ -64,7 +65,8 @@ class Remainder:
         common_share: share common to the points of a pose (None with one point per pose).
         joint_r2: largest R^2 against one joint angle, and that joint.
         exceeds_spec: rms is above :data:`TYPICAL_REPEATABILITY_MM` (in the model's unit).
-        structure: the multivariate test of :mod:`.structure` (None with too few poses).
+        structure: the multivariate test of :mod:`.structure` (None when it did not run).
+        structure_not_run: why it did not run (None when it ran).
     """
 
     rms: float
@@ -77,6 +79,7 @@ class Remainder:
     joint_r2: tuple[int, float]
     exceeds_spec: bool
     structure: Structure | None = None
+    structure_not_run: str | None = None
 
     def findings(self) -> list[tuple[str, str, str]]:
         """(explanation, "supported" / "not supported" / "cannot tell", evidence) per
@@ -176,9 +179,21 @@ def remainder_evidence(ctx: Context, fit: FitResult, where: WhereAnalysis,
     jr = max(((j.joint, j.r2) for j in where.joints), key=lambda t: t[1], default=(0, 0.0))
     spec = TYPICAL_REPEATABILITY_MM / (1e3 * metres_per_unit(ctx.model.length_unit,
                                                              "model.length_unit"))
+    structure, why = _structure(ctx, fit, rms, resolution)
     return Remainder(rms, rep, ng, where.order_r2, where.time_r2, dist_r2, where.common_share,
-                     jr, bool(rms > spec),
-                     remainder_structure(ctx, fit) if rms > 10 * resolution else None)
+                     jr, bool(rms > spec), structure, why)
+
+
+def _structure(ctx: Context, fit: FitResult, rms: float, resolution: float
+               ) -> tuple[Structure | None, str | None]:
+    """The multivariate test of what remains, or why it did not run."""
+    if rms <= 10 * resolution:
+        return None, (f"what remains ({rms:.3g} RMS) is within 10x the fits' numerical "
+                      "resolution: rounding, not a remainder")
+    try:
+        return remainder_structure(ctx, fit), None
+    except NotRun as exc:
+        return None, str(exc)
 
 
 def compliance_units(ctx: Context) -> dict[str, Any]:
@@ -224,6 +239,7 @@ class Assessment:
             data cannot tell from its offset (empty without MJCF torques).
         residual_model: the learned residual term and its withheld test, when asked for
             (:mod:`zrp.gap.analysis.residual`).
+        residual_model_not_run: why the learned term, when asked for, did not run.
     """
 
     baseline: GeometricBaseline
@@ -238,6 +254,7 @@ class Assessment:
     compliance: dict[str, Any] | None = None
     one_sided: tuple[int, ...] = ()
     residual_model: ResidualModel | None = None
+    residual_model_not_run: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return dict_from_dataclass(self, exclude=("stderr",), rename={

@@ -4,8 +4,9 @@ final model (:mod:`.structure`, :mod:`.residual`).
 * **inputs** (:class:`Inputs`) - per pose (sin q, cos q) of each revolute joint that moves
   (q of a prismatic one), and time, temperature and load where logged; each input's columns
   centred and scaled to unit spread on the poses the inputs are set on (the fitting poses);
-* **targets** (:func:`pose_targets`) - per pose the residual of all its measured points
-  (x, y, z of each), complete poses only;
+* **targets** (:func:`pose_targets`) - per pose the residual of a fixed set of its measured
+  points (x, y, z of each; all points, or the set :func:`target_points` chooses when the poses
+  carry different points), the poses that measure all of the set only;
 * **model** (:func:`fit_kernel_ridge`) - a Gaussian (RBF) kernel on the inputs scaled by
   per-input length scales (ARD) that a scikit-learn Gaussian process sets on at most
   :data:`ARD_POSES` poses (its leading :data:`ARD_COMPONENTS` principal components of the
@@ -35,7 +36,7 @@ from zrp.gap.model.context import MIN_EXCITATION_RAD, Context
 from zrp.rotations.rodrigues import er_from_axis_angle, matrix_from_er
 
 __all__ = ["Inputs", "KernelModel", "arm_frames", "fit_kernel_ridge", "length_scales",
-           "pose_inputs", "pose_targets"]
+           "measured_points", "pose_inputs", "pose_targets", "target_points"]
 
 #: most poses the Gaussian process that sets the length scales sees.
 ARD_POSES = 200
@@ -128,11 +129,41 @@ def _cat(parts: list[F64]) -> F64:
     return np.concatenate(parts) if parts else np.zeros(0)
 
 
-def pose_targets(ctx: Context, poses: NDArray[np.int64], residual: F64
-                 ) -> tuple[F64, NDArray[np.int64]]:
-    """Per complete pose of ``poses`` the residual (3R,) of all its points, shape (P, 3M), and
-    one row of each such pose (for its inputs)."""
+def measured_points(ctx: Context, poses: NDArray[np.int64]) -> NDArray[np.bool_]:
+    """Per pose of ``poses`` (sorted), which points it measures, shape (P, M)."""
     meas = ctx.meas
+    rows = np.flatnonzero(np.isin(meas.pose_index, poses))
+    up, inv = np.unique(meas.pose_index[rows], return_inverse=True)
+    has = np.zeros((up.size, len(meas.point_labels)), dtype=bool)
+    has[inv, meas.point_index[rows]] = True
+    return has
+
+
+def target_points(ctx: Context, poses: NDArray[np.int64]) -> NDArray[np.int64]:
+    """The points (indices into the point labels) whose residual makes a pose's target: of
+    the point sets the poses of ``poses`` carry, the one with the most measured values on the
+    poses that measure all of it (poses x points; ties: more poses). Every point when every
+    pose measures the same; with three points on some poses and one other on the rest, the
+    three; with one point per pose (one label per run), the label of the most poses."""
+    has = measured_points(ctx, poses)
+    if has.size == 0:
+        return np.arange(has.shape[1])
+    best, key = np.flatnonzero(has[0]), (-1, -1)
+    for cand in np.unique(has, axis=0):
+        count = int(np.all(has[:, cand], axis=1).sum())
+        k = (count * int(cand.sum()), count)
+        if k > key:
+            best, key = np.flatnonzero(cand), k
+    return best
+
+
+def pose_targets(ctx: Context, poses: NDArray[np.int64], residual: F64,
+                 points: NDArray[np.int64] | None = None) -> tuple[F64, NDArray[np.int64]]:
+    """Per pose of ``poses`` that measures every point of ``points`` (indices into the point
+    labels; None: all) the residual (3R,) of those points, shape (P, 3 len(points)), and one
+    row of each such pose (for its inputs)."""
+    meas = ctx.meas
+    pts = np.arange(len(meas.point_labels)) if points is None else np.asarray(points)
     rows = np.flatnonzero(np.isin(meas.pose_index, poses))
     r = residual[: 3 * rows.size].reshape(-1, 3)
     M = len(meas.point_labels)
@@ -141,8 +172,9 @@ def pose_targets(ctx: Context, poses: NDArray[np.int64], residual: F64
     Y[inv, meas.point_index[rows]] = r
     first = np.full(up.size, -1, dtype=np.int64)
     first[inv[::-1]] = rows[::-1]
+    Y = Y[:, pts]
     full = np.all(np.isfinite(Y.reshape(up.size, -1)), axis=1)
-    return Y[full].reshape(int(full.sum()), -1), first[full]
+    return Y[full].reshape(int(full.sum()), 3 * pts.size), first[full]
 
 
 def arm_frames(frame: F64, turn_axis: F64 | None, q1: F64) -> F64:

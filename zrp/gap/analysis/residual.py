@@ -51,6 +51,7 @@ from zrp.gap.analysis.kernel import (
     pose_inputs,
     pose_targets,
 )
+from zrp.gap.analysis.notrun import NotRun
 from zrp.gap.analysis.structure import Structure
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.fit.metrics import Metrics
@@ -140,21 +141,33 @@ def _hybrid_residual(ctx: Context, withheld: NDArray[np.int64], r_after: F64,
 
 
 def fit_residual_model(ctx: Context, final: FitResult, withheld: NDArray[np.int64],
-                       r_after: F64, *, structure: Structure | None) -> ResidualModel | None:
+                       r_after: F64, *, structure: Structure | None) -> ResidualModel:
     """Train the learned term on ``final``'s residual over its fitting poses and test it on
     the ``withheld`` poses (whose final residual is ``r_after``, 3Rw); ``structure``: the test
     of what remains on the same fitting poses (without structure, or None, the term is not
-    kept, whatever it gains). None with too few complete poses or no input that varies."""
+    kept, whatever it gains). Its targets are every point of a pose (the calibration files
+    apply it to each tool point), so it trains on the poses that measure all of them.
+
+    Raises:
+        NotRun: fewer than :data:`MIN_POSES` fitting poses measure every point, no joint
+            moves, or the residual is zero (the message says which).
+    """
     structured = structure is not None and structure.structured
     Y, first = pose_targets(ctx, final.poses, final.residual)
     rng = np.random.default_rng(SEED)
     if Y.shape[0] > MAX_POSES:
         keep = np.sort(rng.choice(Y.shape[0], MAX_POSES, replace=False))
         Y, first = Y[keep], first[keep]
+    if Y.shape[0] < MIN_POSES:
+        raise NotRun(f"only {Y.shape[0]} fitting poses measure every one of the "
+                     f"{len(ctx.meas.point_labels)} points; the learned term predicts all of a "
+                     f"pose's points and needs {MIN_POSES} such poses")
     inputs = pose_inputs(ctx, first, logged=False)
     X = inputs(ctx, first)
-    if Y.shape[0] < MIN_POSES or X.shape[1] == 0 or not np.any(Y):
-        return None
+    if X.shape[1] == 0:
+        raise NotRun("no joint moves enough to be an input")
+    if not np.any(Y):
+        raise NotRun("the final model leaves no residual on the fitting poses")
     frame = np.asarray(final.base_rotation, dtype=float)
     F = arm_frames(frame, _turn_axis(ctx), ctx.q[ctx.meas.pose_index[first], 0])
     Y = np.einsum("pji,pmj->pmi", F, Y.reshape(len(Y), -1, 3)).reshape(Y.shape)  # F^T y

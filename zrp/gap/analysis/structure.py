@@ -50,7 +50,9 @@ from zrp.gap.analysis.kernel import (
     length_scales,
     pose_inputs,
     pose_targets,
+    target_points,
 )
+from zrp.gap.analysis.notrun import NotRun
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.model.context import Context
 from zrp.jsonio import dict_from_dataclass
@@ -84,6 +86,11 @@ class Structure:
         region: where the structured part is largest: (reach band lo, hi, "upper"/"lower",
             its RMS), None without structure.
         n_poses: poses used; folds: cross-validation folds.
+        points: the measured points whose residual the test takes (every point, or the set
+            :func:`~zrp.gap.analysis.kernel.target_points` chose when the poses carry
+            different points: on the poses that measure all of it).
+        subset: ``points`` are not every point of the data, or not every fitting pose
+            measures them (the words say on which poses the test ran).
     """
 
     share: float
@@ -94,6 +101,8 @@ class Structure:
     region: tuple[float, float, str, float] | None
     n_poses: int
     folds: int
+    points: tuple[str, ...] = ()
+    subset: bool = False
 
     def to_dict(self) -> dict[str, Any]:
         out = dict_from_dataclass(self, exclude=("region",))
@@ -121,6 +130,13 @@ class Structure:
 
     def words(self, unit: str) -> str:
         """One short sentence for the verdict (``unit``: the length unit)."""
+        on = (f" (tested on the {self.n_poses} fitting poses that measure the same "
+              f"{len(self.points)} point(s), listed in diagnosis.json)"
+              if self.subset and self.points else "")
+        text = self._words(unit)
+        return text[:-1] + on + "." if on else text
+
+    def _words(self, unit: str) -> str:
         lo, hi = self.interval
         if not self.structured:
             return (f"No structure: the joint angles together predict {_pct(max(self.share, 0))}"
@@ -198,34 +214,59 @@ def _out_of_fold(X: F64, Y: F64, scale: F64, groups: list[list[int]], folds: int
     return P, perm_sse
 
 
-def remainder_structure(ctx: Context, fit: FitResult, *, folds: int = 5,
-                        max_poses: int = MAX_POSES) -> Structure | None:
-    """The multivariate test of what ``fit`` leaves on its fitting poses (module docstring);
-    None with fewer than :data:`MIN_POSES` complete poses or no input that varies."""
-    Y, first = pose_targets(ctx, fit.poses, fit.residual)
-    rng = np.random.default_rng(SEED)
+def _targets(ctx: Context, fit: FitResult, max_poses: int, rng: np.random.Generator
+             ) -> tuple[F64, NDArray[np.int64], tuple[str, ...], bool]:
+    """The targets (at most ``max_poses`` poses, a seeded subsample), one row of each of
+    their poses, the points they are of and whether that is a subset (:attr:`Structure.subset`);
+    :class:`NotRun` when too few poses measure the
+    chosen points."""
+    pts = target_points(ctx, fit.poses)
+    labels = tuple(ctx.meas.point_labels[i] for i in pts)
+    Y, first = pose_targets(ctx, fit.poses, fit.residual, pts)
+    subset = len(labels) < len(ctx.meas.point_labels) or Y.shape[0] < np.unique(fit.poses).size
+    if Y.shape[0] < MIN_POSES:
+        raise NotRun(f"only {Y.shape[0]} fitting poses measure the same {len(labels)} "
+                     f"point(s); the test needs {MIN_POSES}")
     if Y.shape[0] > max_poses:
         keep = np.sort(rng.choice(Y.shape[0], max_poses, replace=False))
         Y, first = Y[keep], first[keep]
+    return Y, first, labels, subset
+
+
+def remainder_structure(ctx: Context, fit: FitResult, *, folds: int = 5,
+                        max_poses: int = MAX_POSES) -> Structure:
+    """The multivariate test of what ``fit`` leaves on its fitting poses (module docstring),
+    on the points :func:`~zrp.gap.analysis.kernel.target_points` chooses.
+
+    Raises:
+        NotRun: fewer than :data:`MIN_POSES` poses measure those points, no input varies or
+            the residual is zero (the message says which).
+    """
+    rng = np.random.default_rng(SEED)
+    Y, first, labels, subset = _targets(ctx, fit, max_poses, rng)
     inputs = pose_inputs(ctx, first)
     X, names = inputs(ctx, first), inputs.names
     F = arm_frames(fit.base_rotation, None if ctx.model.prismatic[0] else
                    np.asarray(ctx.model.axes[0], dtype=float), ctx.q[ctx.meas.pose_index[first], 0])
     Y = np.einsum("pji,pmj->pmi", F, Y.reshape(len(Y), -1, 3)).reshape(Y.shape)  # F^T y
     n = Y.shape[0]
-    if n < MIN_POSES or X.shape[1] == 0 or not np.any(Y):
-        return None
+    if X.shape[1] == 0:
+        raise NotRun("no joint moves and no logged time, temperature or load varies")
+    if not np.any(Y):
+        raise NotRun("the final model leaves no residual on the fitting poses")
     scale = 1.0 / length_scales(X, Y, rng)
-    P, perm_sse = _out_of_fold(X, Y, scale, inputs.groups, folds, rng)
+    P, perm_sse = _out_of_fold(X, Y, scale, inputs.groups, min(folds, n), rng)
     share = _share(Y, P)
     boot = [_share(Y, P, rng.integers(0, n, n)) for _ in range(N_BOOT)]
     lo, hi = (float(v) for v in np.percentile(boot, [2.5, 97.5]))
     sst = float(np.sum((Y - Y.mean(0)) ** 2))
     sse = float(np.sum((Y - P) ** 2))
-    relevance = {nm: float((perm_sse[j] - sse) / sst) for j, nm in enumerate(names)}
+    relevance = {nm: float((perm_sse[j] - sse) / sst) if sst > 0 else 0.0
+                 for j, nm in enumerate(names)}
     structured = bool(lo > 0.0 and share >= MIN_SHARE)
     top = max(relevance.values())
     named = (tuple(nm for nm, v in relevance.items() if v >= NAMED_FRACTION * top and v > 0)
              if structured else ())
     return Structure(share, (lo, hi), structured, relevance, named,
-                     _region(ctx, first, P - Y.mean(0)) if structured else None, n, folds)
+                     _region(ctx, first, P - Y.mean(0)) if structured else None, n, folds,
+                     labels, subset)

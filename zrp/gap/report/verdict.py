@@ -236,8 +236,13 @@ def _structure_words(diag: Diagnosis, *, always: bool) -> list[str]:
     a = diag.assessment
     s = None if a is None else a.remainder.structure
     out = [] if s is None or not (always or s.structured) else [s.words(diag.length_unit)]
+    if a is not None and a.remainder.structure_not_run:
+        out.append("The multivariate test of what remains did not run: "
+                   f"{a.remainder.structure_not_run}.")
     if a is not None and a.residual_model is not None:
         out.append(a.residual_model.words(diag.length_unit))
+    if a is not None and a.residual_model_not_run:
+        out.append(f"The learned residual term did not run: {a.residual_model_not_run}.")
     return out
 
 
