@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 
 from zrp.cli.app import emit
-from zrp.cli.options import SEED, add_deg
+from zrp.cli.options import SEED, add_deg, whole
 from zrp.errors import InputError
 from zrp.escape import csv_text
 from zrp.output import check_writable, write_text
@@ -36,7 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--reregister", action="store_true",
                    help="with --data: fit the instrument frame again to the fresh set (the "
                    "tracker was set up anew; slightly optimistic)")
-    p.add_argument("--min-repeats", type=int, default=3, metavar="K",
+    p.add_argument("--min-repeats", type=whole(2, 1000), default=3, metavar="K",
                    help="with --data: a pose measured at least K times enters ISO 9283 "
                    "(default 3)")
     p.add_argument("--mjcf", metavar="M.xml", help="with --data: the MJCF or URDF with "
