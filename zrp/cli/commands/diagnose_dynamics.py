@@ -57,8 +57,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--validate", metavar="LOG2.csv|BAG2",
                    help="a second torque log of the same arm (another run): the corrected "
                    "model, fitted on --data, is scored on it (nothing refitted)")
-    p.add_argument("--window", type=real(0.0, 10.0, open_lo=True, unit="s"), default=0.1,
-                   help="Savitzky-Golay window for the accelerations, s (default 0.1)")
+    p.add_argument("--window", type=real(0.0, 10.0, open_lo=True, unit="s"), default=None,
+                   help="Savitzky-Golay window for the velocities, accelerations and torques, "
+                   "s (default: chosen from the data among 0.05, 0.1 and 0.2 s, said in the "
+                   "report)")
     p.add_argument("--no-inertial", action="store_true",
                    help="do not fit link inertial parameters")
     p.add_argument("--kp", type=GAIN, nargs="+", help="servo stiffness per joint (N m/rad) "

@@ -26,8 +26,7 @@ Steps:
 
 from __future__ import annotations
 
-import itertools
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
@@ -35,52 +34,26 @@ from zrp.arrays import F64
 from zrp.blas import blas_threads
 from zrp.errors import InputError
 from zrp.gap.dynamics.arm import DynamicArm as Arm
-from zrp.gap.dynamics.baseline import standard_effects
-from zrp.gap.dynamics.cvgram import CVGram
 from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.effects import (
     JOINT_EFFECTS,
     MOTOR_EFFECTS,
     Effect,
     candidate_effects,
-    inertial_correction,
     payload_columns,
 )
-from zrp.gap.dynamics.fit import cross_validate, design, solve
+from zrp.gap.dynamics.final import Setup, baseline_fit, not_worse, small_effects
+from zrp.gap.dynamics.gate import BODY_CHANGES, Fitted, physical_gate
 from zrp.gap.dynamics.localpoly import local_fit
-from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
+from zrp.gap.dynamics.options import DynamicsOptions
+from zrp.gap.dynamics.physical import InertialFit
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
-from zrp.gap.dynamics.resulting import BodyChange, ChangedArm, link_changes, resulting_bodies
-from zrp.gap.dynamics.results import Baseline, DynamicDiagnosis, FoundEffect, Param, Samples
-from zrp.gap.dynamics.select import KEPT, Step, chi2_of, forward_select
+from zrp.gap.dynamics.results import DynamicDiagnosis, FoundEffect, Samples
+from zrp.gap.dynamics.select import forward_select
 from zrp.gap.dynamics.states import States, derive_states
 
 __all__ = ["EFFECT_NAMES", "DynamicDiagnosis", "DynamicsOptions", "FoundEffect", "decimated_states",
            "diagnose_dynamics", "model_torques", "torque_noise"]
-
-#: An effect whose torques stay under this share of the noise on every joint in the final fit
-#: is left out (another effect took them).
-IDLE = 0.05
-
-#: The effects that change a body of the model (their resulting bodies must be physical).
-BODY_CHANGES = ("payload", "absent_part", "link_mass")
-
-
-@dataclass(frozen=True)
-class DynamicsOptions:
-    """How the diagnosis runs (see the module docstring)."""
-
-    window_s: float = 0.1
-    fit_rate_hz: float = 100.0
-    folds: int = 5
-    min_rel: float = 0.03
-    min_abs: float = 0.05
-    max_effects: int | None = None  # None: 3 a joint and 4 more (friction on every joint
-    # takes up to three effects there, Coulomb, viscous and Stribeck)
-    inertial: bool = True
-    collinear: float = 0.1
-    effects: tuple[str, ...] | None = None  # the effect names tried (None: all)
-
 
 def torque_noise(log: TorqueLog, window_s: float, polyorder: int = 3) -> F64:
     """sigma_k of each joint's raw torque (eq. N1), segment by segment on the real time axis
@@ -120,16 +93,6 @@ def _decimated(log: TorqueLog, opt: DynamicsOptions) -> tuple[States, int]:
     states = derive_states(log, opt.window_s)
     stride = max(1, round(1.0 / (opt.fit_rate_hz * log.dt)))
     return states.every(stride), stride
-
-
-def _params(e: Effect, theta: F64, cov: F64, at_bound: np.ndarray) -> dict[str, Param]:
-    """The fitted parameters with 95 % intervals, each held inside its domain (an interval
-    never reaches values the parameter cannot have)."""
-    sd = np.sqrt(np.maximum(np.diag(cov), 0.0))
-    return {p: Param(float(theta[i]), float(max(theta[i] - 1.96 * sd[i], e.lower[i])),
-                     float(min(theta[i] + 1.96 * sd[i], e.upper[i])), e.units[i],
-                     bool(at_bound[i]))
-            for i, p in enumerate(e.params)}
 
 
 def _collinear(k: int, cols: dict[str, F64], limit: float) -> list[str]:
@@ -188,223 +151,6 @@ def diagnose_dynamics(arm: Arm, log: TorqueLog, options: DynamicsOptions | None 
         return _diagnose(arm, log, options)
 
 
-@dataclass(frozen=True)
-class _Fitted:
-    """The chosen effects fitted: found effects, the physical link fit, the withheld
-    prediction and the resulting bodies."""
-
-    found: list[FoundEffect]
-    inert: InertialFit | None
-    pred: F64
-    bodies: dict[int, BodyChange]
-
-
-def _contribution(e: Effect, theta: F64) -> F64:
-    """The RMS torque effect ``e`` adds on each joint with parameters ``theta`` (n,)."""
-    return np.sqrt(np.mean((e.columns @ theta) ** 2, axis=0))
-
-
-def _with_part_mass(arm: Arm, f: FoundEffect) -> FoundEffect:
-    """An absent part's share as the mass missing too (kg, same interval)."""
-    if f.name != "absent_part":
-        return f
-    part = next(a for a in arm.attachments if a.name == f.detail)
-    s = f.params["share"]
-    mass = Param(s.value * part.mass, s.low * part.mass, s.high * part.mass, "kg", s.at_bound)
-    return replace(f, params={**f.params, "mass": mass})
-
-
-def _fit_chosen(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma: F64,
-                opt: DynamicsOptions, guard: int, pred: F64 | None) -> _Fitted:
-    """Fit ``chosen`` on the whole log (eq. F2; the links physically, eq. P1); ``pred`` the
-    withheld prediction when known, else cross-validated here."""
-    d = design(chosen, *b.shape)
-    fit = solve(d, b, sigma)
-    values, inert, named = fit.theta, None, None
-    if any(e.name == "inertial" for e in chosen):
-        # physical by construction (eq. P1); the withheld error is that of the physical fit
-        inert, values, pred, named = _links(arm, chosen, fit.theta, b, sigma, opt, guard)
-    elif pred is None:
-        pred = cross_validate(d, b, sigma, opt.folds, guard)
-    at_bound = np.isclose(values, d.lower) | np.isclose(values, d.upper)
-    drop = {st.key: prev.chi2 - st.chi2 for prev, st in itertools.pairwise(steps)}
-    found = [FoundEffect(e.key, e.name, e.joint, e.detail,
-                         _params(e, values[sl], fit.cov[sl, sl], at_bound[sl]),
-                         drop.get(e.key, 0.0), _contribution(e, values[sl]))
-             for e, sl in zip(chosen, d.slices, strict=True)]
-    # findings in order of the torque they explain (N m over all joints): a hand of 0.76 kg
-    # on the big joints before a wrist's friction that is large only in its own noise units;
-    # the model's physics before the sensors' offsets and gains
-    found = sorted((_with_part_mass(arm, f) for f in found),
-                   key=lambda f: (f.name in ("offset", "gain"),
-                                  -float(np.sqrt(np.mean(f.rms_nm**2)))))
-    if named is not None and inert is not None:
-        return _Fitted(found, inert, pred, link_changes(arm, inert.phi, named))
-    bodies = resulting_bodies(
-        arm, [(f.key, f.name, f.detail, {k: p.value for k, p in f.params.items()})
-              for f in found if f.name in BODY_CHANGES], None if inert is None else inert.phi)
-    return _Fitted(found, inert, pred, bodies)
-
-
-def _links(arm: Arm, chosen: list[Effect], theta: F64, b: F64, sigma: F64,
-           opt: DynamicsOptions, guard: int
-           ) -> tuple[InertialFit, F64, F64, dict[int, BodyChange] | None]:
-    """The link inertias fitted physically (eq. P1). With a named part or link among the
-    chosen effects (an absent hand, a link's mass, a payload), those are applied to the
-    model first at their least-squares values and the links are fitted on top, so that the
-    physical fit holds the resulting bodies. The fit, every effect's values in ``chosen``
-    order, the withheld prediction and the named changes (None without them)."""
-    d = design(chosen, *b.shape)
-    first = [i for i, e in enumerate(chosen) if e.name in BODY_CHANGES]
-    # the named changes at their values without the link inertias (the forty combinations
-    # overlap a link's mass: fitted together the pair is not determined)
-    simple = [e for e in chosen if e.name != "inertial"]
-    ds = design(simple, *b.shape)
-    theta = theta.copy()
-    theta_s = solve(ds, b, sigma, with_cov=False).theta
-    for sl, e in zip(ds.slices, simple, strict=True):
-        theta[d.slices[chosen.index(e)]] = theta_s[sl]
-    named = resulting_bodies(arm, [(chosen[i].key, chosen[i].name, chosen[i].detail,
-                                    dict(zip(chosen[i].params, theta[d.slices[i]],
-                                             strict=True))) for i in first])
-    if not first or not all(c.physical for c in named.values()):
-        inert = physical_fit(arm, chosen, b, sigma)
-        pred, _ = physical_cross_validate(arm, chosen, b, sigma, opt.folds, guard)
-        return inert, inert.theta, pred, None
-    offset = sum(chosen[i].columns @ theta[d.slices[i]] for i in first)
-    rest = [e for i, e in enumerate(chosen) if i not in first]
-    changed = ChangedArm(arm, {bb: c.phi for bb, c in named.items()})
-    inert = physical_fit(changed, rest, b - offset, sigma)
-    pred, _ = physical_cross_validate(changed, rest, b - offset, sigma, opt.folds, guard)
-    values = theta.copy()
-    for sl, e in zip(design(rest, *b.shape).slices, rest, strict=True):
-        values[d.slices[chosen.index(e)]] = inert.theta[sl]
-    return inert, values, pred + offset, named
-
-
-def _physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sigma: F64,
-                   opt: DynamicsOptions, guard: int, pred: F64
-                   ) -> tuple[list[Effect], _Fitted, list[str]]:
-    """Fit the chosen effects; an effect of the masses that leaves a body non-physical (eq.
-    R5) is dropped and the rest refitted, said in the notes: impossible values never reach
-    the result."""
-    notes: list[str] = []
-    fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, pred)
-    for _ in range(len(chosen)):
-        bad = [c for c in fitted.bodies.values() if not c.physical]
-        culprits = [k for c in bad for k in c.effects]
-        if not culprits:
-            break
-        # the link inertias are the last resort: a named part or link stays, they go
-        order = [e.key for e in chosen]
-        key = "inertial" if "inertial" in culprits else max(
-            culprits, key=lambda k: order.index(k) if k in order else -1)
-        body = next(c for c in bad if key in c.effects)
-        notes.append(f"{key} left out: with it link {body.name} would not be physical (mass "
-                     f"{body.phi[0]:.3g} kg, or a centre or inertia no body can have)")
-        chosen = [e for e in chosen if e.key != key]
-        fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, None)
-    idle = _idle(fitted.found, sigma)
-    if idle:
-        notes.append(f"{', '.join(idle)} left out: the final fit leaves it at nothing (under "
-                     f"{IDLE:g} of the noise on every joint; other effects took its torques)")
-        chosen = [e for e in chosen if e.key not in idle]
-        fitted = _fit_chosen(arm, chosen, steps, b, sigma, opt, guard, None)
-    return chosen, fitted, notes
-
-
-_Gated = tuple[list[Effect], "_Fitted", list[str]]
-
-
-def _baseline(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int
-              ) -> tuple[Baseline, F64]:
-    """The standard identification (:mod:`zrp.gap.dynamics.baseline`) on the same samples
-    and withheld segments: unconstrained least squares, as the field fits it (its link
-    combinations are a score, never written to a file); and its withheld prediction."""
-    std = standard_effects(su.effects)
-    pred = CVGram(std, su.b, su.sigma, opt.folds, guard).predict([e.key for e in std])
-    d = design(std, *su.b.shape)
-    theta = solve(d, su.b, su.sigma, with_cov=False).theta
-    found, phi = [], {}
-    for e, sl in zip(std, d.slices, strict=True):
-        if e.name == "inertial" and e.basis is not None:
-            phi = {b: p - arm.body_params(b)
-                   for b, p in inertial_correction(arm, theta[sl], e.basis).items()}
-            continue
-        params = {p: Param(float(theta[sl][i]), float(theta[sl][i]), float(theta[sl][i]),
-                           e.units[i]) for i, p in enumerate(e.params)}
-        found.append(FoundEffect(e.key, e.name, e.joint, e.detail, params, 0.0))
-    r = su.b_raw - pred
-    return Baseline(keys=tuple(e.key for e in std), effects=found, phi_change=phi,
-                    chi2=chi2_of(su.b_raw, pred, su.sigma),
-                    rms_withheld=np.sqrt(np.mean(r * r, axis=0))), pred
-
-
-def _not_worse(arm: Arm, su: _Setup, opt: DynamicsOptions, guard: int, steps: list[Step],
-               selected: _Gated) -> tuple[Baseline, list[Effect], _Fitted, list[str]]:
-    """The final model never worse on the withheld segments than the standard
-    identification (eq. B0), in noise units (chi2) and in N m over the joints (what the
-    report gives): when the selected effects lose to it clearly (by the selection's own
-    threshold, ``min_rel``), they are completed with its terms, said in the notes."""
-    base, base_pred = _baseline(arm, su, opt, guard)
-    chosen, fitted, notes = selected
-    score, ref = _scores(su, fitted.pred), _scores(su, base_pred)
-    if all(r >= x * (1.0 - opt.min_rel) for r, x in zip(ref, score, strict=True)):
-        return base, chosen, fitted, notes
-    taken = {(e.name, e.joint) for e in chosen}
-    more = [e for e in standard_effects(su.effects) if (e.name, e.joint) not in taken]
-    union = _physical_gate(arm, chosen + more, steps, su.b, su.sigma, opt, guard, None)
-    got = _scores(su, union[1].pred)
-    if not all(g <= x for g, x in zip(got, score, strict=True)):
-        return base, chosen, fitted, [*notes, (
-            f"the standard identification predicts the withheld segments better (chi2 "
-            f"{ref[0]:.3g}, {ref[1]:.3g} N m against {score[0]:.3g}, {score[1]:.3g} N m) but "
-            f"not once physical with the selected effects (chi2 {got[0]:.3g}, {got[1]:.3g} "
-            "N m): the selected effects are kept")]
-    added = [e.key for e in union[0] if e.key not in {c.key for c in chosen}]
-    why = (f"the selected effects alone predict the withheld segments worse than the standard "
-           f"identification (chi2 {score[0]:.3g}, {score[1]:.3g} N m against {ref[0]:.3g}, "
-           f"{ref[1]:.3g} N m); completed with its terms {', '.join(added) or '-'} (now chi2 "
-           f"{got[0]:.3g}, {got[1]:.3g} N m)")
-    return base, union[0], union[1], [*notes, *union[2], why]
-
-
-def _scores(su: _Setup, pred: F64) -> tuple[float, float]:
-    """The withheld chi2 and the withheld RMS over the joints (N m) of a prediction (a
-    joint whose torque is not data has no residual: it counts as zero in both)."""
-    r = su.b_raw - pred
-    return chi2_of(su.b_raw, pred, su.sigma), float(np.sqrt(np.mean(r * r)))
-
-
-def _small(chosen: list[Effect], found: list[FoundEffect], su: _Setup, opt: DynamicsOptions,
-           guard: int) -> list[FoundEffect]:
-    """Each effect's withheld chi2 drop in the final set (the rise without it, the others
-    refitted); one below the selection's threshold is small: in the model, not a finding. A
-    part of the model (payload, a part not on the arm) is weighed without the link
-    combinations, which can carry any body's torques (the selection named the part)."""
-    if not chosen:
-        return found
-    cv = CVGram(chosen, su.b, su.sigma, opt.folds, guard)
-    keys = [e.key for e in chosen]
-    full = chi2_of(su.b_raw, cv.predict(keys), su.sigma)
-    limit = max(opt.min_rel * full, opt.min_abs)
-    drops = {}
-    for e in chosen:
-        with_ = [k for k in keys if e.name not in KEPT or not k.startswith("inertial")]
-        ref = full if len(with_) == len(keys) else chi2_of(su.b_raw, cv.predict(with_),
-                                                            su.sigma)
-        drops[e.key] = chi2_of(su.b_raw, cv.predict([k for k in with_ if k != e.key]),
-                               su.sigma) - ref
-    return [replace(f, chi2_drop=drops.get(f.key, f.chi2_drop),
-                    small=drops.get(f.key, np.inf) < limit) for f in found]
-
-
-def _idle(found: list[FoundEffect], sigma: F64) -> list[str]:
-    """The effects the final fit leaves at nothing (their torques taken by others): no
-    findings."""
-    return [f.key for f in found if f.rms_nm is not None and np.all(f.rms_nm < IDLE * sigma)]
-
-
 def _common_gain(found: list[FoundEffect]) -> list[str]:
     """Gains of one sign on several joints: a symptom to explain, not a sensor finding."""
     gains = [e for e in found if e.name == "gain"]
@@ -445,21 +191,7 @@ def _measured_only(e: Effect, measured: np.ndarray) -> Effect:
     return replace(e, columns=cols, full=full)
 
 
-@dataclass(frozen=True)
-class _Setup:
-    """Steps 1-3 and the candidates: the states, the residual torques (filtered and raw),
-    the noise estimate and the weights of the fit (1 on a joint that is not data)."""
-
-    s: States
-    stride: int
-    b: F64
-    b_raw: F64
-    noise: F64
-    sigma: F64
-    effects: list[Effect]
-
-
-def _setup(arm: Arm, log: TorqueLog, opt: DynamicsOptions) -> _Setup:
+def _setup(arm: Arm, log: TorqueLog, opt: DynamicsOptions) -> Setup:
     # a joint whose torque is not data (constant, zero) is left out: no residual, no column
     if not np.any(log.measured):
         raise InputError(f"{log.source}: no joint's torque is data ("
@@ -478,10 +210,10 @@ def _setup(arm: Arm, log: TorqueLog, opt: DynamicsOptions) -> _Setup:
         effects = [_measured_only(e, m) for e in effects if e.joint is None or m[e.joint]]
     if opt.effects is not None:
         effects = [e for e in effects if e.name in _known_effects(opt.effects)]
-    return _Setup(s, stride, b, b_raw, noise, np.where(m, noise, 1.0), effects)
+    return Setup(s, stride, b, b_raw, noise, np.where(m, noise, 1.0), effects)
 
 
-def _notes(arm: Arm, log: TorqueLog, su: _Setup, fitted: _Fitted, gate: list[str]
+def _notes(arm: Arm, log: TorqueLog, su: Setup, fitted: Fitted, gate: list[str]
            ) -> list[str]:
     notes = [*getattr(arm, "notes", ()),
              f"accelerations by Savitzky-Golay, window {su.s.window_s:.3g} s; fit at "
@@ -493,19 +225,63 @@ def _notes(arm: Arm, log: TorqueLog, su: _Setup, fitted: _Fitted, gate: list[str
     return notes
 
 
+#: The derivative filter windows tried when none is given, s: each a zero-phase low-pass of
+#: positions and torques in parallel, about 25, 12 and 6 Hz at its -3 dB point (cubic
+#: Savitzky-Golay, :mod:`zrp.gap.dynamics.states`).
+WINDOWS = (0.05, 0.1, 0.2)
+
+#: Among windows within this share of the best score, the first in :data:`PREFERRED` is
+#: taken (the 0.1 s window, then the shorter one).
+WINDOW_TIE = 0.02
+PREFERRED = (0.1, 0.05, 0.2)
+
+
+def _guard(opt: DynamicsOptions) -> int:
+    return max(1, round(0.5 * float(opt.window_s or 0.1) * opt.fit_rate_hz))
+
+
+def choose_window(arm: Arm, log: TorqueLog, opt: DynamicsOptions) -> tuple[float, str]:
+    """The derivative filter's window from the data (issue 43): each of :data:`WINDOWS`
+    that the log can carry (7 samples and more, within its longest segment) scored by the
+    standard identification's withheld error on the raw torques, every joint in units of
+    one noise estimate (the middle window's), so that the windows are compared on the same
+    scale; within :data:`WINDOW_TIE` of the best, the first of :data:`PREFERRED`. The window
+    and a note."""
+    longest = max(b - a for a, b in log.segment_ranges)
+    fits = [w for w in WINDOWS if 7 <= round(w / log.dt) <= longest]
+    if not fits:
+        return 0.1, "derivative filter window 0.1 s (the log is too short or coarse to choose)"
+    ref = np.where(log.measured, torque_noise(log, fits[len(fits) // 2]), 1.0)
+    scores = {}
+    for w in fits:
+        o = replace(opt, window_s=w)
+        su = _setup(arm, log, o)
+        _, pred = baseline_fit(arm, su, o, _guard(o))
+        scores[w] = float(np.mean(((su.b_raw - pred) / ref) ** 2))
+    best = min(scores.values())
+    w = next(x for x in PREFERRED if scores.get(x, np.inf) <= best * (1.0 + WINDOW_TIE))
+    said = ", ".join(f"{x:g} s: {c:.3g}" for x, c in scores.items())
+    return w, (f"derivative filter window {w:g} s, chosen from the data: the standard "
+               f"identification's withheld chi2 (one noise scale) {said}")
+
+
 def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> DynamicDiagnosis:
     opt = options or DynamicsOptions()
     _check_inputs(arm, log)
+    said = f"derivative filter window {opt.window_s:g} s (given)" if opt.window_s else ""
+    if opt.window_s is None:
+        window, said = choose_window(arm, log, opt)
+        opt = replace(opt, window_s=window)
     su = _setup(arm, log, opt)
     s, b, b_raw, sigma = su.s, su.b, su.b_raw, su.sigma
-    guard = max(1, round(0.5 * opt.window_s * opt.fit_rate_hz))
+    guard = _guard(opt)
     chosen, steps, pred = forward_select(su.effects, b, b_raw, sigma, folds=opt.folds,
                                          guard=guard, min_rel=opt.min_rel, min_abs=opt.min_abs,
                                          max_effects=opt.max_effects or 3 * arm.n + 4)
-    chosen, fitted, gate_notes = _physical_gate(arm, chosen, steps, b, sigma, opt, guard, pred)
-    base, chosen, fitted, gate_notes = _not_worse(arm, su, opt, guard, steps,
+    chosen, fitted, gate_notes = physical_gate(arm, chosen, steps, b, sigma, opt, guard, pred)
+    base, chosen, fitted, gate_notes = not_worse(arm, su, opt, guard, steps,
                                                   (chosen, fitted, gate_notes))
-    fitted = replace(fitted, found=_small(chosen, fitted.found, su, opt, guard))
+    fitted = replace(fitted, found=small_effects(chosen, fitted.found, su, opt, guard))
     masks = regime_masks(s.qd, arm.gravity_torques(s.q), guard)
     ties = [f"{st.key} from {', '.join(st.ties)} (each explains the withheld torques to within "
             "10 % of the other; the simpler is named)" for st in steps[1:] if st.ties]
@@ -519,6 +295,7 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
         ties + _cannot_tell([e for e in su.effects if e.name in JOINT_EFFECTS], sigma,
                             opt.collinear),
         {"before": regime_rms(b_raw, masks), "after": regime_rms(b_raw - pred, masks)},
-        inert, {} if inert is None else inert.phi, _notes(arm, log, su, fitted, gate_notes),
+        inert, {} if inert is None else inert.phi,
+        [said, *_notes(arm, log, su, fitted, gate_notes)],
         Samples(s.t, s.q, s.qd, b_raw, b_raw - pred), bodies, dict(log.unmeasured), base,
         s.window_s)

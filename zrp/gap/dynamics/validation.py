@@ -9,7 +9,7 @@ The prediction along the second log's states is the corrected model's torques (e
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -74,7 +74,8 @@ def validate(arm: Arm, diag: DynamicDiagnosis, log: TorqueLog,
              options: DynamicsOptions | None = None) -> Validation:
     """Score ``diag``'s corrected model on ``log`` (module docstring); ``options`` as the
     diagnosis's (its filter window and fit rate)."""
-    opt = options or DynamicsOptions()
+    # the diagnosis's filter (its window may have been chosen from its log)
+    opt = replace(options or DynamicsOptions(), window_s=diag.window_s)
     if log.n_joints != arm.n:
         raise InputError(f"validate: {log.source} has {log.n_joints} joints, the model "
                          f"{arm.n}")
