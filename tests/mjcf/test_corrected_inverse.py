@@ -189,7 +189,7 @@ def _analytic(diag, arm, m_fixed: mujoco.MjModel, qd, tau_nominal) -> tuple[np.n
 
 
 def _states(arm, log, diag):
-    s, stride = decimated_states(log, DynamicsOptions())
+    s, stride = decimated_states(log, DynamicsOptions(window_s=diag.window_s))
     return s, model_torques(arm, log, s, stride)
 
 

@@ -107,7 +107,7 @@ def ur5e_inertial_case(ur5e):
     command = scenario_command(bench.q0_array, bench.amplitude_rad, 1)
     hidden, sigma_true, _ = draw_hidden(ur5e, command, "inertial", 1)
     log = simulate(ur5e, hidden, command, 20.0, noise_nm=sigma_true, seed=1)
-    opt = dg.DynamicsOptions()
+    opt = dg.DynamicsOptions(window_s=0.1)
     sigma = dg.torque_noise(log, opt.window_s)
     s, _ = dg._decimated(log, opt)
     tau0 = inverse_dynamics(ur5e.model, s.q, s.qd, s.qdd)

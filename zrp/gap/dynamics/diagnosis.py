@@ -90,6 +90,9 @@ def model_torques(arm: Arm, log: TorqueLog, s: States, stride: int) -> F64:
 
 
 def _decimated(log: TorqueLog, opt: DynamicsOptions) -> tuple[States, int]:
+    if opt.window_s is None:
+        raise InputError("window_s: give the filter window (a diagnosis's own: "
+                         "DynamicDiagnosis.window_s), or let diagnose_dynamics choose it")
     states = derive_states(log, opt.window_s)
     stride = max(1, round(1.0 / (opt.fit_rate_hz * log.dt)))
     return states.every(stride), stride
