@@ -11,7 +11,8 @@ wrist motor, offsets: 2.66 N m), friction alone (4.47), FIGAROH 1.0.2's own TX40
 here. Skipped (says so, writes nothing) without ../shared. This script reports what it sees;
 it asserts nothing (tests/cli/test_dynamics_tx40.py does).
 
-Run: python3 tests/benchmarks/bench_dynamics_real.py [--out FILE.md] [--force]
+Run: python3 tests/benchmarks/bench_dynamics_real.py [--quick] [--out FILE.md] [--force]
+(--quick: the same run; the log is 9 s, the whole benchmark takes about 10 s)
 (writes renders/benchmarks/bench_dynamics_real.md and .json)
 """
 
@@ -67,6 +68,8 @@ def _diagnose(work: Path, fit: Path, test: Path) -> tuple[dict, float]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--quick", action="store_true",
+                    help="accepted for the benchmark contract: the run is already short")
     add_output_arguments(ap, "bench_dynamics_real")
     args = ap.parse_args()
     if not (TX40 / "tx40_mdh_modified.urdf").is_file():

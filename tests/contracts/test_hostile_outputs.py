@@ -159,7 +159,7 @@ def _check_markdown(md: str) -> None:
 
 
 def _hostile_dynamics():
-    from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, FoundEffect, Param, Samples
+    from zrp.gap.dynamics.results import DynamicDiagnosis, FoundEffect, Param, Samples
     from zrp.gap.dynamics.select import Step
 
     n = len(MD_HOSTILE)

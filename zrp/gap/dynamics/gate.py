@@ -148,10 +148,7 @@ def physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sig
         culprits = [k for c in bad for k in c.effects]
         if not culprits:
             break
-        # the link inertias are the last resort: a named part or link stays, they go
-        order = [e.key for e in chosen]
-        key = "inertial" if "inertial" in culprits else max(
-            culprits, key=lambda k: order.index(k) if k in order else -1)
+        key = _culprit(culprits, [e.key for e in chosen])
         body = next(c for c in bad if key in c.effects)
         notes.append(f"{key} left out: with it link {body.name} would not be physical (mass "
                      f"{body.phi[0]:.3g} kg, or a centre or inertia no body can have)")
@@ -164,6 +161,14 @@ def physical_gate(arm: Arm, chosen: list[Effect], steps: list[Step], b: F64, sig
         chosen = [e for e in chosen if e.key not in idle]
         fitted = fit_chosen(arm, chosen, steps, b, sigma, opt, guard, None)
     return chosen, fitted, notes
+
+
+def _culprit(culprits: list[str], order: list[str]) -> str:
+    """The effect that goes: the link inertias first (a named part or link stays, they go),
+    else the latest chosen (an effect found early never gives way to a later one)."""
+    if "inertial" in culprits:
+        return "inertial"
+    return max(culprits, key=lambda k: order.index(k) if k in order else -1)
 
 
 def _idle(found: list[FoundEffect], sigma: F64) -> list[str]:

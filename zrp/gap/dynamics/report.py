@@ -83,6 +83,17 @@ def _validation(v: Validation, joints: list[str]) -> list[str]:
     return out
 
 
+def _found(d: DynamicDiagnosis) -> list[str]:
+    """The findings' table, then the small effects in one line."""
+    out = _effects(d) if d.found else ["None: the torques are explained to the noise."]
+    small = [e for e in d.effects if e.small]
+    if small:
+        out += ["", "Small effects (in the corrected model; each lowers the withheld error by "
+                "less than the selection's threshold, so none is a finding): "
+                + md_text(", ".join(e.label for e in small)) + "."]
+    return out
+
+
 def _step(s: Any) -> str:
     if s.replaces:
         return md_line("{} for {} {}", s.key, s.replaces, f"{s.chi2:.3g}")
@@ -131,13 +142,7 @@ def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
         lines += ["", "## Validation on another log (N m RMS)", "",
                   *_validation(validation, d.joints)]
     lines += ["", "## Against the standard identification", "", *_baseline(d, validation)]
-    lines += ["", "## Effects found", ""]
-    lines += _effects(d) if d.found else ["None: the torques are explained to the noise."]
-    small = [e for e in d.effects if e.small]
-    if small:
-        lines += ["", "Small effects (in the corrected model; each lowers the withheld error by "
-                  "less than the selection's threshold, so none is a finding): "
-                  + md_text(", ".join(e.label for e in small)) + "."]
+    lines += ["", "## Effects found", "", *_found(d)]
     lines += ["", "## Selection (withheld chi2: 1 is the noise floor)", "",
               " -> ".join(_step(s) for s in d.steps), "",
               "## Where: residual RMS per regime (N m; before / after)", ""]
