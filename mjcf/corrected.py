@@ -59,6 +59,7 @@ HELD_RTOL = 1e-9
 PAYLOAD_BODY = "identified_payload"
 
 _JOINT_FIELDS = {"coulomb": "frictionloss", "viscous": "damping", "armature": "armature"}
+_MOTOR_FIELDS = {"motor_coulomb": 1, "motor_viscous": 2, "motor_armature": 3}
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,9 @@ class Corrections:
     payload_pos_m: F64 = field(default_factory=lambda: np.zeros(3))
     inertial: dict[int, F64] = field(default_factory=dict)
     not_in_model: list[str] = field(default_factory=list)
+    # a coupled motor (0-based) -> (joint-scale direction, frictionloss, damping, armature):
+    # a fixed tendon over the joints it turns
+    motors: dict[int, tuple[F64, float, float, float]] = field(default_factory=dict)
 
 
 def _separate_payload(arm: Arm, diag: DynamicDiagnosis) -> tuple[float, F64]:
@@ -92,16 +96,20 @@ def corrections(arm: Arm, diag: DynamicDiagnosis) -> Corrections:
     link's mass, a part not on the arm, a payload taken away) with its resulting inertial."""
     add = {f: np.zeros(arm.n) for f in _JOINT_FIELDS.values()}
     skipped = []
+    motors: dict[int, list] = {}
     for e in diag.effects:
         if e.name in _JOINT_FIELDS and e.joint is not None:
             add[_JOINT_FIELDS[e.name]][e.joint] += e.params[e.name].value
+        elif e.name in _MOTOR_FIELDS and e.joint in diag.motors:
+            row = motors.setdefault(e.joint, [np.array(diag.motors[e.joint]), 0.0, 0.0, 0.0])
+            row[_MOTOR_FIELDS[e.name]] = e.params[e.name].value
         elif e.name not in ("payload", "inertial", "absent_part", "link_mass"):
             skipped.append(e.label)
     payload, pos = _separate_payload(arm, diag)
     # only the bodies the diagnosis changed (every other keeps the model's inertial)
     bodies = {b: c.phi for b, c in diag.bodies.items() if not (payload and b == arm.tool_body)}
     return Corrections(add["frictionloss"], add["damping"], add["armature"], payload, pos,
-                       bodies, skipped)
+                       bodies, skipped, {k: tuple(v) for k, v in motors.items()})
 
 
 def _body_name(m: mujoco.MjModel, b: int) -> str:
@@ -137,6 +145,22 @@ def _set_inertial(body: mujoco.MjsBody, phi: F64) -> None:
     body.fullinertia = [np.nan, 0.0, 0.0, 0.0, 0.0, 0.0]  # "not given" (the default)
 
 
+def _add_motors(spec: mujoco.MjSpec, arm: Arm, fix: Corrections) -> None:
+    """Each coupled motor as a fixed tendon over the joints it turns (length g . q): its
+    damping, armature and frictionloss act on the motor's velocity g . qd and reach every
+    joint it turns through g, as the diagnosis's motor effects do."""
+    for k, (g, friction, damping, armature) in sorted(fix.motors.items()):
+        t = spec.add_tendon(name=f"identified_motor{k + 1}")
+        for j, coef in enumerate(g):
+            if coef != 0.0:
+                t.wrap_joint(arm.joint_names[j], float(coef))
+        t.frictionloss = float(friction)
+        d = np.array(t.damping, dtype=float).ravel()  # MuJoCo 4: [linear, higher...]
+        d[0] = damping
+        t.damping = d
+        t.armature = float(armature)
+
+
 def corrected_spec(arm: Arm, fix: Corrections) -> mujoco.MjSpec:
     """A copy of the arm's spec with ``fix`` written in (module docstring)."""
     spec = arm.spec.copy()
@@ -150,6 +174,7 @@ def corrected_spec(arm: Arm, fix: Corrections) -> mujoco.MjSpec:
         j.armature = float(m.dof_armature[k] + fix.armature[k])
     for b, phi in fix.inertial.items():
         _set_inertial(spec.body(_body_name(m, b)), phi)
+    _add_motors(spec, arm, fix)
     if fix.payload_kg > 0.0:
         tool = spec.body(_body_name(m, arm.tool_body))
         load = tool.add_body(name=PAYLOAD_BODY, pos=list(fix.payload_pos_m))
@@ -222,6 +247,9 @@ class CorrectedMJCF:
         held += ["an identified payload body"] if fix.payload_kg else []
         held += [f"the inertial of {', '.join(self.arm.body_name(b) for b in fix.inertial)}"
                  ] if fix.inertial else []
+        motors = ", ".join(f"motor {k + 1}" for k in fix.motors)
+        held += [f"a fixed tendon per coupled motor ({motors}: its frictionloss, damping and "
+                 "armature)"] if fix.motors else []
         notes = [f"corrected.xml: the model with {'; '.join(held)}."]
         if fix.not_in_model:
             notes.append(f"not in MJCF (report only): {', '.join(fix.not_in_model)}")

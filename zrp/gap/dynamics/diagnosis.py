@@ -301,4 +301,5 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
         inert, {} if inert is None else inert.phi,
         [said, *_notes(arm, log, su, fitted, gate_notes)],
         Samples(s.t, s.q, s.qd, b_raw, b_raw - pred), bodies, dict(log.unmeasured), base,
-        s.window_s)
+        s.window_s, {k: tuple(float(x) for x in g) for k, g in (
+            log.transmission.coupled_motors() if log.transmission else [])})

@@ -120,6 +120,8 @@ class DynamicDiagnosis:
         baseline: the standard identification on the same samples and withheld segments
             (:mod:`zrp.gap.dynamics.baseline`), or None.
         window_s: the derivative filter's window used (chosen from the data).
+        motors: each coupled motor of the log's transmission (0-based) and its joint-scale
+            direction g_k (:meth:`~zrp.gap.dynamics.transmission.Transmission.coupled_motors`).
     """
 
     arm: str
@@ -139,6 +141,7 @@ class DynamicDiagnosis:
     unmeasured: dict[int, str] = field(default_factory=dict)
     baseline: Baseline | None = None
     window_s: float = 0.1
+    motors: dict[int, tuple[float, ...]] = field(default_factory=dict)
 
     @property
     def found(self) -> list[FoundEffect]:
