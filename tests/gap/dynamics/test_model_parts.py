@@ -149,3 +149,29 @@ def test_a_joint_whose_torque_is_not_logged_is_left_out_and_named(panda, hand_lo
     doc = diagnosis_json(d)
     assert doc["unmeasured"] == {"7": d.unmeasured[6]}
     assert np.isfinite(doc["overall_nm"]["after_withheld"])
+
+
+def test_absent_hand_kept_and_final_never_worse_than_a_step(panda, hand_logs):
+    """Issue 43: the hand found first stays a finding to the end (no later step, link
+    combinations or exchange takes it out), and the final model's withheld chi2 is no worse
+    than any step's (each step's chi2 is the selection's unconstrained score, the final one
+    that of the physical link fit: 1 % is allowed for the constraint) nor than the standard
+    identification's."""
+    _, (log, _), _ = hand_logs
+    d = diagnose_dynamics(panda, log, DynamicsOptions())
+    hand = d.effect("absent_part")
+    assert hand is not None and not hand.small
+    assert d.steps[1].key == hand.key
+    m = d.measured
+    final = float(np.mean((d.rms_after[m] / d.noise_nm[m]) ** 2))
+    assert final <= 1.01 * min(s.chi2 for s in d.steps)
+    assert final <= d.baseline.chi2
+
+
+def test_a_later_effect_that_breaks_a_body_goes_not_the_earlier():
+    from zrp.gap.dynamics.gate import _culprit
+
+    order = ["absent_part@panda_hand", "coulomb_j1", "link_mass@panda_link7"]
+    assert _culprit(["absent_part@panda_hand", "link_mass@panda_link7"], order) == (
+        "link_mass@panda_link7")
+    assert _culprit(["absent_part@panda_hand", "inertial"], [*order, "inertial"]) == "inertial"
