@@ -74,6 +74,7 @@ def test_tx40_raw_motor_side_log_reaches_an_experts_level(tx40, capsys, monkeypa
     assert {("armature", 0), ("armature", 1)} <= found  # rotor inertia on joints 1 and 2
     assert ("motor_coulomb", 5) in found  # the coupled wrist motor's friction
     assert any("motor 6 turns with joints 5 and 6" in n for n in d["notes"])
+    assert d["unmeasured"] == {}  # every drive channel is a torque
     assert any("link 'link_6'" in n and "point mass" in n for n in d["notes"])
 
 

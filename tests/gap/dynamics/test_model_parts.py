@@ -175,3 +175,23 @@ def test_a_later_effect_that_breaks_a_body_goes_not_the_earlier():
     assert _culprit(["absent_part@panda_hand", "link_mass@panda_link7"], order) == (
         "link_mass@panda_link7")
     assert _culprit(["absent_part@panda_hand", "inertial"], [*order, "inertial"]) == "inertial"
+
+
+def test_an_effort_that_is_no_torque_is_left_out_and_named(panda, hand_logs):
+    """Issue 44: a joint whose logged effort is something else (here a slow sine: a channel
+    of another signal) is named and not fitted; the other joints are diagnosed as before
+    (the absent hand first), and a joint whose model is merely wrong (joint 5 carries the
+    absent hand's torque) is not taken for such a channel."""
+    from dataclasses import replace
+
+    _, (log, _), _ = hand_logs
+    tau = log.tau.copy()
+    tau[:, 3] = 5.0 * np.sin(2 * np.pi * 0.37 * log.t + 1.0) + np.random.default_rng(3).normal(
+        0.0, 0.05, log.n_samples)
+    d = diagnose_dynamics(panda, replace(log, tau=tau), DynamicsOptions())
+    assert set(d.unmeasured) == {3}
+    assert "does not behave like a torque" in d.unmeasured[3]
+    assert d.found[0].name == "absent_part"
+    assert all(e.joint != 3 for e in d.effects)
+    clean = diagnose_dynamics(panda, log, DynamicsOptions())
+    assert clean.unmeasured == {}

@@ -268,6 +268,51 @@ def choose_window(arm: Arm, log: TorqueLog, opt: DynamicsOptions) -> tuple[float
                f"identification's withheld chi2 (one noise scale) {said}")
 
 
+#: A joint whose model torque varies by more than UNUSABLE_NOISE times its noise while its
+#: effort follows it with a correlation under UNUSABLE_CORR, and of whose effort the standard
+#: identification explains less than UNUSABLE_SHARE on the withheld segments, is not
+#: carrying a torque.
+UNUSABLE_NOISE = 3.0
+UNUSABLE_CORR = 0.3
+UNUSABLE_SHARE = 0.2
+
+
+def _why_unusable(tau: F64, tau0: F64, left: F64, noise: float) -> str | None:
+    """Why a joint's effort ``tau`` is no torque (None: it is one): ``tau0`` the model's
+    torque, ``left`` what the standard identification leaves of it (withheld)."""
+    spread, var = float(np.std(tau0)), float(np.var(tau))
+    if spread <= UNUSABLE_NOISE * noise or var == 0.0:
+        return None
+    r = float(np.corrcoef(tau, tau0)[0, 1])
+    if r >= UNUSABLE_CORR or 1.0 - float(np.mean(left**2)) / var > UNUSABLE_SHARE:
+        return None
+    head = (f"its effort does not behave like a torque: the model's torque there varies by "
+            f"{spread:.3g} N m RMS ({spread / noise:.1f}x the noise) and the effort follows it "
+            f"with a correlation of {r:+.2f}")
+    if r <= -UNUSABLE_CORR:
+        return head + ("; it runs the other way: a torque constant or transmission sign "
+                       "reversed on this joint?")
+    return head + ("; and the standard identification explains none of it: check what this "
+                   "channel logs (a current of another drive, a position error)")
+
+
+def unusable_efforts(arm: Arm, log: TorqueLog, opt: DynamicsOptions) -> TorqueLog:
+    """``log`` with the joints whose effort does not behave like a torque left out (issue
+    44): the model's torque varies far above the noise there and the logged effort does not
+    follow it (a torso's lift whose effort is a position error, a channel that logs something
+    else, a reversed sign). Such a joint is named in :attr:`TorqueLog.unmeasured`, not
+    fitted; with every joint so, nothing is left out (the diagnosis says what it finds)."""
+    su = _setup(arm, log, opt)
+    _, pred = baseline_fit(arm, su, opt, _guard(opt))
+    tau, left = su.s.tau_raw, su.b_raw - pred
+    bad = {int(k): why for k in np.flatnonzero(log.measured)
+           if (why := _why_unusable(tau[:, k], tau[:, k] - su.b_raw[:, k], left[:, k],
+                                    float(su.noise[k])))}
+    if not bad or len(bad) == int(np.sum(log.measured)):
+        return log
+    return replace(log, unmeasured={**log.unmeasured, **bad})
+
+
 def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> DynamicDiagnosis:
     opt = options or DynamicsOptions()
     _check_inputs(arm, log)
@@ -275,6 +320,7 @@ def _diagnose(arm: Arm, log: TorqueLog, options: DynamicsOptions | None) -> Dyna
     if opt.window_s is None:
         window, said = choose_window(arm, log, opt)
         opt = replace(opt, window_s=window)
+    log = unusable_efforts(arm, log, opt)
     su = _setup(arm, log, opt)
     s, b, b_raw, sigma = su.s, su.b, su.b_raw, su.sigma
     guard = _guard(opt)
