@@ -43,6 +43,7 @@ import numpy as np
 
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.errors import InputError, ZRPWarning
+from zrp.jsonio import MAX_JSON_DEPTH, loads_json
 from zrp.kinematics import forward_kinematics
 from zrp.units import LENGTH_UNITS
 
@@ -51,7 +52,6 @@ __all__ = ["BASE_REACH_FACTOR", "MAX_HARMONIC", "MAX_JSON_DEPTH", "MAX_PAYLOAD_K
            "PairWarning", "TamperedPairError", "bind_pair", "check_fields", "check_pair",
            "document_sha256", "field_problems", "loads_bounded"]
 
-MAX_JSON_DEPTH = 32
 BASE_REACH_FACTOR = 100.0
 TOOL_REACH_FACTOR = 2.0
 MAX_HARMONIC = 100
@@ -77,27 +77,12 @@ class PairWarning(ZRPWarning):
 
 def loads_bounded(text: str, src: str) -> Any:
     """``json.loads(text)`` after checking that arrays and objects nest at most
-    :data:`MAX_JSON_DEPTH` deep (brackets inside strings do not count).
+    :data:`MAX_JSON_DEPTH` deep (:func:`zrp.jsonio.loads_json`, the one bounded reader).
 
     Raises:
         InputError: too deep, or not JSON (naming ``src``).
     """
-    raw = np.frombuffer(re.sub(r'"(?:[^"\\]|\\.)*"', '""', text, flags=re.S).encode(
-        "utf-8", "replace"), dtype=np.uint8)
-    step = (np.isin(raw, (ord("["), ord("{"))).astype(np.int64)
-            - np.isin(raw, (ord("]"), ord("}"))).astype(np.int64))
-    depth = int(np.cumsum(step).max()) if step.size else 0
-    if depth > MAX_JSON_DEPTH:
-        raise InputError(f"{src}: JSON nested {depth} deep; a calibration file nests at most "
-                         f"{MAX_JSON_DEPTH} deep")
-    try:
-        return json.loads(text, parse_constant=_no_constant)
-    except (ValueError, RecursionError) as exc:
-        raise InputError(f"{src}: cannot read the compensation file: {exc}") from None
-
-
-def _no_constant(name: str) -> None:
-    raise ValueError(f"{name} is not a JSON number (the files hold finite numbers only)")
+    return loads_json(text, src, what="compensation file")
 
 
 def _reach(cal: CalibratedRobot) -> float:

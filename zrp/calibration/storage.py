@@ -27,7 +27,6 @@ from zrp.calibration.filecheck import (
     bind_pair,
     check_fields,
     check_pair,
-    loads_bounded,
 )
 from zrp.calibration.jointmap import Term
 from zrp.calibration.learned import LearnedTerm
@@ -36,12 +35,11 @@ from zrp.errors import InputError, ZRPError
 from zrp.escape import one_line
 from zrp.gap.finalrecord import ProbeRecord, switch_weights
 from zrp.gap.fit.fullpose import FullPoseFit
-from zrp.jsonio import dumps, to_jsonable, version_field
+from zrp.jsonio import MAX_COMPENSATION_BYTES, dumps, read_json, to_jsonable, version_field
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
 from zrp.rotations import er_from_matrix, rotvec_from_er
-from zrp.textio import read_text
 from zrp.version import __version__
 
 __all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "model_file_path",
@@ -251,8 +249,9 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
         ImplausibleValueError: a value outside its physical domain.
     """
     src = str(comp_path)
-    # a regular file, size checked; nesting bounded (zrp.calibration.filecheck)
-    doc = loads_bounded(read_text(comp_path, label=src), src)
+    # a regular file, its size checked before parsing; nesting bounded (zrp.jsonio)
+    doc = read_json(comp_path, label=src, max_bytes=MAX_COMPENSATION_BYTES,
+                    what="compensation file")
     if not isinstance(doc, dict):
         raise InputError(f"{src}: expected a JSON object")
     version_field(doc, "schema_version", READABLE_VERSIONS, src=src,
