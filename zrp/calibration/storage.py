@@ -30,6 +30,7 @@ from zrp.calibration.filecheck import (
 )
 from zrp.calibration.jointmap import Term
 from zrp.calibration.learned import LearnedTerm
+from zrp.calibration.schema import check_schema
 from zrp.calibration.validation import validate_calibration
 from zrp.errors import InputError, ZRPError
 from zrp.escape import one_line
@@ -180,10 +181,13 @@ def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: s
 
     Raises:
         OutputExistsError: a file exists and ``overwrite`` is False.
+        FieldDomainError: a field the reader would refuse
+            (:func:`zrp.calibration.filecheck.check_fields`); nothing is written.
         ImplausibleValueError: a value outside its physical domain
             (:func:`zrp.calibration.validation.validate_calibration`); nothing is written.
     """
     validate_calibration(cal, cal.widen, "write_calibration")
+    check_fields(cal, cal.model.length_unit, "write_calibration")  # the reader's checks
     check_writable([model_path, comp_path], overwrite)
     folder = Path(comp_path).resolve().parent
     try:
@@ -254,13 +258,10 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
                     what="compensation file")
     if not isinstance(doc, dict):
         raise InputError(f"{src}: expected a JSON object")
-    version_field(doc, "schema_version", READABLE_VERSIONS, src=src,
-                  hint=f" (a file from a newer zrp-accuracy? zrp_version "
-                       f"{doc.get('zrp_version')!r})")
-    bl = doc.get("backlash")
-    if doc.get("schema_version") == 1 and isinstance(bl, dict) and "lead" in bl:
-        raise InputError(f"{src}: backlash.lead in a schema_version 1 file (version 1 has "
-                         f"no leading flanks)")
+    version = version_field(doc, "schema_version", READABLE_VERSIONS, src=src,
+                            hint=f" (a file from a newer zrp-accuracy? zrp_version "
+                                 f"{str(doc.get('zrp_version'))[:40]!r})")
+    check_schema(doc, version, src)  # by what the file holds (zrp.calibration.schema)
     mpath = (model_file_path(comp_path, _get(doc, "model_file", src),
                              allow_outside=allow_outside)
              if model_path is None else Path(model_path))
