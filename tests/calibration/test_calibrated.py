@@ -118,7 +118,8 @@ def test_a_leading_flank_is_written_read_and_checked(leading, tmp_path):
         assert read_calibration(c).backlash_lead is None
     doc["backlash"]["lead"] = list(cal.backlash_lead)
     c.write_text(json.dumps(doc))
-    with pytest.raises(InputError, match=r"backlash\.lead \(schema_version 2\), which schema_version 1 never had"):
+    with pytest.raises(InputError, match=r"backlash\.lead \(schema_version 2\), which "
+                                         r"schema_version 1 never had"):
         read_calibration(c)
     doc["schema_version"] = 4
     c.write_text(json.dumps(doc))

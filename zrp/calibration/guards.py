@@ -67,16 +67,19 @@ class NonFiniteResultError(InputError):
 
 
 def check_finite(ids: tuple[str, ...], *arrays: F64, learned: LearnedTerm | None) -> None:
-    """Refuse non-finite commands or predicted errors (each array's first axis: the targets),
-    naming the first target and the field that made them: no command file holds NaN.
+    """Refuse non-finite commands, predictions or errors (each array's first axis: the
+    targets; also their squares, which an RMS takes: 1e300 is refused as the inf its square
+    is), naming the first target and the field that made them: no command file holds NaN.
 
     Raises:
         NonFiniteResultError: naming the target and ``learned_residual`` (coef, mean) when the
             calibration carries a learned term, else its values.
     """
     bad = np.zeros(len(ids), dtype=bool)
-    for a in arrays:
-        bad |= ~np.all(np.isfinite(np.asarray(a, dtype=float).reshape(len(ids), -1)), axis=1)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for a in arrays:
+            rows = np.asarray(a, dtype=float).reshape(len(ids), -1)
+            bad |= ~np.isfinite(np.sum(rows ** 2, axis=1))
     if bad.any():
         i = int(np.argmax(bad))
         field = ("learned_residual (its coef and mean: the learned term's correction)"

@@ -186,8 +186,8 @@ def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: s
         ImplausibleValueError: a value outside its physical domain
             (:func:`zrp.calibration.validation.validate_calibration`); nothing is written.
     """
-    validate_calibration(cal, cal.widen, "write_calibration")
     check_fields(cal, cal.model.length_unit, "write_calibration")  # the reader's checks
+    validate_calibration(cal, cal.widen, "write_calibration")
     check_writable([model_path, comp_path], overwrite)
     folder = Path(comp_path).resolve().parent
     try:
