@@ -208,7 +208,8 @@ class FinalModelRecord:
         try:
             return _from_dict(cls, d)
         except RecordDomainError as exc:
-            raise RecordDomainError(f"{src}: {exc}") from None
+            raise RecordDomainError(f"{src}: {str(exc).removeprefix('final_model_record: ')}"
+                                    ) from None
         except (KeyError, TypeError, ValueError, IndexError, OverflowError,
                 AttributeError) as exc:
             if isinstance(exc, InputError):
