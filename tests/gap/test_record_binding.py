@@ -87,8 +87,8 @@ def test_the_record_as_written_is_read(stored):
 def test_an_edited_record_is_refused_naming_what_to_do(stored):
     root, meas, doc = stored
     path = _write(root, doc, lambda r: _offset(r).update(value=0.36), rehash=False)
-    with pytest.raises(TamperedRecordError, match="changed after zrp diagnose wrote it.*"
-                                                  "re-run zrp diagnose"):
+    with pytest.raises(TamperedRecordError, match=r"changed after zrp diagnose wrote it.*"
+                                                  r"re-run zrp diagnose"):
         _calibrate(meas, path)
 
 
@@ -99,7 +99,7 @@ def test_a_record_of_0_5_0_without_its_hash_is_stale(stored):
         r["version"] = 1
         del r["content_sha256"]
 
-    with pytest.raises(StaleDiagnosisError, match="version 1.*no content_sha256.*re-run zrp"):
+    with pytest.raises(StaleDiagnosisError, match=r"version 1.*no content_sha256.*re-run zrp"):
         _calibrate(meas, _write(root, doc, old, rehash=False))
 
 
@@ -172,9 +172,9 @@ def test_the_writer_runs_the_readers_checks(stored):
     p = rec.parameters[0]
     import dataclasses
 
-    with pytest.raises(RecordDomainError, match="joint 0; expected 1..6"):
+    with pytest.raises(RecordDomainError, match=r"joint 0; expected 1\.\.6"):
         dataclasses.replace(rec, parameters=(dataclasses.replace(p, joint=0),))
-    with pytest.raises(RecordDomainError, match="q2.offset: joint offset"):
+    with pytest.raises(RecordDomainError, match=r"q2\.offset: joint offset"):
         dataclasses.replace(rec, parameters=(dataclasses.replace(
             next(q for q in rec.parameters if q.name == "q2.offset"), value=4.0),)
                             ).check_domains(PUMA)
