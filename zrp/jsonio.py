@@ -11,6 +11,15 @@ fields in declaration order, renamed or left out where the JSON schema says so.
 
 :func:`version_field` is the one way a reader checks a file's format version: an integer
 among the known ones (``true`` is not version 1, though Python's ``True == 1``).
+
+:func:`read_json` is the one way a user's JSON file is read (diagnosis.json,
+compensation.json, a fleet's stored diagnoses): a regular file whose size is checked before
+a byte is parsed (``max_bytes``, named in the error: :data:`MAX_DIAGNOSIS_BYTES`,
+:data:`MAX_COMPENSATION_BYTES`), arrays and objects nested at most :data:`MAX_JSON_DEPTH`
+deep (counted in chunks: memory a small multiple of the text, whatever it holds), and
+``NaN``/``Infinity`` refused (the files hold finite numbers only; ``1e999`` reads as
+infinity, which each reader's domain checks refuse by field). :func:`loads_json` is the same
+for a text already read.
 """
 
 from __future__ import annotations
@@ -18,6 +27,8 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
+import re
 from collections.abc import Collection, Mapping
 from pathlib import PurePath
 from typing import Any
@@ -25,8 +36,23 @@ from typing import Any
 import numpy as np
 
 from zrp.errors import InputError, ZRPError
+from zrp.textio import read_text
 
-__all__ = ["dict_from_dataclass", "dumps", "to_jsonable", "version_field"]
+__all__ = ["MAX_COMPENSATION_BYTES", "MAX_DIAGNOSIS_BYTES", "MAX_JSON_DEPTH",
+           "dict_from_dataclass", "dumps", "json_depth", "loads_json", "read_json",
+           "to_jsonable", "version_field"]
+
+#: deepest nesting of arrays and objects a file of this toolkit may hold
+MAX_JSON_DEPTH = 32
+#: largest diagnosis.json read: 50 MiB (a diagnosis of 100,000 points is ~15 MB)
+MAX_DIAGNOSIS_BYTES = 50 * 2**20
+#: largest compensation.json read: 20 MiB (a learned term of 5,000 poses is ~3 MB)
+MAX_COMPENSATION_BYTES = 20 * 2**20
+#: characters scanned at a time by :func:`json_depth`
+_SCAN_CHUNK = 2**20
+#: a JSON string (its brackets do not nest)
+_STRING = re.compile(r'"(?:[^"\\]|\\.)*"', re.S)
+_OPEN = str.maketrans({"[": "\x01", "{": "\x01", "]": "\x02", "}": "\x02"})
 
 
 def to_jsonable(obj: Any) -> Any:
@@ -131,3 +157,62 @@ def version_field(doc: Mapping[str, Any], key: str, accepted: Collection[int], *
 
 def _plain(v: Any) -> bool:
     return v is None or isinstance(v, (bool, int, float, str))
+
+
+def json_depth(text: str) -> int:
+    """The deepest nesting of arrays and objects in the JSON ``text`` (brackets inside
+    strings do not count), counted a chunk at a time: the memory it takes is one copy of the
+    text with its strings emptied plus a few times :data:`_SCAN_CHUNK`, not eight bytes a
+    character (an unterminated string is left to the parser)."""
+    bare = _STRING.sub('""', text)
+    depth = best = 0
+    for a in range(0, len(bare), _SCAN_CHUNK):
+        raw = np.frombuffer(bare[a:a + _SCAN_CHUNK].translate(_OPEN).encode(
+            "utf-8", "replace"), dtype=np.uint8)
+        run = np.cumsum((raw == 1).astype(np.int32) - (raw == 2).astype(np.int32),
+                        dtype=np.int64)
+        best = max(best, depth + int(run.max()))
+        depth += int(run[-1])
+    return best
+
+
+def loads_json(text: str, src: str, *, what: str = "file") -> Any:
+    """``json.loads(text)`` after checking its nesting (:data:`MAX_JSON_DEPTH`); ``NaN``
+    and ``Infinity`` refused.
+
+    Raises:
+        InputError: too deep or not JSON, naming ``src`` (``what``: what the file is, e.g.
+            "diagnosis.json").
+    """
+    depth = json_depth(text)
+    if depth > MAX_JSON_DEPTH:
+        raise InputError(f"{src}: JSON nested {depth} deep; a {what} nests at most "
+                         f"{MAX_JSON_DEPTH} deep")
+    try:
+        return json.loads(text, parse_constant=_no_constant)
+    except (ValueError, RecursionError) as exc:
+        raise InputError(f"{src}: cannot read the {what}: {exc}") from None
+
+
+def read_json(path: str | os.PathLike[str], *, max_bytes: int, label: str | None = None,
+              what: str = "file") -> Any:
+    """The JSON document of a user's file: a regular file of at most ``max_bytes`` (checked
+    before it is read), then :func:`loads_json`.
+
+    Raises:
+        InputError: not a regular file, larger than ``max_bytes`` (naming the limit), not
+            UTF-8, too deep or not JSON (naming the file).
+    """
+    src = str(path) if label is None else label
+    try:
+        text = read_text(path, label=src, max_bytes=max_bytes)
+    except InputError as exc:
+        if "more than the" in str(exc):
+            raise InputError(f"{exc} (a {what} holds at most {max_bytes // 2**20} MiB)"
+                             ) from None
+        raise
+    return loads_json(text, src, what=what)
+
+
+def _no_constant(name: str) -> None:
+    raise ValueError(f"{name} is not a JSON number (the files hold finite numbers only)")

@@ -109,14 +109,17 @@ def test_a_leading_flank_is_written_read_and_checked(leading, tmp_path):
     with pytest.raises(InputError, match="backlash_lead: 5 flags for 6 joints"):
         read_calibration(c)
     # a version-1 file (0.3.0) has no leading flanks: read as lagging, and a lead in it refused
-    doc["schema_version"] = 1
-    del doc["backlash"]["lead"]
+    doc["schema_version"] = 1  # as 0.3.0 wrote it: none of the keys versions 2, 3 added
+    for key in ("model_sha256", "learned_residual", "taken_out_non_physical", "undetermined"):
+        del doc[key]
+    del doc["backlash"]["lead"], doc["backlash"]["switch_weights"]
     c.write_text(json.dumps(doc))
     with pytest.warns(PairWarning, match="before schema_version 3"):
         assert read_calibration(c).backlash_lead is None
     doc["backlash"]["lead"] = list(cal.backlash_lead)
     c.write_text(json.dumps(doc))
-    with pytest.raises(InputError, match=r"backlash\.lead in a schema_version 1 file"):
+    with pytest.raises(InputError, match=r"backlash\.lead \(schema_version 2\), which "
+                                         r"schema_version 1 never had"):
         read_calibration(c)
     doc["schema_version"] = 4
     c.write_text(json.dumps(doc))

@@ -65,7 +65,7 @@ def test_the_record_is_in_diagnosis_json(runs):
     doc = json.loads((runs / "diag" / "diagnosis.json").read_text(encoding="utf-8"))
     assert doc["schema_version"] == 2
     rec = doc["final_model_record"]
-    assert rec["version"] == 1 and len(rec["measurements_sha256"]) == 64
+    assert rec["version"] == 2 and len(rec["measurements_sha256"]) == 64
     comp = json.loads((runs / "fresh" / FILES[1]).read_text(encoding="utf-8"))
     # the written joint map is the record's, term by term (joints from 1)
     written = {t["name"]: t["value"] for t in comp["joint_map"]}

@@ -243,7 +243,9 @@ class CalibratedRobot:
         """The calibrated robot of a diagnosis's final-model record
         (:class:`zrp.gap.FinalModelRecord`, stored in diagnosis.json): its revolute offsets
         folded into its geometry (module doc), on the ``nominal`` model the diagnosis started
-        from, with the data's ``conditions`` and the widened domains."""
+        from, with the data's ``conditions`` and the widened domains (every value of the
+        record checked in its domain on ``nominal`` first: RecordDomainError)."""
+        rec.check_domains(nominal)
         delta, terms, kappa = _joint_terms(rec, nominal)
         folded, tools_f = _fold(nominal, rec.axes, rec.bodies, delta, rec.tool_offsets)
         return cls(

@@ -35,7 +35,7 @@ from zrp.calibration.conditions import (
     out_of_range,
     payload_separated,
 )
-from zrp.calibration.guards import guard, reference_poses
+from zrp.calibration.guards import check_finite, guard, reference_poses
 from zrp.calibration.learned import correct_hand
 from zrp.errors import InputError, ZRPWarning
 from zrp.kinematics.forward import forward_kinematics
@@ -353,6 +353,7 @@ def compensate(cal: CalibratedRobot, targets: ArrayLike, seed: ArrayLike, *,
     e0, _, _ = _errors(cal, q0, cond, tg)
     q, cond = _solve(cal, q0, cond, base, gravity_torque, tg, tol, max_iter, max_rounds)
     e, _, full = _errors(cal, q, cond, tg)
+    check_finite(ids, q, e, e0, y + e[:, :3], learned=cal.learned)
     ok = np.linalg.norm(e, axis=1) < tol
     near_limit = _check_limits(q, lim, limit_margin, ids)
     smin = np.linalg.svd(full, compute_uv=False)[:, -1]

@@ -42,7 +42,17 @@ from typing import Any
 import numpy as np
 
 from zrp.calibration.calibrated import CalibratedRobot
+from zrp.calibration.jointmap import NON_GEOMETRIC
 from zrp.errors import InputError, ZRPWarning
+from zrp.gap.recordcheck import (  # the same bounds as the diagnosis's final-model record
+    BASE_REACH_FACTOR,
+    MAX_HARMONIC,
+    MAX_PAYLOAD_KG,
+    ROTATION_TOL,
+    TEMP_RANGE_DEGC,
+    TOOL_REACH_FACTOR,
+)
+from zrp.jsonio import MAX_JSON_DEPTH, loads_json
 from zrp.kinematics import forward_kinematics
 from zrp.units import LENGTH_UNITS
 
@@ -51,13 +61,6 @@ __all__ = ["BASE_REACH_FACTOR", "MAX_HARMONIC", "MAX_JSON_DEPTH", "MAX_PAYLOAD_K
            "PairWarning", "TamperedPairError", "bind_pair", "check_fields", "check_pair",
            "document_sha256", "field_problems", "loads_bounded"]
 
-MAX_JSON_DEPTH = 32
-BASE_REACH_FACTOR = 100.0
-TOOL_REACH_FACTOR = 2.0
-MAX_HARMONIC = 100
-MAX_PAYLOAD_KG = 1.0e4
-TEMP_RANGE_DEGC = (-273.15, 1000.0)
-ROTATION_TOL = 1e-6
 #: the comment line of calibrated.toml that names its compensation file's hash
 _TOML_HASH = re.compile(r"^# compensation_sha256 = ([0-9a-f]{64})\s*$", re.MULTILINE)
 _HASH_KEY = "model_sha256"
@@ -77,27 +80,12 @@ class PairWarning(ZRPWarning):
 
 def loads_bounded(text: str, src: str) -> Any:
     """``json.loads(text)`` after checking that arrays and objects nest at most
-    :data:`MAX_JSON_DEPTH` deep (brackets inside strings do not count).
+    :data:`MAX_JSON_DEPTH` deep (:func:`zrp.jsonio.loads_json`, the one bounded reader).
 
     Raises:
         InputError: too deep, or not JSON (naming ``src``).
     """
-    raw = np.frombuffer(re.sub(r'"(?:[^"\\]|\\.)*"', '""', text, flags=re.S).encode(
-        "utf-8", "replace"), dtype=np.uint8)
-    step = (np.isin(raw, (ord("["), ord("{"))).astype(np.int64)
-            - np.isin(raw, (ord("]"), ord("}"))).astype(np.int64))
-    depth = int(np.cumsum(step).max()) if step.size else 0
-    if depth > MAX_JSON_DEPTH:
-        raise InputError(f"{src}: JSON nested {depth} deep; a calibration file nests at most "
-                         f"{MAX_JSON_DEPTH} deep")
-    try:
-        return json.loads(text, parse_constant=_no_constant)
-    except (ValueError, RecursionError) as exc:
-        raise InputError(f"{src}: cannot read the compensation file: {exc}") from None
-
-
-def _no_constant(name: str) -> None:
-    raise ValueError(f"{name} is not a JSON number (the files hold finite numbers only)")
+    return loads_json(text, src, what="compensation file")
 
 
 def _reach(cal: CalibratedRobot) -> float:
@@ -214,7 +202,53 @@ def field_problems(cal: CalibratedRobot, length_unit: object) -> list[str]:
         out.append(f"length_unit: {length_unit!r}, but the model file's is "
                    f"{cal.model.length_unit!r} (was the model file changed?)")
     with np.errstate(over="ignore", invalid="ignore"):  # 1e300 squared: inf, refused
-        return out + _lengths(cal) + _scalars(cal) + _conditions(cal)
+        return (out + _lengths(cal) + _scalars(cal) + _conditions(cal) + _offsets(cal)
+                + _terms(cal) + _learned(cal))
+
+
+def _offsets(cal: CalibratedRobot) -> list[str]:
+    """joint_offsets_folded: finite, at most pi on a revolute joint, 0 on a prismatic one
+    (its offset is a joint-map term)."""
+    d = np.asarray(cal.joint_offsets, dtype=float)
+    bad = [k + 1 for k in range(cal.n) if not (
+        d[k] == 0.0 if cal.model.prismatic[k] else abs(d[k]) <= math.pi)]
+    return [] if not bad else [f"joint_offsets_folded: joint(s) {bad} ({d[bad[0] - 1]!r}); "
+                               "expected at most pi rad on a revolute joint, 0 on a prismatic "
+                               "one"]
+
+
+def _terms(cal: CalibratedRobot) -> list[str]:
+    """joint_map: each term of a known effect, named ``q{joint}.``, finite (a prismatic
+    offset within the arm's reach; cyclic terms of the file's harmonics)."""
+    out = []
+    for i, t in enumerate(cal.terms):
+        head, _, what = t.name.partition(".")
+        cyc = re.fullmatch(r"(sin|cos)([0-9]+)", what)
+        if t.effect not in NON_GEOMETRIC:
+            out.append(f"joint_map[{i}]: effect {t.effect!r}; expected one of "
+                       f"{', '.join(NON_GEOMETRIC)}")
+        elif head != f"q{t.joint}" or not what:
+            out.append(f"joint_map[{i}]: name {t.name!r} is not joint {t.joint}'s")
+        elif not math.isfinite(t.value) or (t.effect == "joint_offset" and not abs(
+                t.value) <= (_reach(cal) if cal.model.prismatic[t.joint - 1] else math.pi)):
+            out.append(f"joint_map[{i}] ({t.name}): value {t.value!r}; expected a finite "
+                       "value (an offset of at most pi rad, or the arm's reach if prismatic)")
+        elif t.effect == "cyclic_error" and (cyc is None or int(cyc[2]) not in cal.harmonics):
+            out.append(f"joint_map[{i}] ({t.name}): not a harmonic of {list(cal.harmonics)}")
+    return out
+
+
+def _learned(cal: CalibratedRobot) -> list[str]:
+    """learned_residual: the largest correction it can give (|mean| + sum |coef| per output,
+    the kernel is at most 1) within the arm's reach: 1e300 coefficients are not a residual."""
+    t = cal.learned
+    if t is None:
+        return []
+    most = float(np.max(np.abs(t.mean) + np.sum(np.abs(t.coef), axis=0)))
+    reach = _reach(cal)
+    return [] if most <= reach else [
+        f"learned_residual.coef, mean: a correction of up to {most:.4g} "
+        f"{cal.model.length_unit}; expected at most the arm's reach ({reach:.4g})"]
 
 
 def check_fields(cal: CalibratedRobot, length_unit: object, src: str) -> None:

@@ -39,7 +39,8 @@ from zrp.errors import InputError
 from zrp.model.manipulator import Manipulator
 
 __all__ = ["NEAR_SINGULAR_SHARE", "RANGE_SHARE", "REFERENCE_POSES", "NearSingularTargetError",
-           "UnmeasuredTargetError", "guard", "reference_poses"]
+           "NonFiniteResultError", "UnmeasuredTargetError", "check_finite", "guard",
+           "reference_poses"]
 
 #: a command whose sigma_min is below this share of the arm's median is near-singular (a
 #: correction there costs ten times the joint motion it costs typically, or more).
@@ -59,6 +60,34 @@ class UnmeasuredTargetError(InputError):
 
 class NearSingularTargetError(InputError):
     """A command near a singularity of the arm (relative to its own conditioning)."""
+
+
+class NonFiniteResultError(InputError):
+    """The calibration predicts a non-finite position or command (NaN, infinity)."""
+
+
+def check_finite(ids: tuple[str, ...], *arrays: F64, learned: LearnedTerm | None) -> None:
+    """Refuse non-finite commands, predictions or errors (each array's first axis: the
+    targets; also their squares, which an RMS takes: 1e300 is refused as the inf its square
+    is), naming the first target and the field that made them: no command file holds NaN.
+
+    Raises:
+        NonFiniteResultError: naming the target and ``learned_residual`` (coef, mean) when the
+            calibration carries a learned term, else its values.
+    """
+    bad = np.zeros(len(ids), dtype=bool)
+    with np.errstate(over="ignore", invalid="ignore"):
+        for a in arrays:
+            rows = np.asarray(a, dtype=float).reshape(len(ids), -1)
+            bad |= ~np.isfinite(np.sum(rows ** 2, axis=1))
+    if bad.any():
+        i = int(np.argmax(bad))
+        field = ("learned_residual (its coef and mean: the learned term's correction)"
+                 if learned is not None else "its values (joint map, geometry)")
+        raise NonFiniteResultError(
+            f"target {ids[i]}: the calibration predicts a non-finite position or command "
+            f"({int(bad.sum())} target(s)); the field that gives it: {field}. Refused: no "
+            "command is written; calibrate again")
 
 
 def _ranges(model: Manipulator, conditions: Conditions | None) -> F64:

@@ -23,7 +23,6 @@ from numpy.typing import ArrayLike
 
 from zrp.calibration.calibrated import CalibratedRobot
 from zrp.calibration.conditions import Conditions
-from zrp.calibration.filecheck import loads_bounded
 from zrp.calibration.fullpose import FullPoseCalibration, full_pose_calibration
 from zrp.calibration.learned import LearnedTerm
 from zrp.calibration.storage import write_calibration
@@ -34,8 +33,8 @@ from zrp.gap.model.choices import EFFECTS
 from zrp.gap.model.domains import DEFAULT_MAX_TILT_RAD
 from zrp.gap.pipeline import diagnose
 from zrp.gap.results import SCHEMA_VERSION, Diagnosis
+from zrp.jsonio import MAX_DIAGNOSIS_BYTES, read_json
 from zrp.model.manipulator import Manipulator
-from zrp.textio import read_text
 
 __all__ = ["Calibration", "CalibrationOptions", "calibrate", "stored_record"]
 
@@ -153,8 +152,8 @@ def stored_record(source: str | Path | Mapping[str, Any]) -> FinalModelRecord:
 
 def _stored_document(source: str | Path | Mapping[str, Any]) -> tuple[Mapping[str, Any], str]:
     src = "diagnosis" if isinstance(source, Mapping) else str(source)
-    doc = source if isinstance(source, Mapping) else loads_bounded(read_text(
-        source, label=src), src)
+    doc = source if isinstance(source, Mapping) else read_json(
+        source, label=src, max_bytes=MAX_DIAGNOSIS_BYTES, what="diagnosis.json")
     if not isinstance(doc, Mapping):
         raise InputError(f"{src}: expected a diagnosis.json object")
     version = doc.get("schema_version")

@@ -27,21 +27,20 @@ from zrp.calibration.filecheck import (
     bind_pair,
     check_fields,
     check_pair,
-    loads_bounded,
 )
 from zrp.calibration.jointmap import Term
 from zrp.calibration.learned import LearnedTerm
+from zrp.calibration.schema import check_schema
 from zrp.calibration.validation import validate_calibration
 from zrp.errors import InputError, ZRPError
 from zrp.escape import one_line
 from zrp.gap.finalrecord import ProbeRecord, switch_weights
 from zrp.gap.fit.fullpose import FullPoseFit
-from zrp.jsonio import dumps, to_jsonable, version_field
+from zrp.jsonio import MAX_COMPENSATION_BYTES, dumps, read_json, to_jsonable, version_field
 from zrp.model.files import dumps_model, load_model, loads_model
 from zrp.model.manipulator import Manipulator
 from zrp.output import check_writable, write_text
 from zrp.rotations import er_from_matrix, rotvec_from_er
-from zrp.textio import read_text
 from zrp.version import __version__
 
 __all__ = ["SCHEMA_VERSION", "calibration_document", "full_pose_document", "model_file_path",
@@ -182,9 +181,12 @@ def write_calibration(cal: CalibratedRobot, model_path: str | Path, comp_path: s
 
     Raises:
         OutputExistsError: a file exists and ``overwrite`` is False.
+        FieldDomainError: a field the reader would refuse
+            (:func:`zrp.calibration.filecheck.check_fields`); nothing is written.
         ImplausibleValueError: a value outside its physical domain
             (:func:`zrp.calibration.validation.validate_calibration`); nothing is written.
     """
+    check_fields(cal, cal.model.length_unit, "write_calibration")  # the reader's checks
     validate_calibration(cal, cal.widen, "write_calibration")
     check_writable([model_path, comp_path], overwrite)
     folder = Path(comp_path).resolve().parent
@@ -251,17 +253,15 @@ def read_calibration(comp_path: str | Path, model_path: str | Path | None = None
         ImplausibleValueError: a value outside its physical domain.
     """
     src = str(comp_path)
-    # a regular file, size checked; nesting bounded (zrp.calibration.filecheck)
-    doc = loads_bounded(read_text(comp_path, label=src), src)
+    # a regular file, its size checked before parsing; nesting bounded (zrp.jsonio)
+    doc = read_json(comp_path, label=src, max_bytes=MAX_COMPENSATION_BYTES,
+                    what="compensation file")
     if not isinstance(doc, dict):
         raise InputError(f"{src}: expected a JSON object")
-    version_field(doc, "schema_version", READABLE_VERSIONS, src=src,
-                  hint=f" (a file from a newer zrp-accuracy? zrp_version "
-                       f"{doc.get('zrp_version')!r})")
-    bl = doc.get("backlash")
-    if doc.get("schema_version") == 1 and isinstance(bl, dict) and "lead" in bl:
-        raise InputError(f"{src}: backlash.lead in a schema_version 1 file (version 1 has "
-                         f"no leading flanks)")
+    version = version_field(doc, "schema_version", READABLE_VERSIONS, src=src,
+                            hint=f" (a file from a newer zrp-accuracy? zrp_version "
+                                 f"{str(doc.get('zrp_version'))[:40]!r})")
+    check_schema(doc, version, src)  # by what the file holds (zrp.calibration.schema)
     mpath = (model_file_path(comp_path, _get(doc, "model_file", src),
                              allow_outside=allow_outside)
              if model_path is None else Path(model_path))

@@ -15,13 +15,14 @@ exactly) in both cases.
 
 It records the SHA-256 of the nominal model (its TOML text) and of the measurements
 diagnosed (:func:`zrp.gap.data.digest.measurements_sha256`): a record is refused for other
-ones (:meth:`FinalModelRecord.check`).
+ones (:meth:`FinalModelRecord.check`). It is bound to its own content too (record version 2,
+issue 41): ``content_sha256``, written last and checked first, and every value in its domain
+when it is made and when it is read, by one checker (:mod:`zrp.gap.recordcheck`).
 """
 
 from __future__ import annotations
 
 import hashlib
-import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any, Protocol
@@ -35,6 +36,19 @@ from zrp.gap.data.measurements import Measurements
 from zrp.gap.fit.leastsq import FitResult
 from zrp.gap.model.context import Context
 from zrp.gap.model.problem import Problem
+from zrp.gap.recordcheck import (
+    HASH_KEY,
+    MAX_HARMONIC,
+    RecordDomainError,
+    TamperedRecordError,
+    check_content,
+    content_sha256,
+    joint_index,
+    record_problems,
+    switch_weights,
+    whole,
+)
+from zrp.gap.recordcheck import number as _num
 from zrp.gap.search.determination import fit_determinations
 from zrp.jsonio import to_jsonable
 from zrp.model.files import dumps_model
@@ -58,11 +72,13 @@ class Diagnosis(Protocol):
     length_unit: str
     outside_domain: tuple[tuple[str, str], ...]
 
-__all__ = ["RECORD_VERSION", "FinalModelRecord", "ProbeRecord", "StaleDiagnosisError",
-           "final_model_record", "full_pose_fit_result", "model_sha256", "switch_weights"]
+__all__ = ["RECORD_VERSION", "FinalModelRecord", "ProbeRecord", "RecordDomainError",
+           "StaleDiagnosisError", "TamperedRecordError", "final_model_record",
+           "full_pose_fit_result", "model_sha256", "switch_weights"]
 
-#: version of the ``final_model_record`` entry (diagnosis.json schema_version 2 on)
-RECORD_VERSION = 1
+#: version of the ``final_model_record`` entry (diagnosis.json schema_version 2 on; 2: its
+#: ``content_sha256``, issue 41)
+RECORD_VERSION = 2
 #: the joint-space parameter kinds a calibration keeps (the rest are in the geometry)
 _JOINT_KINDS = ("dq", "thermal")
 
@@ -104,10 +120,6 @@ class ProbeRecord:
     orientation: bool = True
 
 
-def _num(x: Any, missing: float = math.nan) -> float:
-    return missing if x is None else float(x)
-
-
 @dataclass(frozen=True, eq=False)
 class FinalModelRecord:
     """The final model of a diagnosis as a calibration takes it (module doc). Arrays in the
@@ -138,7 +150,18 @@ class FinalModelRecord:
     taken_out: tuple[str, ...] = ()
     probe: ProbeRecord | None = None
 
+    def __post_init__(self) -> None:
+        bad = record_problems(self)
+        if bad:
+            raise RecordDomainError(f"final_model_record: {len(bad)} value(s) outside their "
+                                    "domain, refused: " + "; ".join(bad))
+
     def to_dict(self) -> dict[str, Any]:
+        """The record as diagnosis.json stores it, its ``content_sha256`` last."""
+        doc = self._content()
+        return {**doc, HASH_KEY: content_sha256(doc)}
+
+    def _content(self) -> dict[str, Any]:
         p = self.probe
         return to_jsonable({
             "version": RECORD_VERSION, "model_sha256": self.model_sha256,
@@ -167,17 +190,30 @@ class FinalModelRecord:
         """Read a record back (:meth:`to_dict`).
 
         Raises:
-            StaleDiagnosisError: another record version.
+            StaleDiagnosisError: another record version (1: written by 0.5.0 without its
+                content hash).
+            TamperedRecordError: its content is not the one its ``content_sha256`` names.
+            RecordDomainError: a value outside its domain (naming ``src`` and the field).
             InputError: a missing or malformed key (naming ``src``).
         """
-        if not isinstance(d, Mapping) or d.get("version") != RECORD_VERSION:
+        version = d.get("version") if isinstance(d, Mapping) else None
+        if type(version) is not int or version != RECORD_VERSION:
             raise StaleDiagnosisError(
-                f"{src}: final_model_record version "
-                f"{d.get('version') if isinstance(d, Mapping) else None!r}, expected "
-                f"{RECORD_VERSION}; re-run zrp diagnose with this version")
+                f"{src}: final_model_record version {str(version)[:20]!r}, expected "
+                f"{RECORD_VERSION}" + (" (version 1, 0.5.0, does not bind its values: no "
+                                       "content_sha256)" if version == 1 and type(version)
+                                       is int else "")
+                + "; re-run zrp diagnose with this version")
+        check_content(d, src)
         try:
             return _from_dict(cls, d)
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
+        except RecordDomainError as exc:
+            raise RecordDomainError(f"{src}: {str(exc).removeprefix('final_model_record: ')}"
+                                    ) from None
+        except (KeyError, TypeError, ValueError, IndexError, OverflowError,
+                AttributeError) as exc:
+            if isinstance(exc, InputError):
+                raise
             raise InputError(f"{src}: malformed final_model_record ({type(exc).__name__}: "
                              f"{exc})") from None
 
@@ -187,6 +223,8 @@ class FinalModelRecord:
 
         Raises:
             StaleDiagnosisError: naming which and both hashes.
+            RecordDomainError: a value outside its domain on ``model`` (its joints, its
+                reach; :func:`zrp.gap.recordcheck.record_problems`).
         """
         pairs = [("model", self.model_sha256, model_sha256(model), f"the model {model.name!r}")]
         if meas is not None:
@@ -199,6 +237,18 @@ class FinalModelRecord:
                     f"{src}: this diagnosis was made from other {what} (SHA-256 {mine[:12]}... "
                     f"recorded, {theirs[:12]}... for {hint}); diagnose these {what} or pass "
                     "the ones the diagnosis used")
+        self.check_domains(model, src)
+
+    def check_domains(self, model: Manipulator, src: str = "final_model_record") -> None:
+        """Refuse the record when a value is outside its domain on the nominal ``model``.
+
+        Raises:
+            RecordDomainError: naming ``src`` and every such value.
+        """
+        bad = record_problems(self, model)
+        if bad:
+            raise RecordDomainError(f"{src}: {len(bad)} value(s) outside their domain on "
+                                    f"the model {model.name!r}, refused: " + "; ".join(bad))
 
 
 def _from_dict(cls: type[FinalModelRecord], d: Mapping[str, Any]) -> FinalModelRecord:
@@ -210,10 +260,13 @@ def _from_dict(cls: type[FinalModelRecord], d: Mapping[str, Any]) -> FinalModelR
         np.array([tools[k] for k in tools], dtype=float).reshape(-1, 3),
         arr("base_rotation"), arr("base_translation"),
         tuple(JointParameter(str(q["name"]), str(q["effect"]), str(q["kind"]),
-                             int(q["joint"] or 0), str(q["unit"]), float(q["value"]),
-                             _num(q["stderr"])) for q in d["parameters"]),
-        float(d["t_ref_degC"]), tuple(float(v) for v in d["gravity_dir"]),  # type: ignore[arg-type]
-        tuple(int(h) for h in d["harmonics"]), str(d["frame"]), str(d["compliance_model"]),
+                             joint_index(q["joint"], f"parameters[{i}].joint"), str(q["unit"]),
+                             _num(q["value"], where=f"parameters[{i}].value"),
+                             _num(q["stderr"])) for i, q in enumerate(d["parameters"])),
+        _num(d["t_ref_degC"], where="t_ref_degC"),
+        tuple(_num(v, where="gravity_dir") for v in d["gravity_dir"]),  # type: ignore[arg-type]
+        tuple(whole(h, "harmonics", 1, MAX_HARMONIC) for h in d["harmonics"]),
+        str(d["frame"]), str(d["compliance_model"]),
         _num(d["withheld_rms"]), **_backlash_from_dict(d["backlash"]),
         gravity_side_weights=(None if d["gravity_side_weights"] is None
                               else arr("gravity_side_weights")),
@@ -223,10 +276,13 @@ def _from_dict(cls: type[FinalModelRecord], d: Mapping[str, Any]) -> FinalModelR
 
 
 def _backlash_from_dict(bl: Mapping[str, Any]) -> dict[str, Any]:
+    lead = bl["lead"]
+    if lead is not None and not all(isinstance(v, bool) for v in lead):
+        raise RecordDomainError("backlash.lead: expected null or true/false per joint")
     return {"backlash_switch": None if bl["switch"] is None else tuple(
-                None if v is None else float(v) for v in bl["switch"]),
-            "payload_kg": float(bl["payload_kg"]),
-            "backlash_lead": None if bl["lead"] is None else tuple(bool(v) for v in bl["lead"]),
+                None if v is None else _num(v, where="backlash.switch") for v in bl["switch"]),
+            "payload_kg": _num(bl["payload_kg"], where="backlash.payload_kg"),
+            "backlash_lead": None if lead is None else tuple(lead),
             "backlash_switch_weights": switch_weights(bl["switch_weights"])}
 
 
@@ -236,16 +292,6 @@ def _probe_from_dict(p: Mapping[str, Any] | None) -> ProbeRecord | None:
     return ProbeRecord(np.array(p["probe_rotation"], dtype=float),
                        _num(p["sigma_orientation_rad"]), bool(p["sigma_orientation_given"]),
                        _num(p["sigma_position"]), _num(p["orientation_rms_rad"]))
-
-
-def switch_weights(value: Any) -> tuple[tuple[tuple[float, ...], tuple[float, ...]], ...] | None:
-    """Per joint, (switching torques, their weights) as tuples of floats (a null torque, as
-    JSON writes infinity: infinity), or None."""
-    if value is None:
-        return None
-    return tuple((tuple(math.inf if t is None else float(t) for t in thr),
-                  tuple(float(w) for w in wts))
-                 for thr, wts in value)
 
 
 def full_pose_fit_result(diag: Diagnosis) -> FitResult | None:
@@ -308,7 +354,7 @@ def final_model_record(diag: Diagnosis, *, registration_only: bool = False,
                                   float(se))
                    for s, v, se in zip(fit.specs, fit.theta, fit.stderr, strict=True)
                    if s.kind in _JOINT_KINDS)
-    return FinalModelRecord(
+    rec = FinalModelRecord(
         model_sha256(ctx.model),
         diag.settings.get("measurements_sha256") or measurements_sha256(ctx.meas), source,
         np.asarray(u, dtype=float), np.asarray(bodies, dtype=float),
@@ -321,6 +367,8 @@ def final_model_record(diag: Diagnosis, *, registration_only: bool = False,
         **_backlash_fields(None if registration_only else diag.where.backlash),
         gravity_side_weights=_side_weights(ctx), undetermined=_undetermined(diag, fit),
         taken_out=() if registration_only else _taken_out(diag), probe=probe)
+    rec.check_domains(ctx.model, "the diagnosis's final-model record")  # the reader's checks
+    return rec
 
 
 def _chosen_fit(diag: Diagnosis, registration_only: bool, fit: FitResult | None

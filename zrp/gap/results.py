@@ -10,13 +10,11 @@ report.
 
 from __future__ import annotations
 
-import json
 import math
 import os
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
 from functools import cached_property
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -44,7 +42,7 @@ from zrp.gap.search.steps import EffectsFound
 from zrp.gap.search.steps import ParameterEstimate as ParameterEstimate
 from zrp.gap.search.steps import Step as Step
 from zrp.gap.search.steps import parameter_estimates as parameter_estimates
-from zrp.jsonio import version_field
+from zrp.jsonio import MAX_DIAGNOSIS_BYTES, read_json, version_field
 
 __all__ = [
     "SCHEMA_VERSION",
@@ -388,7 +386,7 @@ def load_diagnosis(source: str | os.PathLike[str] | Mapping[str, Any]) -> Diagno
         KeyError: the document lacks ``nominal.rms``, ``final.rms`` or a step's ``effect``.
     """
     doc = (source if isinstance(source, Mapping)
-           else json.loads(Path(source).read_text(encoding="utf-8")))
+           else read_json(source, max_bytes=MAX_DIAGNOSIS_BYTES, what="diagnosis.json"))
     if "schema_version" in doc:  # the in-memory documents and refusals may omit it
         # schema 1 (0.4.0) holds every field read here; schema 2 adds the final model's record
         version_field(doc, "schema_version", (1, SCHEMA_VERSION), src=str(

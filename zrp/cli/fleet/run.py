@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import argparse
 import glob
-import json
 import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -82,14 +81,15 @@ def _tasks(args: argparse.Namespace, files: list[Path], out: Path) -> list[Robot
 def _previous(tasks: list[RobotTask]) -> dict[str, dict[str, Any]]:
     """Rows of the robots an interrupted run finished."""
     from zrp.cli.fleet.tasks import robot_row  # on use: keeps --help quick
+    from zrp.jsonio import MAX_DIAGNOSIS_BYTES, read_json  # on use: keeps --help quick
 
     done = {}
     for t in tasks:
         path = t.out / "diagnosis.json"
         if (t.out / DONE_MARKER).exists() and path.exists():
             try:
-                done[t.name] = _checked_row(robot_row(t.name, str(t.data), json.loads(
-                    path.read_text(encoding="utf-8"))))
+                done[t.name] = _checked_row(robot_row(t.name, str(t.data), read_json(
+                    path, max_bytes=MAX_DIAGNOSIS_BYTES, what="diagnosis.json")))
             except (ValueError, KeyError, TypeError, AttributeError, IndexError,
                     RecursionError) as exc:  # JSONDecodeError, UnicodeDecodeError are ValueErrors
                 raise InputError(f"--resume: {path}: not a diagnosis this toolkit wrote "
