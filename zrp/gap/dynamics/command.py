@@ -49,8 +49,8 @@ from zrp.output import atomic_path
 from zrp.units import angle_bounds
 from zrp.version import __version__
 
-__all__ = ["DEFAULT_ACCELERATION", "MAX_SAMPLES", "MIN_SAMPLES_PER_CYCLE", "ExcitationCommand", "ExciteOptions",
-           "command_limits", "command_summary", "excitation_command", "read_command_conditions",
+__all__ = ["DEFAULT_ACCELERATION", "MAX_SAMPLES", "MIN_SAMPLES_PER_CYCLE", "ExcitationCommand",
+           "ExciteOptions", "command_limits", "command_summary", "excitation_command", "read_command_conditions",
            "write_excitation_command"]
 
 #: The acceleration limit when none is given, rad/s^2 (m/s^2).
