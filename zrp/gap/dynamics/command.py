@@ -50,8 +50,8 @@ from zrp.units import angle_bounds
 from zrp.version import __version__
 
 __all__ = ["DEFAULT_ACCELERATION", "MAX_SAMPLES", "MIN_SAMPLES_PER_CYCLE", "ExcitationCommand",
-           "ExciteOptions", "command_limits", "command_summary", "excitation_command", "read_command_conditions",
-           "write_excitation_command"]
+           "ExciteOptions", "command_limits", "command_summary", "excitation_command",
+           "read_command_conditions", "write_excitation_command"]
 
 #: The acceleration limit when none is given, rad/s^2 (m/s^2).
 DEFAULT_ACCELERATION = 3.0
