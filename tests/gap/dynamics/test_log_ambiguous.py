@@ -88,7 +88,8 @@ def _sunrise(tmp_path, sec, nsec):
     table = np.column_stack([sec, nsec, _q(t), _tau(t)])
     p = tmp_path / "trace.csv"
     p.write_text(",".join(head) + "\n" + "\n".join(
-        ",".join([str(int(r[0])), str(int(r[1])), *(repr(float(v)) for v in r[2:])]) for r in table) + "\n")
+        ",".join([str(int(r[0])), str(int(r[1])), *(repr(float(v)) for v in r[2:])])
+        for r in table) + "\n")
     return p
 
 
