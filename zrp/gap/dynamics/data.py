@@ -46,6 +46,7 @@ from zrp.errors import InputError
 from zrp.gap.data.measurements import DataWarning
 from zrp.gap.dynamics.ambiguous import other_clock, seconds_and_nanos
 from zrp.gap.dynamics.columns import GROUP_KIND, Mapping, map_header, time_columns
+from zrp.gap.dynamics.frozen import frozen_joints
 from zrp.gap.dynamics.logcheck import check_log, unmeasured_joints
 from zrp.gap.dynamics.logfile import RawTable, read_table
 from zrp.gap.dynamics.timebase import Conditioning, clock, condition
@@ -311,7 +312,8 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
     block, tau = _at_joints(block, tau, m, transmission, src)
     payload = None if m.payload is None else vals[:, at[m.payload]] * factor[m.payload]
     names = _joint_names(m, raw.first_row)
-    unmeasured = unmeasured_joints(block["q"], tau)
+    frozen, frozen_notes = frozen_joints(t, block["q"], tau, lines)
+    unmeasured = {**frozen, **unmeasured_joints(block["q"], tau)}
     if len(unmeasured) == m.n:
         raise InputError(f"{src}: no joint's torque is data: " + "; ".join(
             f"joint {k + 1}: {w}" for k, w in sorted(unmeasured.items())))
@@ -321,7 +323,8 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
                       "m/s, N for slides)", DataWarning, stacklevel=2)
     columns = m.describe() + ("" if transmission is None else "; " + transmission.describe())
     cond = Conditioning(columns=columns, clock=said, skipped_lines=raw.skipped,
-                        excluded=excluded_notes(unmeasured, names), **rec)  # type: ignore[arg-type]
+                        excluded=(*excluded_notes(unmeasured, names), *frozen_notes),
+                        **rec)  # type: ignore[arg-type]
     return TorqueLog(t, block["q"], block.get("qd"), tau, block.get("qc"), payload, lines, src,
                      tfrom, segments if len(segments) > 1 else (), unmeasured, names, cond,
                      transmission)

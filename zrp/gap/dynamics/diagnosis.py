@@ -49,6 +49,7 @@ from zrp.gap.dynamics.effects import (
 from zrp.gap.dynamics.fit import cross_validate, design, solve
 from zrp.gap.dynamics.localpoly import local_fit
 from zrp.gap.dynamics.physical import InertialFit, physical_cross_validate, physical_fit
+from zrp.gap.dynamics.plausible import plausibility
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
 from zrp.gap.dynamics.resulting import BodyChange, ChangedArm, link_changes, resulting_bodies
 from zrp.gap.dynamics.results import Baseline, DynamicDiagnosis, FoundEffect, Param, Samples
@@ -185,7 +186,7 @@ def diagnose_dynamics(arm: Arm, log: TorqueLog, options: DynamicsOptions | None 
     """Diagnose the dynamic gap of ``arm`` along ``log`` (module docstring); one BLAS thread
     (many small products: see :mod:`zrp.blas`)."""
     with blas_threads(1):
-        return _diagnose(arm, log, options)
+        return plausibility(arm, log, _diagnose(arm, log, options))  # issue 41: data problems
 
 
 @dataclass(frozen=True)

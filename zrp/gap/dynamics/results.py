@@ -120,6 +120,8 @@ class DynamicDiagnosis:
         baseline: the standard identification on the same samples and withheld segments
             (:mod:`zrp.gap.dynamics.baseline`), or None.
         window_s: the derivative filter's window used (chosen from the data).
+        data_problems: findings far outside any physical arm and their likely cause in the
+            data (:mod:`zrp.gap.dynamics.plausible`); when any, no effect is reported.
     """
 
     arm: str
@@ -139,6 +141,7 @@ class DynamicDiagnosis:
     unmeasured: dict[int, str] = field(default_factory=dict)
     baseline: Baseline | None = None
     window_s: float = 0.1
+    data_problems: list[str] = field(default_factory=list)
 
     @property
     def found(self) -> list[FoundEffect]:
