@@ -30,6 +30,7 @@ import mujoco
 import numpy as np
 from numpy.typing import NDArray
 
+from mjcf.actuator_limits import actuator_torque_limits
 from mjcf.attachments import find_attachments
 from mjcf.builder import MJCFOptions, build
 from mjcf.errors import MJCFImportError
@@ -117,12 +118,10 @@ class Arm:
         return np.array(self.model.jnt_type, dtype=int) == int(mujoco.mjtJoint.mjJNT_HINGE)
 
     def torque_limits(self) -> F64:
-        m = self.model
-        out = np.full(self.n, np.inf)
-        for k in range(self.n):
-            if m.jnt_actfrclimited[k]:
-                out[k] = float(np.abs(m.jnt_actfrcrange[k]).max())
-        return out
+        """Every limit the model states (:mod:`mjcf.actuator_limits`): the joint's
+        actuatorfrcrange (a URDF's effort), its actuators' forcerange and a motor's ctrlrange,
+        times gear; inf where none."""
+        return actuator_torque_limits(self.model)[0]
 
     def inverse_dynamics(self, q: F64, qd: F64, qdd: F64) -> F64:
         return inverse_dynamics(self.model, q, qd, qdd)

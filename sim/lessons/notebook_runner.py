@@ -180,8 +180,12 @@ def execute_notebook(source: str | Path, timeout_s: float = DEFAULT_TIMEOUT_S,
         client = NotebookClient(nb, timeout_func=left_s, kernel_name=kernel,
                                 resources={"metadata": {"path": work}},
                                 config=kernel_transport(sockets))
+        # the kernel's own stderr (a message it could not send once interrupted at the time
+        # limit: a ZMQError traceback) goes to a file, not the terminal: what ended the run
+        # is said by the NotebookError below (issue 41 finding 7)
         try:
-            client.execute()
+            with open(Path(sockets) / "kernel.err", "wb") as err:
+                client.execute(stderr=err)
         except CellTimeoutError as exc:
             raise NotebookError(f"notebook {name}: ran over the time limit of {timeout_s:g} s "
                                 "(the cell running then was interrupted)") from exc

@@ -101,7 +101,7 @@ def test_the_command_file_records_its_conditions(ur10, tmp_path, capsys):
     text = "\n".join(comments)
     for key in ("# zrp: ", "# model: ur10_robot.urdf (sha256 ", "# q0 [rad]: 0 -1.2 1.2",
                 "# period [s]: 10", "# rate [Hz]: 100", "# velocity limits [rad/s]: 0.8",
-                "# torque limits [N m]: 330 330 150 54 54 54 (the model's own",
+                "# torque limits [N m]: 330 330 150 54 54 54 (model",
                 "# position limits [rad]: lower -6.28319", "# units: "):
         assert key in text, key
     assert "every one within the position, velocity, acceleration and torque" in cap.out

@@ -52,9 +52,40 @@ DISTINCT: dict[tuple[str, str], str] = {
 }
 
 
+_USES = "_zrp_option_uses"
+
+
+def _record(p: argparse.ArgumentParser, ns: argparse.Namespace, dest: str, name: str) -> None:
+    """Record that option ``name`` set ``dest``; an old and a new name of one option that
+    set it to different values are refused naming both (issue 41 finding 9: the last no
+    longer wins silently)."""
+    uses: dict[str, list[tuple[str, Any]]] = ns.__dict__.setdefault(_USES, {})
+    value = getattr(ns, dest, None)
+    for other, was in uses.get(dest, []):
+        if other != name and was != value:
+            p.error(f"{other} and {name} are two names of one option (one deprecated) and "
+                    f"were given different values ({was!r}, {value!r}); give it once")
+    uses.setdefault(dest, []).append((name, value))
+
+
+class _Recorded:
+    """Mixed into the current name's action of an alias: records each use (:func:`_record`)."""
+
+    def __call__(self, p: argparse.ArgumentParser, ns: argparse.Namespace, values: Any,
+                 option_string: str | None = None) -> None:
+        super().__call__(p, ns, values, option_string)  # type: ignore[misc]
+        _record(p, ns, self.dest, option_string or "")  # type: ignore[attr-defined]
+
+
+def _recorded(action: argparse.Action) -> None:
+    cls = type(action)
+    if not issubclass(cls, _Recorded):
+        action.__class__ = type(f"Recorded{cls.__name__}", (_Recorded, cls), {})
+
+
 class DeprecatedAlias(argparse.Action):
     """An old option name: stores through ``target`` (the action of the current name) after a
-    one-line notice on stderr."""
+    one-line notice on stderr; given with the current name and another value: refused."""
 
     def __init__(self, option_strings: list[str], dest: str, *, target: argparse.Action,
                  new_name: str, **kwargs: Any) -> None:
@@ -65,14 +96,18 @@ class DeprecatedAlias(argparse.Action):
                  option_string: str | None = None) -> None:
         print(f"zrp: warning: {option_string} is deprecated and will be removed in "
               f"{REMOVED_IN}; use {self.new_name}", file=sys.stderr)
-        self.target(p, ns, values, self.new_name)
+        # the target stores (not recorded as the new name: this use is the old name's)
+        super(_Recorded, self.target).__call__(p, ns, values, self.new_name)  # type: ignore[misc]
+        _record(p, ns, self.dest, option_string or "")
 
 
 def deprecated_alias(parser: argparse.ArgumentParser | argparse._ArgumentGroup, old: str,
                      new: argparse.Action, new_name: str | None = None) -> None:
     """Accept ``old`` as ``new`` (the action of the current name), with a one-line notice on
     stderr; hidden from ``--help``. ``new_name``: the option string ``new`` is called with
-    (default its first; e.g. ``--no-progress`` of a ``--progress/--no-progress`` pair)."""
+    (default its first; e.g. ``--no-progress`` of a ``--progress/--no-progress`` pair). Both
+    given with different values: refused naming both."""
+    _recorded(new)
     parser.add_argument(old, dest=new.dest, nargs=new.nargs, type=new.type, choices=new.choices,
                         metavar=new.metavar, action=DeprecatedAlias, help=argparse.SUPPRESS,
                         default=argparse.SUPPRESS, target=new,

@@ -203,6 +203,7 @@ def _run(argv: Sequence[str] | None) -> int:
         return 2
     parser = build_parser()
     args = parser.parse_args(argv)
+    vars(args).pop("_zrp_option_uses", None)  # the aliases' record (zrp.cli.aliases)
     if not getattr(args, "func", None):
         parser.print_help()
         return 1

@@ -24,6 +24,7 @@ from zrp.gap.dynamics.diagnosis import DynamicsOptions
 from zrp.gap.dynamics.joints import match_joints
 from zrp.gap.dynamics.report import REPORT_FILES, run_json, write_run
 from zrp.gap.dynamics.run import TrackingOptions, run_dynamics
+from zrp.gap.dynamics.samelog import check_other_log
 from zrp.gap.dynamics.transmission import load_transmission
 from zrp.gap.dynamics.verdict import headline
 from zrp.output import OutputDir, check_writable
@@ -67,6 +68,7 @@ def run_diagnosis(args: argparse.Namespace, out: Path, *, overwrite: bool = Fals
 def _diagnose(args: argparse.Namespace, out: Path, overwrite: bool, stage: Stages
               ) -> tuple[dict, str]:
     stage("reading the log")
+    check_other_log(args.data, args.validate)
     tr = None if args.transmission is None else load_transmission(args.transmission)
     log = read_log(args.data, torque_constant=args.torque_constant, topic=args.topic,
                    transmission=tr, rate_hz=args.rate)

@@ -290,4 +290,4 @@ def test_a_joint_without_limits_still_refuses_more_than_a_turn(puma):
     assert "joint 1 (q1) is 45 rad, beyond one turn" in msg and "did you type degrees" in msg
     cmd = excitation_command(puma, ExciteOptions(q0=[45, 0, 0, 0, 0, 0], deg=True, **FAST))
     np.testing.assert_allclose(cmd.q0, np.radians([45, 0, 0, 0, 0, 0]))
-    assert cmd.sources["torque"] == "the model's own" and np.all(np.isinf(cmd.limits.torque))
+    assert cmd.sources["torque"] == "none known" and np.all(np.isinf(cmd.limits.torque))

@@ -43,11 +43,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--max-velocity", type=POSITIVE, nargs="+", metavar="RAD_S",
                    help="one or one a joint, rad/s (default 1, or the model's own limit where "
                    "lower; never above it)")
-    p.add_argument("--max-acceleration", type=POSITIVE, nargs="+", default=[3.0],
-                   metavar="RAD_S2", help="one or one a joint, rad/s^2 (default 3)")
+    p.add_argument("--max-acceleration", type=POSITIVE, nargs="+",
+                   metavar="RAD_S2", help="one or one a joint, rad/s^2 (default 3, recorded as "
+                   "the default)")
     p.add_argument("--max-torque", type=POSITIVE, nargs="+", metavar="NM",
-                   help="one or one a joint, N m (default: the model's effort limits; never "
-                   "above them)")
+                   help="one or one a joint, N m (default: the model's own: URDF effort "
+                   "limits, MJCF actuatorfrcrange, actuator forcerange or a motor's ctrlrange, "
+                   "times gear; never above them)")
     p.add_argument("--period", type=real(0.5, 3600.0, unit="s"), default=10.0,
                    help="period of the series, s (default 10)")
     p.add_argument("--harmonics", type=whole(2, MAX_HARMONICS), default=5,

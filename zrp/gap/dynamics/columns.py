@@ -58,9 +58,10 @@ import re
 from dataclasses import dataclass, field
 
 from zrp.errors import InputError
+from zrp.gap.dynamics.ambiguous import check_one_form
 from zrp.units import split_unit
 
-__all__ = ["FORMS", "GROUP_KIND", "Mapping", "accepted_forms", "map_header"]
+__all__ = ["FORMS", "GROUP_KIND", "Mapping", "accepted_forms", "map_header", "time_columns"]
 
 #: Per-joint groups: name -> unit kind (zrp.units).
 GROUP_KIND = {"q": "position", "qd": "velocity", "tau": "effort", "i": "current",
@@ -189,6 +190,11 @@ def _time_column(names: list[str]) -> int | None:
     return None
 
 
+def time_columns(names: list[str]) -> list[int]:
+    """Every column whose name is a clock's (:data:`TIME`)."""
+    return [i for i, c in enumerate(names) if any(re.fullmatch(p, c, re.I) for p in TIME)]
+
+
 def _match_indexed(form: str, names: list[str]) -> dict[str, dict[int, int]]:
     """group -> {index: column} of one indexed form (the first base present per group)."""
     out: dict[str, dict[int, int]] = {}
@@ -304,7 +310,9 @@ def _choose(names: list[str], src: str) -> tuple[str, dict]:
     cands = _candidates(names)
     full = [(f, m) for f, m in cands if "tau" in m or "i" in m]
     if full:
-        return max(full, key=lambda fm: len(_claimed(fm[1])))
+        best = max(full, key=lambda fm: len(_claimed(fm[1])))
+        check_one_form(full, best, names, src)
+        return best
     if cands:
         raise InputError(f"{src} line 1: no torques: the {cands[0][0]} form's positions are "
                          "there, but no torques (tau1..taun, N m) or motor currents (i1..in, "

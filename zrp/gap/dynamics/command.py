@@ -5,9 +5,11 @@ is written, and the file recording what it is valid for.
 
 The limits (:func:`command_limits`): the model's position limits; the velocity limit given
 (default 1 rad/s, or the model's own where lower), never above the model's own (a URDF's
-``<limit velocity=>``); the acceleration limit given; the torque limit given, never above
-the model's own effort limits (their default). q0 must lie inside the position limits and
-q0 +- amplitude too (a value beyond one turn, or one that fits only read as degrees, is
+``<limit velocity=>``); the acceleration limit given (default 3 rad/s^2); the torque limit
+given, never above the model's own (their default: every limit the model states, the MJCF
+reader's ``mjcf.actuator_limits``). The file records where each comes from: "model",
+"default", "none known" or "given" (only for a value given). q0 must lie inside the position
+limits and q0 +- amplitude too (a value beyond one turn, or one that fits only read as degrees, is
 named as likely degrees: ``deg`` reads q0 and the amplitude in degrees).
 
 Sizes are bounded before anything is allocated: at most :data:`MAX_SAMPLES` samples (period
@@ -47,10 +49,12 @@ from zrp.output import atomic_path
 from zrp.units import angle_bounds
 from zrp.version import __version__
 
-__all__ = ["MAX_SAMPLES", "MIN_SAMPLES_PER_CYCLE", "ExcitationCommand", "ExciteOptions",
-           "command_limits", "command_summary", "excitation_command", "read_command_conditions",
-           "write_excitation_command"]
+__all__ = ["DEFAULT_ACCELERATION", "MAX_SAMPLES", "MIN_SAMPLES_PER_CYCLE", "ExcitationCommand",
+           "ExciteOptions", "command_limits", "command_summary", "excitation_command",
+           "read_command_conditions", "write_excitation_command"]
 
+#: The acceleration limit when none is given, rad/s^2 (m/s^2).
+DEFAULT_ACCELERATION = 3.0
 #: Fewest samples a cycle of the series' highest harmonic.
 MIN_SAMPLES_PER_CYCLE = 20
 _TURN = 2.0 * np.pi
@@ -68,7 +72,8 @@ class ExciteOptions:
         q0: the posture the motion is centred on, one value a joint.
         amplitude: largest |q - q0|, one for all joints or one a joint.
         max_velocity: largest |qd|; None: 1 rad/s (m/s), or the model's own where lower.
-        max_acceleration: largest |qdd|.
+        max_acceleration: largest |qdd|; None: :data:`DEFAULT_ACCELERATION` (recorded as
+            the default, not as given).
         max_torque: largest |tau| of the model; None: the model's own effort limits.
         deg: q0 and amplitude of the hinges in degrees.
         period_s, rate_hz: the period of the series and the samples a second of the command.
@@ -79,7 +84,7 @@ class ExciteOptions:
     q0: PerJoint
     amplitude: PerJoint = 0.5
     max_velocity: PerJoint | None = None
-    max_acceleration: PerJoint = 3.0
+    max_acceleration: PerJoint | None = None
     max_torque: PerJoint | None = None
     deg: bool = False
     period_s: float = 10.0
@@ -158,9 +163,7 @@ def _own(given: object, own: F64, default: F64, field: str, limits_names: list[s
          unit: list[str]) -> tuple[F64, str]:
     """A user's limit, refused above the model's own; the default where none given."""
     if given is None:
-        return default, ("the model's own" if np.all(default == own) else
-                         "default" if np.all(default < own) else
-                         "default, or the model's own where lower")
+        return default, _default_source(default, own)
     v = _per_joint(given, own.size, field)
     above = v > own
     if above.any():
@@ -168,6 +171,18 @@ def _own(given: object, own: F64, default: F64, field: str, limits_names: list[s
         raise InputError(f"{field}: joint {k + 1} ({limits_names[k]}) {v[k]:g} {unit[k]} is "
                          f"above the model's own limit {own[k]:g} {unit[k]}")
     return v, "given"
+
+
+def _default_source(default: F64, own: F64) -> str:
+    """Where a limit nobody gave comes from, as the command file records it: "model" (the
+    model's own), "default" (the built-in one), "none known" (inf); never "given"."""
+    if np.all(np.isinf(default)):
+        return "none known"
+    if np.all(default == own):
+        return "model" if np.all(np.isfinite(own)) else "model; inf: none known"
+    if np.all(default < own):
+        return "default"
+    return "default, or the model's where lower"
 
 
 def command_limits(arm: Arm, o: ExciteOptions) -> tuple[JointLimits, dict[str, str]]:
@@ -180,11 +195,14 @@ def command_limits(arm: Arm, o: ExciteOptions) -> tuple[JointLimits, dict[str, s
     vel, v_src = _own(o.max_velocity, own_v, np.minimum(1.0, own_v), "max_velocity", names,
                       per_s)
     tau, t_src = _own(o.max_torque, own_t, own_t, "max_torque", names, nm)
-    acc = _per_joint(o.max_acceleration, n, "max_acceleration")
+    acc_given = o.max_acceleration is not None
+    acc = _per_joint(o.max_acceleration if acc_given else DEFAULT_ACCELERATION, n,
+                     "max_acceleration")
     lo, hi = arm.position_limits()
     lim = JointLimits(lower=lo, upper=hi, velocity=vel, acceleration=acc, torque=tau,
                       names=tuple(names), revolute=rev)
-    sources = {"position": "the model's", "velocity": v_src, "acceleration": "given",
+    sources = {"position": "model", "velocity": v_src,
+               "acceleration": "given" if acc_given else "default",
                "torque": t_src}
     return lim, sources
 

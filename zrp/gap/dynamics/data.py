@@ -44,7 +44,9 @@ import numpy as np
 from zrp.arrays import F64
 from zrp.errors import InputError
 from zrp.gap.data.measurements import DataWarning
-from zrp.gap.dynamics.columns import GROUP_KIND, Mapping, map_header
+from zrp.gap.dynamics.ambiguous import other_clock, seconds_and_nanos
+from zrp.gap.dynamics.columns import GROUP_KIND, Mapping, map_header, time_columns
+from zrp.gap.dynamics.frozen import frozen_joints
 from zrp.gap.dynamics.logcheck import check_log, unmeasured_joints
 from zrp.gap.dynamics.logfile import RawTable, read_table
 from zrp.gap.dynamics.timebase import Conditioning, clock, condition
@@ -238,10 +240,14 @@ def _time(m: Mapping, raw: RawTable, at: dict[int, int], rate_hz: float | None, 
         n = raw.values.shape[0]
         return np.arange(n) / float(rate_hz), (f"no clock column: samples {1e3 / rate_hz:.4g} "
                                                f"ms apart (the given rate, {rate_hz:g} Hz)")
-    t_raw = raw.values[:, at[m.time]]
+    names = [m.names[i] for i in range(len(m.names))]
+    also = other_clock(names, m.time, time_columns(names), src)
+    t_raw, ns_note = raw.values[:, at[m.time]], ""
     if m.time_ns is not None:  # a Sunrise trace: ZeitInSec + ZeitInNanoSec
-        t_raw = (t_raw - t_raw[0]) + raw.values[:, at[m.time_ns]] * 1e-9
-    return clock(t_raw, m.units[m.time], _default_time(m), m.names[m.time], src)
+        t_raw, ns_note = seconds_and_nanos(t_raw, raw.values[:, at[m.time_ns]],
+                                           names[m.time], names[m.time_ns], src)
+    t, said = clock(t_raw, m.units[m.time], _default_time(m), m.names[m.time], src)
+    return t, said + ns_note + also
 
 
 def _at_joints(block: dict[str, F64], tau: F64, m: Mapping, tr: Transmission | None, src: str
@@ -306,7 +312,8 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
     block, tau = _at_joints(block, tau, m, transmission, src)
     payload = None if m.payload is None else vals[:, at[m.payload]] * factor[m.payload]
     names = _joint_names(m, raw.first_row)
-    unmeasured = unmeasured_joints(block["q"], tau)
+    frozen, frozen_notes = frozen_joints(t, block["q"], tau, lines)
+    unmeasured = {**frozen, **unmeasured_joints(block["q"], tau)}
     if len(unmeasured) == m.n:
         raise InputError(f"{src}: no joint's torque is data: " + "; ".join(
             f"joint {k + 1}: {w}" for k, w in sorted(unmeasured.items())))
@@ -316,7 +323,8 @@ def load_torque_log(path: str | os.PathLike[str], *, torque_constant: Sequence[f
                       "m/s, N for slides)", DataWarning, stacklevel=2)
     columns = m.describe() + ("" if transmission is None else "; " + transmission.describe())
     cond = Conditioning(columns=columns, clock=said, skipped_lines=raw.skipped,
-                        excluded=excluded_notes(unmeasured, names), **rec)  # type: ignore[arg-type]
+                        excluded=(*excluded_notes(unmeasured, names), *frozen_notes),
+                        **rec)  # type: ignore[arg-type]
     return TorqueLog(t, block["q"], block.get("qd"), tau, block.get("qc"), payload, lines, src,
                      tfrom, segments if len(segments) > 1 else (), unmeasured, names, cond,
                      transmission)

@@ -47,6 +47,7 @@ from zrp.gap.dynamics.gate import BODY_CHANGES, Fitted, physical_gate
 from zrp.gap.dynamics.localpoly import local_fit
 from zrp.gap.dynamics.options import DynamicsOptions
 from zrp.gap.dynamics.physical import InertialFit
+from zrp.gap.dynamics.plausible import plausibility
 from zrp.gap.dynamics.regimes import regime_masks, regime_rms
 from zrp.gap.dynamics.results import DynamicDiagnosis, FoundEffect, Samples
 from zrp.gap.dynamics.select import forward_select
@@ -151,7 +152,7 @@ def diagnose_dynamics(arm: Arm, log: TorqueLog, options: DynamicsOptions | None 
     """Diagnose the dynamic gap of ``arm`` along ``log`` (module docstring); one BLAS thread
     (many small products: see :mod:`zrp.blas`)."""
     with blas_threads(1):
-        return _diagnose(arm, log, options)
+        return plausibility(arm, log, _diagnose(arm, log, options))  # issue 41: data problems
 
 
 def _common_gain(found: list[FoundEffect]) -> list[str]:

@@ -141,6 +141,8 @@ def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
     if validation is not None:
         lines += ["", "## Validation on another log (N m RMS)", "",
                   *_validation(validation, d.joints)]
+    if d.data_problems:
+        lines += ["", "## Data problems", "", *(md_line("- {}", s) for s in d.data_problems)]
     lines += ["", "## Against the standard identification", "", *_baseline(d, validation)]
     lines += ["", "## Effects found", "", *_found(d)]
     lines += ["", "## Selection (withheld chi2: 1 is the noise floor)", "",
@@ -234,7 +236,8 @@ def diagnosis_json(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
                "overall_withheld_nm": overall_rms(d.baseline.rms_withheld, d.measured)},
            "window_s": d.window_s,
            "regimes": d.regimes, "inertial_fit": _inertial_fit(d),
-           "inertial_phi": {str(b): v for b, v in d.inertial_phi.items()}, "notes": d.notes}
+           "inertial_phi": {str(b): v for b, v in d.inertial_phi.items()}, "notes": d.notes,
+           "data_problems": d.data_problems}
     return to_jsonable({**out, **(extra or {})})
 
 

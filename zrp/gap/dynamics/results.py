@@ -122,6 +122,8 @@ class DynamicDiagnosis:
         window_s: the derivative filter's window used (chosen from the data).
         motors: each coupled motor of the log's transmission (0-based) and its joint-scale
             direction g_k (:meth:`~zrp.gap.dynamics.transmission.Transmission.coupled_motors`).
+        data_problems: findings far outside any physical arm and their likely cause in the
+            data (:mod:`zrp.gap.dynamics.plausible`); when any, no effect is reported.
     """
 
     arm: str
@@ -142,6 +144,7 @@ class DynamicDiagnosis:
     baseline: Baseline | None = None
     window_s: float = 0.1
     motors: dict[int, tuple[float, ...]] = field(default_factory=dict)
+    data_problems: list[str] = field(default_factory=list)
 
     @property
     def found(self) -> list[FoundEffect]:

@@ -18,6 +18,7 @@ from zrp.arrays import F64
 from zrp.gap.dynamics.arm import DynamicArm
 from zrp.gap.dynamics.data import TorqueLog
 from zrp.gap.dynamics.diagnosis import DynamicDiagnosis, DynamicsOptions, diagnose_dynamics
+from zrp.gap.dynamics.samelog import check_other_arrays
 from zrp.gap.dynamics.validation import Validation, validate
 
 __all__ = ["DynamicsRun", "ModelWriter", "TrackingOptions", "run_dynamics"]
@@ -70,6 +71,9 @@ def run_dynamics(arm: DynamicArm, log: TorqueLog, *, options: DynamicsOptions | 
     ``progress(stage)`` is called as each stage starts (its name, in words)."""
     stage = progress or (lambda name: None)
     opt = options or DynamicsOptions()
+    if validation_log is not None:
+        check_other_arrays(log.t, log.q, log.tau, validation_log.t, validation_log.q,
+                           validation_log.tau)
     stage("diagnosing")
     diag = diagnose_dynamics(arm, log, opt)
     if validation_log is not None:

@@ -145,6 +145,9 @@ def clock(t_raw: F64, declared: str | None, default: str, col: str, src: str
     seen = _looks_like(step)
     if declared is not None:
         unit = declared.strip().lower()
+        if unit not in table:
+            raise InputError(f"{src}: column {col} [{declared}]: {declared!r} is not a clock "
+                             f"unit; declare one of {', '.join(table)} (e.g. {col} [s])")
         if not _plausible(step * table[unit]):
             hint = (f"the values look like {seen}: declare {col} [{seen}]" if seen else
                     "no time unit gives a controller's step")

@@ -153,6 +153,9 @@ def _headline(d: DynamicDiagnosis) -> str:
     head = (f"Withheld torque error {before:.3g} -> {after:.3g} N m RMS over all joints "
             f"({removed:.0%} removed; noise floor {noise:.3g} N m). Largest misses: "
             f"{_misses(np.where(m, d.rms_before, 0.0), d.rms_after, d.noise_nm)}.")
+    if d.data_problems:
+        return head.split(" Largest")[0] + (" The log points at a data problem, not at the "
+                                            "model (see Data problems): " + d.data_problems[0])
     if not d.found:
         return head.split(" Largest")[0] + (" The model's torques match the log down to the "
                                             "noise; no effect is needed.")
