@@ -19,7 +19,8 @@ from zrp.output import OutputDir, reading, write_text
 #: the options that name files a command reads (any other file option must be declared
 #: written: app._WRITTEN or the command's set_defaults(writes=...))
 INPUTS = {"calibration", "commands", "data", "diagnosis", "joints", "mjcf", "model",
-          "model_file", "poses", "source", "targets", "truth", "urdf", "validate"}
+          "model_file", "poses", "source", "targets", "transmission", "truth", "urdf",
+          "validate"}
 _FILEISH = ("FILE", "DIR", "CSV", "TOML", "NPZ", "PNG", "XML", "JSON", "MP4")
 
 
