@@ -15,6 +15,7 @@ import pytest
 from zrp.gap.dynamics import load_torque_log
 from zrp.gap.dynamics.diagnosis import diagnose_dynamics
 from zrp.gap.dynamics.plausible import plausibility
+from zrp.gap.dynamics.report import diagnosis_json, report_markdown
 from zrp.gap.dynamics.results import FoundEffect, Param
 from zrp.gap.dynamics.verdict import headline
 
@@ -76,6 +77,7 @@ def test_torques_in_mnm_are_a_data_problem(puma_run, tmp_path):
     text = " ".join(d.data_problems)
     assert "mN m read as N m" in text and "kg" in text
     assert "points at a data problem" in headline(d)
+    assert "## Data problems" in report_markdown(d) and diagnosis_json(d)["data_problems"]
 
 
 def test_a_torque_frozen_for_half_the_log_excludes_the_joint_named(puma_run, tmp_path):

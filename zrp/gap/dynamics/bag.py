@@ -38,6 +38,7 @@ from zrp.gap.dynamics.data import (
     load_torque_log,
     torque_constants,
 )
+from zrp.gap.dynamics.frozen import frozen_joints
 from zrp.gap.dynamics.logcheck import unmeasured_joints
 from zrp.gap.dynamics.timebase import Conditioning, clock, condition
 from zrp.gap.dynamics.transmission import Transmission
@@ -137,7 +138,8 @@ def load_bag_log(path: str | os.PathLike[str], *, topic: str | None = None,
         kt = torque_constants(torque_constant, n, st.names)
         tau, tfrom = tau * kt, "current"
     q = q[kept]
-    unmeasured = unmeasured_joints(q, tau)
+    frozen, frozen_notes = frozen_joints(t[kept], q, tau, lines[kept])
+    unmeasured = {**frozen, **unmeasured_joints(q, tau)}
     if len(unmeasured) == n:
         raise InputError(f"{src}: no joint's torque is data: " + "; ".join(
             f"joint {k + 1} ({st.names[k]}): {w}" for k, w in sorted(unmeasured.items())))
@@ -146,7 +148,8 @@ def load_bag_log(path: str | os.PathLike[str], *, topic: str | None = None,
         dropped += (f"{st.skipped} JointState message(s) not naming all of the first "
                     f"message's joints (e.g. {', '.join(st.other) or 'none'}) skipped",)
     cond = Conditioning(columns=_describe(st, has_qd, tfrom, torque_constant), clock=said,
-                        excluded=excluded_notes(unmeasured, st.names), dropped=dropped,
+                        excluded=(*excluded_notes(unmeasured, st.names), *frozen_notes),
+                        dropped=dropped,
                         **rec)  # type: ignore[arg-type]
     return TorqueLog(t[kept], q, None if qd is None else qd[kept], tau, None, None,
                      lines[kept], src, tfrom, segments if len(segments) > 1 else (),

@@ -118,14 +118,10 @@ def _baseline(d: DynamicDiagnosis, v: Validation | None) -> list[str]:
     return out
 
 
-def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
-                    validation: Validation | None = None) -> str:
-    """The report's text (``extra``: more sections, heading -> lines; ``validation``: the
-    corrected model on a second log)."""
+def _residuals(d: DynamicDiagnosis) -> list[str]:
+    """The table of the torque residual per joint, and the joints not measured."""
     n = len(d.joints)
-    lines = [md_line("# Dynamic gap: {}", d.arm), "", "## Verdict", "", *_verdict(d, validation),
-             "",
-             "## Torque residual per joint (N m RMS)", "",
+    lines = ["## Torque residual per joint (N m RMS)", "",
              "| joint | name | noise floor | model | corrected (withheld) | ratio to noise |",
              "|---|---|---|---|---|---|"]
     lines += [md_row(k + 1, d.joints[k], f"{d.noise_nm[k]:.3g}", f"{d.rms_before[k]:.3g}",
@@ -138,11 +134,26 @@ def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
                  f"{overall_rms(d.rms_after, m) / overall_rms(d.noise_nm, m):.2f} |")
     lines += [md_line("- joint {} is not measured ({}): left out of the fit and of the overall "
                       "figures", k + 1, why) for k, why in sorted(d.unmeasured.items())]
+    return lines
+
+
+def _data_problems(d: DynamicDiagnosis) -> list[str]:
+    """The findings that point at the data (:mod:`zrp.gap.dynamics.plausible`), if any."""
+    if not d.data_problems:
+        return []
+    return ["", "## Data problems", "", *(md_line("- {}", s) for s in d.data_problems)]
+
+
+def report_markdown(d: DynamicDiagnosis, extra: dict[str, Any] | None = None,
+                    validation: Validation | None = None) -> str:
+    """The report's text (``extra``: more sections, heading -> lines; ``validation``: the
+    corrected model on a second log)."""
+    lines = [md_line("# Dynamic gap: {}", d.arm), "", "## Verdict", "", *_verdict(d, validation),
+             "", *_residuals(d)]
     if validation is not None:
         lines += ["", "## Validation on another log (N m RMS)", "",
                   *_validation(validation, d.joints)]
-    if d.data_problems:
-        lines += ["", "## Data problems", "", *(md_line("- {}", s) for s in d.data_problems)]
+    lines += _data_problems(d)
     lines += ["", "## Against the standard identification", "", *_baseline(d, validation)]
     lines += ["", "## Effects found", "", *_found(d)]
     lines += ["", "## Selection (withheld chi2: 1 is the noise floor)", "",
